@@ -1,1 +1,221 @@
-// placeholder
+// Least-squares fit of the thermal bias model with Eigen's Householder QR.
+#include "compensation/fit.hpp"
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+
+namespace station::compensation {
+namespace {
+
+// Belsley, Kuh & Welsch, Regression Diagnostics (1980), ch. 3: a condition index of the
+// column-scaled design matrix above 30 signals a moderate-to-strong near dependency.
+constexpr double kCollinearCondition = 30.0;
+// Past this the standard errors are meaningless: the terms are linearly dependent.
+constexpr double kSingularCondition = 1e10;
+
+struct TermInfo {
+  Term term;
+  std::string_view option;
+  std::string_view coefficient;
+};
+constexpr TermInfo kTerms[] = {
+    {Term::dT, "dT", "k1"},           {Term::dT2, "dT2", "k2"},     {Term::dT3, "dT3", "k3"},
+    {Term::dT4, "dT4", "k4"},         {Term::gradT, "gradT", "k0"}, {Term::dTdt, "dTdt", "kr"},
+    {Term::channel, "channel", "kc"},
+};
+
+const TermInfo& info(Term t) {
+  return kTerms[static_cast<int>(t)];
+}
+
+std::span<const double> source_of(Term t, const ModelInput& in) {
+  switch (t) {
+    case Term::gradT:
+      return in.grad_c;
+    case Term::dTdt:
+      return in.dtdt_c_per_h;
+    case Term::channel:
+      return in.channel;
+    default:
+      return in.temp_c;
+  }
+}
+
+double regressor(Term t, double x, double ref_temp_c) {
+  switch (t) {
+    case Term::dT:
+      return x - ref_temp_c;
+    case Term::dT2:
+      return std::pow(x - ref_temp_c, 2);
+    case Term::dT3:
+      return std::pow(x - ref_temp_c, 3);
+    case Term::dT4:
+      return std::pow(x - ref_temp_c, 4);
+    default:
+      return x;
+  }
+}
+
+Eigen::MatrixXd design_matrix(const ModelInput& in, const ModelSpec& spec) {
+  const auto n = static_cast<Eigen::Index>(in.bias_dph.size());
+  Eigen::MatrixXd x(n, static_cast<Eigen::Index>(spec.terms.size() + 1));
+  x.col(0).setOnes();
+  for (std::size_t j = 0; j < spec.terms.size(); ++j) {
+    const Term t = spec.terms[j];
+    const auto src = source_of(t, in);
+    if (src.size() != in.bias_dph.size()) {
+      throw std::invalid_argument("fit: term " + std::string(info(t).option) +
+                                  " has no data for every point");
+    }
+    for (Eigen::Index i = 0; i < n; ++i) x(i, j + 1) = regressor(t, src[i], spec.ref_temp_c);
+  }
+  return x;
+}
+
+}  // namespace
+
+std::string_view term_option_name(Term t) {
+  return info(t).option;
+}
+std::string_view term_coefficient_name(Term t) {
+  return info(t).coefficient;
+}
+
+std::optional<Term> term_from_option_name(std::string_view name) {
+  for (const auto& ti : kTerms) {
+    if (ti.option == name) return ti.term;
+  }
+  return std::nullopt;
+}
+
+std::vector<Term> parse_terms(std::string_view list) {
+  std::vector<Term> terms;
+  while (!list.empty()) {
+    const auto comma = list.find(',');
+    const auto word = list.substr(0, comma);
+    const auto t = term_from_option_name(word);
+    if (!t) {
+      throw std::invalid_argument("unknown term '" + std::string(word) +
+                                  "' (expected dT, dT2, dT3, dT4, gradT, dTdt, channel)");
+    }
+    for (Term have : terms) {
+      if (have == *t) throw std::invalid_argument("term '" + std::string(word) + "' given twice");
+    }
+    terms.push_back(*t);
+    list = comma == std::string_view::npos ? std::string_view{} : list.substr(comma + 1);
+  }
+  return terms;
+}
+
+ModelData model_data_from_bins(std::span<const Bin> bins, double earth_rate_dph) {
+  ModelData d;
+  for (const Bin& b : bins) {
+    if (!b.complete) continue;
+    d.bias_dph.push_back(b.rate_dph - earth_rate_dph);
+    d.temp_c.push_back(b.temp_c);
+    d.grad_c.push_back(b.grad_c);
+    d.dtdt_c_per_h.push_back(b.dtdt_c_per_h);
+    d.channel.push_back(b.extra);
+    d.t_mid_s.push_back(b.t_mid_s);
+  }
+  return d;
+}
+
+FitResult fit_model(const ModelInput& in, const ModelSpec& spec) {
+  const std::size_t p = spec.terms.size() + 1;
+  const std::size_t n = in.bias_dph.size();
+  if (n <= p) {
+    throw std::invalid_argument("too few bins: " + std::to_string(n) + " bins for " +
+                                std::to_string(p) + " coefficients (need at least " +
+                                std::to_string(p + 1) + ")");
+  }
+  Eigen::MatrixXd x = design_matrix(in, spec);
+  const Eigen::Map<const Eigen::VectorXd> y(in.bias_dph.data(), static_cast<Eigen::Index>(n));
+
+  // Scale each column to unit norm: better conditioned QR and a meaningful condition number.
+  Eigen::VectorXd scale = x.colwise().norm().transpose();
+  for (Eigen::Index j = 0; j < scale.size(); ++j) {
+    if (!(scale(j) > 0)) {
+      throw std::invalid_argument("fit: term " + std::string(info(spec.terms[j - 1]).option) +
+                                  " is zero at every point");
+    }
+  }
+  x = x * scale.cwiseInverse().asDiagonal();
+
+  const Eigen::HouseholderQR<Eigen::MatrixXd> qr(x);
+  const auto pi = static_cast<Eigen::Index>(p);
+  const Eigen::MatrixXd r = qr.matrixQR().topLeftCorner(pi, pi).triangularView<Eigen::Upper>();
+  // Singular values of X equal those of R (X = QR, Q orthonormal columns).
+  const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(r).singularValues();
+  FitResult res;
+  res.spec = spec;
+  res.condition_number = sv(sv.size() - 1) > 0 ? sv(0) / sv(sv.size() - 1) : INFINITY;
+  if (!(res.condition_number < kSingularCondition)) {
+    throw std::invalid_argument("fit: the terms are linearly dependent (condition number " +
+                                std::to_string(res.condition_number) + ")");
+  }
+  const Eigen::VectorXd beta_scaled = qr.solve(y);
+  const Eigen::VectorXd resid = y - x * beta_scaled;
+  const double rss = resid.squaredNorm();
+  res.n_points = n;
+  res.dof = n - p;
+  // Var(beta) = s^2 (X'X)^-1 = s^2 R^-1 R^-T, s^2 = RSS / (n - p) (any regression text,
+  // e.g. Draper & Smith, Applied Regression Analysis, 3rd ed., eq. 5.2.5).
+  const double s2 = rss / static_cast<double>(res.dof);
+  const Eigen::MatrixXd r_inv =
+      r.triangularView<Eigen::Upper>().solve(Eigen::MatrixXd::Identity(pi, pi));
+  const Eigen::VectorXd var_scaled = (r_inv * r_inv.transpose()).diagonal() * s2;
+  res.names.emplace_back("B0");
+  for (Term t : spec.terms) res.names.emplace_back(info(t).coefficient);
+  for (Eigen::Index j = 0; j < pi; ++j) {
+    res.coefficients.push_back(beta_scaled(j) / scale(j));
+    res.std_errors.push_back(std::sqrt(var_scaled(j)) / scale(j));
+  }
+  const double mean_y = y.mean();
+  const double tss = (y.array() - mean_y).square().sum();
+  res.r2 = tss > 0 ? 1.0 - rss / tss : (rss == 0 ? 1.0 : 0.0);
+  res.residual_rms_dph = std::sqrt(rss / static_cast<double>(n));
+  if (res.condition_number > kCollinearCondition) {
+    res.warnings.push_back("terms nearly collinear: condition number " +
+                           std::to_string(res.condition_number) + " > " +
+                           std::to_string(static_cast<int>(kCollinearCondition)) +
+                           " (Belsley); coefficients are poorly separated");
+  }
+  return res;
+}
+
+std::vector<double> predict(const FitResult& fit, const ModelInput& in) {
+  const Eigen::MatrixXd x = design_matrix(in, fit.spec);
+  const Eigen::Map<const Eigen::VectorXd> beta(fit.coefficients.data(),
+                                               static_cast<Eigen::Index>(fit.coefficients.size()));
+  const Eigen::VectorXd b = x * beta;
+  return {b.data(), b.data() + b.size()};
+}
+
+std::vector<double> compensate(const FitResult& fit, const ModelInput& in) {
+  std::vector<double> out = predict(fit, in);
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = in.bias_dph[i] - out[i];
+  return out;
+}
+
+double sample_std(std::span<const double> v) {
+  if (v.size() < 2) return 0.0;
+  const double mean = std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+  double ss = 0;
+  for (double x : v) ss += (x - mean) * (x - mean);
+  return std::sqrt(ss / static_cast<double>(v.size() - 1));
+}
+
+Evaluation evaluate(std::span<const double> before_dph, std::span<const double> after_dph) {
+  Evaluation e;
+  e.std_before_dph = sample_std(before_dph);
+  e.std_after_dph = sample_std(after_dph);
+  e.std_ratio = e.std_before_dph > 0 ? e.std_after_dph / e.std_before_dph : 0.0;
+  e.improvement_pct = 100.0 * (1.0 - e.std_ratio);
+  return e;
+}
+
+}  // namespace station::compensation

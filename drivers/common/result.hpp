@@ -20,12 +20,18 @@ enum class ErrorKind {
 /// Human-readable name of an ErrorKind ("timeout", "protocol", ...).
 constexpr const char* to_string(ErrorKind k) {
   switch (k) {
-    case ErrorKind::timeout: return "timeout";
-    case ErrorKind::protocol: return "protocol";
-    case ErrorKind::exception: return "exception";
-    case ErrorKind::disconnected: return "disconnected";
-    case ErrorKind::range: return "range";
-    case ErrorKind::io: return "io";
+    case ErrorKind::timeout:
+      return "timeout";
+    case ErrorKind::protocol:
+      return "protocol";
+    case ErrorKind::exception:
+      return "exception";
+    case ErrorKind::disconnected:
+      return "disconnected";
+    case ErrorKind::range:
+      return "range";
+    case ErrorKind::io:
+      return "io";
   }
   return "unknown";
 }
@@ -40,7 +46,7 @@ struct Error {
 template <typename T>
 class [[nodiscard]] Result {
  public:
-  Result(T value) : v_(std::move(value)) {}  // NOLINT(google-explicit-constructor)
+  Result(T value) : v_(std::move(value)) {}      // NOLINT(google-explicit-constructor)
   Result(Error error) : v_(std::move(error)) {}  // NOLINT(google-explicit-constructor)
 
   bool ok() const { return v_.index() == 0; }
@@ -71,6 +77,8 @@ class [[nodiscard]] Result<void> {
 };
 
 /// Shorthand for building an Error result.
-inline Error make_error(ErrorKind kind, std::string message) { return Error{kind, std::move(message)}; }
+inline Error make_error(ErrorKind kind, std::string message) {
+  return Error{kind, std::move(message)};
+}
 
 }  // namespace station::drivers

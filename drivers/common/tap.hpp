@@ -13,12 +13,12 @@ enum class TapDirection : std::uint8_t { tx, rx, event };
 
 /// One exchange on one transport.
 struct TapRecord {
-  double wall_time_s = 0;          ///< CLOCK_REALTIME seconds since the Unix epoch
-  std::string device;              ///< transport name, e.g. "chamber", "can0", "gpio"
+  double wall_time_s = 0;  ///< CLOCK_REALTIME seconds since the Unix epoch
+  std::string device;      ///< transport name, e.g. "chamber", "can0", "gpio"
   TapDirection direction = TapDirection::tx;
-  std::string kind;                ///< "modbus-read", "modbus-write", "can", "gpio-edge", "error"
-  std::vector<std::uint8_t> bytes; ///< wire payload: CAN frame (16 bytes), Modbus PDU, line value
-  std::string detail;              ///< human-readable summary (addresses, counts, error text)
+  std::string kind;                 ///< "modbus-read", "modbus-write", "can", "gpio-edge", "error"
+  std::vector<std::uint8_t> bytes;  ///< wire payload: CAN frame (16 bytes), Modbus PDU, line value
+  std::string detail;               ///< human-readable summary (addresses, counts, error text)
 };
 
 /// Receives every exchange. Implementations must be cheap and must not throw.

@@ -1,0 +1,32 @@
+// Earth rotation rate and its component along a gyro input axis (WGS-84).
+#pragma once
+
+#include <optional>
+#include <string_view>
+
+namespace station::compensation {
+
+/// WGS-84 angular velocity of the Earth, rad/s (NIMA TR8350.2, Table 3.1).
+inline constexpr double kEarthRateRadPerS = 7.292115e-5;
+/// The same in deg/h: 7.292115e-5 * 180/pi * 3600 = 15.041067 deg/h.
+inline constexpr double kEarthRateDph = kEarthRateRadPerS * 180.0 / 3.14159265358979323846 * 3600.0;
+
+/// A unit vector in the local-level East-North-Up frame.
+struct EnuAxis {
+  double east = 0;
+  double north = 0;
+  double up = 1;
+};
+
+/// Named input axes: "up", "down", "north", "south", "east", "west". Empty for any other name.
+std::optional<EnuAxis> axis_from_name(std::string_view name);
+
+/// Horizontal axis at heading psi (degrees clockwise from north).
+EnuAxis horizontal_axis(double heading_deg);
+
+/// Earth-rate component along `axis` at geodetic latitude `latitude_deg`, deg/h.
+/// In ENU the Earth rate is (0, W cos(phi), W sin(phi)) (Titterton & Weston, Strapdown Inertial
+/// Navigation Technology, eq. 3.41); the component is its dot product with the (normalized) axis.
+double earth_rate_along_axis_dph(double latitude_deg, const EnuAxis& axis);
+
+}  // namespace station::compensation

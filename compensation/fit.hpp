@@ -1,0 +1,91 @@
+// Thermal bias model of the paper, eq. (3)/(4), generalized, fitted by least squares (QR).
+//   B = B0 + sum_i k_i dT^i (i = 1..4) + k0 gradT [+ kr dT/dt] [+ kc channel],  dT = T - T_ref.
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "compensation/binning.hpp"
+
+namespace station::compensation {
+
+/// A regressor of the model besides the constant B0.
+enum class Term { dT, dT2, dT3, dT4, gradT, dTdt, channel };
+
+/// Option name of a term: "dT", "dT2", "dT3", "dT4", "gradT", "dTdt", "channel".
+std::string_view term_option_name(Term t);
+/// Coefficient name of a term as the paper writes it: k1..k4, k0 (gradient), kr (rate), kc.
+std::string_view term_coefficient_name(Term t);
+/// Parses an option name; empty when unknown.
+std::optional<Term> term_from_option_name(std::string_view name);
+/// Parses a comma-separated list of option names; throws std::invalid_argument naming a bad one.
+std::vector<Term> parse_terms(std::string_view list);
+
+/// Which terms, and the reference temperature for dT.
+struct ModelSpec {
+  std::vector<Term> terms{Term::dT, Term::gradT};  ///< the paper's k1 and k0
+  double ref_temp_c = 25.0;                        ///< T_ref, deg C
+};
+
+/// Per-bin model inputs (all spans the same length; grad/dtdt/channel may be empty if unused).
+struct ModelInput {
+  std::span<const double> bias_dph;      ///< bin mean rate minus Earth rate, deg/h
+  std::span<const double> temp_c;        ///< bin mean temperature, deg C
+  std::span<const double> grad_c;        ///< bin mean gradient, deg C
+  std::span<const double> dtdt_c_per_h;  ///< bin temperature slope, deg C/h
+  std::span<const double> channel;       ///< bin mean of an extra channel
+};
+
+/// Owning per-bin series built from bins; view() gives the ModelInput.
+struct ModelData {
+  std::vector<double> bias_dph, temp_c, grad_c, dtdt_c_per_h, channel, t_mid_s;
+  ModelInput view() const { return {bias_dph, temp_c, grad_c, dtdt_c_per_h, channel}; }
+};
+
+/// Complete bins only, bias = bin mean rate - earth_rate_dph.
+ModelData model_data_from_bins(std::span<const Bin> bins, double earth_rate_dph);
+
+/// A fitted model with its statistics. coefficients[0] is B0; names[i] labels coefficients[i].
+struct FitResult {
+  ModelSpec spec;
+  std::vector<std::string> names;
+  std::vector<double> coefficients;   ///< deg/h, deg/h/C^i, deg/h/C, deg/h/(C/h), ...
+  std::vector<double> std_errors;     ///< one standard error per coefficient
+  std::size_t n_points = 0;           ///< bins used
+  std::size_t dof = 0;                ///< n_points - coefficients
+  double r2 = 0;                      ///< coefficient of determination
+  double residual_rms_dph = 0;        ///< sqrt(RSS / n)
+  double condition_number = 0;        ///< 2-norm condition of the column-scaled design matrix
+  std::vector<std::string> warnings;  ///< e.g. nearly collinear terms
+};
+
+/// Least squares through Householder QR of the column-scaled design matrix (not normal
+/// equations). Throws std::invalid_argument on too few points, missing or constant series.
+FitResult fit_model(const ModelInput& in, const ModelSpec& spec);
+
+/// Model value B(x) at each point.
+std::vector<double> predict(const FitResult& fit, const ModelInput& in);
+
+/// Compensated bias: bias - B(x) at each point (the residuals for the fitted data).
+std::vector<double> compensate(const FitResult& fit, const ModelInput& in);
+
+/// Sample standard deviation with N-1 in the denominator (0 for fewer than 2 values).
+double sample_std(std::span<const double> v);
+
+/// Std of the bias before and after compensation, their ratio and 1 - ratio in percent
+/// (the paper's figure of merit: ratio 0.13, "87 %").
+struct Evaluation {
+  double std_before_dph = 0;
+  double std_after_dph = 0;
+  double std_ratio = 0;
+  double improvement_pct = 0;
+};
+
+/// Evaluates before/after series of equal meaning (bias and compensated bias).
+Evaluation evaluate(std::span<const double> before_dph, std::span<const double> after_dph);
+
+}  // namespace station::compensation

@@ -1,0 +1,148 @@
+// Thermal bias model fit: exact recovery, recovery within standard errors, diagnostics.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "compensation/fit.hpp"
+
+namespace sc = station::compensation;
+
+namespace {
+
+// 66 bins of 600 s over an 11 h heat from -40 to +70 C at 10 C/h, with a gradient that follows
+// the ramp rate (hysteresis) plus a slow wobble so it is not collinear with dT.
+sc::ModelData scenario(double b0, double k1, double k2, double k0, double noise_dph,
+                       unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0.0, noise_dph);
+  sc::ModelData d;
+  for (int i = 0; i < 66; ++i) {
+    const double t_h = (i + 0.5) / 6.0;
+    const double temp = -40.0 + 10.0 * t_h;
+    const double grad = 0.8 * (1.0 - std::exp(-t_h / 0.7)) + 0.2 * std::sin(t_h);
+    const double dT = temp - 25.0;
+    d.temp_c.push_back(temp);
+    d.grad_c.push_back(grad);
+    d.dtdt_c_per_h.push_back(10.0);
+    d.channel.push_back(0.0);
+    d.bias_dph.push_back(b0 + k1 * dT + k2 * dT * dT + k0 * grad + noise(rng));
+  }
+  return d;
+}
+
+}  // namespace
+
+TEST(Fit, RecoversCoefficientsExactlyFromNoiseFreeData) {
+  const auto d = scenario(0.05, 1.2e-3, -8e-6, 0.03, 0.0, 1);
+  sc::ModelSpec spec;
+  spec.terms = {sc::Term::dT, sc::Term::dT2, sc::Term::gradT};
+  const auto fit = sc::fit_model(d.view(), spec);
+  ASSERT_EQ(fit.coefficients.size(), 4u);
+  EXPECT_EQ(fit.names, (std::vector<std::string>{"B0", "k1", "k2", "k0"}));
+  // QR on unit-norm columns: relative error ~ condition number * machine epsilon.
+  EXPECT_NEAR(fit.coefficients[0], 0.05, 1e-12);
+  EXPECT_NEAR(fit.coefficients[1], 1.2e-3, 1e-13);
+  EXPECT_NEAR(fit.coefficients[2], -8e-6, 1e-15);
+  EXPECT_NEAR(fit.coefficients[3], 0.03, 1e-12);
+  EXPECT_NEAR(fit.r2, 1.0, 1e-12);
+  EXPECT_LT(fit.residual_rms_dph, 1e-13);
+  EXPECT_EQ(fit.dof, 62u);
+}
+
+TEST(Fit, EstimatesScatterAsTheirReportedStandardErrors) {
+  // Over many seeded experiments, (estimate - truth) / SE follows Student's t with 63 dof:
+  // about 68.3 % within 1 SE (binomial sd over 300 trials: 2.7 %, so +-3 sd = +-8 %), and the
+  // mean SE equals the empirical scatter of the estimates within the Monte-Carlo error (~4 %).
+  const double k1 = 1.0e-3, k0 = 0.04;
+  const int trials = 300;
+  int within_k1 = 0, within_k0 = 0;
+  double se_k1_sum = 0, err2_k1 = 0;
+  sc::ModelSpec spec;  // default: dT, gradT
+  for (int s = 0; s < trials; ++s) {
+    const auto d = scenario(0.02, k1, 0.0, k0, 0.003, 1000 + s);
+    const auto fit = sc::fit_model(d.view(), spec);
+    within_k1 += std::abs(fit.coefficients[1] - k1) < fit.std_errors[1];
+    within_k0 += std::abs(fit.coefficients[2] - k0) < fit.std_errors[2];
+    se_k1_sum += fit.std_errors[1];
+    err2_k1 += std::pow(fit.coefficients[1] - k1, 2);
+  }
+  EXPECT_NEAR(within_k1 / double(trials), 0.683, 0.08);
+  EXPECT_NEAR(within_k0 / double(trials), 0.683, 0.08);
+  const double rms_err = std::sqrt(err2_k1 / trials);
+  EXPECT_NEAR(se_k1_sum / trials / rms_err, 1.0, 0.15);
+}
+
+TEST(Fit, GradientTermCompensatesHysteresis) {
+  // The paper's point: a dT-only model leaves the ramp-rate hysteresis; adding k0 * gradT
+  // removes it down to the noise.
+  const auto d = scenario(0.02, 1e-3, 0.0, 0.05, 0.001, 7);
+  sc::ModelSpec dT_only;
+  dT_only.terms = {sc::Term::dT};
+  const auto without = sc::fit_model(d.view(), dT_only);
+  const auto with = sc::fit_model(d.view(), sc::ModelSpec{});
+  const auto e_without = sc::evaluate(d.bias_dph, sc::compensate(without, d.view()));
+  const auto e_with = sc::evaluate(d.bias_dph, sc::compensate(with, d.view()));
+  EXPECT_LT(e_with.std_after_dph, e_without.std_after_dph);
+  // Residual std approaches the noise: sigma * sqrt((n - p) / (n - 1)) in expectation.
+  EXPECT_NEAR(e_with.std_after_dph, 0.001, 0.0003);
+  EXPECT_NEAR(e_with.improvement_pct, 100.0 * (1.0 - e_with.std_ratio), 1e-12);
+}
+
+TEST(Fit, WarnsOnNearlyCollinearTerms) {
+  auto d = scenario(0.02, 1e-3, 0.0, 0.05, 0.001, 3);
+  // dT/dt made proportional to the gradient plus a whisker: the two are nearly collinear.
+  for (std::size_t i = 0; i < d.grad_c.size(); ++i)
+    d.dtdt_c_per_h[i] = 12.5 * d.grad_c[i] + 0.01 * std::cos(0.9 * i);
+  sc::ModelSpec spec;
+  spec.terms = {sc::Term::dT, sc::Term::gradT, sc::Term::dTdt};
+  const auto fit = sc::fit_model(d.view(), spec);
+  EXPECT_GT(fit.condition_number, 30.0);
+  ASSERT_EQ(fit.warnings.size(), 1u);
+  EXPECT_NE(fit.warnings[0].find("collinear"), std::string::npos);
+  EXPECT_TRUE(sc::fit_model(d.view(), sc::ModelSpec{}).warnings.empty());
+}
+
+TEST(Fit, RejectsTooFewPointsAndDependentTerms) {
+  auto d = scenario(0.02, 1e-3, 0.0, 0.05, 0.001, 3);
+  sc::ModelData three;
+  for (int i = 0; i < 3; ++i) {
+    three.bias_dph.push_back(d.bias_dph[i]);
+    three.temp_c.push_back(d.temp_c[i]);
+    three.grad_c.push_back(d.grad_c[i]);
+  }
+  EXPECT_THROW(sc::fit_model(three.view(), sc::ModelSpec{}), std::invalid_argument);
+  sc::ModelSpec rate_only;
+  rate_only.terms = {sc::Term::dTdt};  // constant 10 C/h: same column as B0
+  EXPECT_THROW(sc::fit_model(d.view(), rate_only), std::invalid_argument);
+}
+
+TEST(Fit, ParsesTermLists) {
+  EXPECT_EQ(sc::parse_terms("dT,gradT"), (std::vector<sc::Term>{sc::Term::dT, sc::Term::gradT}));
+  EXPECT_EQ(sc::parse_terms(""), std::vector<sc::Term>{});
+  EXPECT_THROW(sc::parse_terms("dT,foo"), std::invalid_argument);
+  EXPECT_THROW(sc::parse_terms("dT,dT"), std::invalid_argument);
+}
+
+TEST(Fit, SampleStdUsesNMinusOne) {
+  const std::vector<double> v{1, 2, 3, 4};  // mean 2.5, SS = 5, s^2 = 5/3
+  EXPECT_NEAR(sc::sample_std(v), std::sqrt(5.0 / 3.0), 1e-15);
+  const std::vector<double> after{0.5, 1, 1.5, 2};
+  const auto e = sc::evaluate(v, after);
+  EXPECT_NEAR(e.std_ratio, 0.5, 1e-15);
+  EXPECT_NEAR(e.improvement_pct, 50.0, 1e-12);
+}
+
+TEST(Fit, BinsBecomeModelDataWithEarthRateRemoved) {
+  std::vector<sc::Bin> bins(3);
+  for (int i = 0; i < 3; ++i) {
+    bins[i].rate_dph = 10.0 + i;
+    bins[i].temp_c = i;
+    bins[i].complete = i != 1;
+  }
+  const auto d = sc::model_data_from_bins(bins, 9.5);
+  ASSERT_EQ(d.bias_dph.size(), 2u);
+  EXPECT_DOUBLE_EQ(d.bias_dph[0], 0.5);
+  EXPECT_DOUBLE_EQ(d.bias_dph[1], 2.5);
+}
