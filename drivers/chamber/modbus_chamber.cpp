@@ -1,0 +1,103 @@
+// ModbusChamber: decodes chamber state from the register map and range-checks commands.
+#include "drivers/chamber/modbus_chamber.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <limits>
+
+#include "drivers/chamber/chamber_map.hpp"
+
+namespace station::drivers {
+namespace cm = chamber_map;
+
+namespace {
+
+AlarmBits decode_alarms(unsigned bits) {
+  return AlarmBits{(bits & cm::kDeviation) != 0, (bits & cm::kSensorBreak) != 0,
+                   (bits & cm::kDoorOpen) != 0, (bits & cm::kHighLimitTrip) != 0};
+}
+
+}  // namespace
+
+ModbusChamber::ModbusChamber(std::string name, modbus::Endpoint endpoint, modbus::RegisterMap map,
+                             double response_timeout_s)
+    : name_(std::move(name)),
+      map_(std::move(map)),
+      client_(name_, std::move(endpoint), response_timeout_s) {
+  for (const char* p : {cm::kAir, cm::kProduct, cm::kStatus, cm::kAlarms, cm::kSetpoint, cm::kRamp,
+                        cm::kSetpointLow, cm::kSetpointHigh, cm::kRun})
+    (void)map_.at(p);  // throws naming the missing point
+}
+
+Result<void> ModbusChamber::connect() {
+  return client_.connect();
+}
+
+Result<double> ModbusChamber::get(const char* point) {
+  return client_.read(map_.at(point));
+}
+
+Result<ChamberState> ModbusChamber::read() {
+  ChamberState s;
+  auto alarms = get(cm::kAlarms);
+  if (!alarms) return alarms.error();
+  s.alarms = decode_alarms(static_cast<unsigned>(alarms.value()));
+  auto status = get(cm::kStatus);
+  if (!status) return status.error();
+  int st = static_cast<int>(status.value());
+  if (st < 0 || st > 3)
+    return make_error(ErrorKind::protocol,
+                      fmt::format("{}: status register {} not 0..3", name_, st));
+  s.mode = static_cast<ChamberMode>(st);
+  struct Field {
+    const char* point;
+    double* out;
+  };
+  for (auto [point, out] :
+       {Field{cm::kAir, &s.air_c}, Field{cm::kProduct, &s.product_c},
+        Field{cm::kSetpoint, &s.setpoint_c}, Field{cm::kRamp, &s.ramp_c_per_min}}) {
+    auto v = get(point);
+    if (!v) return v.error();
+    *out = v.value();
+  }
+  auto run = get(cm::kRun);
+  if (!run) return run.error();
+  s.run_enabled = run.value() != 0;
+  // On sensor break the controller's air value is meaningless; never let it reach a record.
+  if (s.alarms.sensor_break) s.air_c = std::numeric_limits<double>::quiet_NaN();
+  return s;
+}
+
+Result<void> ModbusChamber::check_setpoint(double setpoint_c) {
+  auto lo = get(cm::kSetpointLow);
+  if (!lo) return lo.error();
+  auto hi = get(cm::kSetpointHigh);
+  if (!hi) return hi.error();
+  if (!std::isfinite(setpoint_c) || setpoint_c < lo.value() || setpoint_c > hi.value())
+    return make_error(ErrorKind::range,
+                      fmt::format("{}: setpoint {} C outside the chamber limits [{}, {}] C", name_,
+                                  setpoint_c, lo.value(), hi.value()));
+  return {};
+}
+
+Result<void> ModbusChamber::command(const ChamberCommand& c) {
+  if (c.ramp_c_per_min && !(*c.ramp_c_per_min >= 0 && std::isfinite(*c.ramp_c_per_min)))
+    return make_error(ErrorKind::range,
+                      fmt::format("{}: ramp {} C/min must be >= 0", name_, *c.ramp_c_per_min));
+  if (c.setpoint_c) {
+    if (auto ok = check_setpoint(*c.setpoint_c); !ok) return ok;
+  }
+  if (c.ramp_c_per_min) {
+    if (auto ok = client_.write(map_.at(cm::kRamp), *c.ramp_c_per_min); !ok) return ok;
+  }
+  if (c.setpoint_c) {
+    if (auto ok = client_.write(map_.at(cm::kSetpoint), *c.setpoint_c); !ok) return ok;
+  }
+  if (c.run) {
+    if (auto ok = client_.write(map_.at(cm::kRun), *c.run ? 1.0 : 0.0); !ok) return ok;
+  }
+  return {};
+}
+
+}  // namespace station::drivers

@@ -1,0 +1,39 @@
+// Point-by-point overrides of a register map (what the station config supplies), and the
+// parsers for the enum spellings a config file uses. Errors throw std::invalid_argument.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "drivers/modbus/register_map.hpp"
+
+namespace station::drivers::modbus {
+
+/// Changes to one existing point; unset fields keep the preset's value.
+struct PointOverride {
+  std::string name;                      ///< point to change; must exist in the map
+  std::optional<std::uint16_t> address;  ///< register number as the manual lists it
+  std::optional<PointType> type;         ///< int16 / uint16 / float32
+  std::optional<double> scale;           ///< engineering value per raw count, non-zero
+  std::optional<WordOrder> order;        ///< float32 word order
+  std::optional<FunctionCode> function;  ///< 3 or 4
+  std::optional<int> unit_id;            ///< 0..247
+  std::optional<bool> one_based;         ///< manual numbering
+  std::optional<Access> access;          ///< ro / rw
+};
+
+/// Applies overrides in order; throws std::invalid_argument naming the point and field.
+void apply_overrides(RegisterMap& map, const std::vector<PointOverride>& overrides);
+
+/// "int16" | "uint16" | "float32"; throws std::invalid_argument otherwise.
+PointType parse_point_type(std::string_view s);
+/// "ABCD" | "CDAB" (case-insensitive); throws std::invalid_argument otherwise.
+WordOrder parse_word_order(std::string_view s);
+/// "3" | "holding" | "4" | "input"; throws std::invalid_argument otherwise.
+FunctionCode parse_function_code(std::string_view s);
+/// "ro" | "rw"; throws std::invalid_argument otherwise.
+Access parse_access(std::string_view s);
+
+}  // namespace station::drivers::modbus

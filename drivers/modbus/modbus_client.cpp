@@ -1,0 +1,166 @@
+// Modbus client transactions, error translation and tap records.
+#include "drivers/modbus/modbus_client.hpp"
+
+#include <fmt/format.h>
+
+#include <cerrno>
+#include <cmath>
+
+namespace station::drivers::modbus {
+namespace {
+
+// Request PDU bytes as the Modbus spec lays them out (function, address, count): libmodbus does
+// not expose the raw frame, so the tap records the reconstructed PDU.
+std::vector<std::uint8_t> request_pdu(int fc, std::uint16_t addr, int count) {
+  return {static_cast<std::uint8_t>(fc), static_cast<std::uint8_t>(addr >> 8),
+          static_cast<std::uint8_t>(addr & 0xFF), static_cast<std::uint8_t>(count >> 8),
+          static_cast<std::uint8_t>(count & 0xFF)};
+}
+
+std::vector<std::uint8_t> words_pdu(int fc, std::span<const std::uint16_t> words) {
+  std::vector<std::uint8_t> out{static_cast<std::uint8_t>(fc),
+                                static_cast<std::uint8_t>(2 * words.size())};
+  for (auto w : words) {
+    out.push_back(static_cast<std::uint8_t>(w >> 8));
+    out.push_back(static_cast<std::uint8_t>(w & 0xFF));
+  }
+  return out;
+}
+
+}  // namespace
+
+Error translate_modbus_error(int err, const std::string& what) {
+  std::string msg = what + ": " + modbus_strerror(err);
+  if (err == ETIMEDOUT || err == EAGAIN) return make_error(ErrorKind::timeout, msg);
+  if (err >= EMBXILFUN && err <= EMBXGTAR) return make_error(ErrorKind::exception, msg);
+  if (err >= EMBBADCRC && err <= EMBBADSLAVE) return make_error(ErrorKind::protocol, msg);
+  switch (err) {
+    case ECONNRESET:
+    case ECONNREFUSED:
+    case ECONNABORTED:
+    case EPIPE:
+    case ENOTCONN:
+    case EBADF:
+    case ENOENT:
+    case EHOSTUNREACH:
+      return make_error(ErrorKind::disconnected, msg);
+    case EINVAL:
+      return make_error(ErrorKind::range, msg);
+    default:
+      return make_error(ErrorKind::io, msg);
+  }
+}
+
+ModbusClient::ModbusClient(std::string device, Endpoint endpoint, double response_timeout_s)
+    : device_(std::move(device)), endpoint_(std::move(endpoint)), timeout_s_(response_timeout_s) {}
+
+Result<void> ModbusClient::connect() {
+  disconnect();
+  try {
+    ctx_ = make_context(endpoint_);
+  } catch (const std::exception& e) {
+    return make_error(ErrorKind::io, device_ + ": " + e.what());
+  }
+  double whole = std::floor(timeout_s_);
+  auto sec = static_cast<std::uint32_t>(whole);
+  auto usec = static_cast<std::uint32_t>(std::lround((timeout_s_ - whole) * 1e6));
+  modbus_set_response_timeout(ctx_.get(), sec, usec);
+  if (modbus_connect(ctx_.get()) == -1) {
+    int err = errno;
+    ctx_.reset();
+    // A refused or failed connect is always "not connected", whatever errno says.
+    auto e = translate_modbus_error(err, device_ + " connect " + to_string(endpoint_));
+    if (e.kind != ErrorKind::timeout) e.kind = ErrorKind::disconnected;
+    tap(TapDirection::event, "error", {}, e.message);
+    return e;
+  }
+  connected_ = true;
+  tap(TapDirection::event, "connect", {}, to_string(endpoint_));
+  return {};
+}
+
+void ModbusClient::disconnect() {
+  if (ctx_ && connected_) tap(TapDirection::event, "disconnect", {}, to_string(endpoint_));
+  ctx_.reset();
+  connected_ = false;
+}
+
+Result<void> ModbusClient::ensure_connected() {
+  if (connected_) return {};
+  return connect();
+}
+
+Error ModbusClient::fail(int err, const std::string& what) {
+  Error e = translate_modbus_error(err, device_ + " " + what);
+  if (e.kind == ErrorKind::disconnected) {
+    disconnect();  // reconnect on the next call
+  } else if (e.kind == ErrorKind::timeout || e.kind == ErrorKind::protocol) {
+    // Discard late or partial bytes so the next reply is not misread as this one's.
+    if (ctx_) modbus_flush(ctx_.get());
+  }
+  tap(TapDirection::event, "error", {}, e.message);
+  return e;
+}
+
+Result<std::vector<std::uint16_t>> ModbusClient::read_registers(FunctionCode fc, int unit,
+                                                                std::uint16_t addr, int count) {
+  if (auto c = ensure_connected(); !c) return c.error();
+  int code = static_cast<int>(fc);
+  modbus_set_slave(ctx_.get(), unit);
+  tap(TapDirection::tx, "modbus-read", request_pdu(code, addr, count),
+      fmt::format("unit={} fc={} addr={} count={}", unit, code, addr, count));
+  std::vector<std::uint16_t> words(static_cast<std::size_t>(count));
+  int rc = fc == FunctionCode::holding
+               ? modbus_read_registers(ctx_.get(), addr, count, words.data())
+               : modbus_read_input_registers(ctx_.get(), addr, count, words.data());
+  if (rc == -1) return fail(errno, fmt::format("read fc={} addr={} count={}", code, addr, count));
+  if (rc != count)
+    return fail(EMBBADDATA, fmt::format("read addr={}: {} registers, wanted {}", addr, rc, count));
+  tap(TapDirection::rx, "modbus-read", words_pdu(code, words), fmt::format("addr={}", addr));
+  return words;
+}
+
+Result<void> ModbusClient::write_registers(int unit, std::uint16_t addr,
+                                           std::span<const std::uint16_t> words) {
+  if (auto c = ensure_connected(); !c) return c.error();
+  modbus_set_slave(ctx_.get(), unit);
+  int n = static_cast<int>(words.size());
+  int code = n == 1 ? 6 : 16;
+  auto pdu = request_pdu(code, addr, n == 1 ? words[0] : n);
+  tap(TapDirection::tx, "modbus-write", pdu,
+      fmt::format("unit={} fc={} addr={} count={}", unit, code, addr, n));
+  int rc = n == 1 ? modbus_write_register(ctx_.get(), addr, words[0])
+                  : modbus_write_registers(ctx_.get(), addr, n, words.data());
+  if (rc == -1) return fail(errno, fmt::format("write fc={} addr={} count={}", code, addr, n));
+  tap(TapDirection::rx, "modbus-write", pdu, fmt::format("addr={} ok", addr));
+  return {};
+}
+
+Result<double> ModbusClient::read(const Point& p) {
+  auto words = read_registers(p.function, p.unit_id, p.pdu_address(), p.word_count());
+  if (!words) return words.error();
+  double v = decode_point(p, words.value().data());
+  if (!std::isfinite(v))
+    return make_error(ErrorKind::protocol, device_ + " point '" + p.name + "' is not finite");
+  return v;
+}
+
+Result<void> ModbusClient::write(const Point& p, double value) {
+  if (p.access != Access::rw || p.function != FunctionCode::holding)
+    return make_error(ErrorKind::range, device_ + " point '" + p.name + "' is read-only");
+  auto words = encode_point(p, value);
+  if (!words)
+    return make_error(ErrorKind::range,
+                      fmt::format("{} point '{}': {} does not fit", device_, p.name, value));
+  return write_registers(p.unit_id, p.pdu_address(),
+                         std::span<const std::uint16_t>(words->data(), p.word_count()));
+}
+
+void ModbusClient::tap(TapDirection dir, const char* kind, std::vector<std::uint8_t> bytes,
+                       std::string detail) {
+  if (tap_ == nullptr) return;
+  TapRecord r{tap_wall_time_s(), device_, dir, kind, std::move(bytes), std::move(detail)};
+  tap_->on_exchange(r);
+}
+
+}  // namespace station::drivers::modbus

@@ -1,0 +1,64 @@
+// A small Modbus client: reads and writes register-map points as one bounded transaction each,
+// translating libmodbus/errno failures into ErrorKind in one place and reconnecting after loss.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "drivers/common/result.hpp"
+#include "drivers/common/tap.hpp"
+#include "drivers/modbus/endpoint.hpp"
+#include "drivers/modbus/modbus_handle.hpp"
+#include "drivers/modbus/register_map.hpp"
+
+namespace station::drivers::modbus {
+
+/// Translates a libmodbus/errno code from a failed call into a typed Error (the one place).
+Error translate_modbus_error(int err, const std::string& what);
+
+/// Modbus master for one endpoint. Not thread-safe; one caller at a time.
+class ModbusClient {
+ public:
+  /// Stores the parameters; no I/O. `device` names the transport in errors and tap records.
+  ModbusClient(std::string device, Endpoint endpoint, double response_timeout_s = 0.5);
+
+  /// Sets the tap every exchange passes (nullptr: none). Not owned.
+  void set_tap(Tap* tap) { tap_ = tap; }
+  /// Opens the transport (TCP connect / open the serial line); blocks up to the timeout.
+  Result<void> connect();
+  /// Closes the transport; the next read/write reconnects.
+  void disconnect();
+  /// True while the transport is open.
+  bool connected() const { return connected_; }
+
+  /// Reads one point's engineering value; blocks up to the response timeout.
+  Result<double> read(const Point& p);
+  /// Writes one rw point (function 6 for one word, 16 for two); blocks up to the timeout.
+  Result<void> write(const Point& p, double value);
+  /// Reads `count` raw registers (function 3 or 4) at a PDU address; blocks up to the timeout.
+  Result<std::vector<std::uint16_t>> read_registers(FunctionCode fc, int unit, std::uint16_t addr,
+                                                    int count);
+  /// Writes raw holding registers at a PDU address; blocks up to the timeout.
+  Result<void> write_registers(int unit, std::uint16_t addr, std::span<const std::uint16_t> words);
+
+  /// Name given at construction.
+  const std::string& device() const { return device_; }
+  /// Response timeout in seconds.
+  double response_timeout_s() const { return timeout_s_; }
+
+ private:
+  Result<void> ensure_connected();
+  Error fail(int err, const std::string& what);
+  void tap(TapDirection dir, const char* kind, std::vector<std::uint8_t> bytes, std::string detail);
+
+  std::string device_;
+  Endpoint endpoint_;
+  double timeout_s_;
+  ModbusHandle ctx_;
+  bool connected_ = false;
+  Tap* tap_ = nullptr;
+};
+
+}  // namespace station::drivers::modbus

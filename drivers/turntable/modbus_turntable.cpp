@@ -1,0 +1,81 @@
+// ModbusTurntable: decodes table state and range-checks demands.
+#include "drivers/turntable/modbus_turntable.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "drivers/turntable/turntable_map.hpp"
+
+namespace station::drivers {
+namespace tm = turntable_map;
+
+ModbusTurntable::ModbusTurntable(std::string name, modbus::Endpoint endpoint,
+                                 modbus::RegisterMap map, TurntableLimits limits,
+                                 double response_timeout_s)
+    : name_(std::move(name)),
+      map_(std::move(map)),
+      limits_(limits),
+      client_(name_, std::move(endpoint), response_timeout_s) {
+  for (const char* p : {tm::kModeDemand, tm::kPositionDemand, tm::kRateDemand, tm::kLock, tm::kStop,
+                        tm::kAngle, tm::kRate, tm::kStatus, tm::kModeActual})
+    (void)map_.at(p);
+}
+
+Result<void> ModbusTurntable::connect() {
+  return client_.connect();
+}
+
+Result<TurntableState> ModbusTurntable::read() {
+  TurntableState s;
+  auto mode = client_.read(map_.at(tm::kModeActual));
+  if (!mode) return mode.error();
+  int m = static_cast<int>(mode.value());
+  if (m < 0 || m > 2)
+    return make_error(ErrorKind::protocol, fmt::format("{}: mode register {} not 0..2", name_, m));
+  s.mode = static_cast<TurntableMode>(m);
+  auto angle = client_.read(map_.at(tm::kAngle));
+  if (!angle) return angle.error();
+  s.angle_deg = angle.value();
+  auto rate = client_.read(map_.at(tm::kRate));
+  if (!rate) return rate.error();
+  s.rate_dps = rate.value();
+  auto status = client_.read(map_.at(tm::kStatus));
+  if (!status) return status.error();
+  auto bits = static_cast<unsigned>(status.value());
+  s.in_position = (bits & tm::kInPosition) != 0;
+  s.at_rate = (bits & tm::kAtRate) != 0;
+  s.fault = (bits & tm::kFault) != 0;
+  s.interlock_open = (bits & tm::kInterlockOpen) != 0;
+  return s;
+}
+
+Result<void> ModbusTurntable::check(const TurntableCommand& c) const {
+  if (c.position_deg && !std::isfinite(*c.position_deg))
+    return make_error(ErrorKind::range, name_ + ": position demand is not finite");
+  if (c.rate_dps && !(std::fabs(*c.rate_dps) <= limits_.max_rate_dps))
+    return make_error(ErrorKind::range, fmt::format("{}: rate {} deg/s beyond +-{} deg/s", name_,
+                                                    *c.rate_dps, limits_.max_rate_dps));
+  return {};
+}
+
+Result<void> ModbusTurntable::command(const TurntableCommand& c) {
+  if (auto ok = check(c); !ok) return ok;
+  if (c.lock) {
+    if (auto ok = client_.write(map_.at(tm::kLock), *c.lock ? 1 : 0); !ok) return ok;
+  }
+  if (c.position_deg) {
+    double wrapped = std::fmod(std::fmod(*c.position_deg, 360.0) + 360.0, 360.0);
+    if (auto ok = client_.write(map_.at(tm::kPositionDemand), wrapped); !ok) return ok;
+  }
+  if (c.rate_dps) {
+    if (auto ok = client_.write(map_.at(tm::kRateDemand), *c.rate_dps); !ok) return ok;
+  }
+  return client_.write(map_.at(tm::kModeDemand), static_cast<double>(c.mode));
+}
+
+Result<void> ModbusTurntable::stop() {
+  return client_.write(map_.at(tm::kStop), 1);
+}
+
+}  // namespace station::drivers

@@ -1,0 +1,43 @@
+// Turntable over Modbus TCP through the turntable register map.
+#pragma once
+
+#include <string>
+
+#include "drivers/modbus/modbus_client.hpp"
+#include "drivers/modbus/register_map.hpp"
+#include "drivers/turntable/turntable.hpp"
+
+namespace station::drivers {
+
+/// Limits the driver enforces before writing a demand.
+struct TurntableLimits {
+  double max_rate_dps = 500.0;  ///< |rate demand| bound, deg/s
+};
+
+/// A servo turntable on Modbus TCP. Constructor does no I/O.
+class ModbusTurntable final : public Turntable {
+ public:
+  /// `map` must define every turntable_map point (throws std::invalid_argument otherwise).
+  ModbusTurntable(std::string name, modbus::Endpoint endpoint, modbus::RegisterMap map,
+                  TurntableLimits limits = {}, double response_timeout_s = 0.5);
+
+  Result<void> connect() override;
+  Result<TurntableState> read() override;
+  /// Writes lock, demands, then mode; out-of-range demands give ErrorKind::range, nothing written.
+  Result<void> command(const TurntableCommand& c) override;
+  Result<void> stop() override;
+  std::string name() const override { return name_; }
+
+  /// Sets the tap every Modbus exchange passes (nullptr: none).
+  void set_tap(Tap* tap) { client_.set_tap(tap); }
+
+ private:
+  Result<void> check(const TurntableCommand& c) const;
+
+  std::string name_;
+  modbus::RegisterMap map_;
+  TurntableLimits limits_;
+  modbus::ModbusClient client_;
+};
+
+}  // namespace station::drivers
