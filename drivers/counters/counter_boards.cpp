@@ -1,0 +1,233 @@
+// Counter-board driver: latch protocol (SYNC, STATUS+COUNTS+TEMPS+DISCHARGE) and delta maths.
+#include "drivers/counters/counter_boards.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "drivers/counters/counter_frames.hpp"
+
+namespace station::drivers::counters {
+
+using Clock = std::chrono::steady_clock;
+
+struct CounterBoards::SlotState {
+  // Across ticks: the last good latch.
+  bool has_prev = false;
+  std::uint32_t prev_up = 0, prev_down = 0, prev_time_us = 0;
+  int ticks_since_prev = 0;
+  // This tick.
+  bool attributing = false;  // the node's latest STATUS names the current latch
+  std::optional<StatusFrame> status;
+  std::optional<CountsFrame> counts;
+  std::optional<TempsFrame> temps;
+  std::optional<DischargeFrame> discharge;
+  int duplicates = 0, stale = 0, corrupt = 0;
+
+  void start_tick() {
+    attributing = false;
+    status.reset();
+    counts.reset();
+    temps.reset();
+    discharge.reset();
+    duplicates = stale = corrupt = 0;
+  }
+  bool complete() const {
+    if (!status || !counts) return false;
+    if ((status->follows & kFollowsTemps) && !temps) return false;
+    return !((status->follows & kFollowsDischarge) && !discharge);
+  }
+};
+
+CounterBoards::CounterBoards(std::unique_ptr<can::CanTransport> transport,
+                             CounterBoardsConfig config)
+    : transport_(std::move(transport)), config_(std::move(config)) {
+  if (!transport_) throw std::invalid_argument("counter boards: no CAN transport");
+  if (config_.slots.empty()) throw std::invalid_argument("counter boards: no slots configured");
+  if (!(config_.nominal_interval_s > 0))
+    throw std::invalid_argument("counter boards: nominal_interval_s must be > 0");
+  for (std::size_t i = 0; i < config_.slots.size(); ++i) {
+    const auto& s = config_.slots[i];
+    if (s.node < 1 || s.node > kMaxNode)
+      throw std::invalid_argument(
+          fmt::format("counter boards: slot {} node {} not in 1..{}", i, s.node, kMaxNode));
+    if (!(s.pulse_weight_arcsec > 0))
+      throw std::invalid_argument(fmt::format("counter boards: slot {} pulse weight <= 0", i));
+    for (std::size_t j = 0; j < i; ++j)
+      if (config_.slots[j].node == s.node)
+        throw std::invalid_argument(
+            fmt::format("counter boards: node {} in slots {} and {}", s.node, j, i));
+  }
+  state_.resize(config_.slots.size());
+}
+
+CounterBoards::~CounterBoards() = default;
+
+Result<TickResult> CounterBoards::tick(std::uint8_t latch_seq) {
+  if (auto s = send_sync(latch_seq); !s) return s.error();
+  return collect(config_.tick_timeout);
+}
+
+Result<void> CounterBoards::send_sync(std::uint8_t latch_seq) {
+  latch_seq_ = latch_seq;
+  for (auto& s : state_) s.start_tick();
+  return transport_->send(encode(SyncFrame{latch_seq}));
+}
+
+Result<TickResult> CounterBoards::collect(std::chrono::milliseconds timeout) {
+  TickResult out;
+  out.latch_seq = latch_seq_;
+  const auto deadline = Clock::now() + timeout;
+  while (!all_complete()) {
+    const auto left = std::chrono::ceil<std::chrono::milliseconds>(deadline - Clock::now());
+    if (left.count() <= 0) break;
+    auto f = transport_->receive(left);
+    if (f) {
+      handle(f.value(), out);
+    } else if (f.error().kind == ErrorKind::protocol) {
+      ++out.corrupt_frames;  // a record that is not a can_frame: count it and keep listening
+      out.last_error = f.error().message;
+    } else if (f.error().kind == ErrorKind::timeout) {
+      break;
+    } else {
+      return f.error();
+    }
+  }
+  finish(out);
+  return out;
+}
+
+bool CounterBoards::all_complete() const {
+  return std::all_of(state_.begin(), state_.end(), [](const SlotState& s) { return s.complete(); });
+}
+
+namespace {
+
+// Stores `value` in `slot` unless already present (then it is a duplicate).
+template <typename T>
+void keep_first(std::optional<T>& slot, T value, int& duplicates) {
+  if (slot)
+    ++duplicates;
+  else
+    slot = std::move(value);
+}
+
+}  // namespace
+
+void CounterBoards::handle(const can_frame& f, TickResult& out) {
+  std::uint8_t node = 0;
+  auto kind = classify(f, &node);
+  const auto it = std::find_if(config_.slots.begin(), config_.slots.end(),
+                               [&](const CounterSlot& s) { return s.node == node_bits(f.can_id); });
+  SlotState* s = it == config_.slots.end() ? nullptr : &state_[it - config_.slots.begin()];
+  auto bad = [&](const Error& e) {
+    ++out.corrupt_frames;
+    out.last_error = e.message;
+    if (s) ++s->corrupt;
+  };
+  if (!kind) return bad(kind.error());
+  if (kind.value() == FrameKind::sync) return;  // our own SYNC echoed by a real bus
+  if (!s) {
+    ++out.unknown_frames;
+    return;
+  }
+  switch (kind.value()) {
+    case FrameKind::status: {
+      auto st = decode_status(f);
+      if (!st) return bad(st.error());
+      s->attributing = st.value().latch_seq == latch_seq_;
+      if (!s->attributing) return void(++s->stale);
+      return keep_first(s->status, st.value(), s->duplicates);
+    }
+    case FrameKind::counts: {
+      auto c = decode_counts(f);
+      if (!c) return bad(c.error());
+      if (!s->attributing) return void(++s->stale);
+      return keep_first(s->counts, c.value(), s->duplicates);
+    }
+    case FrameKind::temps: {
+      auto t = decode_temps(f);
+      if (!t) return bad(t.error());
+      if (!s->attributing) return void(++s->stale);
+      return keep_first(s->temps, t.value(), s->duplicates);
+    }
+    case FrameKind::discharge: {
+      auto d = decode_discharge(f);
+      if (!d) return bad(d.error());
+      if (!s->attributing) return void(++s->stale);
+      return keep_first(s->discharge, d.value(), s->duplicates);
+    }
+    case FrameKind::sync:
+      return;
+  }
+}
+
+namespace {
+
+// Fills net pulses, angle, interval and rate of a reading whose deltas are set.
+void fill_delta(CounterReading& r, std::uint32_t prev_time_us, double nominal_s,
+                double pulse_weight_arcsec) {
+  r.has_delta = true;
+  r.net_pulses = static_cast<std::int64_t>(r.delta_up) - static_cast<std::int64_t>(r.delta_down);
+  r.angle_arcsec = static_cast<double>(r.net_pulses) * pulse_weight_arcsec;
+  const double nominal = nominal_s * r.intervals_spanned;
+  const double board_s = static_cast<std::uint32_t>(r.board_time_us - prev_time_us) * 1e-6;
+  // Board time wraps every 2^32 µs (71.6 min) and restarts on a board reset: trust it only
+  // when it agrees with the nominal interval to within half an interval.
+  r.interval_from_board_time = std::abs(board_s - nominal) < 0.5 * nominal;
+  r.interval_s = r.interval_from_board_time ? board_s : nominal;
+  r.rate_dph = r.angle_arcsec / r.interval_s;  // arcsec/s == deg/h
+}
+
+}  // namespace
+
+void CounterBoards::finish(TickResult& out) {
+  out.readings.clear();
+  for (std::size_t i = 0; i < state_.size(); ++i) {
+    SlotState& s = state_[i];
+    const CounterSlot& slot = config_.slots[i];
+    CounterReading r;
+    r.node = slot.node;
+    r.serial = slot.serial;
+    r.duplicate_frames = s.duplicates;
+    r.stale_frames = s.stale;
+    r.corrupt_frames = s.corrupt;
+    r.answered = s.status && s.counts;
+    ++s.ticks_since_prev;
+    if (!r.answered) {
+      r.latch_lost = true;
+      out.readings.push_back(std::move(r));
+      continue;
+    }
+    r.status_flags = s.status->flags;
+    r.board_time_us = s.status->board_time_us;
+    r.temps_missing = (s.status->follows & kFollowsTemps) && !s.temps;
+    r.discharge_missing = (s.status->follows & kFollowsDischarge) && !s.discharge;
+    if (s.temps)
+      for (std::size_t k = 0; k < s.temps->count; ++k)
+        r.temps_c.push_back(s.temps->centi_c[k] == std::numeric_limits<std::int16_t>::min()
+                                ? std::numeric_limits<double>::quiet_NaN()  // 0x8000: no value
+                                : s.temps->centi_c[k] * kTempScaleC);
+    if (s.discharge) r.discharge_ua = s.discharge->leg_ua;
+    // Unsigned subtraction makes the 2^32 counter wrap harmless as long as fewer than 2^32
+    // pulses pass between good latches.
+    r.delta_up = s.counts->up - s.prev_up;
+    r.delta_down = s.counts->down - s.prev_down;
+    r.intervals_spanned = s.ticks_since_prev;
+    // A counter reset breaks the cumulative chain: re-baseline instead of reporting garbage.
+    if (s.has_prev && !(r.status_flags & kFlagCounterReset))
+      fill_delta(r, s.prev_time_us, config_.nominal_interval_s, slot.pulse_weight_arcsec);
+    if (!r.has_delta) r.delta_up = r.delta_down = 0, r.intervals_spanned = 0;
+    s.has_prev = true;
+    s.prev_up = s.counts->up;
+    s.prev_down = s.counts->down;
+    s.prev_time_us = r.board_time_us;
+    s.ticks_since_prev = 0;
+    out.readings.push_back(std::move(r));
+  }
+}
+
+}  // namespace station::drivers::counters
