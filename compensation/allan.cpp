@@ -1,1 +1,193 @@
-// placeholder
+// Overlapping Allan deviation from the integrated angle, its confidence intervals, noise terms.
+#include "compensation/allan.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "compensation/chi_squared.hpp"
+
+namespace station::compensation {
+namespace {
+
+// Sum over k < n_terms of (theta[k+2m] - 2 theta[k+m] + theta[k])^2. Four independent
+// accumulators break the add dependency chain so the loop pipelines without -ffast-math.
+double second_difference_sum(const double* theta, std::size_t m, std::size_t n_terms) {
+  const double* a = theta;
+  const double* b = theta + m;
+  const double* c = theta + 2 * m;
+  double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+  std::size_t k = 0;
+  for (; k + 4 <= n_terms; k += 4) {
+    const double d0 = c[k] - 2.0 * b[k] + a[k];
+    const double d1 = c[k + 1] - 2.0 * b[k + 1] + a[k + 1];
+    const double d2 = c[k + 2] - 2.0 * b[k + 2] + a[k + 2];
+    const double d3 = c[k + 3] - 2.0 * b[k + 3] + a[k + 3];
+    s0 += d0 * d0;
+    s1 += d1 * d1;
+    s2 += d2 * d2;
+    s3 += d3 * d3;
+  }
+  for (; k < n_terms; ++k) {
+    const double d = c[k] - 2.0 * b[k] + a[k];
+    s0 += d * d;
+  }
+  return (s0 + s1) + (s2 + s3);
+}
+
+// Equivalent degrees of freedom of the overlapping AVAR for white FM noise (gyro angle random
+// walk: rate = frequency, angle = phase), the simple approximation of Howe, Allan & Barnes (1981)
+// given in NIST SP 1065 §5.3, Table 5: edf = [3(N-1)/(2m) - 2(N-2)/N] * 4m^2/(4m^2+5), with N
+// the number of phase (angle) points. Floored at 1: for N - 2m close to 1 the formula drops
+// below the single degree of freedom a one-term sum still has.
+double white_fm_edf(double n_angle, double m) {
+  const double edf = (3.0 * (n_angle - 1.0) / (2.0 * m) - 2.0 * (n_angle - 2.0) / n_angle) *
+                     (4.0 * m * m / (4.0 * m * m + 5.0));
+  return std::max(edf, 1.0);
+}
+
+// Reading noise terms off the curve (IEEE Std 952-1997 Annex C, Table C.2). A term whose ADEV
+// is c * tau^s shows as a line of slope s on the log-log curve. AVAR is a sum of the
+// non-negative AVARs of independent terms, so each term's line lies at or below the curve; its
+// coefficient is read as the tangent of slope s from below: c = min over points of sigma/tau^s.
+// That equals c where the term dominates, and it is only taken as present when the curve has a
+// stretch whose local slope is within kSlopeWindow of s.
+constexpr double kSlopeWindow = 0.25;
+// Flicker (bias instability) floor: sigma = B sqrt(2 ln 2 / pi) = 0.664 B (IEEE 952 Table C.2).
+constexpr double kFlickerFloor = 0.664;
+
+struct CurvePoint {
+  double tau_s;
+  double adev;
+};
+
+// Points usable for reading: positive values and, when an edf is given, at least min_edf.
+std::vector<CurvePoint> usable_points(std::span<const AdevPoint> curve, double min_edf) {
+  std::vector<CurvePoint> pts;
+  for (const AdevPoint& p : curve) {
+    const bool edf_ok = p.edf == 0.0 || p.edf >= min_edf;
+    if (p.tau_s > 0.0 && p.adev > 0.0 && edf_ok) pts.push_back({p.tau_s, p.adev});
+  }
+  std::sort(pts.begin(), pts.end(),
+            [](const CurvePoint& l, const CurvePoint& r) { return l.tau_s < r.tau_s; });
+  return pts;
+}
+
+bool has_slope_near(const std::vector<CurvePoint>& pts, double slope) {
+  for (std::size_t i = 0; i + 1 < pts.size(); ++i) {
+    const double dlog_tau = std::log(pts[i + 1].tau_s / pts[i].tau_s);
+    if (dlog_tau <= 0.0) continue;
+    const double local = std::log(pts[i + 1].adev / pts[i].adev) / dlog_tau;
+    if (std::fabs(local - slope) <= kSlopeWindow) return true;
+  }
+  return false;
+}
+
+// Coefficient c of the tangent line sigma = c * tau^slope touching the curve from below.
+double tangent_coefficient(const std::vector<CurvePoint>& pts, double slope) {
+  double c = std::numeric_limits<double>::infinity();
+  for (const CurvePoint& p : pts) c = std::min(c, p.adev / std::pow(p.tau_s, slope));
+  return c;
+}
+
+}  // namespace
+
+std::vector<std::size_t> tau_factors(std::size_t n, TauSpacing spacing) {
+  std::vector<std::size_t> out;
+  if (n < 3) return out;
+  const std::size_t m_max = (n - 1) / 2;  // n - 2m + 1 >= 2
+  switch (spacing) {
+    case TauSpacing::octave:
+      for (std::size_t m = 1; m <= m_max; m *= 2) out.push_back(m);
+      break;
+    case TauSpacing::decade:
+      for (std::size_t decade = 1; decade <= m_max; decade *= 10) {
+        for (std::size_t f : {1, 2, 4}) {
+          if (f * decade <= m_max) out.push_back(f * decade);
+        }
+      }
+      break;
+    case TauSpacing::all:
+      for (std::size_t m = 1; m <= m_max; ++m) out.push_back(m);
+      break;
+  }
+  return out;
+}
+
+std::vector<AdevPoint> overlapping_adev(std::span<const double> rate, double rate_hz,
+                                        std::span<const std::size_t> m_list, double confidence) {
+  if (!(rate_hz > 0.0) || !(confidence > 0.0 && confidence < 1.0)) {
+    throw std::invalid_argument("overlapping_adev: need rate_hz > 0 and 0 < confidence < 1, got " +
+                                std::to_string(rate_hz) + ", " + std::to_string(confidence));
+  }
+  std::vector<AdevPoint> out;
+  if (rate.empty()) return out;
+  // Integrated angle in units of (rate unit) x (sample interval): theta_0 = 0,
+  // theta_k = sum_{i<k} (y_i - mean). Working in sample units, tau0 cancels out of AVAR below.
+  // The mean rate is removed first: AVAR is invariant to a constant rate offset (it only adds a
+  // linear ramp to theta, which the second difference annihilates), and it keeps the cumulative
+  // sum a zero-mean random walk, small enough for 1e7 samples not to lose precision.
+  double mean = 0;
+  for (double y : rate) mean += y;
+  mean /= static_cast<double>(rate.size());
+  const std::size_t n_angle = rate.size() + 1;  // N = M + 1 angle points
+  std::vector<double> theta(n_angle);
+  theta[0] = 0.0;
+  for (std::size_t i = 0; i < rate.size(); ++i) theta[i + 1] = theta[i] + (rate[i] - mean);
+
+  const double alpha = 1.0 - confidence;
+  const double tau0_s = 1.0 / rate_hz;
+  for (std::size_t m : m_list) {
+    if (m == 0 || 2 * m >= n_angle) continue;  // fewer than 1 term
+    const std::size_t n_terms = n_angle - 2 * m;
+    // NIST SP 1065 §5.2.4, overlapping AVAR from phase data:
+    //   AVAR(m tau0) = 1 / (2 tau^2 (N - 2m)) sum_{k} (x_{k+2m} - 2 x_{k+m} + x_k)^2,
+    // with x = tau0 * theta and tau = m tau0, so tau0^2 cancels: 1 / (2 m^2 (N - 2m)).
+    const double sum = second_difference_sum(theta.data(), m, n_terms);
+    const double md = static_cast<double>(m);
+    AdevPoint p;
+    p.m = m;
+    p.tau_s = md * tau0_s;
+    p.n = n_terms;
+    p.adev = std::sqrt(sum / (2.0 * md * md * static_cast<double>(n_terms)));
+    p.edf = white_fm_edf(static_cast<double>(n_angle), md);
+    // Chi-squared interval, NIST SP 1065 §5.3: edf * s^2 / sigma^2 ~ chi^2(edf).
+    p.ci_low = p.adev * std::sqrt(p.edf / chi_squared_quantile(1.0 - alpha / 2.0, p.edf));
+    p.ci_high = p.adev * std::sqrt(p.edf / chi_squared_quantile(alpha / 2.0, p.edf));
+    out.push_back(p);
+  }
+  return out;
+}
+
+NoiseTerms noise_terms(std::span<const AdevPoint> curve, double min_edf) {
+  NoiseTerms out;
+  const std::vector<CurvePoint> pts = usable_points(curve, min_edf);
+  if (pts.size() < 2) return out;
+  // Rate in deg/h, tau in s; 1 (deg/h) * s = 1 arcsec.
+  if (has_slope_near(pts, -1.0)) {
+    // Quantization: sigma = sqrt(3) Q / tau, so Q[arcsec] = c / sqrt(3).
+    out.quantization_arcsec = tangent_coefficient(pts, -1.0) / std::sqrt(3.0);
+  }
+  if (has_slope_near(pts, -0.5)) {
+    // Angle random walk: sigma = N / sqrt(tau); read at tau = 1 s, c is sigma(1 s) in deg/h,
+    // and N[deg/sqrt(h)] = c / sqrt(3600 s/h) = c / 60.
+    out.angle_random_walk_deg_rth = tangent_coefficient(pts, -0.5) / 60.0;
+  }
+  if (has_slope_near(pts, 0.0)) {
+    const auto min_it =
+        std::min_element(pts.begin(), pts.end(),
+                         [](const CurvePoint& l, const CurvePoint& r) { return l.adev < r.adev; });
+    out.bias_instability_dph = min_it->adev / kFlickerFloor;
+    out.bias_instability_tau_s = min_it->tau_s;
+  }
+  if (has_slope_near(pts, 0.5)) {
+    // Rate random walk: sigma = K sqrt(tau / 3) with tau in h. With c = sigma / sqrt(tau_s):
+    // K[deg/h/sqrt(h)] = sigma * sqrt(3 / tau_h) = c * sqrt(3 * 3600).
+    out.rate_random_walk_dph_rth = tangent_coefficient(pts, 0.5) * std::sqrt(3.0 * 3600.0);
+  }
+  return out;
+}
+
+}  // namespace station::compensation

@@ -13,24 +13,26 @@ namespace station::compensation {
 enum class TauSpacing { octave, decade, all };
 
 /// Averaging factors for a series of n rate samples: octave 1,2,4,...; decade 1,2,4 x 10^k;
-/// all 1..; each m kept while the overlapping estimator still has at least 2 terms (n - 2m + 1 >= 2).
+/// all 1..; each m kept while the overlapping estimator still has at least 2 terms (n - 2m + 1 >=
+/// 2).
 std::vector<std::size_t> tau_factors(std::size_t n, TauSpacing spacing);
 
 /// One point of an Allan deviation curve.
 struct AdevPoint {
-  double tau_s = 0;     ///< averaging time m * tau0, seconds
-  std::size_t m = 0;    ///< averaging factor
-  double adev = 0;      ///< overlapping Allan deviation, in the input's rate unit
-  double ci_low = 0;    ///< lower bound of the confidence interval (same unit)
-  double ci_high = 0;   ///< upper bound
-  std::size_t n = 0;    ///< number of terms in the overlapping sum (N - 2m, N angle points)
-  double edf = 0;       ///< equivalent degrees of freedom used for the interval
+  double tau_s = 0;    ///< averaging time m * tau0, seconds
+  std::size_t m = 0;   ///< averaging factor
+  double adev = 0;     ///< overlapping Allan deviation, in the input's rate unit
+  double ci_low = 0;   ///< lower bound of the confidence interval (same unit)
+  double ci_high = 0;  ///< upper bound
+  std::size_t n = 0;   ///< number of terms in the overlapping sum (N - 2m, N angle points)
+  double edf = 0;      ///< equivalent degrees of freedom used for the interval
 };
 
 /// Overlapping ADEV of `rate` (any rate unit, sampled at rate_hz) at each factor in `m_list`,
 /// computed from the integrated angle in O(N) per tau; interval at `confidence` (two-sided).
-/// Factors with fewer than 1 term are skipped. Pure; no allocation beyond the result and one
-/// cumulative-sum buffer.
+/// Factors with fewer than 1 term are skipped. Interval from the white-FM (angle random walk)
+/// edf of NIST SP 1065 Table 5. Throws std::invalid_argument unless rate_hz > 0 and
+/// 0 < confidence < 1. Pure; no allocation beyond the result and one cumulative-sum buffer.
 std::vector<AdevPoint> overlapping_adev(std::span<const double> rate, double rate_hz,
                                         std::span<const std::size_t> m_list,
                                         double confidence = 0.683);
@@ -38,14 +40,17 @@ std::vector<AdevPoint> overlapping_adev(std::span<const double> rate, double rat
 /// Noise coefficients read off an ADEV curve of a rate series in deg/h (IEEE 952 Table C.2).
 /// Each is empty when the curve does not reach the region it is read from.
 struct NoiseTerms {
-  std::optional<double> quantization_arcsec;           ///< Q: tau^-1 line, sigma = sqrt(3) Q / tau
-  std::optional<double> angle_random_walk_deg_rth;     ///< N: tau^-1/2 line at tau = 1 s, deg/sqrt(h)
-  std::optional<double> bias_instability_dph;          ///< B: flat minimum / 0.664, deg/h
-  std::optional<double> bias_instability_tau_s;        ///< tau of that minimum, s
-  std::optional<double> rate_random_walk_dph_rth;      ///< K: tau^+1/2 line at tau = 3, deg/h/sqrt(h)
+  std::optional<double> quantization_arcsec;        ///< Q: tau^-1 line, sigma = sqrt(3) Q / tau
+  std::optional<double> angle_random_walk_deg_rth;  ///< N: tau^-1/2 line at tau = 1 s, deg/sqrt(h)
+  std::optional<double> bias_instability_dph;       ///< B: flat minimum / 0.664, deg/h
+  std::optional<double> bias_instability_tau_s;     ///< tau of that minimum, s
+  std::optional<double> rate_random_walk_dph_rth;   ///< K: tau^+1/2 line at tau = 3, deg/h/sqrt(h)
 };
 
-/// Reads the noise terms off `curve` (rate in deg/h, tau in s).
-NoiseTerms noise_terms(std::span<const AdevPoint> curve);
+/// Reads the noise terms off `curve` (rate in deg/h, tau in s): each coefficient from the tangent
+/// line of its slope touching the curve from below, only where the curve has a stretch of that
+/// slope (+-0.25). Points with 0 < edf < min_edf are ignored (too noisy to read); edf == 0 marks
+/// an exact (e.g. analytic) point. Pure.
+NoiseTerms noise_terms(std::span<const AdevPoint> curve, double min_edf = 50.0);
 
 }  // namespace station::compensation
