@@ -1,0 +1,154 @@
+// Counter-board simulator: latch on SYNC, answer with the shared wire codec, inject faults.
+#include "sim_devices/counter_board_sim.hpp"
+
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+
+#include "drivers/counters/counter_frames.hpp"
+
+namespace station::sim {
+
+namespace wire = station::drivers::counters;
+
+CounterBoardSim::CounterBoardSim(const BoardConfig& config)
+    : config_(config), gyro_(config.gyro), fault_rng_(config.gyro.seed ^ 0x9E3779B97F4A7C15ULL) {
+  if (config.node < 1 || config.node > wire::kMaxNode)
+    throw std::invalid_argument("counter board sim: node out of range 1..16");
+}
+
+std::uint32_t CounterBoardSim::up_count() const {
+  // Dither runs both counters; positive rotation adds to up only (schemas/can_frames.md).
+  return config_.initial_up + static_cast<std::uint32_t>(gyro_.dither_pulses()) +
+         static_cast<std::uint32_t>(gyro_.up_pulses());
+}
+
+std::uint32_t CounterBoardSim::down_count() const {
+  return config_.initial_down + static_cast<std::uint32_t>(gyro_.dither_pulses()) +
+         static_cast<std::uint32_t>(gyro_.down_pulses());
+}
+
+std::vector<BoardRecord> CounterBoardSim::on_sync(std::uint8_t latch_seq) {
+  if (!answering_) return {};
+  return apply_faults(build_frames(latch_seq));
+}
+
+std::vector<can_frame> CounterBoardSim::build_frames(std::uint8_t latch_seq) {
+  const std::uint8_t node = config_.node;
+  wire::StatusFrame st{node, latch_seq, extra_flags_, 0, wire::kFollowsCounts};
+  st.board_time_us =
+      config_.board_time_offset_us + static_cast<std::uint32_t>(std::llround(gyro_.time_s() * 1e6));
+  if (failed_temp_ >= 0) st.flags |= wire::kFlagTempSensorFault;
+  if (config_.temp_channels > 0) st.follows |= wire::kFollowsTemps;
+  if (config_.send_discharge) st.follows |= wire::kFollowsDischarge;
+  std::vector<can_frame> out{wire::encode(st),
+                             wire::encode(wire::CountsFrame{node, up_count(), down_count()})};
+  if (config_.temp_channels > 0) {
+    wire::TempsFrame t{node, config_.temp_channels, {}};
+    const double temps[] = {gyro_.temp_a_c(), gyro_.temp_b_c(), gyro_.temp_a_c(), 0.0};
+    for (int i = 0; i < t.count && i < 4; ++i)
+      t.centi_c[i] = i == failed_temp_ ? INT16_MIN  // the sensor's "no value" sentinel
+                                       : static_cast<std::int16_t>(std::lround(temps[i] * 100));
+    out.push_back(wire::encode(t));
+  }
+  if (config_.send_discharge)
+    out.push_back(wire::encode(wire::DischargeFrame{node, config_.discharge_ua}));
+  return out;
+}
+
+std::vector<BoardRecord> CounterBoardSim::apply_faults(const std::vector<can_frame>& frames) {
+  std::vector<BoardRecord> out;
+  for (const can_frame& f : frames) {
+    if (drop_ > 0) {
+      --drop_;
+      continue;
+    }
+    BoardRecord r{f, false};
+    if (corrupt_ > 0) {
+      --corrupt_;
+      if (corrupt_kind_ == CorruptKind::bad_dlc) r.frame.can_dlc = 3;
+      if (corrupt_kind_ == CorruptKind::short_record) r.short_record = true;
+      if (corrupt_kind_ == CorruptKind::garbage_id) {
+        r.frame.can_id = 0x700 + config_.node;
+        for (auto& b : r.frame.data) b = static_cast<std::uint8_t>(fault_rng_());
+      }
+    }
+    out.push_back(r);
+    if (duplicate_ > 0) {
+      --duplicate_;
+      out.push_back(r);
+    }
+  }
+  return out;
+}
+
+CounterBoardBus::CounterBoardBus(int fd) : fd_(fd) {}
+
+CounterBoardBus::~CounterBoardBus() {
+  stop();
+  if (fd_ >= 0) ::close(fd_);
+}
+
+CounterBoardSim& CounterBoardBus::add_board(const BoardConfig& config) {
+  const std::lock_guard lock(mutex_);
+  boards_.push_back(std::make_unique<CounterBoardSim>(config));
+  return *boards_.back();
+}
+
+CounterBoardSim& CounterBoardBus::board(std::uint8_t node) {
+  const std::lock_guard lock(mutex_);
+  for (auto& b : boards_)
+    if (b->node() == node) return *b;
+  throw std::out_of_range("counter board bus: no board with that node");
+}
+
+void CounterBoardBus::step_to(double sim_time_s, double chamber_air_c) {
+  const std::lock_guard lock(mutex_);
+  for (auto& b : boards_) b->step_to(sim_time_s, chamber_air_c);
+}
+
+int CounterBoardBus::service(std::chrono::milliseconds timeout) {
+  pollfd p{fd_, POLLIN, 0};
+  if (::poll(&p, 1, static_cast<int>(timeout.count())) <= 0 || !(p.revents & POLLIN)) return 0;
+  int syncs = 0;
+  can_frame f;
+  for (;;) {
+    const ssize_t n = ::recv(fd_, &f, sizeof f, MSG_DONTWAIT);
+    if (n == 0) peer_closed_ = true;
+    if (n <= 0) break;  // drained (EAGAIN) or the peer closed
+    if (n != sizeof f) continue;
+    auto sync = wire::decode_sync(f);
+    if (!sync) continue;  // board frames from elsewhere on the bus are not for us
+    ++syncs;
+    const std::lock_guard lock(mutex_);
+    for (auto& b : boards_) send_all(b->on_sync(sync.value().latch_seq));
+  }
+  return syncs;
+}
+
+void CounterBoardBus::send_all(const std::vector<BoardRecord>& records) {
+  for (const auto& r : records) {
+    const std::size_t len = r.short_record ? 8 : sizeof(can_frame);
+    pollfd p{fd_, POLLOUT, 0};
+    if (::poll(&p, 1, 100) <= 0) return;  // peer not reading: drop, like a full CAN tx queue
+    if (::send(fd_, &r.frame, len, MSG_NOSIGNAL | MSG_DONTWAIT) < 0) return;
+  }
+}
+
+void CounterBoardBus::start() {
+  if (running_.exchange(true)) return;
+  thread_ = std::thread([this] {
+    while (running_ && !peer_closed_) service(std::chrono::milliseconds(50));
+  });
+}
+
+void CounterBoardBus::stop() {
+  running_ = false;
+  if (thread_.joinable()) thread_.join();
+}
+
+}  // namespace station::sim
