@@ -1,1 +1,33 @@
-int main() { return 0; }
+// The `station` executable: subcommands over the station core. Setup and input errors are
+// caught here and become one line on stderr and exit status 2.
+#include <fmt/format.h>
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+
+#include "station/commands.hpp"
+#include "station/csv_table.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"Gyro thermal-calibration test station"};
+  app.require_subcommand(1);
+  station::CommandStatus status;
+  station::add_analyze_command(app, status);
+  station::add_adev_command(app, status);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? 0 : 2;
+  } catch (const station::InputError& e) {
+    fmt::print(stderr, "station: {}\n", e.what());
+    return 2;
+  } catch (const std::invalid_argument& e) {
+    fmt::print(stderr, "station: {}\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "station: error: {}\n", e.what());
+    return 1;
+  }
+  return status.exit_code;
+}

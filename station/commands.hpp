@@ -1,0 +1,19 @@
+// Subcommand registration for the `station` executable: each adds itself to the CLI11 app and
+// stores its exit status in the shared slot when it runs.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace station {
+
+/// Exit status of the subcommand that ran (0 ok, 2 bad input, 1 run failure).
+struct CommandStatus {
+  int exit_code = 0;
+};
+
+/// `station analyze FILE.csv ...`: bin, fit and evaluate the thermal bias model offline.
+void add_analyze_command(CLI::App& app, CommandStatus& status);
+/// `station adev FILE.csv --col NAME ...`: overlapping Allan deviation and noise terms.
+void add_adev_command(CLI::App& app, CommandStatus& status);
+
+}  // namespace station

@@ -1,0 +1,104 @@
+// The `station` executable end to end: analyze/adev output and exit status 2 on bad input.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+namespace {
+
+struct Outcome {
+  int status = -1;
+  std::string out;
+};
+
+// Runs the station binary with `args` (stderr folded into the output).
+Outcome run_station(const std::string& args) {
+  const std::string cmd = std::string(STATION_BINARY_DIR) + "/station/station " + args + " 2>&1";
+  Outcome o;
+  FILE* p = popen(cmd.c_str(), "r");
+  if (p == nullptr) return o;
+  std::array<char, 4096> buf{};
+  std::size_t n = 0;
+  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) o.out.append(buf.data(), n);
+  const int raw = pclose(p);
+  o.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  return o;
+}
+
+const std::string kExample = std::string(STATION_SOURCE_DIR) + "/examples/thermal_cycle.csv";
+
+}  // namespace
+
+TEST(Cli, AnalyzeExampleRecoversTheGeneratorsCoefficients) {
+  // examples/thermal_cycle.csv was made by scripts/make_example_csv.py with B0 0.05 deg/h,
+  // k1 1.2e-3 deg/h/C, k0 0.012 deg/h/C and Earth rate at 39.9 N removed by the command.
+  const auto o =
+      run_station("analyze " + kExample + " --temp2-col temp2_c --latitude 39.9 --axis up --json");
+  ASSERT_EQ(o.status, 0) << o.out;
+  const auto j = nlohmann::json::parse(o.out);
+  const auto& c = j["coefficients"];
+  const auto& se = j["std_errors"];
+  EXPECT_NEAR(c["k1"].get<double>(), 1.2e-3, 4 * se["k1"].get<double>());
+  EXPECT_NEAR(c["k0"].get<double>(), 0.012, 4 * se["k0"].get<double>());
+  EXPECT_NEAR(c["B0"].get<double>(), 0.05, 4 * se["B0"].get<double>());
+  EXPECT_EQ(j["bins"].get<int>(), 66);
+  EXPECT_LT(j["std_ratio"].get<double>(), 0.2);
+  EXPECT_NEAR(j["improvement_pct"].get<double>(), 100 * (1 - j["std_ratio"].get<double>()), 1e-9);
+  EXPECT_TRUE(j["warnings"].empty());
+}
+
+TEST(Cli, AnalyzeBadInputExitsTwoNamingFileLineColumn) {
+  const std::string path = testing::TempDir() + "bad_cli.csv";
+  std::ofstream(path) << "time_s,rate_dph,temp_c\n0,1,2\n1,x,2\n";
+  const auto o = run_station("analyze " + path + " --terms dT");
+  EXPECT_EQ(o.status, 2);
+  EXPECT_NE(o.out.find("bad_cli.csv:3: column 'rate_dph': not a number: 'x'"), std::string::npos)
+      << o.out;
+}
+
+TEST(Cli, AnalyzeTooFewBinsForTheTermsExitsTwo) {
+  const std::string path = testing::TempDir() + "short_cli.csv";
+  std::ofstream f(path);
+  f << "time_s,rate_dph,temp_c\n";
+  for (int i = 0; i < 1800; ++i) f << i << ",1," << i * 0.01 << "\n";
+  f.close();
+  const auto o = run_station("analyze " + path + " --terms dT,dT2,dT3");
+  EXPECT_EQ(o.status, 2);
+  EXPECT_NE(o.out.find("too few bins: 3 bins for 4 coefficients"), std::string::npos) << o.out;
+}
+
+TEST(Cli, AnalyzeNeedsAGradientSourceForGradT) {
+  const auto o = run_station("analyze " + kExample);
+  EXPECT_EQ(o.status, 2);
+  EXPECT_NE(o.out.find("gradT needs --grad-col"), std::string::npos) << o.out;
+}
+
+TEST(Cli, AdevJsonHasRowsAndNoise) {
+  const auto o = run_station("adev " + kExample + " --col rate_dph --json");
+  ASSERT_EQ(o.status, 0) << o.out;
+  const auto j = nlohmann::json::parse(o.out);
+  ASSERT_GT(j["rows"].size(), 10u);
+  EXPECT_EQ(j["rows"][0]["m"].get<int>(), 1);
+  EXPECT_DOUBLE_EQ(j["rows"][1]["tau_s"].get<double>(), 2.0);
+  for (const auto& r : j["rows"]) {
+    EXPECT_LE(r["ci_low"].get<double>(), r["adev"].get<double>());
+    EXPECT_GE(r["ci_high"].get<double>(), r["adev"].get<double>());
+  }
+  EXPECT_TRUE(j["noise"].contains("angle_random_walk_deg_rth"));
+}
+
+TEST(Cli, AdevRejectsATauThatIsNotAMultipleOfThePeriod) {
+  const auto o = run_station("adev " + kExample + " --col rate_dph --rate-hz 1 --taus 1,2.5");
+  EXPECT_EQ(o.status, 2);
+  EXPECT_NE(o.out.find("2.5 s is not a whole multiple"), std::string::npos) << o.out;
+}
+
+TEST(Cli, AdevMissingColumnExitsTwo) {
+  const auto o = run_station("adev " + kExample + " --col nope");
+  EXPECT_EQ(o.status, 2);
+  EXPECT_NE(o.out.find("no column 'nope'"), std::string::npos) << o.out;
+}
