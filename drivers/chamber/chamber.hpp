@@ -35,9 +35,9 @@ struct ChamberState {
 
 /// A change to the chamber; unset fields are left alone.
 struct ChamberCommand {
-  std::optional<double> setpoint_c;      ///< new setpoint, °C (checked against the limits)
-  std::optional<double> ramp_c_per_min;  ///< new ramp rate, °C/min, >= 0, 0 = step
-  std::optional<bool> run;               ///< enable/disable the controller output
+  std::optional<double> setpoint_c{};      ///< new setpoint, °C (checked against the limits)
+  std::optional<double> ramp_c_per_min{};  ///< new ramp rate, °C/min, >= 0, 0 = step
+  std::optional<bool> run{};               ///< enable/disable the controller output
 };
 
 /// A thermal chamber. Every call is one bounded transaction; none blocks past its timeout.

@@ -13,15 +13,15 @@ namespace station::drivers::modbus {
 
 /// Changes to one existing point; unset fields keep the preset's value.
 struct PointOverride {
-  std::string name;                      ///< point to change; must exist in the map
-  std::optional<std::uint16_t> address;  ///< register number as the manual lists it
-  std::optional<PointType> type;         ///< int16 / uint16 / float32
-  std::optional<double> scale;           ///< engineering value per raw count, non-zero
-  std::optional<WordOrder> order;        ///< float32 word order
-  std::optional<FunctionCode> function;  ///< 3 or 4
-  std::optional<int> unit_id;            ///< 0..247
-  std::optional<bool> one_based;         ///< manual numbering
-  std::optional<Access> access;          ///< ro / rw
+  std::string name;                        ///< point to change; must exist in the map
+  std::optional<std::uint16_t> address{};  ///< register number as the manual lists it
+  std::optional<PointType> type{};         ///< int16 / uint16 / float32
+  std::optional<double> scale{};           ///< engineering value per raw count, non-zero
+  std::optional<WordOrder> order{};        ///< float32 word order
+  std::optional<FunctionCode> function{};  ///< 3 or 4
+  std::optional<int> unit_id{};            ///< 0..247
+  std::optional<bool> one_based{};         ///< manual numbering
+  std::optional<Access> access{};          ///< ro / rw
 };
 
 /// Applies overrides in order; throws std::invalid_argument naming the point and field.

@@ -25,9 +25,9 @@ struct TurntableState {
 /// A demand to the table; unset optionals are left alone.
 struct TurntableCommand {
   TurntableMode mode = TurntableMode::off;
-  std::optional<double> position_deg;  ///< position demand, degrees (position mode)
-  std::optional<double> rate_dps;      ///< rate demand, degrees per second (rate mode)
-  std::optional<bool> lock;            ///< engage (true) / release (false) the axis lock
+  std::optional<double> position_deg{};  ///< position demand, degrees (position mode)
+  std::optional<double> rate_dps{};      ///< rate demand, degrees per second (rate mode)
+  std::optional<bool> lock{};            ///< engage (true) / release (false) the axis lock
 };
 
 /// A single-axis turntable.

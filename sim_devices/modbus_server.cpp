@@ -1,0 +1,228 @@
+// ModbusServer: a poll()-driven libmodbus server thread, TCP or RTU-on-pty, with fault injection.
+#include "sim_devices/modbus_server.hpp"
+
+#include <arpa/inet.h>
+#include <fcntl.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <termios.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <stdexcept>
+
+namespace station::sim {
+namespace {
+
+constexpr int kPollMs = 100;
+
+[[noreturn]] void sys_fail(const std::string& what) {
+  throw std::runtime_error("modbus server: " + what + ": " + std::strerror(errno));
+}
+
+std::uint16_t be16(const std::uint8_t* p) {
+  return static_cast<std::uint16_t>(p[0] << 8 | p[1]);
+}
+
+std::uint16_t* table(const modbus_mapping_t& regs, const drivers::modbus::Point& p) {
+  return p.function == drivers::modbus::FunctionCode::input ? regs.tab_input_registers
+                                                            : regs.tab_registers;
+}
+
+}  // namespace
+
+int register_count(const drivers::modbus::RegisterMap& map) {
+  int n = 0;
+  for (const auto& [name, p] : map.points()) n = std::max(n, p.pdu_address() + p.word_count());
+  return n;
+}
+
+void put_point(modbus_mapping_t& regs, const drivers::modbus::Point& p, double value) {
+  auto words = drivers::modbus::encode_point(p, value);
+  if (!words) {
+    // Saturate like a controller display would rather than publish garbage.
+    double lim = p.type == drivers::modbus::PointType::uint16 ? 65535.0 : 32767.0;
+    double lo = p.type == drivers::modbus::PointType::uint16 ? 0.0 : -32768.0;
+    words = drivers::modbus::encode_point(p, std::clamp(value / p.scale, lo, lim) * p.scale);
+    if (!words) return;
+  }
+  std::uint16_t* t = table(regs, p) + p.pdu_address();
+  for (int i = 0; i < p.word_count(); ++i) t[i] = (*words)[i];
+}
+
+double get_point(const modbus_mapping_t& regs, const drivers::modbus::Point& p) {
+  return drivers::modbus::decode_point(p, table(regs, p) + p.pdu_address());
+}
+
+bool point_written(const drivers::modbus::Point& p, std::uint16_t pdu_address, int count) {
+  int a = p.pdu_address();
+  return p.function == drivers::modbus::FunctionCode::holding && a < pdu_address + count &&
+         pdu_address < a + p.word_count();
+}
+
+void ModbusServer::FreeServerCtx::operator()(modbus_t* c) const noexcept {
+  modbus_set_socket(c, -1);  // descriptors are owned by the server, not by the context
+  modbus_free(c);
+}
+
+ModbusServer::ModbusServer(ModbusDeviceModel& model, int unit_id)
+    : model_(model), unit_id_(unit_id) {}
+
+ModbusServer::~ModbusServer() {
+  stop();
+}
+
+void ModbusServer::make_mapping() {
+  int n = model_.register_count();
+  mapping_.reset(modbus_mapping_new(0, 0, n, n));
+  if (!mapping_) sys_fail("modbus_mapping_new");
+}
+
+void ModbusServer::start_tcp() {
+  make_mapping();
+  ctx_.reset(modbus_new_tcp("127.0.0.1", 0));
+  if (!ctx_) sys_fail("modbus_new_tcp");
+  listen_fd_ = modbus_tcp_listen(ctx_.get(), 8);
+  if (listen_fd_ == -1) sys_fail("modbus_tcp_listen");
+  sockaddr_in addr{};
+  socklen_t len = sizeof addr;
+  if (getsockname(listen_fd_, reinterpret_cast<sockaddr*>(&addr), &len) == -1)
+    sys_fail("getsockname");
+  port_ = ntohs(addr.sin_port);
+  thread_ = std::thread([this] { run_tcp(); });
+}
+
+void ModbusServer::start_rtu_pty(int baud) {
+  make_mapping();
+  baud_ = baud;
+  pty_master_ = posix_openpt(O_RDWR | O_NOCTTY | O_CLOEXEC);
+  if (pty_master_ == -1) sys_fail("posix_openpt");
+  if (grantpt(pty_master_) == -1 || unlockpt(pty_master_) == -1) sys_fail("grantpt/unlockpt");
+  char name[128];
+  if (ptsname_r(pty_master_, name, sizeof name) != 0) sys_fail("ptsname_r");
+  pty_path_ = name;
+  pty_slave_ = open(name, O_RDWR | O_NOCTTY | O_CLOEXEC);
+  if (pty_slave_ == -1) sys_fail("open " + pty_path_);
+  termios tios{};
+  tcgetattr(pty_slave_, &tios);
+  cfmakeraw(&tios);  // no echo, no line editing: bytes pass as they are
+  tcsetattr(pty_slave_, TCSANOW, &tios);
+  ctx_.reset(modbus_new_rtu(name, baud, 'N', 8, 1));
+  if (!ctx_) sys_fail("modbus_new_rtu");
+  modbus_set_slave(ctx_.get(), unit_id_);
+  thread_ = std::thread([this] { run_rtu(); });
+}
+
+void ModbusServer::stop() {
+  stop_ = true;
+  if (thread_.joinable()) thread_.join();
+  for (int* fd : {&listen_fd_, &pty_master_, &pty_slave_}) {
+    if (*fd != -1) close(*fd);
+    *fd = -1;
+  }
+}
+
+std::string ModbusServer::endpoint() const {
+  if (!pty_path_.empty())
+    return "rtu:" + pty_path_ + "?baud=" + std::to_string(baud_) + "&parity=N&data=8&stop=1";
+  return "tcp://127.0.0.1:" + std::to_string(port_);
+}
+
+void ModbusServer::inject_timeouts(int n) {
+  std::lock_guard lock(fault_mutex_);
+  timeouts_ = n;
+}
+
+void ModbusServer::inject_exception(int code, int n) {
+  std::lock_guard lock(fault_mutex_);
+  exception_code_ = code;
+  exceptions_ = n;
+}
+
+void ModbusServer::inject_drop(int n) {
+  std::lock_guard lock(fault_mutex_);
+  drops_ = n;
+}
+
+ModbusServer::Fault ModbusServer::take_fault(int& code) {
+  std::lock_guard lock(fault_mutex_);
+  if (timeouts_ > 0) return --timeouts_, Fault::timeout;
+  if (drops_ > 0) return --drops_, Fault::drop;
+  if (exceptions_ > 0) {
+    code = exception_code_;
+    return --exceptions_, Fault::exception;
+  }
+  return Fault::none;
+}
+
+void ModbusServer::accept_client(std::vector<int>& clients) {
+  int fd = accept4(listen_fd_, nullptr, nullptr, SOCK_CLOEXEC);
+  if (fd != -1) clients.push_back(fd);
+}
+
+void ModbusServer::run_tcp() {
+  std::vector<int> clients;
+  while (!stop_) {
+    std::vector<pollfd> fds{{listen_fd_, POLLIN, 0}};
+    for (int c : clients) fds.push_back({c, POLLIN, 0});
+    if (poll(fds.data(), fds.size(), kPollMs) <= 0) continue;
+    if (fds[0].revents & POLLIN) accept_client(clients);
+    for (std::size_t i = 1; i < fds.size(); ++i) {
+      if (fds[i].revents == 0 || serve_one(fds[i].fd)) continue;
+      close(fds[i].fd);
+      clients.erase(std::find(clients.begin(), clients.end(), fds[i].fd));
+    }
+  }
+  for (int c : clients) close(c);
+}
+
+void ModbusServer::run_rtu() {
+  while (!stop_) {
+    pollfd pfd{pty_master_, POLLIN, 0};
+    if (poll(&pfd, 1, kPollMs) <= 0 || !(pfd.revents & POLLIN)) continue;
+    if (!serve_one(pty_master_)) modbus_flush(ctx_.get());  // resynchronise on a bad frame
+  }
+}
+
+bool ModbusServer::serve_one(int fd) {
+  modbus_set_socket(ctx_.get(), fd);
+  std::uint8_t query[MODBUS_MAX_ADU_LENGTH];
+  int len = modbus_receive(ctx_.get(), query);
+  if (len == -1) return false;  // peer closed, or a malformed/timed-out frame
+  if (len == 0) return true;    // addressed to another unit
+  return handle(query, len);
+}
+
+bool ModbusServer::handle(const std::uint8_t* query, int len) {
+  ++requests_;
+  int code = 0;
+  switch (take_fault(code)) {
+    case Fault::timeout:
+      return true;
+    case Fault::drop:
+      return pty_master_ != -1;  // TCP: close; RTU: just stay silent
+    case Fault::exception:
+      modbus_reply_exception(ctx_.get(), query, static_cast<unsigned>(code));
+      return true;
+    case Fault::none:
+      break;
+  }
+  model_.publish(*mapping_);
+  if (modbus_reply(ctx_.get(), query, len, mapping_.get()) == -1) return false;
+  notify_writes(query);
+  return true;
+}
+
+void ModbusServer::notify_writes(const std::uint8_t* query) {
+  const std::uint8_t* pdu = query + modbus_get_header_length(ctx_.get());
+  std::uint16_t addr = be16(pdu + 1);
+  int count = 0;
+  if (pdu[0] == MODBUS_FC_WRITE_SINGLE_REGISTER) count = 1;
+  if (pdu[0] == MODBUS_FC_WRITE_MULTIPLE_REGISTERS) count = be16(pdu + 3);
+  if (count > 0 && addr + count <= mapping_->nb_registers) model_.on_write(*mapping_, addr, count);
+}
+
+}  // namespace station::sim

@@ -1,0 +1,110 @@
+// A reusable in-process Modbus server (libmodbus) over TCP on 127.0.0.1 or RTU on a pty, whose
+// registers are backed by a device model, with fault injection for driver tests.
+#pragma once
+
+#include <modbus/modbus.h>
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "drivers/modbus/register_map.hpp"
+
+namespace station::sim {
+
+/// Registers a map needs in each table: highest PDU address + words.
+int register_count(const drivers::modbus::RegisterMap& map);
+/// Encodes `value` into the point's table (holding or input); values that do not fit saturate.
+void put_point(modbus_mapping_t& regs, const drivers::modbus::Point& p, double value);
+/// Decodes the point's current holding/input words.
+double get_point(const modbus_mapping_t& regs, const drivers::modbus::Point& p);
+/// True if the point's words intersect [pdu_address, pdu_address + count).
+bool point_written(const drivers::modbus::Point& p, std::uint16_t pdu_address, int count);
+
+/// A device whose state the server exposes as registers. Called from the server thread only.
+class ModbusDeviceModel {
+ public:
+  virtual ~ModbusDeviceModel() = default;
+  /// Registers needed (holding and input tables each): highest PDU address + 1.
+  virtual int register_count() const = 0;
+  /// Copies the model's current state into the register tables (before every reply).
+  virtual void publish(modbus_mapping_t& regs) = 0;
+  /// Applies holding registers [pdu_address, pdu_address + count) just written by a client.
+  virtual void on_write(const modbus_mapping_t& regs, std::uint16_t pdu_address, int count) = 0;
+};
+
+/// Serves one model. start_*() spawns the thread; the destructor stops and joins it (the loop
+/// polls with a 100 ms timeout, so shutdown never hangs).
+class ModbusServer {
+ public:
+  /// Stores the model (not owned; must outlive the server) and unit id; no I/O.
+  explicit ModbusServer(ModbusDeviceModel& model, int unit_id = 1);
+  ~ModbusServer();
+  ModbusServer(const ModbusServer&) = delete;
+  ModbusServer& operator=(const ModbusServer&) = delete;
+
+  /// Listens on 127.0.0.1 with an ephemeral port and starts serving; throws std::runtime_error.
+  void start_tcp();
+  /// Opens a pty pair and serves RTU on its master; clients open pty_path(). Throws on failure.
+  void start_rtu_pty(int baud = 19200);
+  /// Stops the thread and closes every descriptor; blocks at most ~100 ms. Idempotent.
+  void stop();
+
+  /// TCP port chosen by the kernel (0 before start_tcp).
+  int port() const { return port_; }
+  /// Pty slave path (empty before start_rtu_pty).
+  const std::string& pty_path() const { return pty_path_; }
+  /// Endpoint string for drivers: tcp://127.0.0.1:PORT or rtu:/dev/pts/N?baud=..&parity=N&...
+  std::string endpoint() const;
+  /// Requests received so far (including faulted ones).
+  std::uint64_t requests() const { return requests_.load(); }
+
+  /// The next `n` requests get no reply at all (the client times out).
+  void inject_timeouts(int n);
+  /// The next `n` requests get exception reply `code` (e.g.
+  /// MODBUS_EXCEPTION_SLAVE_OR_SERVER_FAILURE).
+  void inject_exception(int code, int n = 1);
+  /// The next `n` requests make the server close the connection without replying (TCP; on RTU
+  /// this is a missing reply).
+  void inject_drop(int n = 1);
+
+ private:
+  enum class Fault { none, timeout, exception, drop };
+  struct FreeServerCtx {
+    void operator()(modbus_t* c) const noexcept;
+  };
+  struct FreeMapping {
+    void operator()(modbus_mapping_t* m) const noexcept { modbus_mapping_free(m); }
+  };
+
+  void make_mapping();
+  void run_tcp();
+  void run_rtu();
+  void accept_client(std::vector<int>& clients);
+  bool serve_one(int fd);
+  bool handle(const std::uint8_t* query, int len);
+  void notify_writes(const std::uint8_t* query);
+  Fault take_fault(int& code);
+
+  ModbusDeviceModel& model_;
+  int unit_id_;
+  std::unique_ptr<modbus_t, FreeServerCtx> ctx_;
+  std::unique_ptr<modbus_mapping_t, FreeMapping> mapping_;
+  int listen_fd_ = -1;
+  int pty_master_ = -1;
+  int pty_slave_ = -1;  // held open so the master never sees a hang-up between clients
+  int port_ = 0;
+  int baud_ = 19200;
+  std::string pty_path_;
+  std::atomic<bool> stop_{false};
+  std::atomic<std::uint64_t> requests_{0};
+  std::thread thread_;
+  std::mutex fault_mutex_;
+  int timeouts_ = 0, exceptions_ = 0, exception_code_ = 0, drops_ = 0;
+};
+
+}  // namespace station::sim

@@ -1,0 +1,134 @@
+// TurntableSim: velocity-limited, acceleration-limited motion (trapezoidal profile).
+#include "sim_devices/turntable_sim.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "drivers/turntable/turntable_map.hpp"
+
+namespace station::sim {
+namespace tm = drivers::turntable_map;
+
+namespace {
+double wrap360(double a) {
+  return std::fmod(std::fmod(a, 360.0) + 360.0, 360.0);
+}
+}  // namespace
+
+TurntableSim::TurntableSim(drivers::modbus::RegisterMap map, TurntableSimConfig cfg)
+    : map_(std::move(map)), cfg_(cfg) {}
+
+void TurntableSim::step_to(double sim_time_s) {
+  std::lock_guard lock(mutex_);
+  while (t_s_ + 1e-9 < sim_time_s) {
+    double dt = std::min(cfg_.step_s, sim_time_s - t_s_);
+    step_once(dt);
+    t_s_ += dt;
+  }
+}
+
+double TurntableSim::velocity_demand() const {
+  bool enabled = !interlock_open_ && !fault_ && !locked_ && !stopping_;
+  if (!enabled || mode_ == 0) return 0.0;
+  if (mode_ == 2) return rate_demand_dps_;
+  // Position: the fastest velocity from which the table can still stop at the target,
+  // v = sqrt(2 a d), capped at the velocity limit; this yields the trapezoidal profile.
+  double d = std::remainder(position_demand_deg_ - angle_deg_, 360.0);
+  double v = std::min(cfg_.max_rate_dps, std::sqrt(2.0 * cfg_.max_accel_dps2 * std::fabs(d)));
+  return std::copysign(v, d);
+}
+
+void TurntableSim::step_once(double dt) {
+  double dv_max = cfg_.max_accel_dps2 * dt;
+  double v_old = rate_dps_;
+  double v_new = v_old + std::clamp(velocity_demand() - v_old, -dv_max, dv_max);
+  // Trapezoidal integration: exact while the acceleration is constant over the step.
+  double next = angle_deg_ + 0.5 * (v_old + v_new) * dt;
+  if (mode_ == 1 && !stopping_) {
+    double before = std::remainder(position_demand_deg_ - angle_deg_, 360.0);
+    double after = std::remainder(position_demand_deg_ - next, 360.0);
+    // Do not overshoot the final approach: snap when the error changes sign at low speed.
+    if (before * after <= 0 && std::fabs(v_new) <= dv_max) {
+      next = position_demand_deg_;
+      v_new = 0;
+    }
+  }
+  rate_dps_ = v_new;
+  angle_deg_ = wrap360(next);
+  if (stopping_ && rate_dps_ == 0) {
+    stopping_ = false;
+    mode_ = 0;
+  }
+  if ((interlock_open_ || fault_) && rate_dps_ == 0) mode_ = 0;
+}
+
+double TurntableSim::angle_deg() const {
+  std::lock_guard lock(mutex_);
+  return angle_deg_;
+}
+
+double TurntableSim::rate_dps() const {
+  std::lock_guard lock(mutex_);
+  return rate_dps_;
+}
+
+void TurntableSim::set_interlock_open(bool open) {
+  std::lock_guard lock(mutex_);
+  interlock_open_ = open;
+}
+
+void TurntableSim::set_fault(bool fault) {
+  std::lock_guard lock(mutex_);
+  fault_ = fault;
+}
+
+unsigned TurntableSim::status_locked() const {
+  unsigned bits = 0;
+  double err = std::fabs(std::remainder(position_demand_deg_ - angle_deg_, 360.0));
+  if (mode_ == 1 && err < cfg_.in_position_deg && std::fabs(rate_dps_) < cfg_.at_rate_dps)
+    bits |= tm::kInPosition;
+  if (mode_ == 2 && std::fabs(rate_dps_ - rate_demand_dps_) < cfg_.at_rate_dps) bits |= tm::kAtRate;
+  if (fault_) bits |= tm::kFault;
+  if (interlock_open_) bits |= tm::kInterlockOpen;
+  return bits;
+}
+
+int TurntableSim::register_count() const {
+  return sim::register_count(map_);
+}
+
+void TurntableSim::publish(modbus_mapping_t& regs) {
+  std::lock_guard lock(mutex_);
+  put_point(regs, map_.at(tm::kModeDemand), mode_);
+  put_point(regs, map_.at(tm::kPositionDemand), position_demand_deg_);
+  put_point(regs, map_.at(tm::kRateDemand), rate_demand_dps_);
+  put_point(regs, map_.at(tm::kLock), locked_ ? 1 : 0);
+  put_point(regs, map_.at(tm::kStop), stopping_ ? 1 : 0);
+  put_point(regs, map_.at(tm::kAngle), angle_deg_);
+  put_point(regs, map_.at(tm::kRate), rate_dps_);
+  put_point(regs, map_.at(tm::kStatus), status_locked());
+  put_point(regs, map_.at(tm::kModeActual), mode_);
+}
+
+void TurntableSim::on_write(const modbus_mapping_t& regs, std::uint16_t pdu_address, int count) {
+  std::lock_guard lock(mutex_);
+  auto written = [&](const char* name, auto&& apply) {
+    const auto& p = map_.at(name);
+    if (!point_written(p, pdu_address, count)) return;
+    double v = get_point(regs, p);
+    if (std::isfinite(v)) apply(v);
+  };
+  written(tm::kPositionDemand, [&](double v) { position_demand_deg_ = wrap360(v); });
+  written(tm::kRateDemand, [&](double v) { rate_demand_dps_ = v; });
+  written(tm::kLock, [&](double v) { locked_ = v != 0 && rate_dps_ == 0; });
+  written(tm::kStop, [&](double v) { stopping_ = v != 0; });
+  written(tm::kModeDemand, [&](double v) {
+    // The drive refuses to enable while the interlock or a fault is active.
+    if (v >= 0 && v <= 2 && !interlock_open_ && !fault_) {
+      mode_ = static_cast<int>(v);
+      stopping_ = false;
+    }
+  });
+}
+
+}  // namespace station::sim

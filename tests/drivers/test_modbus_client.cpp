@@ -1,0 +1,134 @@
+// ModbusClient against a real libmodbus server on 127.0.0.1: errors are typed, faults recover.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <vector>
+
+#include "drivers/chamber/chamber_map.hpp"
+#include "drivers/modbus/modbus_client.hpp"
+#include "sim_devices/chamber_sim.hpp"
+#include "sim_devices/modbus_server.hpp"
+
+namespace mb = station::drivers::modbus;
+namespace cm = station::drivers::chamber_map;
+using station::drivers::ErrorKind;
+
+namespace {
+
+struct RecordingTap : station::drivers::Tap {
+  std::vector<station::drivers::TapRecord> records;
+  void on_exchange(const station::drivers::TapRecord& r) noexcept override { records.push_back(r); }
+};
+
+class ModbusClientTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    server.start_tcp();
+    client =
+        std::make_unique<mb::ModbusClient>("chamber", mb::parse_endpoint(server.endpoint()), 0.3);
+  }
+  mb::RegisterMap map = cm::watlow_f4();
+  station::sim::ChamberSim sim{map};
+  station::sim::ModbusServer server{sim};
+  std::unique_ptr<mb::ModbusClient> client;
+};
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
+TEST_F(ModbusClientTest, ConstructorDoesNoIoAndFirstReadConnects) {
+  EXPECT_FALSE(client->connected());
+  EXPECT_EQ(server.requests(), 0u);
+  auto v = client->read(map.at(cm::kAir));
+  ASSERT_TRUE(v) << v.error().message;
+  EXPECT_DOUBLE_EQ(v.value(), 25.0);
+  EXPECT_TRUE(client->connected());
+}
+
+TEST_F(ModbusClientTest, TimeoutIsTypedBoundedAndNextCallWorks) {
+  ASSERT_TRUE(client->connect());
+  server.inject_timeouts(1);
+  auto t0 = std::chrono::steady_clock::now();
+  auto v = client->read(map.at(cm::kAir));
+  double waited = seconds_since(t0);
+  ASSERT_FALSE(v);
+  EXPECT_EQ(v.error().kind, ErrorKind::timeout) << v.error().message;
+  // It waited for the configured 0.3 s and then gave up (bound, not a speed assertion).
+  EXPECT_GE(waited, 0.25);
+  EXPECT_LT(waited, 3.0);
+  auto again = client->read(map.at(cm::kAir));
+  ASSERT_TRUE(again) << again.error().message;
+  EXPECT_DOUBLE_EQ(again.value(), 25.0);
+}
+
+TEST_F(ModbusClientTest, ExceptionRepliesAreTypedAsException) {
+  server.inject_exception(MODBUS_EXCEPTION_SLAVE_OR_SERVER_FAILURE);
+  auto v = client->read(map.at(cm::kAir));
+  ASSERT_FALSE(v);
+  EXPECT_EQ(v.error().kind, ErrorKind::exception);
+  EXPECT_NE(v.error().message.find("chamber"), std::string::npos);
+  // A genuine ILLEGAL_DATA_ADDRESS: a register beyond the server's table.
+  mb::Point beyond{"beyond", 9000};
+  auto b = client->read(beyond);
+  ASSERT_FALSE(b);
+  EXPECT_EQ(b.error().kind, ErrorKind::exception);
+  EXPECT_NE(b.error().message.find("Illegal data address"), std::string::npos) << b.error().message;
+  EXPECT_TRUE(client->read(map.at(cm::kAir)));
+}
+
+TEST_F(ModbusClientTest, DroppedConnectionIsDisconnectedThenReconnects) {
+  ASSERT_TRUE(client->connect());
+  server.inject_drop();
+  auto v = client->read(map.at(cm::kAir));
+  ASSERT_FALSE(v);
+  EXPECT_EQ(v.error().kind, ErrorKind::disconnected) << v.error().message;
+  EXPECT_FALSE(client->connected());
+  auto again = client->read(map.at(cm::kAir));
+  ASSERT_TRUE(again) << again.error().message;
+  EXPECT_TRUE(client->connected());
+}
+
+TEST_F(ModbusClientTest, ConnectRefusedIsDisconnected) {
+  int port = server.port();
+  server.stop();
+  mb::ModbusClient lonely("chamber", mb::TcpEndpoint{"127.0.0.1", port}, 0.3);
+  auto c = lonely.connect();
+  ASSERT_FALSE(c);
+  EXPECT_EQ(c.error().kind, ErrorKind::disconnected) << c.error().message;
+  auto r = lonely.read(map.at(cm::kAir));
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().kind, ErrorKind::disconnected);
+}
+
+TEST_F(ModbusClientTest, WritesRespectAccessAndRange) {
+  auto ro = client->write(map.at(cm::kAir), 10.0);
+  ASSERT_FALSE(ro);
+  EXPECT_EQ(ro.error().kind, ErrorKind::range);
+  auto big = client->write(map.at(cm::kSetpoint), 5000.0);  // 50000 raw: not an int16
+  ASSERT_FALSE(big);
+  EXPECT_EQ(big.error().kind, ErrorKind::range);
+  EXPECT_EQ(server.requests(), 0u);  // nothing went on the wire
+  ASSERT_TRUE(client->write(map.at(cm::kSetpoint), -12.3));
+  auto back = client->read(map.at(cm::kSetpoint));
+  ASSERT_TRUE(back);
+  EXPECT_NEAR(back.value(), -12.3, 1e-9);
+}
+
+TEST_F(ModbusClientTest, EveryExchangePassesTheTap) {
+  RecordingTap tap;
+  client->set_tap(&tap);
+  ASSERT_TRUE(client->read(map.at(cm::kAir)));
+  ASSERT_GE(tap.records.size(), 3u);  // connect event, tx, rx
+  const auto& tx = tap.records[tap.records.size() - 2];
+  const auto& rx = tap.records.back();
+  EXPECT_EQ(tx.direction, station::drivers::TapDirection::tx);
+  EXPECT_EQ(tx.bytes, (std::vector<std::uint8_t>{3, 0, 100, 0, 1}));  // fc 3, addr 100, count 1
+  EXPECT_EQ(rx.bytes, (std::vector<std::uint8_t>{3, 2, 0, 250}));     // 25.0 C = 250
+  EXPECT_GT(rx.wall_time_s, 1.6e9);
+  server.inject_timeouts(1);
+  ASSERT_FALSE(client->read(map.at(cm::kAir)));
+  EXPECT_EQ(tap.records.back().kind, "error");
+}
