@@ -2,17 +2,12 @@
 #pragma once
 
 #include <cstddef>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
-namespace station {
+#include "station/input_error.hpp"
 
-/// Bad user input (file, config, protocol): the message names where and what. Exit status 2.
-class InputError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
+namespace station {
 
 /// The requested columns of a CSV file, as doubles, with the file line of each row.
 struct CsvColumns {

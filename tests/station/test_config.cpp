@@ -1,0 +1,126 @@
+// Station configuration: examples load and match the JSON Schema; bad files name file, line, key.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <string>
+
+#include "station/config.hpp"
+
+namespace {
+
+const std::string kSrc = STATION_SOURCE_DIR;
+
+// Message of the InputError parsing `text` raises (empty if none).
+std::string error_of(const std::string& text) {
+  try {
+    station::parse_station_config(text, "rig.toml");
+  } catch (const station::InputError& e) {
+    return e.what();
+  }
+  return {};
+}
+
+const std::string kMinimal = R"([station]
+latitude_deg = 39.9
+[chamber]
+endpoint = "tcp://127.0.0.1:502"
+[can]
+transport = "unix:/tmp/can.sock"
+[[slot]]
+node = 1
+serial = "A"
+)";
+
+int run_validator(const std::string& files) {
+  const std::string cmd = "/usr/bin/python3 " + kSrc + "/schemas/validate_toml.py " + kSrc +
+                          "/schemas/station_config.schema.json " + files + " >/dev/null 2>&1";
+  const int raw = std::system(cmd.c_str());
+  return WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+}
+
+}  // namespace
+
+TEST(Config, ExamplesLoad) {
+  const auto sim = station::load_station_config(kSrc + "/examples/station.toml");
+  EXPECT_EQ(sim.slots.size(), 2u);
+  EXPECT_DOUBLE_EQ(sim.latitude_deg, 39.9);
+  EXPECT_TRUE(sim.turntable.has_value());
+  const auto rtu = station::load_station_config(kSrc + "/examples/station_rtu.toml");
+  EXPECT_EQ(rtu.chamber.preset, "f4t");
+  ASSERT_EQ(rtu.chamber.overrides.size(), 1u);
+  EXPECT_EQ(*rtu.chamber.overrides[0].address, 2890);
+  EXPECT_NEAR(rtu.slots[1].enu.east, 1.0, 1e-12);  // heading 90 = east
+  ASSERT_TRUE(rtu.gpio.has_value());
+  EXPECT_EQ(rtu.gpio->lines.at("interlock"), "DOOR_SW");
+}
+
+TEST(Config, ExamplesMatchTheJsonSchema) {
+  if (std::system("/usr/bin/python3 -c 'import jsonschema, tomllib' >/dev/null 2>&1") != 0) {
+    GTEST_SKIP() << "python3-jsonschema not installed (scripts/dev installs it)";
+  }
+  EXPECT_EQ(run_validator(kSrc + "/examples/station.toml " + kSrc + "/examples/station_rtu.toml"),
+            0);
+  // The validator must be able to fail: a config with an unknown key and a bad node.
+  const std::string bad = testing::TempDir() + "bad_schema.toml";
+  std::ofstream(bad) << kMinimal << "colour = \"red\"\n";
+  EXPECT_EQ(run_validator(bad), 1);
+}
+
+TEST(Config, MinimalFileGetsDefaults) {
+  const auto c = station::parse_station_config(kMinimal, "rig.toml");
+  EXPECT_EQ(c.chamber.preset, "watlow_f4");
+  EXPECT_DOUBLE_EQ(c.slots[0].pulse_weight_arcsec, 1.5);
+  EXPECT_DOUBLE_EQ(c.limits.max_ramp_c_per_min, 3.0);
+  EXPECT_FALSE(c.turntable.has_value());
+}
+
+TEST(Config, UnknownKeyNamesLineAndKey) {
+  const auto msg = error_of(kMinimal + "colour = \"red\"\n");
+  EXPECT_NE(msg.find("rig.toml:10: key 'slot[0].colour': unknown key"), std::string::npos) << msg;
+}
+
+TEST(Config, WrongTypeAndRange) {
+  std::string t = kMinimal;
+  t.replace(t.find("39.9"), 4, "\"north\"");
+  EXPECT_NE(error_of(t).find("rig.toml:2: key 'station.latitude_deg': expected a number"),
+            std::string::npos)
+      << error_of(t);
+  std::string n = kMinimal;
+  n.replace(n.find("node = 1"), 8, "node = 40");
+  EXPECT_NE(error_of(n).find("rig.toml:8: key 'slot[0].node': CAN node must be 1..16"),
+            std::string::npos)
+      << error_of(n);
+}
+
+TEST(Config, BadEndpointPresetAndTransport) {
+  std::string e = kMinimal;
+  e.replace(e.find("tcp://127.0.0.1:502"), 19, "tcp://127.0.0.1:99999");
+  EXPECT_NE(error_of(e).find("rig.toml:4: key 'chamber.endpoint'"), std::string::npos)
+      << error_of(e);
+  EXPECT_NE(error_of(kMinimal + "[chamber]\n").find("rig.toml"), std::string::npos);
+  std::string p = kMinimal;
+  p.insert(p.find("[can]"), "preset = \"acme\"\n");
+  EXPECT_NE(error_of(p).find("key 'chamber.preset': unknown chamber register-map preset 'acme'"),
+            std::string::npos)
+      << error_of(p);
+  std::string c = kMinimal;
+  c.replace(c.find("unix:/tmp/can.sock"), 18, "carrier-pigeon:1");
+  EXPECT_NE(error_of(c).find("rig.toml:6: key 'can.transport'"), std::string::npos) << error_of(c);
+}
+
+TEST(Config, OverrideOfAnUnknownPointIsRejected) {
+  std::string o = kMinimal;
+  o.insert(o.find("[can]"), "[[chamber.point]]\nname = \"humidity\"\naddress = 7\n");
+  EXPECT_NE(error_of(o).find("humidity"), std::string::npos) << error_of(o);
+}
+
+TEST(Config, DuplicateSerialAndMissingTables) {
+  EXPECT_NE(error_of(kMinimal + "[[slot]]\nnode = 2\nserial = \"A\"\n").find("serial used twice"),
+            std::string::npos);
+  EXPECT_NE(error_of("[station]\nlatitude_deg = 1\n").find("missing [chamber] table"),
+            std::string::npos);
+  EXPECT_NE(error_of("[station\n").find("rig.toml:1:"), std::string::npos)
+      << error_of("[station\n");
+}
