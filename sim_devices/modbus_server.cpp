@@ -211,18 +211,31 @@ bool ModbusServer::handle(const std::uint8_t* query, int len) {
       break;
   }
   model_.publish(*mapping_);
-  if (modbus_reply(ctx_.get(), query, len, mapping_.get()) == -1) return false;
-  notify_writes(query);
-  return true;
+  // Apply a write to the model BEFORE the reply leaves, so a client that has its reply sees the
+  // model already changed (no race with the next step_to()).
+  apply_writes(query, len);
+  return modbus_reply(ctx_.get(), query, len, mapping_.get()) != -1;
 }
 
-void ModbusServer::notify_writes(const std::uint8_t* query) {
-  const std::uint8_t* pdu = query + modbus_get_header_length(ctx_.get());
+void ModbusServer::apply_writes(const std::uint8_t* query, int len) {
+  int header = modbus_get_header_length(ctx_.get());
+  const std::uint8_t* pdu = query + header;
+  int pdu_len = len - header - (pty_master_ != -1 ? 2 : 0);  // RTU frames end with a CRC
+  if (pdu_len < 5) return;
   std::uint16_t addr = be16(pdu + 1);
   int count = 0;
-  if (pdu[0] == MODBUS_FC_WRITE_SINGLE_REGISTER) count = 1;
-  if (pdu[0] == MODBUS_FC_WRITE_MULTIPLE_REGISTERS) count = be16(pdu + 3);
-  if (count > 0 && addr + count <= mapping_->nb_registers) model_.on_write(*mapping_, addr, count);
+  const std::uint8_t* values = nullptr;
+  if (pdu[0] == MODBUS_FC_WRITE_SINGLE_REGISTER) {
+    count = 1;
+    values = pdu + 3;
+  } else if (pdu[0] == MODBUS_FC_WRITE_MULTIPLE_REGISTERS && pdu_len >= 6) {
+    count = be16(pdu + 3);
+    values = pdu + 6;
+    if (pdu_len < 6 + 2 * count || pdu[5] != 2 * count) return;  // libmodbus will reject it
+  }
+  if (count <= 0 || addr + count > mapping_->nb_registers) return;
+  for (int i = 0; i < count; ++i) mapping_->tab_registers[addr + i] = be16(values + 2 * i);
+  model_.on_write(*mapping_, addr, count);
 }
 
 }  // namespace station::sim

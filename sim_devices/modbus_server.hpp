@@ -87,7 +87,7 @@ class ModbusServer {
   void accept_client(std::vector<int>& clients);
   bool serve_one(int fd);
   bool handle(const std::uint8_t* query, int len);
-  void notify_writes(const std::uint8_t* query);
+  void apply_writes(const std::uint8_t* query, int len);
   Fault take_fault(int& code);
 
   ModbusDeviceModel& model_;
