@@ -117,12 +117,16 @@ void keep_first(std::optional<T>& slot, T value, int& duplicates) {
 
 }  // namespace
 
+CounterBoards::SlotState* CounterBoards::slot_for(std::uint8_t node) {
+  for (std::size_t i = 0; i < config_.slots.size(); ++i)
+    if (config_.slots[i].node == node) return &state_[i];
+  return nullptr;
+}
+
 void CounterBoards::handle(const can_frame& f, TickResult& out) {
   std::uint8_t node = 0;
   auto kind = classify(f, &node);
-  const auto it = std::find_if(config_.slots.begin(), config_.slots.end(),
-                               [&](const CounterSlot& s) { return s.node == node_bits(f.can_id); });
-  SlotState* s = it == config_.slots.end() ? nullptr : &state_[it - config_.slots.begin()];
+  SlotState* s = slot_for(node_bits(f.can_id));  // attribute even a bad frame by its ID bits
   auto bad = [&](const Error& e) {
     ++out.corrupt_frames;
     out.last_error = e.message;
@@ -130,36 +134,24 @@ void CounterBoards::handle(const can_frame& f, TickResult& out) {
   };
   if (!kind) return bad(kind.error());
   if (kind.value() == FrameKind::sync) return;  // our own SYNC echoed by a real bus
-  if (!s) {
-    ++out.unknown_frames;
-    return;
-  }
+  if (!s) return void(++out.unknown_frames);
+  auto take = [&](auto decoded, auto& slot) {
+    if (!decoded) return bad(decoded.error());
+    if (!s->attributing) return void(++s->stale);
+    keep_first(slot, std::move(decoded).value(), s->duplicates);
+  };
   switch (kind.value()) {
     case FrameKind::status: {
       auto st = decode_status(f);
-      if (!st) return bad(st.error());
-      s->attributing = st.value().latch_seq == latch_seq_;
-      if (!s->attributing) return void(++s->stale);
-      return keep_first(s->status, st.value(), s->duplicates);
+      if (st) s->attributing = st.value().latch_seq == latch_seq_;
+      return take(std::move(st), s->status);
     }
-    case FrameKind::counts: {
-      auto c = decode_counts(f);
-      if (!c) return bad(c.error());
-      if (!s->attributing) return void(++s->stale);
-      return keep_first(s->counts, c.value(), s->duplicates);
-    }
-    case FrameKind::temps: {
-      auto t = decode_temps(f);
-      if (!t) return bad(t.error());
-      if (!s->attributing) return void(++s->stale);
-      return keep_first(s->temps, t.value(), s->duplicates);
-    }
-    case FrameKind::discharge: {
-      auto d = decode_discharge(f);
-      if (!d) return bad(d.error());
-      if (!s->attributing) return void(++s->stale);
-      return keep_first(s->discharge, d.value(), s->duplicates);
-    }
+    case FrameKind::counts:
+      return take(decode_counts(f), s->counts);
+    case FrameKind::temps:
+      return take(decode_temps(f), s->temps);
+    case FrameKind::discharge:
+      return take(decode_discharge(f), s->discharge);
     case FrameKind::sync:
       return;
   }
@@ -188,46 +180,45 @@ void CounterBoards::finish(TickResult& out) {
   out.readings.clear();
   for (std::size_t i = 0; i < state_.size(); ++i) {
     SlotState& s = state_[i];
-    const CounterSlot& slot = config_.slots[i];
     CounterReading r;
-    r.node = slot.node;
-    r.serial = slot.serial;
+    r.node = config_.slots[i].node;
+    r.serial = config_.slots[i].serial;
     r.duplicate_frames = s.duplicates;
     r.stale_frames = s.stale;
     r.corrupt_frames = s.corrupt;
     r.answered = s.status && s.counts;
+    r.latch_lost = !r.answered;
     ++s.ticks_since_prev;
-    if (!r.answered) {
-      r.latch_lost = true;
-      out.readings.push_back(std::move(r));
-      continue;
-    }
-    r.status_flags = s.status->flags;
-    r.board_time_us = s.status->board_time_us;
-    r.temps_missing = (s.status->follows & kFollowsTemps) && !s.temps;
-    r.discharge_missing = (s.status->follows & kFollowsDischarge) && !s.discharge;
-    if (s.temps)
-      for (std::size_t k = 0; k < s.temps->count; ++k)
-        r.temps_c.push_back(s.temps->centi_c[k] == std::numeric_limits<std::int16_t>::min()
-                                ? std::numeric_limits<double>::quiet_NaN()  // 0x8000: no value
-                                : s.temps->centi_c[k] * kTempScaleC);
-    if (s.discharge) r.discharge_ua = s.discharge->leg_ua;
-    // Unsigned subtraction makes the 2^32 counter wrap harmless as long as fewer than 2^32
-    // pulses pass between good latches.
-    r.delta_up = s.counts->up - s.prev_up;
-    r.delta_down = s.counts->down - s.prev_down;
-    r.intervals_spanned = s.ticks_since_prev;
-    // A counter reset breaks the cumulative chain: re-baseline instead of reporting garbage.
-    if (s.has_prev && !(r.status_flags & kFlagCounterReset))
-      fill_delta(r, s.prev_time_us, config_.nominal_interval_s, slot.pulse_weight_arcsec);
-    if (!r.has_delta) r.delta_up = r.delta_down = 0, r.intervals_spanned = 0;
-    s.has_prev = true;
-    s.prev_up = s.counts->up;
-    s.prev_down = s.counts->down;
-    s.prev_time_us = r.board_time_us;
-    s.ticks_since_prev = 0;
+    if (r.answered) fill_reading(s, config_.slots[i], r);
     out.readings.push_back(std::move(r));
   }
+}
+
+void CounterBoards::fill_reading(SlotState& s, const CounterSlot& slot, CounterReading& r) {
+  r.status_flags = s.status->flags;
+  r.board_time_us = s.status->board_time_us;
+  r.temps_missing = (s.status->follows & kFollowsTemps) && !s.temps;
+  r.discharge_missing = (s.status->follows & kFollowsDischarge) && !s.discharge;
+  if (s.temps)
+    for (std::size_t k = 0; k < s.temps->count; ++k)
+      r.temps_c.push_back(s.temps->centi_c[k] == std::numeric_limits<std::int16_t>::min()
+                              ? std::numeric_limits<double>::quiet_NaN()  // 0x8000: no value
+                              : s.temps->centi_c[k] * kTempScaleC);
+  if (s.discharge) r.discharge_ua = s.discharge->leg_ua;
+  // Unsigned subtraction makes the 2^32 counter wrap harmless as long as fewer than 2^32
+  // pulses pass between good latches.
+  r.delta_up = s.counts->up - s.prev_up;
+  r.delta_down = s.counts->down - s.prev_down;
+  r.intervals_spanned = s.ticks_since_prev;
+  // A counter reset breaks the cumulative chain: re-baseline instead of reporting garbage.
+  if (s.has_prev && !(r.status_flags & kFlagCounterReset))
+    fill_delta(r, s.prev_time_us, config_.nominal_interval_s, slot.pulse_weight_arcsec);
+  if (!r.has_delta) r.delta_up = r.delta_down = 0, r.intervals_spanned = 0;
+  s.has_prev = true;
+  s.prev_up = s.counts->up;
+  s.prev_down = s.counts->down;
+  s.prev_time_us = r.board_time_us;
+  s.ticks_since_prev = 0;
 }
 
 }  // namespace station::drivers::counters

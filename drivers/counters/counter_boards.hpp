@@ -85,7 +85,9 @@ class CounterBoards {
 
  private:
   struct SlotState;
+  SlotState* slot_for(std::uint8_t node);
   void handle(const can_frame& f, TickResult& out);
+  void fill_reading(SlotState& s, const CounterSlot& slot, CounterReading& r);
   bool all_complete() const;
   void finish(TickResult& out);
 
