@@ -127,7 +127,7 @@ void ChamberSim::publish(modbus_mapping_t& regs) {
 void ChamberSim::on_write(const modbus_mapping_t& regs, std::uint16_t pdu_address, int count) {
   std::lock_guard lock(mutex_);
   const auto& sp = map_.at(cm::kSetpoint);
-  if (point_written(sp, pdu_address, count)) {
+  if (point_written(sp, pdu_address, count) && std::isfinite(get_point(regs, sp))) {
     // The controller clamps to its own limits, as the F4 does.
     setpoint_c_ = std::clamp(get_point(regs, sp), cfg_.setpoint_low_c, cfg_.setpoint_high_c);
   }

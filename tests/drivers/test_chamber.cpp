@@ -105,13 +105,25 @@ TEST(ModbusChamber, SetpointOutsideLimitRegistersIsRangeAndNotWritten) {
   EXPECT_TRUE(rig.chamber->command({.setpoint_c = 85.0}));
 }
 
-TEST(ModbusChamber, RunDisableTurnsOffAndDriftsToAmbient) {
+TEST(ModbusChamber, HoldFreezesRampAndRunDisableTurnsOff) {
   Rig rig(cm::watlow_f4());
+  ASSERT_TRUE(rig.chamber->command({.setpoint_c = 70.0, .ramp_c_per_min = 1.0}));
+  rig.sim.step_to(600.0);
+  rig.sim.set_hold(true);
+  rig.sim.step_to(1200.0);
+  auto h = rig.chamber->read();
+  ASSERT_TRUE(h);
+  EXPECT_EQ(h.value().mode, ChamberMode::hold);
+  EXPECT_NEAR(rig.sim.effective_setpoint_c(), 35.0, 1e-6);  // 25 + 10 min x 1 C/min, then held
   ASSERT_TRUE(rig.chamber->command({.run = false}));
   auto s = rig.chamber->read();
   ASSERT_TRUE(s);
   EXPECT_EQ(s.value().mode, ChamberMode::off);
   EXPECT_FALSE(s.value().run_enabled);
+  // Output disabled: the air relaxes toward the 25 C ambient.
+  double before = rig.sim.air_c();
+  rig.sim.step_to(1800.0);
+  EXPECT_LT(rig.sim.air_c(), before);
 }
 
 TEST(ModbusChamber, F4tFloat32CdabRoundTripsOverTheWire) {
