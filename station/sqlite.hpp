@@ -1,0 +1,93 @@
+// RAII over the SQLite C API (SQLiteCpp's shape): a move-only database, prepared statements,
+// and a transaction that rolls back in its destructor unless committed. Errors throw
+// SqliteError naming the database and the statement: storage failures are setup-class faults.
+#pragma once
+
+#include <sqlite3.h>
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+namespace station {
+
+/// A SQLite failure: database path, statement and sqlite3_errmsg.
+class SqliteError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct SqliteClose {
+  void operator()(sqlite3* db) const noexcept { sqlite3_close_v2(db); }
+};
+struct SqliteFinalize {
+  void operator()(sqlite3_stmt* s) const noexcept { sqlite3_finalize(s); }
+};
+
+/// One prepared statement. bind() is 1-based; step() returns true while rows come.
+class Statement {
+ public:
+  Statement(sqlite3* db, std::string_view sql, std::string db_path);
+  Statement& bind(int i, double v);
+  Statement& bind(int i, std::int64_t v);
+  Statement& bind(int i, int v) { return bind(i, static_cast<std::int64_t>(v)); }
+  Statement& bind(int i, std::string_view v);
+  Statement& bind(int i, std::optional<double> v);
+  Statement& bind_null(int i);
+  /// Runs one step; true when a row is available.
+  bool step();
+  /// Resets for re-use with new bindings.
+  void reset();
+  double column_double(int c) const { return sqlite3_column_double(stmt_.get(), c); }
+  std::int64_t column_int(int c) const { return sqlite3_column_int64(stmt_.get(), c); }
+  std::string column_text(int c) const;
+  bool column_is_null(int c) const { return sqlite3_column_type(stmt_.get(), c) == SQLITE_NULL; }
+
+ private:
+  [[noreturn]] void fail(const char* what) const;
+  std::unique_ptr<sqlite3_stmt, SqliteFinalize> stmt_;
+  sqlite3* db_;
+  std::string db_path_;
+};
+
+/// A database file. Opens in WAL mode with a busy timeout; applies migrations on request.
+class Database {
+ public:
+  /// Opens (creating if needed) `path`; throws SqliteError.
+  explicit Database(const std::string& path);
+  /// Runs one or more statements without results.
+  void exec(std::string_view sql);
+  /// Prepares a statement.
+  Statement prepare(std::string_view sql) { return Statement(db_.get(), sql, path_); }
+  /// Row id of the last insert.
+  std::int64_t last_insert_id() const { return sqlite3_last_insert_rowid(db_.get()); }
+  /// Applies schemas/migrations/*.sql past PRAGMA user_version, each in a transaction.
+  /// Throws when the file is newer than this software.
+  void migrate();
+  /// PRAGMA user_version.
+  int schema_version();
+  const std::string& path() const { return path_; }
+
+ private:
+  std::unique_ptr<sqlite3, SqliteClose> db_;
+  std::string path_;
+};
+
+/// BEGIN IMMEDIATE now; ROLLBACK in the destructor unless commit() ran.
+class Transaction {
+ public:
+  explicit Transaction(Database& db);
+  ~Transaction();
+  Transaction(const Transaction&) = delete;
+  Transaction& operator=(const Transaction&) = delete;
+  void commit();
+
+ private:
+  Database& db_;
+  bool done_ = false;
+};
+
+}  // namespace station
