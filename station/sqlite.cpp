@@ -108,7 +108,7 @@ void Database::migrate() {
   }
   for (int v = have; v < known; ++v) {
     Transaction tx(*this);
-    exec(schemas::kMigrations[static_cast<std::size_t>(v)]);
+    exec(schemas::kMigrations[static_cast<std::size_t>(v)].second);
     exec(fmt::format("PRAGMA user_version = {}", v + 1));
     tx.commit();
   }
