@@ -11,7 +11,7 @@ struct TrueCoefficients {
   double B0_dph = 0.05;      ///< bias at the reference temperature, deg/h
   double k1 = 1.0e-3;        ///< deg/h per C of dT = T_A - ref_temp_c
   double k2 = 2.0e-5;        ///< deg/h per C^2
-  double k0 = 0.02;          ///< deg/h per C of gradT = T_A - T_B
+  double k0 = 0.02;          ///< deg/h per C of gradT = T_B - T_A (second sensor minus first)
   double ref_temp_c = 25.0;  ///< reference temperature of dT, C
 };
 
@@ -53,10 +53,12 @@ class RlgGyroModel {
 
   /// Simulated time reached, s.
   double time_s() const { return time_s_; }
-  /// Housing (sensor A) and core (sensor B) temperatures, C; gradT = A - B.
+  /// Housing (sensor A, TEMPS channel 0) and core (sensor B, channel 1) temperatures, C.
+  /// gradT = B - A: second sensor minus first, the convention of `station analyze --temp2-col`
+  /// and of the station's samples (temp2_c - temp_c); dT is taken from sensor A.
   double temp_a_c() const { return temp_a_c_; }
   double temp_b_c() const { return temp_b_c_; }
-  double grad_t_c() const { return temp_a_c_ - temp_b_c_; }
+  double grad_t_c() const { return temp_b_c_ - temp_a_c_; }
   /// Deterministic thermal bias at the current temperatures, deg/h (no noise, no Earth rate).
   double thermal_bias_dph() const;
   /// True integrated angle since time 0 (Earth rate + bias + noise), arcsec.

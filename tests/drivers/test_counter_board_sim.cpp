@@ -28,14 +28,14 @@ double grad_after_ramp(double rate_c_per_h, double hours) {
 
 }  // namespace
 
-// Series lags air -> A (tau_h) -> B (tau_c): under a steady ramp r, A - B -> r * tau_c. The
+// Series lags air -> A (tau_h) -> B (tau_c): under a steady ramp r, B - A -> -r * tau_c. The
 // transient decays as exp(-t/tau_c); after 6 h (6 tau_c) it is below 1.5 * exp(-6) = 0.4 %.
 TEST(CounterBoardSim, GradientGrowsWithRampRate) {
   const double g20 = grad_after_ramp(20.0, 6.0);
   const double g10 = grad_after_ramp(10.0, 6.0);
   const double g0 = grad_after_ramp(0.0, 6.0);
-  EXPECT_NEAR(g20, 20.0 / 3600.0 * 3600.0, 0.01 * 20.0);
-  EXPECT_NEAR(g10, 10.0 / 3600.0 * 3600.0, 0.01 * 10.0);
+  EXPECT_NEAR(g20, -20.0 / 3600.0 * 3600.0, 0.01 * 20.0);
+  EXPECT_NEAR(g10, -10.0 / 3600.0 * 3600.0, 0.01 * 10.0);
   EXPECT_GT(std::abs(g20), std::abs(g10));
   EXPECT_GT(std::abs(g10), 100 * std::abs(g0));
   EXPECT_NEAR(g0, 0.0, 1e-9);
@@ -50,7 +50,7 @@ TEST(CounterBoardSim, ThermalBiasFollowsTrueCoefficients) {
   const double dT = m.temp_a_c() - 25.0;
   EXPECT_GT(dT, 20.0);
   EXPECT_DOUBLE_EQ(m.thermal_bias_dph(),
-                   0.07 + 1.2e-3 * dT + 3e-5 * dT * dT + 0.03 * (m.temp_a_c() - m.temp_b_c()));
+                   0.07 + 1.2e-3 * dT + 3e-5 * dT * dT + 0.03 * (m.temp_b_c() - m.temp_a_c()));
 }
 
 // White rate noise at 1 Hz has sigma = 60 * ARW deg/h (IEEE 952). The sample std of n = 20000

@@ -1,0 +1,134 @@
+// SimWorld: every simulator of a rig, wired to real transports and stepped in lockstep.
+#include "sim_devices/sim_world.hpp"
+
+#include <fmt/format.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+#include <cstring>
+#include <random>
+#include <stdexcept>
+
+#include "drivers/chamber/chamber_map.hpp"
+#include "drivers/turntable/turntable_map.hpp"
+
+namespace station::sim {
+
+TrueCoefficients sim_coefficients(std::uint64_t seed, int index) {
+  std::mt19937_64 rng(seed * 1000003u + static_cast<std::uint64_t>(index));
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  auto sign = [&] { return u(rng) < 0.5 ? -1.0 : 1.0; };
+  TrueCoefficients c;
+  c.B0_dph = sign() * (0.01 + 0.09 * u(rng));  // |B0| 0.01..0.1 deg/h
+  c.k1 = sign() * (0.5e-3 + 1.5e-3 * u(rng));  // |k1| 0.5..2 x 1e-3 deg/h/C
+  c.k2 = 0.0;
+  c.k0 = sign() * (0.01 + 0.03 * u(rng));  // |k0| 0.01..0.04 deg/h/C
+  c.ref_temp_c = 25.0;
+  return c;
+}
+
+namespace {
+
+int listen_unix(const std::string& path) {
+  const int fd = socket(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0);
+  sockaddr_un addr{};
+  addr.sun_family = AF_UNIX;
+  if (fd < 0 || path.size() >= sizeof(addr.sun_path)) {
+    throw std::runtime_error("simworld: cannot create unix socket " + path);
+  }
+  std::strncpy(addr.sun_path, path.c_str(), sizeof(addr.sun_path) - 1);
+  unlink(path.c_str());
+  if (bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof(addr)) != 0 || listen(fd, 1) != 0) {
+    close(fd);
+    throw std::runtime_error(
+        fmt::format("simworld: cannot listen on {}: {}", path, strerror(errno)));
+  }
+  return fd;
+}
+
+std::vector<GpioSimChipSpec> gpio_lines(int gyros) {
+  GpioSimChipSpec chip{"gpiochip0", {"DOOR_SW", "ESTOP", "TOWER_G", "TOWER_A", "TOWER_R"}};
+  for (int i = 1; i <= gyros; ++i) chip.line_names.push_back(fmt::format("GYRO_PWR{}", i));
+  return {chip};
+}
+
+}  // namespace
+
+SimWorld::SimWorld(const SimWorldConfig& config) : config_(config) {
+  if (config_.gyros < 1 || config_.gyros > 16) throw std::invalid_argument("simworld: 1..16 gyros");
+  config_.chamber.initial_c = config_.initial_c;
+  chamber_ = std::make_unique<ChamberSim>(drivers::chamber_map::watlow_f4(1), config_.chamber);
+  table_ = std::make_unique<TurntableSim>(drivers::turntable_map::default_map(1));
+  chamber_server_ = std::make_unique<ModbusServer>(*chamber_, 1);
+  table_server_ = std::make_unique<ModbusServer>(*table_, 1);
+  chamber_server_->start_tcp();
+  table_server_->start_tcp();
+  gpio_ = std::make_shared<GpioSimChips>(gpio_lines(config_.gyros));
+  gpio_->set_input("DOOR_SW", true);  // door closed
+  gpio_->set_input("ESTOP", false);   // not pressed
+  for (int i = 0; i < config_.gyros; ++i) {
+    gyros_.push_back({static_cast<std::uint8_t>(i + 1), fmt::format("SIM-{:04d}", i + 1),
+                      config_.pulse_weight_arcsec, sim_coefficients(config_.seed, i)});
+  }
+  if (config_.can_unix_path.empty()) {
+    int sv[2];
+    if (socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, sv) != 0) {
+      throw std::runtime_error("simworld: socketpair failed");
+    }
+    // The station's end must survive exec-free use only; it is handed over as "fd:N".
+    can_transport_ = fmt::format("fd:{}", sv[0]);
+    bus_ = std::make_unique<CounterBoardBus>(sv[1]);
+    add_boards();
+    bus_->start();
+  } else {
+    listen_fd_ = listen_unix(config_.can_unix_path);
+    can_transport_ = "unix:" + config_.can_unix_path;
+  }
+}
+
+SimWorld::~SimWorld() {
+  if (bus_) bus_->stop();
+  if (listen_fd_ >= 0) {
+    close(listen_fd_);
+    unlink(config_.can_unix_path.c_str());
+  }
+}
+
+void SimWorld::add_boards() {
+  for (std::size_t i = 0; i < gyros_.size(); ++i) {
+    BoardConfig b;
+    b.node = gyros_[i].node;
+    b.gyro.coefficients = gyros_[i].truth;
+    b.gyro.thermal.initial_c = config_.initial_c;
+    b.gyro.earth_rate_dph = config_.earth_rate_dph;
+    b.gyro.pulse_weight_arcsec = gyros_[i].pulse_weight_arcsec;
+    b.gyro.seed = config_.seed * 7919u + i + 1;
+    b.board_time_offset_us = static_cast<std::uint32_t>(i * 123457u);
+    bus_->add_board(b);
+  }
+}
+
+bool SimWorld::accept_station(int timeout_ms) {
+  if (bus_) return true;
+  pollfd p{listen_fd_, POLLIN, 0};
+  if (poll(&p, 1, timeout_ms) <= 0) return false;
+  const int fd = accept4(listen_fd_, nullptr, nullptr, SOCK_CLOEXEC);
+  if (fd < 0) return false;
+  bus_ = std::make_unique<CounterBoardBus>(fd);
+  add_boards();
+  bus_->step_to(now_s_, chamber_->air_c());
+  bus_->start();
+  return true;
+}
+
+void SimWorld::advance_to(double t_s) {
+  if (t_s <= now_s_) return;
+  chamber_->step_to(t_s);
+  table_->step_to(t_s);
+  if (bus_) bus_->step_to(t_s, chamber_->air_c());
+  now_s_ = t_s;
+}
+
+}  // namespace station::sim

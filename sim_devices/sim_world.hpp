@@ -1,0 +1,87 @@
+// A whole simulated rig: chamber and turntable Modbus servers, N simulated RLG counter boards on
+// one CAN bus, and a GPIO line bank, advanced together in lockstep on simulated time. Used by
+// `station run --sim`, by the daemon tests and (on the wall clock) by `simrig`.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sim_devices/chamber_sim.hpp"
+#include "sim_devices/counter_board_sim.hpp"
+#include "sim_devices/gpio_sim.hpp"
+#include "sim_devices/modbus_server.hpp"
+#include "sim_devices/turntable_sim.hpp"
+
+namespace station::sim {
+
+/// What to simulate.
+struct SimWorldConfig {
+  int gyros = 4;                     ///< simulated RLGs, nodes 1..gyros (at most 16)
+  std::uint64_t seed = 1;            ///< drives coefficients and every noise source
+  double earth_rate_dph = 0;         ///< Earth rate along each gyro's input axis, deg/h
+  double initial_c = 25.0;           ///< chamber and gyros at t = 0, deg C
+  double pulse_weight_arcsec = 1.5;  ///< every gyro's pulse weight
+  std::string can_unix_path;         ///< empty: socketpair (in-process); else listen on this path
+  ChamberSimConfig chamber;          ///< chamber model
+};
+
+/// One simulated gyro as the station will see it.
+struct SimGyro {
+  std::uint8_t node = 1;
+  std::string serial;
+  double pulse_weight_arcsec = 1.5;
+  TrueCoefficients truth;
+};
+
+/// The simulated rig. Construction starts the Modbus servers (loopback, ephemeral ports) and
+/// creates the CAN bus; it is the hardware, so it does I/O.
+class SimWorld {
+ public:
+  explicit SimWorld(const SimWorldConfig& config);
+  ~SimWorld();
+  SimWorld(const SimWorld&) = delete;
+  SimWorld& operator=(const SimWorld&) = delete;
+
+  /// tcp://127.0.0.1:PORT of the chamber and turntable servers.
+  std::string chamber_endpoint() const { return chamber_server_->endpoint(); }
+  std::string turntable_endpoint() const { return table_server_->endpoint(); }
+  /// CAN transport spec for the station: "fd:N" (socketpair end) or "unix:PATH".
+  std::string can_transport() const { return can_transport_; }
+  /// With can_unix_path: blocks up to timeout_ms for the station to connect, then serves.
+  /// Returns false on timeout. (With a socketpair the bus is serving from construction.)
+  bool accept_station(int timeout_ms);
+  /// GPIO line names: DOOR_SW, ESTOP, TOWER_G/A/R, GYRO_PWR1..N.
+  std::shared_ptr<GpioSimChips> gpio_chips() const { return gpio_; }
+
+  /// Advances chamber, table and every gyro to t_s (air temperature feeds the gyros).
+  void advance_to(double t_s);
+  double now_s() const { return now_s_; }
+
+  const std::vector<SimGyro>& gyros() const { return gyros_; }
+  ChamberSim& chamber() { return *chamber_; }
+  TurntableSim& turntable() { return *table_; }
+  ModbusServer& chamber_server() { return *chamber_server_; }
+  CounterBoardBus* bus() { return bus_.get(); }
+
+ private:
+  void add_boards();
+
+  SimWorldConfig config_;
+  std::vector<SimGyro> gyros_;
+  std::unique_ptr<ChamberSim> chamber_;
+  std::unique_ptr<TurntableSim> table_;
+  std::unique_ptr<ModbusServer> chamber_server_, table_server_;
+  std::unique_ptr<CounterBoardBus> bus_;
+  std::shared_ptr<GpioSimChips> gpio_;
+  std::string can_transport_;
+  int listen_fd_ = -1;
+  double now_s_ = 0;
+};
+
+/// Distinct, realistic true coefficients for gyro `index` of a world seeded with `seed`
+/// (k2 = 0 so the paper's model B0 + k1 dT + k0 gradT is exact).
+TrueCoefficients sim_coefficients(std::uint64_t seed, int index);
+
+}  // namespace station::sim
