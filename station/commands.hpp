@@ -15,5 +15,11 @@ struct CommandStatus {
 void add_analyze_command(CLI::App& app, CommandStatus& status);
 /// `station adev FILE.csv --col NAME ...`: overlapping Allan deviation and noise terms.
 void add_adev_command(CLI::App& app, CommandStatus& status);
+/// `station probe --config FILE [--json]`: read every configured device once (commissioning).
+void add_probe_command(CLI::App& app, CommandStatus& status);
+/// `station run`: run a protocol on a rig (--sim: the embedded simulated rig).
+void add_run_command(CLI::App& app, CommandStatus& status);
+/// `station fit` and `station export`: per-serial fits from the database and their export.
+void add_fit_commands(CLI::App& app, CommandStatus& status);
 
 }  // namespace station

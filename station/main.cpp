@@ -14,6 +14,9 @@ int main(int argc, char** argv) {
   station::CommandStatus status;
   station::add_analyze_command(app, status);
   station::add_adev_command(app, status);
+  station::add_probe_command(app, status);
+  station::add_run_command(app, status);
+  station::add_fit_commands(app, status);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -30,7 +30,8 @@ StepKind kind_of(const TomlView& v) {
     if (type == k.name) return k.kind;
   }
   throw v.error("type", fmt::format("unknown step type '{}' (set_temperature, soak, hold, "
-                                    "record_start, record_stop, lock_turntable)", type));
+                                    "record_start, record_stop, lock_turntable)",
+                                    type));
 }
 
 double non_negative(const TomlView& v, const char* key, double fallback) {
@@ -109,7 +110,8 @@ Protocol parse_protocol(const std::string& text, const std::string& path) {
     const bool start = s.kind == StepKind::record_start, stop = s.kind == StepKind::record_stop;
     if ((start && recording) || (stop && !recording)) {
       throw InputError(fmt::format("{}:{}: key 'step[{}].type': {} while the record window is {}",
-                                   path, s.line, i, to_string(s.kind), recording ? "open" : "closed"));
+                                   path, s.line, i, to_string(s.kind),
+                                   recording ? "open" : "closed"));
     }
     if (start || stop) recording = start;
   }
@@ -118,7 +120,8 @@ Protocol parse_protocol(const std::string& text, const std::string& path) {
 
 Protocol load_protocol(const std::string& file_or_name) {
   for (const auto& [name, text] : builtin::kProtocols) {
-    if (name == file_or_name) return parse_protocol(std::string(text), "builtin:" + std::string(name));
+    if (name == file_or_name)
+      return parse_protocol(std::string(text), "builtin:" + std::string(name));
   }
   std::ifstream in(file_or_name);
   if (!in) {

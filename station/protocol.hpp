@@ -23,16 +23,16 @@ enum class StepKind {
 /// One protocol step. Fields not used by its kind are ignored.
 struct Step {
   StepKind kind = StepKind::hold;
-  std::string label;                    ///< for logs and events
-  int line = 0;                         ///< line in the protocol file
-  std::optional<double> setpoint_c;     ///< set_temperature: target, deg C
-  bool to_start = false;                ///< set_temperature: target is the run's start temperature
-  double ramp_c_per_h = 0;              ///< set_temperature: ramp rate, 0 = step
-  bool wait = true;                     ///< set_temperature: wait for the air to arrive
-  double tolerance_c = 1.0;             ///< set_temperature/soak: band around the setpoint
-  double duration_s = 0;                ///< soak: time stable; hold: time
-  double timeout_s = 0;                 ///< 0 = none; past it the step ends with a warning
-  double position_deg = 0;              ///< lock_turntable
+  std::string label;                 ///< for logs and events
+  int line = 0;                      ///< line in the protocol file
+  std::optional<double> setpoint_c;  ///< set_temperature: target, deg C
+  bool to_start = false;             ///< set_temperature: target is the run's start temperature
+  double ramp_c_per_h = 0;           ///< set_temperature: ramp rate, 0 = step
+  bool wait = true;                  ///< set_temperature: wait for the air to arrive
+  double tolerance_c = 1.0;          ///< set_temperature/soak: band around the setpoint
+  double duration_s = 0;             ///< soak: time stable; hold: time
+  double timeout_s = 0;              ///< 0 = none; past it the step ends with a warning
+  double position_deg = 0;           ///< lock_turntable
 };
 
 /// A parsed protocol with its source text.

@@ -57,7 +57,7 @@ std::int64_t Store::create_run(const RunInfo& info, const std::vector<RunSlot>& 
 namespace {
 constexpr const char* kRunColumns =
     "SELECT id, state, protocol_name, protocol_text, config_text, station, sim_seed, step_index, "
-    "step_started_s, t_s, recording, record_start_s FROM runs ";
+    "step_started_s, t_s, recording, record_start_s, start_temp_c FROM runs ";
 
 RunRecord read_run(const Statement& st) {
   RunRecord r;
@@ -73,6 +73,7 @@ RunRecord read_run(const Statement& st) {
   r.progress.t_s = st.column_double(9);
   r.progress.recording = st.column_int(10) != 0;
   if (!st.column_is_null(11)) r.progress.record_start_s = st.column_double(11);
+  if (!st.column_is_null(12)) r.progress.start_temp_c = st.column_double(12);
   return r;
 }
 }  // namespace
@@ -127,9 +128,9 @@ void Store::append_tick(std::int64_t run_id, const std::vector<SampleRow>& rows,
   }
   auto up = db_.prepare(
       "UPDATE runs SET step_index = ?, step_started_s = ?, t_s = ?, recording = ?, "
-      "record_start_s = ? WHERE id = ?");
+      "record_start_s = ?, start_temp_c = ? WHERE id = ?");
   up.bind(1, p.step_index).bind(2, p.step_started_s).bind(3, p.t_s).bind(4, p.recording ? 1 : 0);
-  up.bind(5, p.record_start_s).bind(6, run_id);
+  up.bind(5, p.record_start_s).bind(6, p.start_temp_c).bind(7, run_id);
   up.step();
   tx.commit();
 }

@@ -27,6 +27,7 @@ struct RunProgress {
   double t_s = 0;
   bool recording = false;
   std::optional<double> record_start_s;
+  std::optional<double> start_temp_c;  ///< chamber air at the run's first tick
 };
 
 /// A run as stored.

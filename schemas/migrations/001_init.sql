@@ -16,7 +16,8 @@ CREATE TABLE runs (
   step_started_s   REAL NOT NULL DEFAULT 0,
   t_s              REAL NOT NULL DEFAULT 0,   -- last committed tick
   recording        INTEGER NOT NULL DEFAULT 0,
-  record_start_s   REAL
+  record_start_s   REAL,
+  start_temp_c     REAL                 -- chamber air at the first tick (for 'return to start')
 );
 
 CREATE TABLE gyros (

@@ -1,0 +1,184 @@
+// The sequencer's tick: devices in, one stored transaction out, protocol and safety forward.
+#include "station/sequencer.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "compensation/earth_rate.hpp"
+#include "drivers/gpio/gpio_bank.hpp"
+#include "station/logging.hpp"
+
+namespace station {
+
+namespace dr = station::drivers;
+
+/// Sample flag bits stored with every row.
+enum SampleFlag : int {
+  kLatchLost = 1 << 0,
+  kChamberMissing = 1 << 1,
+  kTempsMissing = 1 << 2,
+  kBoardFault = 1 << 3,
+  kSafeHold = 1 << 4,
+};
+
+Sequencer::Sequencer(const StationConfig& config, const Protocol& protocol, Rig& rig, Store& store,
+                     dr::Clock& clock, SequencerOptions options)
+    : config_(config),
+      protocol_(protocol),
+      rig_(rig),
+      store_(store),
+      clock_(clock),
+      options_(std::move(options)),
+      safety_(config.limits) {}
+
+void Sequencer::emit(double t_s, const std::string& severity, const std::string& source,
+                     const std::string& kind, const std::string& message) {
+  if (replaying_) return;
+  const auto lvl = severity == "error"  ? spdlog::level::err
+                   : severity == "warn" ? spdlog::level::warn
+                                        : spdlog::level::info;
+  log(source)->log(lvl, "{} t_s={:.0f} run={} {}", kind, t_s, run_id_, message);
+  store_.add_event(run_id_, t_s, severity, source, kind, message);
+}
+
+void Sequencer::connect_devices() {
+  if (auto r = rig_.chamber->connect(); !r)
+    emit(0, "warn", "chamber", "connect", r.error().message);
+  if (rig_.turntable) {
+    if (auto r = rig_.turntable->connect(); !r)
+      emit(0, "warn", "table", "connect", r.error().message);
+  }
+  if (rig_.gpio) {
+    if (auto r = rig_.gpio->open(); !r) emit(0, "warn", "gpio", "open", r.error().message);
+  }
+}
+
+void Sequencer::read_devices(double t_s, TickData& d) {
+  auto counts = rig_.counters->tick(latch_seq_++);
+  if (counts) {
+    d.counts = std::move(counts).value();
+    counter_failures_ = 0;
+  } else if (counter_failures_++ % 60 == 0) {
+    emit(t_s, "warn", "can", "tick_failed", counts.error().message);
+  }
+  auto chamber = rig_.chamber->read();
+  if (chamber) {
+    if (chamber_failures_ > 0)
+      emit(t_s, "info", "chamber", "recovered",
+           fmt::format("after {} failed reads", chamber_failures_));
+    d.chamber = chamber.value();
+    chamber_failures_ = 0;
+  } else if (chamber_failures_++ % 60 == 0) {
+    emit(t_s, "warn", "chamber", "read_failed", chamber.error().message);
+  }
+  if (rig_.turntable) {
+    auto table = rig_.turntable->read();
+    if (table) d.table = table.value();
+    d.interlock_open = d.table && d.table->interlock_open;
+  }
+  if (rig_.gpio) {
+    if (auto ev = rig_.gpio->read_events(); ev) {
+      for (const auto& e : ev.value()) {
+        emit(t_s, "info", "gpio", "edge",
+             fmt::format("{} {}", e.role, e.rising ? "rising" : "falling"));
+      }
+    }
+    if (auto closed = rig_.gpio->read(dr::gpio::roles::interlock); closed) {
+      d.interlock_open = d.interlock_open || !closed.value();
+    }
+    if (auto pressed = rig_.gpio->read(dr::gpio::roles::estop); pressed) d.estop = pressed.value();
+  }
+}
+
+void Sequencer::assemble_samples(double t_s, TickData& d) {
+  const bool recording = runner_->progress().recording;
+  d.obs.t_s = t_s;
+  d.obs.has_turntable = rig_.turntable != nullptr;
+  if (d.table) d.obs.table_in_position = d.table->in_position;
+  if (d.chamber && std::isfinite(d.chamber->air_c)) d.obs.air_c = d.chamber->air_c;
+  for (const auto& slot : config_.slots) {
+    SampleRow r;
+    r.serial = slot.serial;
+    r.t_s = t_s;
+    r.recording = recording;
+    r.air_c = d.obs.air_c;
+    if (d.chamber) r.setpoint_c = d.chamber->setpoint_c;
+    r.flags = (d.chamber ? 0 : kChamberMissing) | (safety_.holding() ? kSafeHold : 0);
+    const dr::counters::CounterReading* rd = nullptr;
+    if (d.counts) {
+      for (const auto& x : d.counts->readings) rd = x.serial == slot.serial ? &x : rd;
+    }
+    if (rd == nullptr || !rd->answered) r.flags |= kLatchLost;
+    if (rd != nullptr && rd->answered && rd->has_delta) {
+      r.net_pulses = rd->net_pulses;
+      r.interval_s = rd->interval_s;
+      r.rate_dph = rd->rate_dph;
+    }
+    if (rd != nullptr && rd->temps_c.size() >= 2 && std::isfinite(rd->temps_c[0]) &&
+        std::isfinite(rd->temps_c[1])) {
+      r.temp_c = rd->temps_c[0];
+      r.temp2_c = rd->temps_c[1];
+      d.obs.gyro_temps_c.push_back(rd->temps_c[0]);
+    } else {
+      r.flags |= kTempsMissing;
+    }
+    if (rd != nullptr && rd->status_flags != 0) r.flags |= kBoardFault;
+    d.rows.push_back(std::move(r));
+  }
+}
+
+void Sequencer::apply_safety(double t_s, TickData& d) {
+  const auto change = safety_.update(d.interlock_open, d.estop);
+  if (!change) return;
+  if (safety_.holding()) {
+    emit(t_s, "error", "safety", "safe_hold",
+         *change + ": chamber held at its air temperature, turntable stopped");
+    if (d.obs.air_c) pending_chamber_ = safety_.hold_command(*d.obs.air_c);
+    pending_table_.reset();
+    if (rig_.turntable) {
+      if (auto r = rig_.turntable->stop(); !r)
+        emit(t_s, "error", "table", "stop_failed", r.error().message);
+    }
+  } else {
+    emit(t_s, "info", "safety", "safe_hold_cleared", *change + ": resuming the protocol step");
+    runner_->reenter();
+  }
+}
+
+void Sequencer::apply_actions(double t_s, const Actions& a) {
+  for (const auto& e : a.events) emit(t_s, e.severity, "seq", e.kind, e.message);
+  if (a.chamber) {
+    std::vector<std::string> notes;
+    pending_chamber_ = safety_.clamp(*a.chamber, notes);
+    for (const auto& n : notes) emit(t_s, "warn", "safety", "clamp", n);
+  }
+  if (a.table) pending_table_ = a.table;
+  // Commands are retried every tick until the device accepts them.
+  if (pending_chamber_) {
+    if (auto r = rig_.chamber->command(*pending_chamber_); r) {
+      pending_chamber_.reset();
+    } else if (chamber_failures_ % 60 == 0) {
+      emit(t_s, "warn", "chamber", "command_failed", r.error().message);
+    }
+  }
+  if (pending_table_ && rig_.turntable) {
+    if (auto r = rig_.turntable->command(*pending_table_); r) {
+      pending_table_.reset();
+    } else {
+      emit(t_s, "warn", "table", "command_failed", r.error().message);
+    }
+  }
+}
+
+void Sequencer::tick(double t_s, TickData& d) {
+  read_devices(t_s, d);
+  assemble_samples(t_s, d);
+  apply_safety(t_s, d);
+  Actions a;
+  if (!safety_.holding()) a = runner_->tick(d.obs);
+  apply_actions(t_s, a);
+  if (!replaying_) store_.append_tick(run_id_, d.rows, runner_->progress());
+}
+
+}  // namespace station

@@ -1,0 +1,99 @@
+// The 1 Hz loop (gpsd's main loop, small): each tick SYNC the counter boards, read chamber and
+// turntable, assemble one sample per gyro, store the tick in one transaction, advance the
+// protocol through the safety layer, sleep to the next absolute deadline. One device failing
+// never stops the loop: it is reported, retried, and the safety layer owns the safe state.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "drivers/common/clock.hpp"
+#include "station/config.hpp"
+#include "station/protocol.hpp"
+#include "station/protocol_runner.hpp"
+#include "station/rig.hpp"
+#include "station/safety.hpp"
+#include "station/store.hpp"
+
+namespace station {
+
+/// One tick's summary for progress lines and hooks.
+struct TickReport {
+  double t_s = 0;
+  int step_index = 0;
+  int steps = 0;
+  bool recording = false;
+  bool safe_hold = false;
+  std::optional<double> air_c;
+};
+
+/// How to run.
+struct SequencerOptions {
+  double period_s = 1.0;
+  std::string operator_name;
+  std::optional<std::int64_t> sim_seed;            ///< recorded with the run
+  std::function<void(double t_s)> before_tick;     ///< simulation: advance the world to t_s
+  std::function<void(const TickReport&)> on_tick;  ///< progress / tests
+  std::function<void()> watchdog;                  ///< systemd WATCHDOG=1 each tick
+  const std::atomic<bool>* stop = nullptr;         ///< set by SIGTERM/SIGINT
+  /// Deterministic simulation resume: replay ticks up to this time without storing them.
+  std::optional<double> replay_until_t_s;
+};
+
+/// How a run ended.
+struct RunOutcome {
+  std::int64_t run_id = 0;
+  std::string state;  ///< completed | stopped
+  double t_s = 0;     ///< last tick
+  std::int64_t ticks = 0;
+};
+
+/// Runs one protocol on one rig. Not thread-safe.
+class Sequencer {
+ public:
+  Sequencer(const StationConfig& config, const Protocol& protocol, Rig& rig, Store& store,
+            drivers::Clock& clock, SequencerOptions options);
+
+  /// Starts a new run, or continues `resume` (a run left 'running' by a killed daemon).
+  RunOutcome run(const std::optional<RunRecord>& resume = std::nullopt);
+
+ private:
+  /// Everything one tick read.
+  struct TickData {
+    std::optional<drivers::counters::TickResult> counts;
+    std::optional<drivers::ChamberState> chamber;
+    std::optional<drivers::TurntableState> table;
+    bool interlock_open = false, estop = false;
+    std::vector<SampleRow> rows;
+    Observation obs;
+  };
+  void connect_devices();
+  void tick(double t_s, TickData& d);
+  void read_devices(double t_s, TickData& d);
+  void apply_safety(double t_s, TickData& d);
+  void apply_actions(double t_s, const Actions& a);
+  void assemble_samples(double t_s, TickData& d);
+  void finish(const std::string& state, double t_s);
+  void emit(double t_s, const std::string& severity, const std::string& source,
+            const std::string& kind, const std::string& message);
+
+  const StationConfig& config_;
+  const Protocol& protocol_;
+  Rig& rig_;
+  Store& store_;
+  drivers::Clock& clock_;
+  SequencerOptions options_;
+  Safety safety_;
+  std::optional<ProtocolRunner> runner_;
+  std::int64_t run_id_ = 0;
+  std::uint8_t latch_seq_ = 0;
+  bool replaying_ = false;
+  int chamber_failures_ = 0, counter_failures_ = 0;
+  std::optional<drivers::ChamberCommand> pending_chamber_;
+  std::optional<drivers::TurntableCommand> pending_table_;
+};
+
+}  // namespace station

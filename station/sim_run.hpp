@@ -1,0 +1,34 @@
+// `station run --sim`: the embedded default. Simulated gyros with distinct known coefficients
+// on the simulators of sim_devices, reached through their real transports (Modbus TCP on
+// loopback, CAN on a socketpair), the protocol on the simulated clock, and a true-vs-fitted table.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <string>
+
+namespace station {
+
+/// Options of a simulated run.
+struct SimRunOptions {
+  int gyros = 4;
+  std::uint64_t seed = 1;
+  double latitude_deg = 39.9;
+  std::string protocol = "paper";  ///< shipped name or file
+  std::string db_path;             ///< empty: station-sim.db in the current directory
+  bool fresh = false;              ///< ignore an unfinished run in the database
+  bool progress = true;            ///< progress lines on stderr
+  /// Test hooks: open the door interlock at this simulated time for this long.
+  double interlock_open_at_s = -1, interlock_open_for_s = 0;
+  const std::atomic<bool>* stop = nullptr;
+};
+
+/// Runs the simulated rig to the end of the protocol (or a resumed one to its end) and returns
+/// the report: {"run_id","sim_s","wall_s","gyros":[{serial,true,fitted,std_errors,std_*}]}.
+nlohmann::json run_simulated(const SimRunOptions& options);
+
+/// Prints the report as a readable table.
+void print_sim_report(const nlohmann::json& report);
+
+}  // namespace station
