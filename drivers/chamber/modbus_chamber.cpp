@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -12,6 +13,11 @@ namespace station::drivers {
 namespace cm = chamber_map;
 
 namespace {
+
+// The points read() fetches; values come back in this order.
+constexpr std::array kReadPoints{cm::kAlarms,   cm::kStatus, cm::kAir, cm::kProduct,
+                                 cm::kSetpoint, cm::kRamp,   cm::kRun};
+enum ReadField : std::size_t { kAlarmsF, kStatusF, kAirF, kProductF, kSetpointF, kRampF, kRunF };
 
 AlarmBits decode_alarms(unsigned bits) {
   return AlarmBits{(bits & cm::kDeviation) != 0, (bits & cm::kSensorBreak) != 0,
@@ -28,6 +34,12 @@ ModbusChamber::ModbusChamber(std::string name, modbus::Endpoint endpoint, modbus
   for (const char* p : {cm::kAir, cm::kProduct, cm::kStatus, cm::kAlarms, cm::kSetpoint, cm::kRamp,
                         cm::kSetpointLow, cm::kSetpointHigh, cm::kRun})
     (void)map_.at(p);  // throws naming the missing point
+  for (const char* p : kReadPoints) read_points_.push_back(map_.at(p));
+  set_max_read_gap(kDefaultMaxReadGap);
+}
+
+void ModbusChamber::set_max_read_gap(int registers) {
+  read_plan_ = modbus::plan_reads(read_points_, registers);
 }
 
 Result<void> ModbusChamber::connect() {
@@ -38,32 +50,38 @@ Result<double> ModbusChamber::get(const char* point) {
   return client_.read(map_.at(point));
 }
 
+Result<std::vector<double>> ModbusChamber::read_values() {
+  std::vector<double> v(read_points_.size());
+  for (const auto& b : read_plan_) {
+    auto words = client_.read_registers(b.function, b.unit_id, b.start, b.count);
+    if (!words) return words.error();
+    for (std::size_t i : b.points) {
+      const modbus::Point& p = read_points_[i];
+      v[i] = modbus::decode_point(p, words.value().data() + (p.pdu_address() - b.start));
+      if (!std::isfinite(v[i]))
+        return make_error(ErrorKind::protocol,
+                          fmt::format("{} point '{}' is not finite", client_.device(), p.name));
+    }
+  }
+  return v;
+}
+
 Result<ChamberState> ModbusChamber::read() {
+  auto values = read_values();
+  if (!values) return values.error();
+  const auto& v = values.value();
   ChamberState s;
-  auto alarms = get(cm::kAlarms);
-  if (!alarms) return alarms.error();
-  s.alarms = decode_alarms(static_cast<unsigned>(alarms.value()));
-  auto status = get(cm::kStatus);
-  if (!status) return status.error();
-  int st = static_cast<int>(status.value());
+  s.alarms = decode_alarms(static_cast<unsigned>(v[kAlarmsF]));
+  const int st = static_cast<int>(v[kStatusF]);
   if (st < 0 || st > 3)
     return make_error(ErrorKind::protocol,
                       fmt::format("{}: status register {} not 0..3", name_, st));
   s.mode = static_cast<ChamberMode>(st);
-  struct Field {
-    const char* point;
-    double* out;
-  };
-  for (auto [point, out] :
-       {Field{cm::kAir, &s.air_c}, Field{cm::kProduct, &s.product_c},
-        Field{cm::kSetpoint, &s.setpoint_c}, Field{cm::kRamp, &s.ramp_c_per_min}}) {
-    auto v = get(point);
-    if (!v) return v.error();
-    *out = v.value();
-  }
-  auto run = get(cm::kRun);
-  if (!run) return run.error();
-  s.run_enabled = run.value() != 0;
+  s.air_c = v[kAirF];
+  s.product_c = v[kProductF];
+  s.setpoint_c = v[kSetpointF];
+  s.ramp_c_per_min = v[kRampF];
+  s.run_enabled = v[kRunF] != 0;
   // On sensor break the controller's air value is meaningless; never let it reach a record.
   if (s.alarms.sensor_break) s.air_c = std::numeric_limits<double>::quiet_NaN();
   return s;

@@ -2,9 +2,11 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "drivers/chamber/chamber.hpp"
 #include "drivers/modbus/modbus_client.hpp"
+#include "drivers/modbus/read_plan.hpp"
 #include "drivers/modbus/register_map.hpp"
 
 namespace station::drivers {
@@ -12,12 +14,17 @@ namespace station::drivers {
 /// A Watlow-style chamber controller on Modbus. Constructor does no I/O.
 class ModbusChamber final : public Chamber {
  public:
+  /// Default largest run of unused registers read() fetches to merge two points into one read.
+  static constexpr int kDefaultMaxReadGap = 16;
+
   /// `name` for logs; `map` must define every chamber_map point (checked here, throws
   /// std::invalid_argument otherwise); `response_timeout_s` bounds each transaction.
   ModbusChamber(std::string name, modbus::Endpoint endpoint, modbus::RegisterMap map,
                 double response_timeout_s = 0.5);
 
   Result<void> connect() override;
+  /// One block read per group of nearby points (same unit and function code, see
+  /// set_max_read_gap); the first failing transaction's error is returned.
   Result<ChamberState> read() override;
   /// Writes ramp, then setpoint, then run; setpoint outside the chamber's limit registers
   /// gives ErrorKind::range and nothing is written.
@@ -26,16 +33,25 @@ class ModbusChamber final : public Chamber {
 
   /// Sets the tap every Modbus exchange passes (nullptr: none).
   void set_tap(Tap* tap) { client_.set_tap(tap); }
+  /// Largest run of unused registers read() may fetch to merge two points (default 16; 0 = only
+  /// adjacent points, -1 = one transaction per point, for controllers that reject reads of
+  /// unimplemented registers with an exception).
+  void set_max_read_gap(int registers);
+  /// Block reads one read() performs (for diagnostics and tests).
+  const std::vector<modbus::ReadBlock>& read_plan() const { return read_plan_; }
   /// The underlying client (for diagnostics).
   modbus::ModbusClient& client() { return client_; }
 
  private:
   Result<double> get(const char* point);
+  Result<std::vector<double>> read_values();
   Result<void> check_setpoint(double setpoint_c);
 
   std::string name_;
   modbus::RegisterMap map_;
   modbus::ModbusClient client_;
+  std::vector<modbus::Point> read_points_;  // in the order of the state fields (see .cpp)
+  std::vector<modbus::ReadBlock> read_plan_;
 };
 
 }  // namespace station::drivers

@@ -1,0 +1,123 @@
+// Block reads of ModbusChamber::read(): the plan (plan_reads) and the requests the server sees.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "drivers/chamber/chamber_map.hpp"
+#include "drivers/chamber/modbus_chamber.hpp"
+#include "drivers/modbus/read_plan.hpp"
+#include "sim_devices/chamber_sim.hpp"
+#include "sim_devices/modbus_server.hpp"
+
+namespace mb = station::drivers::modbus;
+namespace cm = station::drivers::chamber_map;
+using station::drivers::ChamberState;
+using station::drivers::ErrorKind;
+using station::drivers::ModbusChamber;
+using station::sim::ChamberSim;
+using station::sim::ModbusServer;
+
+namespace {
+
+mb::Point point(const char* name, std::uint16_t addr, int unit = 1,
+                mb::FunctionCode fc = mb::FunctionCode::holding,
+                mb::PointType type = mb::PointType::uint16) {
+  return mb::Point{name, addr, type, 1.0, mb::WordOrder::abcd, fc, unit, false, mb::Access::ro};
+}
+
+// Requests one read() makes, and its state, against a fresh simulated chamber.
+struct Counted {
+  std::uint64_t requests = 0;
+  ChamberState state;
+};
+
+Counted count_one_read(const mb::RegisterMap& map, int max_gap) {
+  ChamberSim sim(map);
+  ModbusServer server(sim);
+  server.start_tcp();
+  ModbusChamber chamber("chamber", mb::parse_endpoint(server.endpoint()), map, 0.5);
+  chamber.set_max_read_gap(max_gap);
+  sim.step_to(600.0);
+  const std::uint64_t before = server.requests();
+  auto s = chamber.read();
+  EXPECT_TRUE(s) << s.error().message;
+  return {server.requests() - before, s ? s.value() : ChamberState{}};
+}
+
+}  // namespace
+
+TEST(ReadPlan, MergesNeighboursWithinTheGapOfOneUnitAndTable) {
+  const std::vector<mb::Point> pts{
+      point("a", 100),
+      point("b", 117),  // 16 unused registers (101..116) after a: merged
+      point("c", 134),  // 16 after b (118..133): merged
+      point("d", 152),  // 17 after c: new block
+      point("e", 152, 2),
+      point("f", 153, 1, mb::FunctionCode::input),
+      point("g", 153, 1, mb::FunctionCode::holding, mb::PointType::float32)};
+  const auto blocks = mb::plan_reads(pts, 16);
+  ASSERT_EQ(blocks.size(), 4u);
+  EXPECT_EQ(blocks[0].start, 100);
+  EXPECT_EQ(blocks[0].count, 35);
+  EXPECT_EQ(blocks[0].points, (std::vector<std::size_t>{0, 1, 2}));
+  EXPECT_EQ(blocks[1].start, 152);  // d and the float32 g at 153..154
+  EXPECT_EQ(blocks[1].count, 3);
+  EXPECT_EQ(blocks[1].points, (std::vector<std::size_t>{3, 6}));
+  EXPECT_EQ(blocks[2].function, mb::FunctionCode::input);
+  EXPECT_EQ(blocks[3].unit_id, 2);
+  EXPECT_EQ(mb::plan_reads(pts, 0).size(), 6u);  // only d and g are adjacent
+  EXPECT_EQ(mb::plan_reads(pts, -1).size(), pts.size());
+}
+
+TEST(ReadPlan, NeverAsksForMoreThan125Registers) {
+  std::vector<mb::Point> pts;
+  for (std::uint16_t a = 0; a <= 112; a += 16) pts.push_back(point("p", a));  // gaps of 15
+  pts.push_back(point("last_in", 124));  // block 0..124 is exactly 125 registers
+  pts.push_back(point("next", 125));     // would make 126
+  const auto blocks = mb::plan_reads(pts, 16);
+  ASSERT_EQ(blocks.size(), 2u);
+  EXPECT_EQ(blocks[0].count, mb::kMaxReadRegisters);
+  EXPECT_EQ(blocks[0].points.size(), pts.size() - 1);
+  EXPECT_EQ(blocks[1].start, 125);
+}
+
+// Watlow F4: 100 air, 104 product, 110 alarms | 200 status | 300 setpoint, 310 ramp | 2000 run:
+// 4 requests instead of 7, and the same state as point by point.
+TEST(ModbusChamber, ReadCoalescesWatlowF4IntoFourRequests) {
+  const auto map = cm::watlow_f4();
+  const Counted block = count_one_read(map, ModbusChamber::kDefaultMaxReadGap);
+  const Counted single = count_one_read(map, -1);
+  EXPECT_EQ(block.requests, 4u);
+  EXPECT_EQ(single.requests, 7u);
+  EXPECT_DOUBLE_EQ(block.state.air_c, single.state.air_c);
+  EXPECT_DOUBLE_EQ(block.state.product_c, single.state.product_c);
+  EXPECT_DOUBLE_EQ(block.state.setpoint_c, single.state.setpoint_c);
+  EXPECT_DOUBLE_EQ(block.state.ramp_c_per_min, single.state.ramp_c_per_min);
+  EXPECT_EQ(block.state.mode, single.state.mode);
+  EXPECT_EQ(block.state.run_enabled, single.state.run_enabled);
+  EXPECT_EQ(block.state.alarms.any(), single.state.alarms.any());
+}
+
+// F4T: only setpoint 2160..2161 and ramp 2168..2169 lie within 16 registers: 6 requests.
+TEST(ModbusChamber, ReadCoalescesF4tFloatPointsIntoSixRequests) {
+  const auto map = cm::f4t();
+  const Counted block = count_one_read(map, ModbusChamber::kDefaultMaxReadGap);
+  EXPECT_EQ(block.requests, 6u);
+  EXPECT_DOUBLE_EQ(block.state.air_c, count_one_read(map, -1).state.air_c);
+}
+
+TEST(ModbusChamber, FailedBlockReadIsOneTypedErrorAndTheNextReadRecovers) {
+  const auto map = cm::watlow_f4();
+  ChamberSim sim(map);
+  ModbusServer server(sim);
+  server.start_tcp();
+  ModbusChamber chamber("chamber", mb::parse_endpoint(server.endpoint()), map, 0.2);
+  server.inject_exception(MODBUS_EXCEPTION_ILLEGAL_DATA_ADDRESS);
+  auto e = chamber.read();
+  ASSERT_FALSE(e);
+  EXPECT_EQ(e.error().kind, ErrorKind::exception);
+  EXPECT_EQ(server.requests(), 1u);  // gave up at the first failing block
+  auto ok = chamber.read();
+  ASSERT_TRUE(ok) << ok.error().message;
+  EXPECT_DOUBLE_EQ(ok.value().air_c, 25.0);
+}
