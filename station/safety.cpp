@@ -33,6 +33,29 @@ drivers::ChamberCommand Safety::clamp(drivers::ChamberCommand cmd,
   return cmd;
 }
 
+Protocol Safety::clamp_protocol(const Protocol& p, std::vector<std::string>& notes) const {
+  Protocol out = p;
+  const double max_ramp_c_per_h = 60.0 * limits_.max_ramp_c_per_min;
+  for (std::size_t i = 0; i < out.steps.size(); ++i) {
+    Step& s = out.steps[i];
+    const auto where = fmt::format("{}:{}: step {} '{}'", p.path, s.line, i, s.label);
+    if (s.setpoint_c) {
+      const double v = std::clamp(*s.setpoint_c, limits_.min_setpoint_c, limits_.max_setpoint_c);
+      if (v != *s.setpoint_c) {
+        notes.push_back(fmt::format("{}: setpoint {:.2f} C clamped to {:.2f} C (station limits {:.1f}..{:.1f} C)",
+                                    where, *s.setpoint_c, v, limits_.min_setpoint_c, limits_.max_setpoint_c));
+        s.setpoint_c = v;
+      }
+    }
+    if (s.ramp_c_per_h > max_ramp_c_per_h) {
+      notes.push_back(fmt::format("{}: ramp {:.1f} C/h clamped to {:.1f} C/h (station limit)", where,
+                                  s.ramp_c_per_h, max_ramp_c_per_h));
+      s.ramp_c_per_h = max_ramp_c_per_h;
+    }
+  }
+  return out;
+}
+
 std::optional<std::string> Safety::update(bool interlock_open, bool estop_pressed) {
   const bool was = holding_;
   const bool changed = interlock_open != interlock_open_ || estop_pressed != estop_;

@@ -8,6 +8,7 @@
 
 #include "drivers/chamber/chamber.hpp"
 #include "station/config.hpp"
+#include "station/protocol.hpp"
 
 namespace station {
 
@@ -18,6 +19,9 @@ class Safety {
 
   /// `cmd` with setpoint and ramp clamped to the limits; a note per clamp in `notes`.
   drivers::ChamberCommand clamp(drivers::ChamberCommand cmd, std::vector<std::string>& notes) const;
+
+  /// A copy of `p` with every setpoint and ramp inside the limits; a note per change.
+  Protocol clamp_protocol(const Protocol& p, std::vector<std::string>& notes) const;
 
   /// Feeds the interlock/e-stop inputs; returns a message when the safe-hold state changes
   /// ("enter: ..." or "clear: ...").

@@ -81,7 +81,7 @@ class Sequencer {
             const std::string& kind, const std::string& message);
 
   const StationConfig& config_;
-  const Protocol& protocol_;
+  Protocol protocol_;  ///< the protocol as clamped to the station's limits
   Rig& rig_;
   Store& store_;
   drivers::Clock& clock_;

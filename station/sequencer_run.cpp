@@ -69,6 +69,12 @@ RunOutcome Sequencer::run(const std::optional<RunRecord>& resume) {
          fmt::format("run {} protocol '{}' with {} gyros", run_id_, protocol_.name,
                      config_.slots.size()));
   }
+  // The safety layer's limits apply to the whole protocol before anything moves.
+  std::vector<std::string> notes;
+  protocol_ = safety_.clamp_protocol(protocol_, notes);
+  if (!resume) {
+    for (const auto& n : notes) emit(0, "warn", "safety", "clamp", n);
+  }
   runner_.emplace(protocol_, progress);
   connect_devices();
   const double start = clock_.now_s();

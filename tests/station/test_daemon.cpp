@@ -1,0 +1,104 @@
+// The daemon end to end on the simulated rig: calibration accuracy, the safety layer.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "station/sim_run.hpp"
+#include "station/store.hpp"
+
+namespace {
+
+const std::string kData = STATION_TEST_DATA_DIR;
+
+std::string fresh_db(const std::string& name) {
+  const std::string path = testing::TempDir() + name + "-" + std::to_string(getpid()) + ".db";
+  for (const char* ext : {"", "-wal", "-shm"}) std::remove((path + ext).c_str());
+  return path;
+}
+
+station::SimRunOptions quiet(const std::string& db, const std::string& protocol) {
+  station::SimRunOptions o;
+  o.db_path = db;
+  o.protocol = protocol;
+  o.progress = false;
+  o.fresh = true;
+  return o;
+}
+
+}  // namespace
+
+// The acceptance test: the paper's protocol (~13 h) on the simulated clock recovers
+// every gyro's k1 and k0 within 4 of their standard errors, with a std ratio <= 0.2.
+TEST(Daemon, PaperProtocolRecoversEveryGyrosCoefficients) {
+  auto o = quiet(fresh_db("paper"), "paper");
+  o.gyros = 4;
+  o.seed = 1;
+  const auto r = station::run_simulated(o);
+  EXPECT_EQ(r["state"], "completed");
+  EXPECT_GT(r["sim_s"].get<double>(), 12 * 3600.0);
+  ASSERT_EQ(r["gyros"].size(), 4u);
+  for (const auto& g : r["gyros"]) {
+    SCOPED_TRACE(g["serial"].get<std::string>());
+    ASSERT_TRUE(g.contains("fitted")) << g.dump();
+    for (const char* k : {"k1", "k0"}) {
+      const double truth = g["true"][k], fit = g["fitted"][k], se = g["std_errors"][k];
+      EXPECT_NEAR(fit, truth, 4 * se) << k;
+    }
+    EXPECT_LE(g["std_ratio"].get<double>(), 0.2);
+    // 9.2 h record window at 600 s: at least 50 bins.
+    EXPECT_GE(g["bins"].get<int>(), 50);
+  }
+}
+
+TEST(Daemon, InterlockOpeningMidRunReachesTheSafeStateAndIsRecorded) {
+  const auto db = fresh_db("interlock");
+  auto o = quiet(db, kData + "/short_cycle.toml");
+  o.gyros = 2;
+  o.interlock_open_at_s = 4000;  // during the recorded ramp
+  o.interlock_open_for_s = 300;
+  const auto r = station::run_simulated(o);
+  EXPECT_EQ(r["state"], "completed");
+  station::Store store(db);
+  const auto run = r["run_id"].get<std::int64_t>();
+  const auto events = store.events(run);
+  auto has = [&](const std::string& prefix) {
+    for (const auto& e : events) {
+      if (e.rfind(prefix, 0) == 0) return true;
+    }
+    return false;
+  };
+  EXPECT_TRUE(has("safe_hold: enter: interlock open")) << ::testing::PrintToString(events);
+  EXPECT_TRUE(has("safe_hold_cleared: clear: interlock closed"));
+  // While held, samples carry the safe-hold flag and the chamber setpoint does not move.
+  const auto samples = store.samples(run, "SIM-0001", false);
+  std::optional<double> held_sp;
+  int flagged = 0;
+  for (const auto& s : samples) {
+    if (s.t_s < 4010 || s.t_s >= 4300) continue;
+    EXPECT_TRUE(s.flags & 16) << s.t_s;
+    if (!held_sp) held_sp = s.setpoint_c;
+    EXPECT_NEAR(*s.setpoint_c, *held_sp, 0.051) << s.t_s;
+    ++flagged;
+  }
+  EXPECT_GT(flagged, 250);
+}
+
+TEST(Daemon, AProtocolBeyondTheLimitsIsClampedAndTheClampLogged) {
+  const auto db = fresh_db("clamp");
+  auto o = quiet(db, kData + "/beyond_limits.toml");
+  o.gyros = 1;
+  const auto r = station::run_simulated(o);
+  station::Store store(db);
+  const auto run = r["run_id"].get<std::int64_t>();
+  int clamps = 0;
+  for (const auto& e : store.events(run)) {
+    if (e.rfind("clamp: ", 0) == 0) ++clamps;
+  }
+  EXPECT_EQ(clamps, 2) << ::testing::PrintToString(store.events(run));  // setpoint and ramp
+  double max_sp = -1e9;
+  for (const auto& s : store.samples(run, "SIM-0001", false)) max_sp = std::max(max_sp, s.setpoint_c.value_or(-1e9));
+  EXPECT_NEAR(max_sp, 85.0, 1e-9);  // the default limit (config [limits] max_setpoint_c)
+}
