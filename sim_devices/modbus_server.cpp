@@ -81,12 +81,14 @@ void ModbusServer::make_mapping() {
   if (!mapping_) sys_fail("modbus_mapping_new");
 }
 
-void ModbusServer::start_tcp() {
+void ModbusServer::start_tcp(int port) {
+  if (port < 0 || port > 65535)
+    throw std::runtime_error("modbus server: port " + std::to_string(port) + " not 0..65535");
   make_mapping();
-  ctx_.reset(modbus_new_tcp("127.0.0.1", 0));
+  ctx_.reset(modbus_new_tcp("127.0.0.1", port));
   if (!ctx_) sys_fail("modbus_new_tcp");
   listen_fd_ = modbus_tcp_listen(ctx_.get(), 8);
-  if (listen_fd_ == -1) sys_fail("modbus_tcp_listen");
+  if (listen_fd_ == -1) sys_fail("modbus_tcp_listen 127.0.0.1:" + std::to_string(port));
   sockaddr_in addr{};
   socklen_t len = sizeof addr;
   if (getsockname(listen_fd_, reinterpret_cast<sockaddr*>(&addr), &len) == -1)

@@ -47,8 +47,8 @@ class ModbusServer {
   ModbusServer(const ModbusServer&) = delete;
   ModbusServer& operator=(const ModbusServer&) = delete;
 
-  /// Listens on 127.0.0.1 with an ephemeral port and starts serving; throws std::runtime_error.
-  void start_tcp();
+  /// Listens on 127.0.0.1:port (0 = ephemeral) and starts serving; throws std::runtime_error.
+  void start_tcp(int port = 0);
   /// Opens a pty pair and serves RTU on its master; clients open pty_path(). Throws on failure.
   void start_rtu_pty(int baud = 19200);
   /// Stops the thread and closes every descriptor; blocks at most ~100 ms. Idempotent.

@@ -63,8 +63,8 @@ SimWorld::SimWorld(const SimWorldConfig& config) : config_(config) {
   table_ = std::make_unique<TurntableSim>(drivers::turntable_map::default_map(1));
   chamber_server_ = std::make_unique<ModbusServer>(*chamber_, 1);
   table_server_ = std::make_unique<ModbusServer>(*table_, 1);
-  chamber_server_->start_tcp();
-  table_server_->start_tcp();
+  chamber_server_->start_tcp(config_.chamber_port);
+  table_server_->start_tcp(config_.turntable_port);
   gpio_ = std::make_shared<GpioSimChips>(gpio_lines(config_.gyros));
   gpio_->set_input("DOOR_SW", true);  // door closed
   gpio_->set_input("ESTOP", false);   // not pressed

@@ -24,6 +24,8 @@ struct SimWorldConfig {
   double initial_c = 25.0;           ///< chamber and gyros at t = 0, deg C
   double pulse_weight_arcsec = 1.5;  ///< every gyro's pulse weight
   std::string can_unix_path;         ///< empty: socketpair (in-process); else listen on this path
+  int chamber_port = 0;              ///< chamber Modbus TCP port on 127.0.0.1, 0 = ephemeral
+  int turntable_port = 0;            ///< turntable Modbus TCP port on 127.0.0.1, 0 = ephemeral
   ChamberSimConfig chamber;          ///< chamber model
 };
 
@@ -35,7 +37,7 @@ struct SimGyro {
   TrueCoefficients truth;
 };
 
-/// The simulated rig. Construction starts the Modbus servers (loopback, ephemeral ports) and
+/// The simulated rig. Construction starts the Modbus servers (loopback, configured ports) and
 /// creates the CAN bus; it is the hardware, so it does I/O.
 class SimWorld {
  public:

@@ -116,7 +116,11 @@ TEST_F(ProbeTest, JsonCarriesTheValuesOfEveryDevice) {
   EXPECT_EQ(d[4]["values"]["serial"], "SIM-0002");
   EXPECT_TRUE(d[3]["values"]["net_pulses"].is_null());  // first latch: no delta
   EXPECT_FALSE(d[3]["values"]["temps_c"].empty());
-  EXPECT_TRUE(d[5]["values"]["active"].get<bool>());
+  for (const auto& dev : d) {
+    if (dev["device"] == "gpio interlock") EXPECT_TRUE(dev["values"]["active"].get<bool>());
+    if (dev["device"] == "gpio estop") EXPECT_FALSE(dev["values"]["active"].get<bool>());
+  }
+  EXPECT_EQ(d[6]["device"], "gpio interlock");  // lines come in the bank's (role-sorted) order
 }
 
 TEST_F(ProbeTest, ChamberTimeoutIsOneTypedLineAndTheOthersStillReport) {
