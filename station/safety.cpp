@@ -42,14 +42,15 @@ Protocol Safety::clamp_protocol(const Protocol& p, std::vector<std::string>& not
     if (s.setpoint_c) {
       const double v = std::clamp(*s.setpoint_c, limits_.min_setpoint_c, limits_.max_setpoint_c);
       if (v != *s.setpoint_c) {
-        notes.push_back(fmt::format("{}: setpoint {:.2f} C clamped to {:.2f} C (station limits {:.1f}..{:.1f} C)",
-                                    where, *s.setpoint_c, v, limits_.min_setpoint_c, limits_.max_setpoint_c));
+        notes.push_back(fmt::format(
+            "{}: setpoint {:.2f} C clamped to {:.2f} C (station limits {:.1f}..{:.1f} C)", where,
+            *s.setpoint_c, v, limits_.min_setpoint_c, limits_.max_setpoint_c));
         s.setpoint_c = v;
       }
     }
     if (s.ramp_c_per_h > max_ramp_c_per_h) {
-      notes.push_back(fmt::format("{}: ramp {:.1f} C/h clamped to {:.1f} C/h (station limit)", where,
-                                  s.ramp_c_per_h, max_ramp_c_per_h));
+      notes.push_back(fmt::format("{}: ramp {:.1f} C/h clamped to {:.1f} C/h (station limit)",
+                                  where, s.ramp_c_per_h, max_ramp_c_per_h));
       s.ramp_c_per_h = max_ramp_c_per_h;
     }
   }

@@ -16,8 +16,9 @@ struct Outcome {
 };
 
 // Runs the station binary with `args` (stderr folded into the output).
-Outcome run_station(const std::string& args) {
-  const std::string cmd = std::string(STATION_BINARY_DIR) + "/station/station " + args + " 2>&1";
+Outcome run_station(const std::string& args, bool with_stderr = true) {
+  const std::string cmd = std::string(STATION_BINARY_DIR) + "/station/station " + args +
+                          (with_stderr ? " 2>&1" : " 2>/dev/null");
   Outcome o;
   FILE* p = popen(cmd.c_str(), "r");
   if (p == nullptr) return o;
@@ -101,4 +102,45 @@ TEST(Cli, AdevMissingColumnExitsTwo) {
   const auto o = run_station("adev " + kExample + " --col nope");
   EXPECT_EQ(o.status, 2);
   EXPECT_NE(o.out.find("no column 'nope'"), std::string::npos) << o.out;
+}
+
+TEST(Cli, SimRunThenFitAllAndExport) {
+  const std::string db = testing::TempDir() + "cli_sim.db";
+  for (const char* ext : {"", "-wal", "-shm"}) std::remove((db + ext).c_str());
+  const auto run = run_station("run --sim --gyros 2 --seed 9 --new --json --db " + db +
+                                   " --protocol " + STATION_TEST_DATA_DIR "/short_cycle.toml",
+                               false);
+  ASSERT_EQ(run.status, 0) << run.out;
+  const auto j = nlohmann::json::parse(run.out);  // exactly one JSON object on stdout
+  for (const char* key : {"run_id", "sim_s", "wall_s", "gyros"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  ASSERT_EQ(j["gyros"].size(), 2u);
+  for (const char* key :
+       {"serial", "true", "fitted", "std_errors", "std_before_dph", "std_after_dph", "std_ratio"}) {
+    EXPECT_TRUE(j["gyros"][0].contains(key)) << key;
+  }
+  const auto run_id = std::to_string(j["run_id"].get<int>());
+
+  const auto fit =
+      run_station("fit --db " + db + " --all --run " + run_id + " --terms dT --json", false);
+  ASSERT_EQ(fit.status, 0) << fit.out;
+  const auto f = nlohmann::json::parse(fit.out);
+  ASSERT_EQ(f.size(), 2u);
+  EXPECT_FALSE(f[0]["coefficients"].contains("k0"));  // --terms dT: B0 and k1 only
+  EXPECT_TRUE(f[0]["coefficients"].contains("k1"));
+
+  const auto one = run_station("fit --db " + db + " --serial SIM-0002 --json", false);
+  ASSERT_EQ(one.status, 0) << one.out;
+  EXPECT_EQ(nlohmann::json::parse(one.out)["runs"][0].get<int>(), j["run_id"].get<int>());
+
+  const auto csv = run_station("export --db " + db + " --serial SIM-0002 --format csv", false);
+  ASSERT_EQ(csv.status, 0) << csv.out;
+  EXPECT_EQ(csv.out.rfind("serial,fit_id,term,value,std_error,unit,ref_temp_c\n", 0), 0u)
+      << csv.out;
+  EXPECT_NE(csv.out.find("SIM-0002,"), std::string::npos);
+  EXPECT_NE(csv.out.find(",k0,"), std::string::npos);  // the latest fit is the dT+gradT one
+
+  const auto missing = run_station("export --db " + db + " --serial NOPE");
+  EXPECT_EQ(missing.status, 2);
+  EXPECT_NE(missing.out.find("no fit stored for serial 'NOPE'"), std::string::npos) << missing.out;
 }

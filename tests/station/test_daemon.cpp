@@ -99,6 +99,7 @@ TEST(Daemon, AProtocolBeyondTheLimitsIsClampedAndTheClampLogged) {
   }
   EXPECT_EQ(clamps, 2) << ::testing::PrintToString(store.events(run));  // setpoint and ramp
   double max_sp = -1e9;
-  for (const auto& s : store.samples(run, "SIM-0001", false)) max_sp = std::max(max_sp, s.setpoint_c.value_or(-1e9));
+  for (const auto& s : store.samples(run, "SIM-0001", false))
+    max_sp = std::max(max_sp, s.setpoint_c.value_or(-1e9));
   EXPECT_NEAR(max_sp, 85.0, 1e-9);  // the default limit (config [limits] max_setpoint_c)
 }

@@ -31,8 +31,8 @@ std::string fresh_db(const std::string& name) {
 
 // Starts `station run --sim` on `db`; output discarded.
 pid_t spawn_run(const std::string& db) {
-  std::vector<std::string> args{kStation, "run",   "--sim", "--gyros", "2",       "--seed",
-                                "5",      "--db",  db,      "--protocol", kProtocol};
+  std::vector<std::string> args{kStation, "run",  "--sim", "--gyros",    "2",      "--seed",
+                                "5",      "--db", db,      "--protocol", kProtocol};
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
@@ -53,7 +53,9 @@ int wait_exit(pid_t pid) {
 }
 
 using Key = std::tuple<std::string, double>;
-using Snapshot = std::map<Key, std::tuple<std::optional<std::int64_t>, std::optional<double>, std::optional<double>>>;
+using Snapshot =
+    std::map<Key,
+             std::tuple<std::optional<std::int64_t>, std::optional<double>, std::optional<double>>>;
 
 Snapshot snapshot_of_run(station::Store& s, std::int64_t run_id) {
   Snapshot out;
@@ -111,7 +113,8 @@ TEST(KillResume, KillNineTwiceLosesNothingAndEndsWithTheSameFit) {
     ASSERT_TRUE(a && b) << serial;
     ASSERT_EQ(a->fit.coefficients.size(), b->fit.coefficients.size());
     for (std::size_t i = 0; i < a->fit.coefficients.size(); ++i) {
-      EXPECT_DOUBLE_EQ(a->fit.coefficients[i], b->fit.coefficients[i]) << serial << " " << a->fit.names[i];
+      EXPECT_DOUBLE_EQ(a->fit.coefficients[i], b->fit.coefficients[i])
+          << serial << " " << a->fit.names[i];
     }
     EXPECT_EQ(a->fit.n_points, b->fit.n_points);
   }
