@@ -1,0 +1,122 @@
+// simrig: a whole simulated rig (SimWorld) on the wall clock, for running `station` against it.
+// stdout is a ready-to-use station TOML (endpoints in its leading comments); logs go to stderr.
+#include <fmt/format.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <exception>
+#include <thread>
+
+#include "sim_devices/sim_world.hpp"
+
+namespace {
+
+namespace sim = station::sim;
+
+volatile std::sig_atomic_t g_stop = 0;
+
+extern "C" void on_signal(int /*sig*/) {
+  g_stop = 1;
+}
+
+struct Options {
+  int gyros = 4;
+  std::uint64_t seed = 1;
+  int chamber_port = 0;
+  int turntable_port = 0;
+  std::string can_socket = "/tmp/simrig-can.sock";
+  double latitude_deg = 39.9;
+};
+
+/// Earth rate along a local-vertical input axis, deg/h: Omega * sin(lat) with the WGS-84
+/// rotation rate Omega = 7.292115e-5 rad/s = 15.041067 deg/h (NIMA TR8350.2, 3.2.4).
+double earth_rate_up_dph(double latitude_deg) {
+  const double omega_dph = 7.292115e-5 * 180.0 / M_PI * 3600.0;
+  return omega_dph * std::sin(latitude_deg * M_PI / 180.0);
+}
+
+void print_config(const sim::SimWorld& world, const Options& o) {
+  fmt::print(
+      "# simrig: simulated rig, seed {}, {} gyros, wall clock\n"
+      "# chamber    {}\n# turntable  {}\n# can        {}\n"
+      "# GPIO lines are simulated inside simrig only: this config has no [gpio].\n"
+      "[station]\nname = \"simrig\"\nlatitude_deg = {}\nref_temp_c = 25.0\nbin_s = 600\n\n"
+      "[limits]\nmin_setpoint_c = -45.0\nmax_setpoint_c = 85.0\nmax_ramp_c_per_min = 3.0\n\n"
+      "[chamber]\nendpoint = \"{}\"\npreset = \"watlow_f4\"\nunit_id = 1\ntimeout_s = 0.5\n\n"
+      "[turntable]\nendpoint = \"{}\"\ntimeout_s = 0.5\n\n"
+      "[can]\ntransport = \"{}\"\ntick_timeout_ms = 200\n",
+      o.seed, o.gyros, world.chamber_endpoint(), world.turntable_endpoint(), world.can_transport(),
+      o.latitude_deg, world.chamber_endpoint(), world.turntable_endpoint(), world.can_transport());
+  for (const auto& g : world.gyros()) {
+    fmt::print("\n[[slot]]\nnode = {}\nserial = \"{}\"\npulse_weight_arcsec = {}\naxis = \"up\"\n",
+               g.node, g.serial, g.pulse_weight_arcsec);
+  }
+  std::fflush(stdout);
+}
+
+/// Steps the world to the wall clock every 100 ms until SIGINT/SIGTERM; accepts the station's
+/// CAN connection meanwhile (accept_station polls, so a connect is served at once).
+void serve(sim::SimWorld& world, const std::string& can) {
+  using Clock = std::chrono::steady_clock;
+  const auto t0 = Clock::now();
+  bool connected = false;
+  fmt::print(stderr, "simrig: waiting for the station on {}\n", can);
+  while (g_stop == 0) {
+    if (!connected) {
+      connected = world.accept_station(100);
+      if (connected) fmt::print(stderr, "simrig: station connected\n");
+    } else {
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+    world.advance_to(std::chrono::duration<double>(Clock::now() - t0).count());
+  }
+  fmt::print(stderr, "simrig: stopping at t = {:.1f} s\n", world.now_s());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Simulated gyro test rig: chamber, turntable, counter boards on the wall clock"};
+  Options o;
+  app.add_option("--gyros", o.gyros, "simulated gyros, nodes 1..N")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 16));
+  app.add_option("--seed", o.seed, "seed of coefficients and noise")->capture_default_str();
+  app.add_option("--chamber-port", o.chamber_port, "chamber Modbus TCP port, 0 = ephemeral")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 65535));
+  app.add_option("--turntable-port", o.turntable_port, "turntable Modbus TCP port, 0 = ephemeral")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 65535));
+  app.add_option("--can-socket", o.can_socket, "unix SEQPACKET socket of the CAN bus")
+      ->capture_default_str();
+  app.add_option("--latitude", o.latitude_deg, "site latitude, deg (Earth rate in the gyros)")
+      ->capture_default_str()
+      ->check(CLI::Range(-90.0, 90.0));
+  CLI11_PARSE(app, argc, argv);
+
+  struct sigaction sa {};
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+  try {
+    sim::SimWorldConfig c;
+    c.gyros = o.gyros;
+    c.seed = o.seed;
+    c.chamber_port = o.chamber_port;
+    c.turntable_port = o.turntable_port;
+    c.can_unix_path = o.can_socket;
+    c.earth_rate_dph = earth_rate_up_dph(o.latitude_deg);
+    sim::SimWorld world(c);
+    print_config(world, o);
+    serve(world, world.can_transport());
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "simrig: {}\n", e.what());
+    return 1;
+  }
+  return 0;
+}
