@@ -107,6 +107,8 @@ class CounterBoardBus {
   /// Background mode: a thread calls service() until stop() or the peer closes (~50 ms).
   void start();
   void stop();
+  /// True once the peer closed its end (the background loop has then ended).
+  bool peer_closed() const { return peer_closed_.load(); }
 
  private:
   void send_all(const std::vector<BoardRecord>& records);

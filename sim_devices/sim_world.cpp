@@ -111,11 +111,12 @@ void SimWorld::add_boards() {
 }
 
 bool SimWorld::accept_station(int timeout_ms) {
-  if (bus_) return true;
+  if (bus_ && !station_gone()) return true;
   pollfd p{listen_fd_, POLLIN, 0};
   if (poll(&p, 1, timeout_ms) <= 0) return false;
   const int fd = accept4(listen_fd_, nullptr, nullptr, SOCK_CLOEXEC);
   if (fd < 0) return false;
+  if (bus_) bus_->stop();  // the previous station's bus; its boards go with it
   bus_ = std::make_unique<CounterBoardBus>(fd);
   add_boards();
   bus_->step_to(now_s_, chamber_->air_c());

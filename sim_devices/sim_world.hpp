@@ -51,9 +51,12 @@ class SimWorld {
   std::string turntable_endpoint() const { return table_server_->endpoint(); }
   /// CAN transport spec for the station: "fd:N" (socketpair end) or "unix:PATH".
   std::string can_transport() const { return can_transport_; }
-  /// With can_unix_path: blocks up to timeout_ms for the station to connect, then serves.
+  /// With can_unix_path: blocks up to timeout_ms for the station to connect, then serves; after
+  /// a station closed its end, the next call accepts a new one (fresh boards at now_s()).
   /// Returns false on timeout. (With a socketpair the bus is serving from construction.)
   bool accept_station(int timeout_ms);
+  /// True when the station connected over can_unix_path has closed its end since.
+  bool station_gone() const { return listen_fd_ >= 0 && bus_ && bus_->peer_closed(); }
   /// GPIO line names: DOOR_SW, ESTOP, TOWER_G/A/R, GYRO_PWR1..N.
   std::shared_ptr<GpioSimChips> gpio_chips() const { return gpio_; }
 

@@ -58,13 +58,18 @@ void print_config(const sim::SimWorld& world, const Options& o) {
 }
 
 /// Steps the world to the wall clock every 100 ms until SIGINT/SIGTERM; accepts the station's
-/// CAN connection meanwhile (accept_station polls, so a connect is served at once).
+/// CAN connection meanwhile (accept_station polls, so a connect is served at once), and a new
+/// one after a station leaves (e.g. `station probe`, then `station run`).
 void serve(sim::SimWorld& world, const std::string& can) {
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
   bool connected = false;
   fmt::print(stderr, "simrig: waiting for the station on {}\n", can);
   while (g_stop == 0) {
+    if (connected && world.station_gone()) {
+      connected = false;
+      fmt::print(stderr, "simrig: station disconnected; waiting for the next one\n");
+    }
     if (!connected) {
       connected = world.accept_station(100);
       if (connected) fmt::print(stderr, "simrig: station connected\n");
