@@ -82,7 +82,13 @@ std::string line_of(const std::string& text, const std::string& device) {
 }
 
 struct ProbeTest : testing::Test {
-  ProbeTest() : world(station::sim::SimWorldConfig{.gyros = 2, .seed = 3}) {}
+  ProbeTest() : world(config()) {}
+  static station::sim::SimWorldConfig config() {
+    station::sim::SimWorldConfig c;
+    c.gyros = 2;
+    c.seed = 3;
+    return c;
+  }
   ~ProbeTest() override { close(world_can_fd(world)); }
   SimWorld world;
 };
@@ -117,8 +123,12 @@ TEST_F(ProbeTest, JsonCarriesTheValuesOfEveryDevice) {
   EXPECT_TRUE(d[3]["values"]["net_pulses"].is_null());  // first latch: no delta
   EXPECT_FALSE(d[3]["values"]["temps_c"].empty());
   for (const auto& dev : d) {
-    if (dev["device"] == "gpio interlock") EXPECT_TRUE(dev["values"]["active"].get<bool>());
-    if (dev["device"] == "gpio estop") EXPECT_FALSE(dev["values"]["active"].get<bool>());
+    if (dev["device"] == "gpio interlock") {
+      EXPECT_TRUE(dev["values"]["active"].get<bool>());
+    }
+    if (dev["device"] == "gpio estop") {
+      EXPECT_FALSE(dev["values"]["active"].get<bool>());
+    }
   }
   EXPECT_EQ(d[6]["device"], "gpio interlock");  // lines come in the bank's (role-sorted) order
 }
