@@ -51,19 +51,7 @@ Result<double> ModbusChamber::get(const char* point) {
 }
 
 Result<std::vector<double>> ModbusChamber::read_values() {
-  std::vector<double> v(read_points_.size());
-  for (const auto& b : read_plan_) {
-    auto words = client_.read_registers(b.function, b.unit_id, b.start, b.count);
-    if (!words) return words.error();
-    for (std::size_t i : b.points) {
-      const modbus::Point& p = read_points_[i];
-      v[i] = modbus::decode_point(p, words.value().data() + (p.pdu_address() - b.start));
-      if (!std::isfinite(v[i]))
-        return make_error(ErrorKind::protocol,
-                          fmt::format("{} point '{}' is not finite", client_.device(), p.name));
-    }
-  }
-  return v;
+  return client_.read_points(read_points_, read_plan_);
 }
 
 Result<ChamberState> ModbusChamber::read() {

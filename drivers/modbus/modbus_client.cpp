@@ -163,4 +163,22 @@ void ModbusClient::tap(TapDirection dir, const char* kind, std::vector<std::uint
   tap_->on_exchange(r);
 }
 
+Result<std::vector<double>> ModbusClient::read_points(std::span<const Point> points,
+                                                      std::span<const ReadBlock> plan) {
+  std::vector<double> v(points.size());
+  for (const auto& b : plan) {
+    auto words = read_registers(b.function, b.unit_id, b.start, b.count);
+    if (!words) return words.error();
+    for (std::size_t i : b.points) {
+      const Point& p = points[i];
+      v[i] = decode_point(p, words.value().data() + (p.pdu_address() - b.start));
+      if (!std::isfinite(v[i])) {
+        return make_error(ErrorKind::protocol,
+                          fmt::format("{} point '{}' is not finite", device(), p.name));
+      }
+    }
+  }
+  return v;
+}
+
 }  // namespace station::drivers::modbus

@@ -11,6 +11,7 @@
 #include "drivers/common/tap.hpp"
 #include "drivers/modbus/endpoint.hpp"
 #include "drivers/modbus/modbus_handle.hpp"
+#include "drivers/modbus/read_plan.hpp"
 #include "drivers/modbus/register_map.hpp"
 
 namespace station::drivers::modbus {
@@ -37,6 +38,10 @@ class ModbusClient {
   Result<double> read(const Point& p);
   /// Writes one rw point (function 6 for one word, 16 for two); blocks up to the timeout.
   Result<void> write(const Point& p, double value);
+  /// Reads `points` with the block reads of `plan` (from plan_reads) and decodes each with the
+  /// shared codec; values in the order of `points`. A non-finite value is a protocol error.
+  Result<std::vector<double>> read_points(std::span<const Point> points,
+                                          std::span<const ReadBlock> plan);
   /// Reads `count` raw registers (function 3 or 4) at a PDU address; blocks up to the timeout.
   Result<std::vector<std::uint16_t>> read_registers(FunctionCode fc, int unit, std::uint16_t addr,
                                                     int count);

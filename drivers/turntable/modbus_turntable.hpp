@@ -4,6 +4,7 @@
 #include <string>
 
 #include "drivers/modbus/modbus_client.hpp"
+#include "drivers/modbus/read_plan.hpp"
 #include "drivers/modbus/register_map.hpp"
 #include "drivers/turntable/turntable.hpp"
 
@@ -38,6 +39,8 @@ class ModbusTurntable final : public Turntable {
   modbus::RegisterMap map_;
   TurntableLimits limits_;
   modbus::ModbusClient client_;
+  std::vector<modbus::Point> read_points_;  // mode, angle, rate, status
+  std::vector<modbus::ReadBlock> read_plan_;
 };
 
 }  // namespace station::drivers

@@ -135,6 +135,17 @@ TEST(ModbusTurntable, OutOfRangeDemandIsRangeAndNothingIsSent) {
   EXPECT_EQ(rig.server.requests(), 0u);
 }
 
+TEST(ModbusTurntable, OneReadIsOneBlockTransaction) {
+  Rig rig;
+  ASSERT_TRUE(rig.table->connect());
+  const auto before = rig.server.requests();
+  auto s = rig.table->read();
+  ASSERT_TRUE(s) << s.error().message;
+  // Input registers 100..105 (mode, angle, rate, status) in one read instead of four.
+  EXPECT_EQ(rig.server.requests() - before, 1u);
+  EXPECT_EQ(s.value().mode, TurntableMode::off);
+}
+
 TEST(ModbusTurntable, InjectedFaultsGiveTypedErrorsThenRecover) {
   Rig rig;
   rig.server.inject_timeouts(1);
