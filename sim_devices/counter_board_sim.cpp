@@ -133,8 +133,10 @@ int CounterBoardBus::service(std::chrono::milliseconds timeout) {
 void CounterBoardBus::send_all(const std::vector<BoardRecord>& records) {
   for (const auto& r : records) {
     const std::size_t len = r.short_record ? 8 : sizeof(can_frame);
+    if (::send(fd_, &r.frame, len, MSG_NOSIGNAL | MSG_DONTWAIT) >= 0) continue;
     pollfd p{fd_, POLLOUT, 0};
-    if (::poll(&p, 1, 100) <= 0) return;  // peer not reading: drop, like a full CAN tx queue
+    if (errno != EAGAIN || ::poll(&p, 1, 100) <= 0)
+      return;  // peer not reading: drop, like a full tx queue
     if (::send(fd_, &r.frame, len, MSG_NOSIGNAL | MSG_DONTWAIT) < 0) return;
   }
 }

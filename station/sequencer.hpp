@@ -92,6 +92,10 @@ class Sequencer {
   std::uint8_t latch_seq_ = 0;
   bool replaying_ = false;
   int chamber_failures_ = 0, counter_failures_ = 0;
+  /// Time spent per tick phase (wall seconds, summed), logged at the end of a run.
+  struct PhaseTimes {
+    double world = 0, can = 0, chamber = 0, table = 0, gpio = 0, store = 0;
+  } phase_s_;
   std::optional<drivers::ChamberCommand> pending_chamber_;
   std::optional<drivers::TurntableCommand> pending_table_;
 };

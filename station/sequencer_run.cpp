@@ -1,6 +1,7 @@
 // The sequencer's outer loop: new or resumed run, absolute 1 Hz deadlines, clean end.
 #include <fmt/format.h>
 
+#include <chrono>
 #include <cmath>
 
 #include "compensation/earth_rate.hpp"
@@ -93,7 +94,12 @@ RunOutcome Sequencer::run(const std::optional<RunRecord>& resume) {
     }
     const double t_s = t_first + static_cast<double>(k) * period;
     replaying_ = options_.replay_until_t_s && t_s <= *options_.replay_until_t_s;
-    if (options_.before_tick) options_.before_tick(t_s);
+    if (options_.before_tick) {
+      const auto w0 = std::chrono::steady_clock::now();
+      options_.before_tick(t_s);
+      phase_s_.world +=
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
+    }
     TickData d;
     tick(t_s, d);
     ++ticks;
@@ -106,6 +112,12 @@ RunOutcome Sequencer::run(const std::optional<RunRecord>& resume) {
     const bool stop = options_.stop != nullptr && options_.stop->load();
     if (runner_->done() || stop) {
       const std::string state = runner_->done() ? "completed" : "stopped";
+      const double n = static_cast<double>(ticks) / 1e6;  // -> microseconds per tick
+      log("seq")->info(
+          "tick phases, mean us: world {:.0f} can {:.0f} chamber {:.0f} table {:.0f} gpio {:.0f} "
+          "store {:.0f}",
+          phase_s_.world / n, phase_s_.can / n, phase_s_.chamber / n, phase_s_.table / n,
+          phase_s_.gpio / n, phase_s_.store / n);
       finish(state, t_s);
       return {run_id_, state, t_s, ticks};
     }

@@ -79,6 +79,9 @@ nlohmann::json run_simulated(const SimRunOptions& o) {
   };
   Rig rig = build_rig(config, ro);
   Store store(o.db_path.empty() ? "station-sim.db" : o.db_path);
+  // One commit per simulated minute: a commit costs more than a simulated tick, and a killed
+  // simulation resumes by deterministic replay anyway. Real rigs commit every tick.
+  store.set_ticks_per_commit(60);
   std::optional<RunRecord> resume = o.fresh ? std::nullopt : store.find_unfinished_run();
   if (resume && resume->sim_seed != static_cast<std::int64_t>(o.seed)) resume.reset();
   sim::SimClock clock;

@@ -26,6 +26,7 @@ Store::Store(const std::string& path) : db_(path) {
 }
 
 std::int64_t Store::create_run(const RunInfo& info, const std::vector<RunSlot>& slots) {
+  flush();
   Transaction tx(db_);
   auto st = db_.prepare(
       "INSERT INTO runs (started_utc, state, protocol_name, protocol_text, config_text, "
@@ -106,6 +107,7 @@ std::vector<RunSlot> Store::run_slots(std::int64_t run_id) {
 }
 
 void Store::finish_run(std::int64_t run_id, const std::string& state) {
+  flush();
   auto st = db_.prepare("UPDATE runs SET state = ?, ended_utc = ? WHERE id = ?");
   st.bind(1, state).bind(2, utc_now_iso()).bind(3, run_id);
   st.step();
@@ -113,9 +115,29 @@ void Store::finish_run(std::int64_t run_id, const std::string& state) {
 
 void Store::append_tick(std::int64_t run_id, const std::vector<SampleRow>& rows,
                         const RunProgress& p) {
-  Transaction tx(db_);
-  auto ins = db_.prepare("INSERT OR REPLACE INTO samples VALUES (?,?,?,?,?,?,?,?,?,?,?,?)");
+  if (!insert_sample_) {
+    insert_sample_.emplace(
+        db_.prepare("INSERT OR REPLACE INTO samples VALUES (?,?,?,?,?,?,?,?,?,?,?,?)"));
+    update_progress_.emplace(
+        db_.prepare("UPDATE runs SET step_index = ?, step_started_s = ?, t_s = ?, recording = ?, "
+                    "record_start_s = ?, start_temp_c = ? WHERE id = ?"));
+  }
+  if (!batch_) batch_.emplace(db_);
+  try {
+    write_tick(run_id, rows, p);
+  } catch (...) {
+    batch_.reset();  // rolls back the whole batch: no half tick is ever committed
+    batch_ticks_ = 0;
+    throw;
+  }
+  if (++batch_ticks_ >= ticks_per_commit_) flush();
+}
+
+void Store::write_tick(std::int64_t run_id, const std::vector<SampleRow>& rows,
+                       const RunProgress& p) {
+  auto& ins = *insert_sample_;
   for (const auto& r : rows) {
+    ins.reset();
     ins.bind(1, run_id).bind(2, r.serial).bind(3, r.t_s);
     if (r.net_pulses)
       ins.bind(4, *r.net_pulses);
@@ -124,15 +146,28 @@ void Store::append_tick(std::int64_t run_id, const std::vector<SampleRow>& rows,
     ins.bind(5, r.interval_s).bind(6, r.rate_dph).bind(7, r.temp_c).bind(8, r.temp2_c);
     ins.bind(9, r.air_c).bind(10, r.setpoint_c).bind(11, r.flags).bind(12, r.recording ? 1 : 0);
     ins.step();
-    ins.reset();
   }
-  auto up = db_.prepare(
-      "UPDATE runs SET step_index = ?, step_started_s = ?, t_s = ?, recording = ?, "
-      "record_start_s = ?, start_temp_c = ? WHERE id = ?");
+  ins.reset();
+  auto& up = *update_progress_;
+  up.reset();
   up.bind(1, p.step_index).bind(2, p.step_started_s).bind(3, p.t_s).bind(4, p.recording ? 1 : 0);
   up.bind(5, p.record_start_s).bind(6, p.start_temp_c).bind(7, run_id);
   up.step();
-  tx.commit();
+  up.reset();
+}
+
+void Store::flush() {
+  if (!batch_) return;
+  batch_->commit();
+  batch_.reset();
+  batch_ticks_ = 0;
+}
+
+Store::~Store() {
+  try {
+    flush();
+  } catch (...) {  // NOLINT(bugprone-empty-catch): the batch rolls back; nothing else to do here
+  }
 }
 
 std::vector<SampleRow> Store::samples(std::int64_t run_id, const std::string& serial,
@@ -173,6 +208,7 @@ std::int64_t Store::sample_count(std::int64_t run_id) {
 
 void Store::replace_bins(std::int64_t run_id, const std::string& serial,
                          const std::vector<sc::Bin>& bins, double earth_rate_dph) {
+  flush();
   Transaction tx(db_);
   auto del = db_.prepare("DELETE FROM bins WHERE run_id = ? AND serial = ?");
   del.bind(1, run_id).bind(2, serial);

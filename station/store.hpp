@@ -77,8 +77,15 @@ class Store {
   std::vector<RunSlot> run_slots(std::int64_t run_id);
   void finish_run(std::int64_t run_id, const std::string& state);
 
-  /// One tick: its samples and the run's progress, in one transaction.
+  /// One tick: its samples and the run's progress, committed together with the ticks of its
+  /// batch (see set_ticks_per_commit); a kill loses only ticks not yet committed.
   void append_tick(std::int64_t run_id, const std::vector<SampleRow>& rows, const RunProgress& p);
+  /// Ticks per transaction: 1 (default) on real hardware, where a tick is a second; the
+  /// simulated clock batches, as a commit costs more than a simulated tick.
+  void set_ticks_per_commit(int n) { ticks_per_commit_ = n < 1 ? 1 : n; }
+  /// Commits an open batch of ticks.
+  void flush();
+  ~Store();
   /// Samples of one serial in a run, by time (recording window only when asked).
   std::vector<SampleRow> samples(std::int64_t run_id, const std::string& serial,
                                  bool recording_only);
@@ -105,7 +112,13 @@ class Store {
   Database& db() { return db_; }
 
  private:
+  void write_tick(std::int64_t run_id, const std::vector<SampleRow>& rows, const RunProgress& p);
+
   Database db_;
+  // The 1 Hz path's statements, prepared once (preparing costs more than the inserts).
+  std::optional<Statement> insert_sample_, update_progress_;
+  std::optional<Transaction> batch_;
+  int ticks_per_commit_ = 1, batch_ticks_ = 0;
 };
 
 /// Current UTC time as ISO-8601 with milliseconds.

@@ -18,9 +18,11 @@ namespace {
 
 // Translates an errno from `op` on transport `name` into a typed Error (the one place we do so).
 Error errno_error(const std::string& name, const char* op, int err) {
+  // EAGAIN on a non-blocking call means "nothing now": the caller's wait decides about time.
   const ErrorKind kind = (err == EPIPE || err == ECONNRESET || err == ENOTCONN || err == EBADF)
                              ? ErrorKind::disconnected
-                             : ErrorKind::io;
+                         : (err == EAGAIN || err == EWOULDBLOCK) ? ErrorKind::timeout
+                                                                 : ErrorKind::io;
   return make_error(kind, fmt::format("{}: {} failed: {} ({})", name, op, std::strerror(err),
                                       strerrorname_np(err) ? strerrorname_np(err) : "?"));
 }
@@ -69,8 +71,11 @@ Result<void> FdCanTransport::wait(short events, std::chrono::milliseconds timeou
 
 Result<void> FdCanTransport::send(const can_frame& frame) {
   if (!fd_.valid()) return make_error(ErrorKind::disconnected, name_ + ": not open");
-  if (auto w = wait(POLLOUT, options_.send_timeout, "send buffer space"); !w) return w;
-  const ssize_t n = ::send(fd_.get(), &frame, sizeof frame, MSG_NOSIGNAL | MSG_DONTWAIT);
+  ssize_t n = ::send(fd_.get(), &frame, sizeof frame, MSG_NOSIGNAL | MSG_DONTWAIT);
+  if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {  // buffer full: wait, bounded
+    if (auto w = wait(POLLOUT, options_.send_timeout, "send buffer space"); !w) return w;
+    n = ::send(fd_.get(), &frame, sizeof frame, MSG_NOSIGNAL | MSG_DONTWAIT);
+  }
   if (n < 0) return errno_error(name_, "send", errno);
   if (static_cast<std::size_t>(n) != sizeof frame)
     return make_error(ErrorKind::io, fmt::format("{}: short send of {} bytes", name_, n));
@@ -80,6 +85,9 @@ Result<void> FdCanTransport::send(const can_frame& frame) {
 
 Result<can_frame> FdCanTransport::receive(std::chrono::milliseconds timeout) {
   if (!fd_.valid()) return make_error(ErrorKind::disconnected, name_ + ": not open");
+  // Frames usually queue up faster than they are read: try first, poll only when none is there.
+  auto f = read_one();
+  if (f || f.error().kind != ErrorKind::timeout) return f;
   if (auto w = wait(POLLIN, timeout, "frame"); !w) return w.error();
   return read_one();
 }
