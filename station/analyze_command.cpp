@@ -10,6 +10,7 @@
 #include "compensation/fit.hpp"
 #include "station/commands.hpp"
 #include "station/csv_table.hpp"
+#include "station/fit_json.hpp"
 
 namespace station {
 namespace {
@@ -91,11 +92,7 @@ Analysis analyze(const AnalyzeOptions& o) {
 }
 
 nlohmann::json to_json(const Analysis& a) {
-  nlohmann::json coef = nlohmann::json::object(), se = nlohmann::json::object();
-  for (std::size_t i = 0; i < a.fit.names.size(); ++i) {
-    coef[a.fit.names[i]] = a.fit.coefficients[i];
-    se[a.fit.names[i]] = a.fit.std_errors[i];
-  }
+  const nlohmann::json coef = coefficients_json(a.fit), se = std_errors_json(a.fit);
   return {{"coefficients", coef},
           {"std_errors", se},
           {"bins", a.bins_used},

@@ -7,6 +7,7 @@
 
 #include "station/calibration.hpp"
 #include "station/commands.hpp"
+#include "station/fit_json.hpp"
 #include "station/input_error.hpp"
 
 namespace station {
@@ -35,11 +36,7 @@ std::string unit_of(const std::string& name) {
 }
 
 nlohmann::json fit_json(const SerialFit& f) {
-  nlohmann::json coef = nlohmann::json::object(), se = nlohmann::json::object();
-  for (std::size_t i = 0; i < f.fit.names.size(); ++i) {
-    coef[f.fit.names[i]] = f.fit.coefficients[i];
-    se[f.fit.names[i]] = f.fit.std_errors[i];
-  }
+  const nlohmann::json coef = coefficients_json(f.fit), se = std_errors_json(f.fit);
   return {{"serial", f.serial},
           {"fit_id", f.fit_id},
           {"runs", f.runs},

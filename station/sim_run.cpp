@@ -10,6 +10,7 @@
 #include "sim_devices/sim_clock.hpp"
 #include "sim_devices/sim_world.hpp"
 #include "station/calibration.hpp"
+#include "station/fit_json.hpp"
 #include "station/logging.hpp"
 #include "station/protocol.hpp"
 #include "station/rig.hpp"
@@ -47,13 +48,8 @@ nlohmann::json gyro_report(Store& store, std::int64_t run_id, const sim::SimGyro
     j["error"] = "no fit for this run";
     return j;
   }
-  nlohmann::json coef = nlohmann::json::object(), se = nlohmann::json::object();
-  for (std::size_t i = 0; i < fit->fit.names.size(); ++i) {
-    coef[fit->fit.names[i]] = fit->fit.coefficients[i];
-    se[fit->fit.names[i]] = fit->fit.std_errors[i];
-  }
-  j["fitted"] = coef;
-  j["std_errors"] = se;
+  j["fitted"] = coefficients_json(fit->fit);
+  j["std_errors"] = std_errors_json(fit->fit);
   j["bins"] = fit->fit.n_points;
   j["std_before_dph"] = fit->eval.std_before_dph;
   j["std_after_dph"] = fit->eval.std_after_dph;

@@ -7,6 +7,8 @@
 #include <chrono>
 #include <nlohmann/json.hpp>
 
+#include "station/fit_json.hpp"
+
 namespace station {
 
 namespace sc = station::compensation;
@@ -257,12 +259,8 @@ std::vector<std::int64_t> Store::runs_of_serial(const std::string& serial) {
 
 std::int64_t Store::save_fit(const std::string& serial, const std::vector<std::int64_t>& runs,
                              const sc::FitResult& fit, const sc::Evaluation& eval) {
-  json coef = json::object(), se = json::object();
+  const json coef = coefficients_json(fit), se = std_errors_json(fit);
   std::string terms;
-  for (std::size_t i = 0; i < fit.names.size(); ++i) {
-    coef[fit.names[i]] = fit.coefficients[i];
-    se[fit.names[i]] = fit.std_errors[i];
-  }
   for (auto t : fit.spec.terms)
     terms += (terms.empty() ? "" : ",") + std::string(sc::term_option_name(t));
   auto st = db_.prepare(

@@ -119,3 +119,20 @@ TEST(KillResume, KillNineTwiceLosesNothingAndEndsWithTheSameFit) {
     EXPECT_EQ(a->fit.n_points, b->fit.n_points);
   }
 }
+
+TEST(KillResume, SigtermEndsTheRunCleanlyAsStopped) {
+  const auto db = fresh_db("sigterm");
+  const pid_t pid = spawn_run(db);
+  std::this_thread::sleep_for(std::chrono::milliseconds(700));
+  kill(pid, SIGTERM);
+  EXPECT_EQ(wait_exit(pid), 0);
+  station::Store s(db);
+  EXPECT_FALSE(s.find_unfinished_run().has_value()) << "a stopped run is not left 'running'";
+  const auto run = s.find_run(1);
+  ASSERT_TRUE(run.has_value());
+  EXPECT_EQ(run->state, "stopped");
+  const auto events = s.events(1);
+  ASSERT_FALSE(events.empty());
+  EXPECT_EQ(events.back(), "run_end: run 1 stopped");
+  EXPECT_GT(s.sample_count(1), 0);
+}

@@ -1,0 +1,16 @@
+// A fit's coefficients and standard errors as JSON objects keyed by coefficient name
+// (B0, k1, k2, k3, k4, k0, kr, kc): the one shape every command and the store use.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include "compensation/fit.hpp"
+
+namespace station {
+
+/// {"B0": value, "k1": value, ...}
+nlohmann::json coefficients_json(const compensation::FitResult& fit);
+/// {"B0": std error, "k1": std error, ...}
+nlohmann::json std_errors_json(const compensation::FitResult& fit);
+
+}  // namespace station
