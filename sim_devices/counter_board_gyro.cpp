@@ -39,8 +39,10 @@ double RlgGyroModel::noise_rate_dph(double dt_s) {
 }
 
 void RlgGyroModel::advance(double dt_s, double air_c) {
-  // Series first-order lags, exact for an input held over the step: air -> A (housing) -> B
-  // (core). Under a ramp r C/s the steady gradient is A - B = r * tau_core_s.
+  // Series first-order lags: air -> A (housing) -> B (core). The housing step is exact for air
+  // held over the step; the core step drives B with the midpoint of A over the step, an
+  // approximation (good while dt << tau_housing_s), not the exact two-node solution.
+  // Under a ramp r C/s the steady gradient is A - B = r * tau_core_s.
   const double a_old = temp_a_c_;
   temp_a_c_ += (air_c - temp_a_c_) * (1.0 - std::exp(-dt_s / config_.thermal.tau_housing_s));
   const double a_mid = 0.5 * (a_old + temp_a_c_);

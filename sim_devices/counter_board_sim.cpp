@@ -32,6 +32,18 @@ std::uint32_t CounterBoardSim::down_count() const {
          static_cast<std::uint32_t>(gyro_.down_pulses());
 }
 
+namespace {
+
+// Takes one from a fault counter if it is positive (atomic against a concurrent setter).
+bool take_one(std::atomic<int>& counter) {
+  int n = counter.load();
+  while (n > 0)
+    if (counter.compare_exchange_weak(n, n - 1)) return true;
+  return false;
+}
+
+}  // namespace
+
 std::vector<BoardRecord> CounterBoardSim::on_sync(std::uint8_t latch_seq) {
   if (!answering_) return {};
   return apply_faults(build_frames(latch_seq));
@@ -39,10 +51,11 @@ std::vector<BoardRecord> CounterBoardSim::on_sync(std::uint8_t latch_seq) {
 
 std::vector<can_frame> CounterBoardSim::build_frames(std::uint8_t latch_seq) {
   const std::uint8_t node = config_.node;
-  wire::StatusFrame st{node, latch_seq, extra_flags_, 0, wire::kFollowsCounts};
+  const int failed_temp = failed_temp_.load();  // one value for STATUS and TEMPS alike
+  wire::StatusFrame st{node, latch_seq, extra_flags_.load(), 0, wire::kFollowsCounts};
   st.board_time_us =
       config_.board_time_offset_us + static_cast<std::uint32_t>(std::llround(gyro_.time_s() * 1e6));
-  if (failed_temp_ >= 0) st.flags |= wire::kFlagTempSensorFault;
+  if (failed_temp >= 0) st.flags |= wire::kFlagTempSensorFault;
   if (config_.temp_channels > 0) st.follows |= wire::kFollowsTemps;
   if (config_.send_discharge) st.follows |= wire::kFollowsDischarge;
   std::vector<can_frame> out{wire::encode(st),
@@ -51,8 +64,8 @@ std::vector<can_frame> CounterBoardSim::build_frames(std::uint8_t latch_seq) {
     wire::TempsFrame t{node, config_.temp_channels, {}};
     const double temps[] = {gyro_.temp_a_c(), gyro_.temp_b_c(), gyro_.temp_a_c(), 0.0};
     for (int i = 0; i < t.count && i < 4; ++i)
-      t.centi_c[i] = i == failed_temp_ ? INT16_MIN  // the sensor's "no value" sentinel
-                                       : static_cast<std::int16_t>(std::lround(temps[i] * 100));
+      t.centi_c[i] = i == failed_temp ? INT16_MIN  // the sensor's "no value" sentinel
+                                      : static_cast<std::int16_t>(std::lround(temps[i] * 100));
     out.push_back(wire::encode(t));
   }
   if (config_.send_discharge)
@@ -63,25 +76,19 @@ std::vector<can_frame> CounterBoardSim::build_frames(std::uint8_t latch_seq) {
 std::vector<BoardRecord> CounterBoardSim::apply_faults(const std::vector<can_frame>& frames) {
   std::vector<BoardRecord> out;
   for (const can_frame& f : frames) {
-    if (drop_ > 0) {
-      --drop_;
-      continue;
-    }
+    if (take_one(drop_)) continue;
     BoardRecord r{f, false};
-    if (corrupt_ > 0) {
-      --corrupt_;
-      if (corrupt_kind_ == CorruptKind::bad_dlc) r.frame.can_dlc = 3;
-      if (corrupt_kind_ == CorruptKind::short_record) r.short_record = true;
-      if (corrupt_kind_ == CorruptKind::garbage_id) {
+    if (take_one(corrupt_)) {
+      const CorruptKind kind = corrupt_kind_.load();
+      if (kind == CorruptKind::bad_dlc) r.frame.can_dlc = 3;
+      if (kind == CorruptKind::short_record) r.short_record = true;
+      if (kind == CorruptKind::garbage_id) {
         r.frame.can_id = 0x700 + config_.node;
         for (auto& b : r.frame.data) b = static_cast<std::uint8_t>(fault_rng_());
       }
     }
     out.push_back(r);
-    if (duplicate_ > 0) {
-      --duplicate_;
-      out.push_back(r);
-    }
+    if (take_one(duplicate_)) out.push_back(r);
   }
   return out;
 }

@@ -63,10 +63,14 @@ class CounterBoardSim {
   const TrueCoefficients& true_coefficients() const { return gyro_.config().coefficients; }
   std::uint8_t node() const { return config_.node; }
 
-  /// Fault injection; each applies to the next frames this board sends.
+  /// Fault injection; each applies to the next frames this board sends. The setters are
+  /// thread-safe (atomics): tests call them while the bus thread answers SYNCs.
   void drop_next_frames(int n) { drop_ = n; }
   void duplicate_next_frames(int n) { duplicate_ = n; }
-  void corrupt_next_frames(int n, CorruptKind kind) { corrupt_ = n, corrupt_kind_ = kind; }
+  void corrupt_next_frames(int n, CorruptKind kind) {
+    corrupt_kind_ = kind;  // kind first, so a frame counted by `n` never sees the old kind
+    corrupt_ = n;
+  }
   /// Temperature channel `channel` reads the sentinel 0x8000 and STATUS flags a sensor fault.
   void fail_temp_sensor(int channel, bool failed = true) { failed_temp_ = failed ? channel : -1; }
   /// Extra STATUS flags (kFlagLaserFault, kFlagDitherFault, ...) reported from now on.
@@ -81,10 +85,11 @@ class CounterBoardSim {
   BoardConfig config_;
   RlgGyroModel gyro_;
   std::mt19937_64 fault_rng_;
-  int drop_ = 0, duplicate_ = 0, corrupt_ = 0, failed_temp_ = -1;
-  CorruptKind corrupt_kind_ = CorruptKind::bad_dlc;
-  std::uint8_t extra_flags_ = 0;
-  bool answering_ = true;
+  // Written by the test thread, read by the bus thread in on_sync().
+  std::atomic<int> drop_{0}, duplicate_{0}, corrupt_{0}, failed_temp_{-1};
+  std::atomic<CorruptKind> corrupt_kind_{CorruptKind::bad_dlc};
+  std::atomic<std::uint8_t> extra_flags_{0};
+  std::atomic<bool> answering_{true};
 };
 
 /// Several boards sharing one bus endpoint (one end of a SEQPACKET socketpair or a unix socket).

@@ -18,9 +18,10 @@ struct CounterBoards::SlotState {
   // Across ticks: the last good latch.
   bool has_prev = false;
   std::uint32_t prev_up = 0, prev_down = 0, prev_time_us = 0;
-  int ticks_since_prev = 0;
+  int ticks_since_prev = 0;  // latch intervals attempted or skipped since the last good latch
   // This tick.
-  bool attributing = false;  // the node's latest STATUS names the current latch
+  bool attributing = false;   // a STATUS naming the current latch has arrived
+  bool stale_status = false;  // a stale STATUS arrived after it (repeats are then stale)
   std::optional<StatusFrame> status;
   std::optional<CountsFrame> counts;
   std::optional<TempsFrame> temps;
@@ -28,7 +29,7 @@ struct CounterBoards::SlotState {
   int duplicates = 0, stale = 0, corrupt = 0;
 
   void start_tick() {
-    attributing = false;
+    attributing = stale_status = false;
     status.reset();
     counts.reset();
     temps.reset();
@@ -73,8 +74,18 @@ Result<TickResult> CounterBoards::tick(std::uint8_t latch_seq) {
 
 Result<void> CounterBoards::send_sync(std::uint8_t latch_seq) {
   latch_seq_ = latch_seq;
-  for (auto& s : state_) s.start_tick();
+  // Counted here, before any I/O, so a failed send or collect still spans its interval: the next
+  // good latch's counts cover the real time since the last good one.
+  for (auto& s : state_) {
+    s.start_tick();
+    ++s.ticks_since_prev;
+  }
   return transport_->send(encode(SyncFrame{latch_seq}));
+}
+
+void CounterBoards::note_skipped_ticks(int n) {
+  if (n <= 0) return;
+  for (auto& s : state_) s.ticks_since_prev += n;
 }
 
 Result<TickResult> CounterBoards::collect(std::chrono::milliseconds timeout) {
@@ -108,9 +119,9 @@ namespace {
 
 // Stores `value` in `slot` unless already present (then it is a duplicate).
 template <typename T>
-void keep_first(std::optional<T>& slot, T value, int& duplicates) {
+void keep_first(std::optional<T>& slot, T value, int& repeats) {
   if (slot)
-    ++duplicates;
+    ++repeats;
   else
     slot = std::move(value);
 }
@@ -138,13 +149,23 @@ void CounterBoards::handle(const can_frame& f, TickResult& out) {
   auto take = [&](auto decoded, auto& slot) {
     if (!decoded) return bad(decoded.error());
     if (!s->attributing) return void(++s->stale);
-    keep_first(slot, std::move(decoded).value(), s->duplicates);
+    // After a late stale STATUS, a second copy is more likely its follower than a duplicate.
+    keep_first(slot, std::move(decoded).value(), s->stale_status ? s->stale : s->duplicates);
   };
   switch (kind.value()) {
     case FrameKind::status: {
       auto st = decode_status(f);
-      if (st) s->attributing = st.value().latch_seq == latch_seq_;
-      return take(std::move(st), s->status);
+      if (!st) return bad(st.error());
+      // Only the current latch's STATUS switches attribution on; a stale one never switches it
+      // off again, or a late STATUS would make the current COUNTS look stale.
+      if (st.value().latch_seq != latch_seq_) {
+        ++s->stale;
+        s->stale_status = s->attributing;
+        return;
+      }
+      s->attributing = true;
+      s->stale_status = false;
+      return keep_first(s->status, std::move(st).value(), s->duplicates);
     }
     case FrameKind::counts:
       return take(decode_counts(f), s->counts);
@@ -168,7 +189,8 @@ void fill_delta(CounterReading& r, std::uint32_t prev_time_us, double nominal_s,
   const double nominal = nominal_s * r.intervals_spanned;
   const double board_s = static_cast<std::uint32_t>(r.board_time_us - prev_time_us) * 1e-6;
   // Board time wraps every 2^32 µs (71.6 min) and restarts on a board reset: trust it only
-  // when it agrees with the nominal interval to within half an interval.
+  // when it agrees with the nominal span (nominal interval * intervals spanned) to within half
+  // of that span.
   r.interval_from_board_time = std::abs(board_s - nominal) < 0.5 * nominal;
   r.interval_s = r.interval_from_board_time ? board_s : nominal;
   r.rate_dph = r.angle_arcsec / r.interval_s;  // arcsec/s == deg/h
@@ -188,7 +210,6 @@ void CounterBoards::finish(TickResult& out) {
     r.corrupt_frames = s.corrupt;
     r.answered = s.status && s.counts;
     r.latch_lost = !r.answered;
-    ++s.ticks_since_prev;
     if (r.answered) fill_reading(s, config_.slots[i], r);
     out.readings.push_back(std::move(r));
   }

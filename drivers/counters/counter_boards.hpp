@@ -76,10 +76,13 @@ class CounterBoards {
 
   /// Sends SYNC with latch_seq and collects the answers; blocks at most tick_timeout.
   Result<TickResult> tick(std::uint8_t latch_seq);
-  /// First half of tick(): sends the SYNC (non-blocking up to the send timeout).
+  /// First half of tick(): sends the SYNC (non-blocking up to the send timeout). Every call
+  /// counts as one latch interval for the next delta, even when the send or collect fails.
   Result<void> send_sync(std::uint8_t latch_seq);
   /// Second half of tick(): collects answers to the last SYNC; blocks at most `timeout`.
   Result<TickResult> collect(std::chrono::milliseconds timeout);
+  /// The caller skipped `n` ticks (no SYNC sent, e.g. on overrun); no I/O, n <= 0 ignored.
+  void note_skipped_ticks(int n);
   /// The configuration in use.
   const CounterBoardsConfig& config() const { return config_; }
 

@@ -5,6 +5,7 @@
 
 #include <cerrno>
 #include <cmath>
+#include <variant>
 
 namespace station::drivers::modbus {
 namespace {
@@ -92,13 +93,21 @@ Result<void> ModbusClient::ensure_connected() {
 
 Error ModbusClient::fail(int err, const std::string& what) {
   Error e = translate_modbus_error(err, device_ + " " + what);
-  if (e.kind == ErrorKind::disconnected) {
+  consecutive_timeouts_ = e.kind == ErrorKind::timeout ? consecutive_timeouts_ + 1 : 0;
+  // A TCP peer that rebooted leaves our socket half-open: requests vanish without an RST, so
+  // only a fresh connection recovers. A serial line has no connection to renew.
+  const bool stale_tcp = consecutive_timeouts_ >= kTimeoutsBeforeReconnect &&
+                         std::holds_alternative<TcpEndpoint>(endpoint_);
+  if (stale_tcp)
+    e.message += fmt::format(" ({} timeouts in a row: reconnecting)", consecutive_timeouts_);
+  tap(TapDirection::event, "error", {}, e.message);
+  if (e.kind == ErrorKind::disconnected || stale_tcp) {
+    consecutive_timeouts_ = 0;
     disconnect();  // reconnect on the next call
   } else if (e.kind == ErrorKind::timeout || e.kind == ErrorKind::protocol) {
     // Discard late or partial bytes so the next reply is not misread as this one's.
     if (ctx_) modbus_flush(ctx_.get());
   }
-  tap(TapDirection::event, "error", {}, e.message);
   return e;
 }
 
@@ -116,6 +125,7 @@ Result<std::vector<std::uint16_t>> ModbusClient::read_registers(FunctionCode fc,
   if (rc == -1) return fail(errno, fmt::format("read fc={} addr={} count={}", code, addr, count));
   if (rc != count)
     return fail(EMBBADDATA, fmt::format("read addr={}: {} registers, wanted {}", addr, rc, count));
+  consecutive_timeouts_ = 0;
   tap(TapDirection::rx, "modbus-read", words_pdu(code, words), fmt::format("addr={}", addr));
   return words;
 }
@@ -132,6 +142,7 @@ Result<void> ModbusClient::write_registers(int unit, std::uint16_t addr,
   int rc = n == 1 ? modbus_write_register(ctx_.get(), addr, words[0])
                   : modbus_write_registers(ctx_.get(), addr, n, words.data());
   if (rc == -1) return fail(errno, fmt::format("write fc={} addr={} count={}", code, addr, n));
+  consecutive_timeouts_ = 0;
   tap(TapDirection::rx, "modbus-write", pdu, fmt::format("addr={} ok", addr));
   return {};
 }

@@ -1,5 +1,6 @@
 // A small Modbus client: reads and writes register-map points as one bounded transaction each,
-// translating libmodbus/errno failures into ErrorKind in one place and reconnecting after loss.
+// translating libmodbus/errno failures into ErrorKind in one place and reconnecting after loss
+// (a lost connection, or kTimeoutsBeforeReconnect timeouts in a row on TCP).
 #pragma once
 
 #include <cstdint>
@@ -64,6 +65,11 @@ class ModbusClient {
   ModbusHandle ctx_;
   bool connected_ = false;
   Tap* tap_ = nullptr;
+  int consecutive_timeouts_ = 0;  ///< timeouts in a row since the last answer of any kind
 };
+
+/// Consecutive timeouts after which a TCP client drops its connection (a half-open socket to a
+/// rebooted gateway never answers again); the next call reconnects. RTU only flushes.
+inline constexpr int kTimeoutsBeforeReconnect = 3;
 
 }  // namespace station::drivers::modbus

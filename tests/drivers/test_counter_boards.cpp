@@ -33,6 +33,7 @@ sim::BoardConfig board_config(std::uint8_t node, std::uint64_t seed) {
 struct Rig {
   std::unique_ptr<sim::CounterBoardBus> bus;
   std::unique_ptr<c::CounterBoards> driver;
+  can::UniqueFd driver_side;  // a second descriptor of the driver's socket, to jam its tx queue
   double t_s = 0;
 
   explicit Rig(std::vector<sim::BoardConfig> boards) {
@@ -45,6 +46,7 @@ struct Rig {
       bus->add_board(b);
       cfg.slots.push_back({b.node, "RLG-" + std::to_string(b.node), b.gyro.pulse_weight_arcsec});
     }
+    driver_side = can::UniqueFd(::dup(sv[0]));
     driver = std::make_unique<c::CounterBoards>(can::make_fd_transport(can::UniqueFd(sv[0])), cfg);
   }
   // One second of simulated time, then one latch answered by the simulator.
@@ -265,6 +267,143 @@ TEST(CounterBoards, BackgroundThreadMode) {
     auto r = rig.driver->tick(static_cast<std::uint8_t>(k));
     ASSERT_TRUE(r.ok()) << r.error().message;
     for (const auto& rd : r.value().readings) EXPECT_TRUE(rd.answered) << int(rd.node);
+  }
+  rig.bus->stop();
+}
+
+namespace {
+
+// Fills the driver's send queue (nobody reads the other end) with frames the simulated boards
+// ignore, so the next SYNC send times out for real. Returns the frames queued.
+int jam_driver_tx(int fd) {
+  const can_frame junk = c::encode(c::CountsFrame{9, 0, 0});  // not a SYNC: the boards skip it
+  int n = 0;
+  while (n < 1'000'000 && ::send(fd, &junk, sizeof junk, MSG_NOSIGNAL | MSG_DONTWAIT) > 0) ++n;
+  return n;
+}
+
+// True mean rate over the last `span_s` seconds from the simulator's true angle, deg/h.
+struct TrueRate {
+  const sim::RlgGyroModel& gyro;
+  double angle0 = gyro.true_angle_arcsec();
+  double since(double span_s) const { return (gyro.true_angle_arcsec() - angle0) / span_s; }
+};
+
+}  // namespace
+
+// A SYNC that could not be sent is still a tick that passed: the next good latch spans two
+// intervals. Counted wrongly, the 2 s board time looks implausible against a 1 s nominal span,
+// the nominal 1 s is used and the rate doubles. Bound: pulse angle within one pulse weight w of
+// the true angle, so |rate - true mean rate| < w / interval_s.
+TEST(CounterBoards, FailedSyncSendCountsItsInterval) {
+  Rig rig({board_config(1, 202)});
+  rig.tick(0);
+  TrueRate truth{rig.bus->board(1).gyro()};
+  rig.t_s += 1.0;
+  rig.bus->step_to(rig.t_s, 25.0);
+  ASSERT_GT(jam_driver_tx(rig.driver_side.get()), 0);
+  auto sent = rig.driver->send_sync(1);
+  ASSERT_FALSE(sent.ok());
+  EXPECT_EQ(sent.error().kind, ErrorKind::timeout) << sent.error().message;
+  EXPECT_EQ(rig.bus->service(1000ms), 0);  // drains the junk; no SYNC reached the boards
+  const auto rd = rig.tick(2).readings[0];
+  ASSERT_TRUE(rd.has_delta);
+  EXPECT_EQ(rd.intervals_spanned, 2);
+  EXPECT_TRUE(rd.interval_from_board_time);
+  EXPECT_NEAR(rd.interval_s, 2.0, 1e-9);
+  EXPECT_LT(std::abs(rd.rate_dph - truth.since(2.0)), kPulseWeightArcsec / 2.0);
+}
+
+// The sequencer skips ticks on overrun and says so; the next delta spans the skipped time.
+TEST(CounterBoards, SkippedTicksAreCountedInTheSpan) {
+  Rig rig({board_config(1, 303), board_config(2, 404)});
+  rig.tick(0);
+  TrueRate truth{rig.bus->board(2).gyro()};
+  rig.t_s += 2.0;  // two ticks without a SYNC
+  rig.driver->note_skipped_ticks(2);
+  rig.driver->note_skipped_ticks(0);  // no-ops
+  rig.driver->note_skipped_ticks(-1);
+  const auto r = rig.tick(3);
+  for (const auto& rd : r.readings) {
+    ASSERT_TRUE(rd.has_delta);
+    EXPECT_EQ(rd.intervals_spanned, 3);
+    EXPECT_TRUE(rd.interval_from_board_time);
+    EXPECT_NEAR(rd.interval_s, 3.0, 1e-9);
+  }
+  EXPECT_LT(std::abs(r.readings[1].rate_dph - truth.since(3.0)), kPulseWeightArcsec / 3.0);
+  const auto next = rig.tick(4).readings[0];  // the span resets after a good latch
+  EXPECT_EQ(next.intervals_spanned, 1);
+}
+
+// A late STATUS of an older latch, arriving after the current STATUS, must not withdraw the
+// attribution: the current COUNTS that follow still belong to the current latch.
+TEST(CounterBoards, LateStaleStatusDoesNotDiscardCurrentCounts) {
+  int sv[2];
+  ASSERT_EQ(::socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, sv), 0);
+  c::CounterBoardsConfig cfg{{{4, "RLG-4", 1.5}}, 50ms, 1.0};
+  c::CounterBoards driver(can::make_fd_transport(can::UniqueFd(sv[0])), cfg);
+  auto board = can::make_fd_transport(can::UniqueFd(sv[1]));
+  auto status = [&](std::uint8_t seq, std::uint32_t t_us) {
+    ASSERT_TRUE(board->send(c::encode(c::StatusFrame{4, seq, 0, t_us, c::kFollowsCounts})).ok());
+  };
+  ASSERT_TRUE(driver.send_sync(0).ok());
+  ASSERT_TRUE(board->receive(1000ms).ok());
+  status(0, 5'000'000);
+  ASSERT_TRUE(board->send(c::encode(c::CountsFrame{4, 100, 50})).ok());
+  ASSERT_TRUE(driver.collect(50ms).ok());
+  ASSERT_TRUE(driver.send_sync(1).ok());
+  ASSERT_TRUE(board->receive(1000ms).ok());
+  status(1, 6'000'000);
+  status(0, 5'000'000);  // late copy of the previous latch's STATUS
+  ASSERT_TRUE(board->send(c::encode(c::CountsFrame{4, 1100, 60})).ok());
+  const auto r = driver.collect(50ms);
+  ASSERT_TRUE(r.ok());
+  const auto& rd = r.value().readings[0];
+  EXPECT_TRUE(rd.answered);
+  EXPECT_FALSE(rd.latch_lost);
+  EXPECT_EQ(rd.stale_frames, 1);
+  EXPECT_EQ(rd.duplicate_frames, 0);
+  EXPECT_EQ(rd.net_pulses, 990);
+  EXPECT_EQ(rd.intervals_spanned, 1);
+  EXPECT_TRUE(rd.interval_from_board_time);
+  EXPECT_DOUBLE_EQ(rd.rate_dph, 1485.0);  // 990 pulses * 1.5 arcsec over 1 s
+}
+
+// A stale STATUS *before* the current one still makes its followers stale.
+TEST(CounterBoards, StaleStatusBeforeCurrentKeepsFollowersStale) {
+  int sv[2];
+  ASSERT_EQ(::socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, sv), 0);
+  c::CounterBoardsConfig cfg{{{4, "RLG-4", 1.5}}, 50ms, 1.0};
+  c::CounterBoards driver(can::make_fd_transport(can::UniqueFd(sv[0])), cfg);
+  auto board = can::make_fd_transport(can::UniqueFd(sv[1]));
+  ASSERT_TRUE(driver.send_sync(7).ok());
+  ASSERT_TRUE(board->receive(1000ms).ok());
+  ASSERT_TRUE(board->send(c::encode(c::StatusFrame{4, 6, 0, 1, c::kFollowsCounts})).ok());
+  ASSERT_TRUE(board->send(c::encode(c::CountsFrame{4, 1, 1})).ok());
+  ASSERT_TRUE(board->send(c::encode(c::StatusFrame{4, 7, 0, 2, c::kFollowsCounts})).ok());
+  ASSERT_TRUE(board->send(c::encode(c::CountsFrame{4, 2, 2})).ok());
+  const auto r = driver.collect(50ms);
+  ASSERT_TRUE(r.ok());
+  const auto& rd = r.value().readings[0];
+  EXPECT_TRUE(rd.answered);
+  EXPECT_EQ(rd.stale_frames, 2);
+  EXPECT_EQ(rd.board_time_us, 2u);
+}
+
+// Fault setters race the bus thread unless they are atomic (run under TSan to see it).
+TEST(CounterBoards, FaultInjectionWhileTheBusThreadRuns) {
+  Rig rig({board_config(1, 505)});
+  rig.bus->start();
+  auto& b = rig.bus->board(1);
+  for (int k = 0; k < 20; ++k) {
+    b.set_extra_flags(k % 2 ? c::kFlagDitherFault : 0);
+    b.fail_temp_sensor(2, k % 3 == 0);
+    b.duplicate_next_frames(k % 2);
+    b.set_answering(k % 5 != 4);
+    rig.bus->step_to(k + 1.0, 25.0);
+    auto r = rig.driver->tick(static_cast<std::uint8_t>(k));
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_EQ(r.value().readings[0].answered, k % 5 != 4) << k;
   }
   rig.bus->stop();
 }

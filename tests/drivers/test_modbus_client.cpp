@@ -132,3 +132,73 @@ TEST_F(ModbusClientTest, EveryExchangePassesTheTap) {
   ASSERT_FALSE(client->read(map.at(cm::kAir)));
   EXPECT_EQ(tap.records.back().kind, "error");
 }
+
+namespace {
+
+int count_kind(const std::vector<station::drivers::TapRecord>& records, const std::string& kind) {
+  int n = 0;
+  for (const auto& r : records) n += r.kind == kind ? 1 : 0;
+  return n;
+}
+
+}  // namespace
+
+// A gateway that rebooted leaves the TCP socket half-open: requests vanish, nothing says
+// "disconnected". After kTimeoutsBeforeReconnect timeouts in a row the client must reconnect.
+TEST_F(ModbusClientTest, RepeatedTimeoutsOnTcpReconnect) {
+  RecordingTap tap;
+  client->set_tap(&tap);
+  ASSERT_TRUE(client->connect());
+  server.inject_timeouts(mb::kTimeoutsBeforeReconnect);
+  for (int i = 1; i <= mb::kTimeoutsBeforeReconnect; ++i) {
+    auto v = client->read(map.at(cm::kAir));
+    ASSERT_FALSE(v);
+    EXPECT_EQ(v.error().kind, ErrorKind::timeout) << v.error().message;
+    // Connected until the last timeout of the run, then dropped.
+    EXPECT_EQ(client->connected(), i < mb::kTimeoutsBeforeReconnect) << "after timeout " << i;
+    if (i == mb::kTimeoutsBeforeReconnect) {
+      EXPECT_NE(v.error().message.find("reconnecting"), std::string::npos) << v.error().message;
+    }
+  }
+  EXPECT_EQ(count_kind(tap.records, "connect"), 1);
+  auto again = client->read(map.at(cm::kAir));
+  ASSERT_TRUE(again) << again.error().message;
+  EXPECT_DOUBLE_EQ(again.value(), 25.0);
+  EXPECT_EQ(count_kind(tap.records, "connect"), 2);  // a fresh connection served it
+  EXPECT_EQ(count_kind(tap.records, "disconnect"), 1);
+}
+
+// Only timeouts *in a row* count: an answer in between resets the run.
+TEST_F(ModbusClientTest, AnAnswerResetsTheTimeoutRun) {
+  RecordingTap tap;
+  client->set_tap(&tap);
+  ASSERT_TRUE(client->connect());
+  server.inject_timeouts(mb::kTimeoutsBeforeReconnect - 1);
+  for (int i = 1; i < mb::kTimeoutsBeforeReconnect; ++i)
+    ASSERT_FALSE(client->read(map.at(cm::kAir)));
+  ASSERT_TRUE(client->read(map.at(cm::kAir)));
+  server.inject_timeouts(1);
+  ASSERT_FALSE(client->read(map.at(cm::kAir)));
+  EXPECT_TRUE(client->connected());
+  EXPECT_EQ(count_kind(tap.records, "connect"), 1);
+}
+
+// RTU has no connection to renew: repeated timeouts keep the line open and it recovers.
+TEST(ModbusClientRtu, RepeatedTimeoutsKeepTheLineOpen) {
+  auto map = cm::watlow_f4();
+  station::sim::ChamberSim sim{map};
+  station::sim::ModbusServer server{sim};
+  server.start_rtu_pty();
+  mb::ModbusClient rtu("chamber-rtu", mb::parse_endpoint(server.endpoint()), 0.2);
+  ASSERT_TRUE(rtu.connect()) << server.endpoint();
+  server.inject_timeouts(mb::kTimeoutsBeforeReconnect);
+  for (int i = 0; i < mb::kTimeoutsBeforeReconnect; ++i) {
+    auto v = rtu.read(map.at(cm::kAir));
+    ASSERT_FALSE(v);
+    EXPECT_EQ(v.error().kind, ErrorKind::timeout) << v.error().message;
+  }
+  EXPECT_TRUE(rtu.connected());
+  auto again = rtu.read(map.at(cm::kAir));
+  ASSERT_TRUE(again) << again.error().message;
+  EXPECT_DOUBLE_EQ(again.value(), 25.0);
+}
