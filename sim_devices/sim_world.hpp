@@ -68,6 +68,7 @@ class SimWorld {
   ChamberSim& chamber() { return *chamber_; }
   TurntableSim& turntable() { return *table_; }
   ModbusServer& chamber_server() { return *chamber_server_; }
+  ModbusServer& turntable_server() { return *table_server_; }
   CounterBoardBus* bus() { return bus_.get(); }
 
  private:

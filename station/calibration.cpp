@@ -14,7 +14,7 @@ void bin_run(Store& store, std::int64_t run_id, double bin_s) {
   for (const auto& slot : store.run_slots(run_id)) {
     std::vector<double> t, rate, temp, grad;
     for (const auto& s : store.samples(run_id, slot.serial, true)) {
-      if (!s.rate_dph || !s.temp_c || !s.temp2_c) continue;
+      if (!s.rate_dph || !s.temp_c || !s.temp2_c || (s.flags & kUnfitFlags) != 0) continue;
       t.push_back(s.t_s);
       rate.push_back(*s.rate_dph);
       temp.push_back(*s.temp_c);

@@ -12,7 +12,8 @@
 namespace station {
 
 /// Bins every slot's recorded samples of `run_id` (bin width bin_s) and stores them.
-/// The gradient is temp2 - temp per sample; samples without rate or temperatures are skipped.
+/// The gradient is temp2 - temp per sample; samples without rate or temperatures, or flagged
+/// safe-hold or board fault (kUnfitFlags), are skipped, so their bins come out incomplete.
 void bin_run(Store& store, std::int64_t run_id, double bin_s);
 
 /// One serial's fit as stored.

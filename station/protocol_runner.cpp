@@ -10,10 +10,15 @@ namespace station {
 ProtocolRunner::ProtocolRunner(const Protocol& protocol, const RunProgress& progress)
     : protocol_(protocol), progress_(progress) {
   // The setpoint in force is the last one commanded before the current step.
+  setpoint_c_ = previous_target();
+}
+
+std::optional<double> ProtocolRunner::previous_target() const {
+  std::optional<double> t;
   for (int i = 0; i < progress_.step_index && i < static_cast<int>(protocol_.steps.size()); ++i) {
-    if (protocol_.steps[i].kind == StepKind::set_temperature)
-      setpoint_c_ = target_of(protocol_.steps[i]);
+    if (protocol_.steps[i].kind == StepKind::set_temperature) t = target_of(protocol_.steps[i]);
   }
+  return t;
 }
 
 double ProtocolRunner::target_of(const Step& s) const {
@@ -30,7 +35,15 @@ void ProtocolRunner::enter(const Step& s, const Observation& obs, Actions& a) {
   switch (s.kind) {
     case StepKind::set_temperature:
       ramp_origin_c_ =
-          setpoint_c_.value_or(progress_.start_temp_c.value_or(obs.air_c.value_or(25.0)));
+          previous_target().value_or(progress_.start_temp_c.value_or(obs.air_c.value_or(25.0)));
+      if (resume_from_c_ && s.ramp_c_per_h > 0) {
+        // Back from a safe hold: the ramp goes on at its rate from where the chamber was held.
+        ramp_origin_c_ = *resume_from_c_;
+        progress_.step_started_s = obs.t_s;
+        a.events.push_back({"info", "ramp_resume",
+                            fmt::format("ramp resumes from {:.2f} C at {:.1f} C/h", ramp_origin_c_,
+                                        s.ramp_c_per_h)});
+      }
       setpoint_c_ = target_of(s);
       ramp_sent_c_.reset();
       if (s.ramp_c_per_h <= 0) a.chamber = drivers::ChamberCommand{setpoint_c_, 0.0, true};
@@ -55,6 +68,7 @@ void ProtocolRunner::enter(const Step& s, const Observation& obs, Actions& a) {
     default:
       break;
   }
+  resume_from_c_.reset();
 }
 
 void ProtocolRunner::ramp(const Step& s, const Observation& obs, Actions& a) {

@@ -50,8 +50,12 @@ class ProtocolRunner {
 
   /// Advances on one observation; returns the commands and events of this tick.
   Actions tick(const Observation& obs);
-  /// Re-issues the current step's entry commands at the next tick (after a safe hold).
-  void reenter() { entered_ = false; }
+  /// After a safe hold: re-issues the current step's entry commands at the next tick; a ramp
+  /// restarts at its rate from `from_c` (where the chamber was held), at that tick.
+  void reenter(std::optional<double> from_c) {
+    entered_ = false;
+    resume_from_c_ = from_c;
+  }
 
   bool done() const { return progress_.step_index >= static_cast<int>(protocol_.steps.size()); }
   const RunProgress& progress() const { return progress_; }
@@ -63,14 +67,17 @@ class ProtocolRunner {
   bool finished(const Step& s, const Observation& obs);
   void advance(const Observation& obs, Actions& a, const std::string& kind, const std::string& sev);
   double target_of(const Step& s) const;
+  /// Target of the last set_temperature step before the current one, if any.
+  std::optional<double> previous_target() const;
   void ramp(const Step& s, const Observation& obs, Actions& a);
 
   const Protocol& protocol_;
   RunProgress progress_;
   bool entered_ = false;
-  std::optional<double> setpoint_c_;   ///< target of the last set_temperature step
-  double ramp_origin_c_ = 25.0;        ///< where the current ramp started
-  std::optional<double> ramp_sent_c_;  ///< last ramp setpoint commanded
+  std::optional<double> setpoint_c_;     ///< target of the last set_temperature step
+  double ramp_origin_c_ = 25.0;          ///< where the current ramp started
+  std::optional<double> ramp_sent_c_;    ///< last ramp setpoint commanded
+  std::optional<double> resume_from_c_;  ///< set by reenter(): restart the ramp from here
   std::optional<double> stable_since_s_;
 };
 

@@ -11,6 +11,7 @@
 #include "drivers/common/clock.hpp"
 #include "station/commands.hpp"
 #include "station/logging.hpp"
+#include "station/resume.hpp"
 #include "station/rig.hpp"
 #include "station/sequencer.hpp"
 #include "station/sim_run.hpp"
@@ -42,10 +43,18 @@ struct RunOptions {
 
 int run_real(const RunOptions& o) {
   const StationConfig config = load_station_config(o.config);
-  const Protocol protocol = load_protocol(o.protocol);
-  Rig rig = build_rig(config);
+  Protocol protocol = load_protocol(o.protocol);
   Store store(o.db);
-  std::optional<RunRecord> resume = o.fresh ? std::nullopt : store.find_unfinished_run();
+  const ResumeDecision resume_decision = decide_resume(store, config, o.fresh, false);
+  const std::optional<RunRecord>& resume = resume_decision.run;
+  if (resume_decision.protocol) {
+    if (resume_decision.protocol->text != protocol.text) {
+      log("seq")->warn("run {} continues with the protocol stored with it, not {}", resume->id,
+                       o.protocol);
+    }
+    protocol = *resume_decision.protocol;
+  }
+  Rig rig = build_rig(config);
   drivers::MonotonicClock clock;
   SequencerOptions so;
   so.operator_name = o.operator_name;

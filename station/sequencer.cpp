@@ -33,15 +33,6 @@ class PhaseTimer {
 
 }  // namespace
 
-/// Sample flag bits stored with every row.
-enum SampleFlag : int {
-  kLatchLost = 1 << 0,
-  kChamberMissing = 1 << 1,
-  kTempsMissing = 1 << 2,
-  kBoardFault = 1 << 3,
-  kSafeHold = 1 << 4,
-};
-
 Sequencer::Sequencer(const StationConfig& config, const Protocol& protocol, Rig& rig, Store& store,
                      dr::Clock& clock, SequencerOptions options)
     : config_(config),
@@ -100,8 +91,10 @@ void Sequencer::read_devices(double t_s, TickData& d) {
   timer.emplace(phase_s_.table);
   if (rig_.turntable) {
     auto table = rig_.turntable->read();
-    if (table) d.table = table.value();
-    d.interlock_open = d.table && d.table->interlock_open;
+    if (table) {
+      d.table = table.value();
+      d.table_interlock_open = d.table->interlock_open;
+    }
   }
   timer.emplace(phase_s_.gpio);
   if (rig_.gpio) {
@@ -112,9 +105,11 @@ void Sequencer::read_devices(double t_s, TickData& d) {
       }
     }
     if (auto closed = rig_.gpio->read(dr::gpio::roles::interlock); closed) {
-      d.interlock_open = d.interlock_open || !closed.value();
+      d.gpio_interlock_closed = closed.value();
     }
-    if (auto pressed = rig_.gpio->read(dr::gpio::roles::estop); pressed) d.estop = pressed.value();
+    if (auto pressed = rig_.gpio->read(dr::gpio::roles::estop); pressed) {
+      d.gpio_estop_pressed = pressed.value();
+    }
   }
 }
 
@@ -156,20 +151,69 @@ void Sequencer::assemble_samples(double t_s, TickData& d) {
 }
 
 void Sequencer::apply_safety(double t_s, TickData& d) {
-  const auto change = safety_.update(d.interlock_open, d.estop);
-  if (!change) return;
-  if (safety_.holding()) {
-    emit(t_s, "error", "safety", "safe_hold",
-         *change + ": chamber held at its air temperature, turntable stopped");
-    if (d.obs.air_c) pending_chamber_ = safety_.hold_command(*d.obs.air_c);
-    pending_table_.reset();
-    if (rig_.turntable) {
-      if (auto r = rig_.turntable->stop(); !r)
-        emit(t_s, "error", "table", "stop_failed", r.error().message);
-    }
-  } else {
+  // Each source keeps its last known value when a read fails; the hold is cleared only on
+  // positive readings, and inputs unreadable for kSafetyBlindTicks count as open.
+  constexpr int kSafetyBlindTicks = 5;
+  const bool has_table = rig_.turntable != nullptr;
+  const auto has_line = [this](std::string_view role) {
+    return rig_.gpio != nullptr && dr::gpio::find_role(rig_.gpio->config(), role) != nullptr;
+  };
+  const bool has_gpio = has_line(dr::gpio::roles::interlock);
+  const bool has_estop = has_line(dr::gpio::roles::estop);
+  const bool blind = (has_table && !d.table_interlock_open) ||
+                     (has_gpio && !d.gpio_interlock_closed) || (has_estop && !d.gpio_estop_pressed);
+  safety_blind_ticks_ = blind ? safety_blind_ticks_ + 1 : 0;
+  if (safety_blind_ticks_ == kSafetyBlindTicks) {
+    emit(t_s, "error", "safety", "inputs_unreadable",
+         fmt::format("interlock / e-stop unreadable for {} ticks: treated as open",
+                     kSafetyBlindTicks));
+  }
+  bool interlock = d.table_interlock_open.value_or(has_table && interlock_open_);
+  if (d.gpio_interlock_closed)
+    interlock = interlock || !*d.gpio_interlock_closed;
+  else if (has_gpio)
+    interlock = interlock || interlock_open_;
+  // The chamber's own door switch counts as an interlock; its high-limit trip as an e-stop.
+  if (d.chamber) interlock = interlock || d.chamber->alarms.door_open;
+  bool estop = d.gpio_estop_pressed.value_or(estop_);
+  if (d.chamber) estop = estop || d.chamber->alarms.high_limit_trip;
+  if (safety_blind_ticks_ >= kSafetyBlindTicks) interlock = true;
+  interlock_open_ = interlock;
+  estop_ = estop;
+  const auto change = safety_.update(interlock, estop);
+  if (change && safety_.holding() && change->rfind("enter", 0) == 0)
+    enter_safe_hold(t_s, d, *change);
+  if (safety_.holding()) keep_safe_hold(t_s, d);
+  if (change && !safety_.holding()) {
     emit(t_s, "info", "safety", "safe_hold_cleared", *change + ": resuming the protocol step");
-    runner_->reenter();
+    runner_->reenter(hold_air_c_);
+  }
+}
+
+void Sequencer::enter_safe_hold(double t_s, const TickData& d, const std::string& why) {
+  emit(t_s, "error", "safety", "safe_hold",
+       why + ": chamber held at its air temperature, turntable stopped");
+  pending_chamber_.reset();  // nothing the protocol asked for goes out during the hold
+  pending_table_.reset();
+  hold_air_c_ = d.obs.air_c;
+  hold_commanded_ = false;
+  table_stopped_ = rig_.turntable == nullptr;
+}
+
+void Sequencer::keep_safe_hold(double t_s, const TickData& d) {
+  // Retried every tick until the devices accept: the hold setpoint needs one air reading.
+  if (!hold_air_c_) hold_air_c_ = d.obs.air_c;
+  if (!hold_commanded_ && hold_air_c_) {
+    const auto r = rig_.chamber->command(safety_.hold_command(*hold_air_c_));
+    hold_commanded_ = r.ok();
+    if (!r && command_failures_++ % 60 == 0)
+      emit(t_s, "error", "chamber", "hold_failed", r.error().message);
+  }
+  if (!table_stopped_) {
+    const auto r = rig_.turntable->stop();
+    table_stopped_ = r.ok();
+    if (!r && command_failures_++ % 60 == 0)
+      emit(t_s, "error", "table", "stop_failed", r.error().message);
   }
 }
 
@@ -185,14 +229,15 @@ void Sequencer::apply_actions(double t_s, const Actions& a) {
   if (pending_chamber_) {
     if (auto r = rig_.chamber->command(*pending_chamber_); r) {
       pending_chamber_.reset();
-    } else if (chamber_failures_ % 60 == 0) {
+      command_failures_ = 0;
+    } else if (command_failures_++ % 60 == 0) {
       emit(t_s, "warn", "chamber", "command_failed", r.error().message);
     }
   }
   if (pending_table_ && rig_.turntable) {
     if (auto r = rig_.turntable->command(*pending_table_); r) {
       pending_table_.reset();
-    } else {
+    } else if (command_failures_++ % 60 == 0) {
       emit(t_s, "warn", "table", "command_failed", r.error().message);
     }
   }

@@ -66,7 +66,8 @@ class Sequencer {
     std::optional<drivers::counters::TickResult> counts;
     std::optional<drivers::ChamberState> chamber;
     std::optional<drivers::TurntableState> table;
-    bool interlock_open = false, estop = false;
+    // Safety inputs as read this tick (empty: not readable this tick).
+    std::optional<bool> table_interlock_open, gpio_interlock_closed, gpio_estop_pressed;
     std::vector<SampleRow> rows;
     Observation obs;
   };
@@ -74,6 +75,8 @@ class Sequencer {
   void tick(double t_s, TickData& d);
   void read_devices(double t_s, TickData& d);
   void apply_safety(double t_s, TickData& d);
+  void enter_safe_hold(double t_s, const TickData& d, const std::string& why);
+  void keep_safe_hold(double t_s, const TickData& d);
   void apply_actions(double t_s, const Actions& a);
   void assemble_samples(double t_s, TickData& d);
   void finish(const std::string& state, double t_s);
@@ -91,7 +94,13 @@ class Sequencer {
   std::int64_t run_id_ = 0;
   std::uint8_t latch_seq_ = 0;
   bool replaying_ = false;
-  int chamber_failures_ = 0, counter_failures_ = 0;
+  int chamber_failures_ = 0, counter_failures_ = 0, command_failures_ = 0;
+  /// Last known safety inputs: a failed read keeps the last value; unreadable for
+  /// kSafetyBlindTicks in a row counts as open (fail safe).
+  bool interlock_open_ = false, estop_ = false;
+  int safety_blind_ticks_ = 0;
+  std::optional<double> hold_air_c_;  ///< where the chamber is held during a safe hold
+  bool hold_commanded_ = false, table_stopped_ = false;
   /// Time spent per tick phase (wall seconds, summed), logged at the end of a run.
   struct PhaseTimes {
     double world = 0, can = 0, chamber = 0, table = 0, gpio = 0, store = 0;

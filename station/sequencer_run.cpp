@@ -1,10 +1,12 @@
 // The sequencer's outer loop: new or resumed run, absolute 1 Hz deadlines, clean end.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
 #include "compensation/earth_rate.hpp"
+#include "drivers/common/tap.hpp"
 #include "station/calibration.hpp"
 #include "station/logging.hpp"
 #include "station/sequencer.hpp"
@@ -56,15 +58,24 @@ RunOutcome Sequencer::run(const std::optional<RunRecord>& resume) {
   if (resume) {
     run_id_ = resume->id;
     if (!options_.replay_until_t_s) {
-      progress = resume->progress;  // real hardware: continue where the record stops
-      t_first = resume->progress.t_s + period;
+      // Real hardware: continue the protocol where the record stops, at the real elapsed time,
+      // so the outage shows as a gap (incomplete bins), not as continuous data.
+      progress = resume->progress;
+      const double elapsed_s = drivers::tap_wall_time_s() - resume->t0_wall_s;
+      t_first = std::max(resume->progress.t_s + period, std::floor(elapsed_s / period) * period);
+      if (t_first > resume->progress.t_s + period) {
+        emit(resume->progress.t_s, "warn", "seq", "resume_gap",
+             fmt::format("no samples from t = {:.0f} s to {:.0f} s (daemon down)",
+                         resume->progress.t_s, t_first));
+      }
     }
     emit(resume->progress.t_s, "warn", "seq", "resume",
          fmt::format("resuming run {} at step {} after t = {:.0f} s", run_id_,
                      resume->progress.step_index, resume->progress.t_s));
   } else {
-    RunInfo info{protocol_.name, protocol_.text,         config_.text,     STATION_VERSION,
-                 config_.name,   options_.operator_name, options_.sim_seed};
+    RunInfo info{
+        protocol_.name, protocol_.text,         config_.text,      STATION_VERSION,
+        config_.name,   options_.operator_name, options_.sim_seed, drivers::tap_wall_time_s()};
     run_id_ = store_.create_run(info, run_slots_of(config_));
     emit(0, "info", "seq", "run_start",
          fmt::format("run {} protocol '{}' with {} gyros", run_id_, protocol_.name,
@@ -87,6 +98,7 @@ RunOutcome Sequencer::run(const std::optional<RunRecord>& resume) {
       if (due > k) {  // absolute deadlines: a late tick skips, it never shifts the schedule
         log("seq")->warn("overrun: {} tick(s) skipped at t_s={:.0f}", due - k,
                          t_first + k * period);
+        rig_.counters->note_skipped_ticks(static_cast<int>(due - k));  // next delta spans them
         k = due;
       } else {
         clock_.sleep_until(deadline);

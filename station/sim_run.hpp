@@ -5,8 +5,13 @@
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
+
+namespace station::sim {
+class SimWorld;
+}
 
 namespace station {
 
@@ -22,6 +27,8 @@ struct SimRunOptions {
   /// Test hooks: open the door interlock at this simulated time for this long.
   double interlock_open_at_s = -1, interlock_open_for_s = 0;
   const std::atomic<bool>* stop = nullptr;
+  /// Test hook: called with each tick's time and the world, after it advanced (fault injection).
+  std::function<void(double t_s, sim::SimWorld& world)> on_world_tick;
 };
 
 /// Runs the simulated rig to the end of the protocol (or a resumed one to its end) and returns

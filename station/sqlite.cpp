@@ -100,18 +100,21 @@ int Database::schema_version() {
 }
 
 void Database::migrate() {
-  const int have = schema_version();
   const int known = static_cast<int>(schemas::kMigrations.size());
+  if (schema_version() == known) return;  // the common case: no write lock needed
+  // Version check and migrations in one write transaction: two processes opening a new file at
+  // once (a daemon and `station fit`) must not both migrate it.
+  Transaction tx(*this);
+  const int have = schema_version();
   if (have > known) {
     throw SqliteError(
         fmt::format("{}: schema version {} is newer than this software ({})", path_, have, known));
   }
   for (int v = have; v < known; ++v) {
-    Transaction tx(*this);
     exec(schemas::kMigrations[static_cast<std::size_t>(v)].second);
     exec(fmt::format("PRAGMA user_version = {}", v + 1));
-    tx.commit();
   }
+  tx.commit();
 }
 
 Transaction::Transaction(Database& db) : db_(db) {

@@ -32,7 +32,8 @@ std::int64_t Store::create_run(const RunInfo& info, const std::vector<RunSlot>& 
   Transaction tx(db_);
   auto st = db_.prepare(
       "INSERT INTO runs (started_utc, state, protocol_name, protocol_text, config_text, "
-      "software_version, station, operator, sim_seed) VALUES (?,'running',?,?,?,?,?,?,?)");
+      "software_version, station, operator, sim_seed, t0_wall_s) "
+      "VALUES (?,'running',?,?,?,?,?,?,?,?)");
   st.bind(1, utc_now_iso()).bind(2, info.protocol_name).bind(3, info.protocol_text);
   st.bind(4, info.config_text).bind(5, info.software_version).bind(6, info.station);
   st.bind(7, info.operator_name);
@@ -40,6 +41,7 @@ std::int64_t Store::create_run(const RunInfo& info, const std::vector<RunSlot>& 
     st.bind(8, *info.sim_seed);
   else
     st.bind_null(8);
+  st.bind(9, info.t0_wall_s);
   st.step();
   const std::int64_t id = db_.last_insert_id();
   auto gyro = db_.prepare("INSERT OR IGNORE INTO gyros (serial, first_seen_utc) VALUES (?, ?)");
@@ -60,7 +62,7 @@ std::int64_t Store::create_run(const RunInfo& info, const std::vector<RunSlot>& 
 namespace {
 constexpr const char* kRunColumns =
     "SELECT id, state, protocol_name, protocol_text, config_text, station, sim_seed, step_index, "
-    "step_started_s, t_s, recording, record_start_s, start_temp_c FROM runs ";
+    "step_started_s, t_s, recording, record_start_s, start_temp_c, t0_wall_s FROM runs ";
 
 RunRecord read_run(const Statement& st) {
   RunRecord r;
@@ -77,6 +79,7 @@ RunRecord read_run(const Statement& st) {
   r.progress.recording = st.column_int(10) != 0;
   if (!st.column_is_null(11)) r.progress.record_start_s = st.column_double(11);
   if (!st.column_is_null(12)) r.progress.start_temp_c = st.column_double(12);
+  r.t0_wall_s = st.column_double(13);
   return r;
 }
 }  // namespace

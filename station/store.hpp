@@ -18,6 +18,7 @@ namespace station {
 struct RunInfo {
   std::string protocol_name, protocol_text, config_text, software_version, station, operator_name;
   std::optional<std::int64_t> sim_seed;
+  double t0_wall_s = 0;  ///< wall-clock seconds (Unix) at t_s = 0
 };
 
 /// Where a run is in its protocol (updated with every tick).
@@ -35,6 +36,7 @@ struct RunRecord {
   std::int64_t id = 0;
   std::string state, protocol_name, protocol_text, config_text, station;
   std::optional<std::int64_t> sim_seed;
+  double t0_wall_s = 0;
   RunProgress progress;
 };
 
@@ -44,6 +46,17 @@ struct RunSlot {
   std::string serial, axis;
   double pulse_weight_arcsec = 0, earth_rate_dph = 0;
 };
+
+/// Flag bits stored with every sample (column samples.flags).
+enum SampleFlag : int {
+  kLatchLost = 1 << 0,       ///< no counter answer this tick (the next delta spans the gap)
+  kChamberMissing = 1 << 1,  ///< the chamber did not answer
+  kTempsMissing = 1 << 2,    ///< the gyro's temperatures did not arrive or failed
+  kBoardFault = 1 << 3,      ///< the board reported a fault flag
+  kSafeHold = 1 << 4,        ///< the rig was in safe hold (door open / e-stop)
+};
+/// Samples with these flags are recorded but left out of the bins.
+inline constexpr int kUnfitFlags = kBoardFault | kSafeHold;
 
 /// One gyro's 1 Hz sample.
 struct SampleRow {

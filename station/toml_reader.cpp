@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 
 namespace station {
 namespace {
@@ -61,7 +62,10 @@ std::optional<double> TomlView::opt_number(std::string_view key) const {
   const toml::node* n = find(key);
   if (n == nullptr) return std::nullopt;
   if (!n->is_number()) throw error(key, "expected a number");
-  return n->value<double>();
+  const double v = *n->value<double>();
+  // TOML allows inf and nan; no setting of ours means either.
+  if (!std::isfinite(v)) throw error(key, "must be a finite number");
+  return v;
 }
 
 std::optional<long long> TomlView::opt_integer(std::string_view key) const {

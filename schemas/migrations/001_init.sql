@@ -17,7 +17,8 @@ CREATE TABLE runs (
   t_s              REAL NOT NULL DEFAULT 0,   -- last committed tick
   recording        INTEGER NOT NULL DEFAULT 0,
   record_start_s   REAL,
-  start_temp_c     REAL                 -- chamber air at the first tick (for 'return to start')
+  start_temp_c     REAL,                -- chamber air at the first tick (for 'return to start')
+  t0_wall_s        REAL                 -- CLOCK_REALTIME at t_s = 0: a resume continues at the real elapsed time
 );
 
 CREATE TABLE gyros (

@@ -94,6 +94,16 @@ TEST(Config, WrongTypeAndRange) {
       << error_of(n);
 }
 
+TEST(Config, NonFiniteNumbersAreRejected) {
+  std::string t = kMinimal;
+  t.replace(t.find("39.9"), 4, "nan");
+  EXPECT_NE(error_of(t).find("rig.toml:2: key 'station.latitude_deg': must be a finite number"),
+            std::string::npos)
+      << error_of(t);
+  EXPECT_NE(error_of(kMinimal + "[limits]\nmax_setpoint_c = inf\n").find("must be a finite number"),
+            std::string::npos);
+}
+
 TEST(Config, BadEndpointPresetAndTransport) {
   std::string e = kMinimal;
   e.replace(e.find("tcp://127.0.0.1:502"), 19, "tcp://127.0.0.1:99999");

@@ -1,5 +1,7 @@
 // CSV reader: every error path names the file, the line and the column.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <fstream>
@@ -9,8 +11,11 @@
 
 namespace {
 
+// ctest runs every test as its own process, in parallel: each gets its own directory.
 std::string write_temp(const std::string& name, const std::string& text) {
-  const std::string path = testing::TempDir() + name;
+  const std::string dir = testing::TempDir() + "csv-" + std::to_string(getpid());
+  mkdir(dir.c_str(), 0755);
+  const std::string path = dir + "/" + name;
   std::ofstream(path) << text;
   return path;
 }

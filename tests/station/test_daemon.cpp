@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <string>
 
+#include "sim_devices/sim_world.hpp"
 #include "station/sim_run.hpp"
 #include "station/store.hpp"
 
@@ -84,6 +85,53 @@ TEST(Daemon, InterlockOpeningMidRunReachesTheSafeStateAndIsRecorded) {
     ++flagged;
   }
   EXPECT_GT(flagged, 250);
+  // After the clear the ramp goes on at 20 C/h from where the chamber was held: no step.
+  // Setpoint register resolution 0.1 C and the 0.05 C write threshold: +-0.2 C over 300 s.
+  std::optional<double> sp_4400, sp_4700;
+  double max_step = 0, prev = NAN;
+  for (const auto& s : samples) {
+    if (s.t_s == 4400) sp_4400 = s.setpoint_c;
+    if (s.t_s == 4700) sp_4700 = s.setpoint_c;
+    if (s.t_s > 4300 && s.t_s <= 4700 && !std::isnan(prev))
+      max_step = std::max(max_step, std::abs(*s.setpoint_c - prev));
+    if (s.t_s >= 4300) prev = *s.setpoint_c;
+  }
+  ASSERT_TRUE(sp_4400 && sp_4700);
+  EXPECT_NEAR(*sp_4700 - *sp_4400, 300.0 * 20.0 / 3600.0, 0.2);
+  EXPECT_LE(max_step, 0.15);
+  // Samples taken in safe hold are recorded but left out of the bins: the bin holding
+  // 4010..4300 s is incomplete.
+  auto st = store.db().prepare(
+      "SELECT count(*) FROM bins WHERE run_id = ? AND serial = 'SIM-0001' AND complete = 0 "
+      "AND t_start_s <= 4300 AND t_start_s + 600 > 4010");
+  st.bind(1, run);
+  ASSERT_TRUE(st.step());
+  EXPECT_GE(st.column_int(0), 1);
+}
+
+TEST(Daemon, UnreadableInterlockIsTreatedAsOpen) {
+  const auto db = fresh_db("blind");
+  auto o = quiet(db, kData + "/short_cycle.toml");
+  o.gyros = 1;
+  // The turntable (which reports the interlock) stops answering for 8 reads at t = 3000 s.
+  o.on_world_tick = [](double t_s, station::sim::SimWorld& w) {
+    if (t_s == 3000) w.turntable_server().inject_timeouts(8);
+  };
+  const auto r = station::run_simulated(o);
+  EXPECT_EQ(r["state"], "completed");
+  station::Store store(db);
+  const auto events = store.events(r["run_id"].get<std::int64_t>());
+  auto index_of = [&](const std::string& prefix) {
+    for (std::size_t i = 0; i < events.size(); ++i) {
+      if (events[i].rfind(prefix, 0) == 0) return static_cast<int>(i);
+    }
+    return -1;
+  };
+  const int blind = index_of("inputs_unreadable"), hold = index_of("safe_hold: enter"),
+            clear = index_of("safe_hold_cleared");
+  ASSERT_GE(blind, 0) << ::testing::PrintToString(events);
+  EXPECT_GT(hold, blind);
+  EXPECT_GT(clear, hold);
 }
 
 TEST(Daemon, AProtocolBeyondTheLimitsIsClampedAndTheClampLogged) {

@@ -123,7 +123,12 @@ TEST(KillResume, KillNineTwiceLosesNothingAndEndsWithTheSameFit) {
 TEST(KillResume, SigtermEndsTheRunCleanlyAsStopped) {
   const auto db = fresh_db("sigterm");
   const pid_t pid = spawn_run(db);
-  std::this_thread::sleep_for(std::chrono::milliseconds(700));
+  // Wait (bounded) until the run has committed samples, then stop it mid-protocol.
+  for (int i = 0; i < 300; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    station::Store peek(db);
+    if (peek.find_run(1) && peek.sample_count(1) > 0) break;
+  }
   kill(pid, SIGTERM);
   EXPECT_EQ(wait_exit(pid), 0);
   station::Store s(db);
