@@ -12,6 +12,7 @@ class SimClock final : public drivers::Clock {
   explicit SimClock(double start_s = 0.0) : now_s_(start_s) {}
   double now_s() const override { return now_s_; }
   void sleep_until(double deadline_s) override;
+  bool wait_readable(int, double) override { return false; }
 
  private:
   double now_s_;

@@ -97,19 +97,22 @@ void Sequencer::read_devices(double t_s, TickData& d) {
     }
   }
   timer.emplace(phase_s_.gpio);
-  if (rig_.gpio) {
-    if (auto ev = rig_.gpio->read_events(); ev) {
-      for (const auto& e : ev.value()) {
-        emit(t_s, "info", "gpio", "edge",
-             fmt::format("{} {}", e.role, e.rising ? "rising" : "falling"));
-      }
+  read_gpio(t_s, d);
+}
+
+void Sequencer::read_gpio(double t_s, TickData& d) {
+  if (!rig_.gpio) return;
+  if (auto ev = rig_.gpio->read_events(); ev) {
+    for (const auto& e : ev.value()) {
+      emit(t_s, "info", "gpio", "edge",
+           fmt::format("{} {}", e.role, e.rising ? "rising" : "falling"));
     }
-    if (auto closed = rig_.gpio->read(dr::gpio::roles::interlock); closed) {
-      d.gpio_interlock_closed = closed.value();
-    }
-    if (auto pressed = rig_.gpio->read(dr::gpio::roles::estop); pressed) {
-      d.gpio_estop_pressed = pressed.value();
-    }
+  }
+  if (auto closed = rig_.gpio->read(dr::gpio::roles::interlock); closed) {
+    d.gpio_interlock_closed = closed.value();
+  }
+  if (auto pressed = rig_.gpio->read(dr::gpio::roles::estop); pressed) {
+    d.gpio_estop_pressed = pressed.value();
   }
 }
 
@@ -119,6 +122,7 @@ void Sequencer::assemble_samples(double t_s, TickData& d) {
   d.obs.has_turntable = rig_.turntable != nullptr;
   if (d.table) d.obs.table_in_position = d.table->in_position;
   if (d.chamber && std::isfinite(d.chamber->air_c)) d.obs.air_c = d.chamber->air_c;
+  if (d.obs.air_c) last_air_c_ = d.obs.air_c;
   for (const auto& slot : config_.slots) {
     SampleRow r;
     r.serial = slot.serial;
@@ -188,6 +192,28 @@ void Sequencer::apply_safety(double t_s, TickData& d) {
     emit(t_s, "info", "safety", "safe_hold_cleared", *change + ": resuming the protocol step");
     runner_->reenter(hold_air_c_);
   }
+}
+
+void Sequencer::watch_inputs_until(double deadline_s, double t_s) {
+  const int fd = rig_.gpio ? rig_.gpio->event_fd() : -1;
+  // Between ticks the loop waits on the GPIO bank's event fd: an interlock opening or an e-stop
+  // puts the rig in safe hold at once, not at the next tick. Clearing waits for a tick.
+  while (fd >= 0 && clock_.wait_readable(fd, deadline_s)) {
+    TickData d;
+    read_gpio(t_s, d);
+    const bool open = d.gpio_interlock_closed && !*d.gpio_interlock_closed;
+    const bool pressed = d.gpio_estop_pressed.value_or(false);
+    if (safety_.holding() || !(open || pressed)) continue;
+    interlock_open_ = interlock_open_ || open;
+    estop_ = estop_ || pressed;
+    const auto change = safety_.update(interlock_open_, estop_);
+    d.obs.air_c = last_air_c_;
+    if (change && safety_.holding()) {
+      enter_safe_hold(t_s, d, *change + " (between ticks)");
+      keep_safe_hold(t_s, d);
+    }
+  }
+  clock_.sleep_until(deadline_s);
 }
 
 void Sequencer::enter_safe_hold(double t_s, const TickData& d, const std::string& why) {

@@ -75,6 +75,8 @@ class Sequencer {
   void tick(double t_s, TickData& d);
   void read_devices(double t_s, TickData& d);
   void apply_safety(double t_s, TickData& d);
+  void read_gpio(double t_s, TickData& d);
+  void watch_inputs_until(double deadline_s, double t_s);
   void enter_safe_hold(double t_s, const TickData& d, const std::string& why);
   void keep_safe_hold(double t_s, const TickData& d);
   void apply_actions(double t_s, const Actions& a);
@@ -100,6 +102,7 @@ class Sequencer {
   bool interlock_open_ = false, estop_ = false;
   int safety_blind_ticks_ = 0;
   std::optional<double> hold_air_c_;  ///< where the chamber is held during a safe hold
+  std::optional<double> last_air_c_;  ///< last chamber air reading
   bool hold_commanded_ = false, table_stopped_ = false;
   /// Time spent per tick phase (wall seconds, summed), logged at the end of a run.
   struct PhaseTimes {

@@ -101,7 +101,7 @@ RunOutcome Sequencer::run(const std::optional<RunRecord>& resume) {
         rig_.counters->note_skipped_ticks(static_cast<int>(due - k));  // next delta spans them
         k = due;
       } else {
-        clock_.sleep_until(deadline);
+        watch_inputs_until(deadline, t_first + static_cast<double>(k - 1) * period);
       }
     }
     const double t_s = t_first + static_cast<double>(k) * period;

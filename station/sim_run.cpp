@@ -80,7 +80,7 @@ nlohmann::json run_simulated(const SimRunOptions& o) {
   Store store(o.db_path.empty() ? "station-sim.db" : o.db_path);
   // One commit per simulated minute: a commit costs more than a simulated tick, and a killed
   // simulation resumes by deterministic replay anyway. Real rigs commit every tick.
-  store.set_ticks_per_commit(60);
+  store.set_ticks_per_commit(o.wall_clock ? 1 : 60);
   // A simulation continues only the same simulation: same slots, seed and protocol text.
   ResumeDecision rd = decide_resume(store, config, o.fresh, true);
   std::optional<RunRecord> resume = rd.run;
@@ -91,7 +91,9 @@ nlohmann::json run_simulated(const SimRunOptions& o) {
     store.finish_run(resume->id, "aborted");
     resume.reset();
   }
-  sim::SimClock clock;
+  sim::SimClock sim_clock;
+  drivers::MonotonicClock wall_clock;
+  drivers::Clock& clock = o.wall_clock ? static_cast<drivers::Clock&>(wall_clock) : sim_clock;
   SequencerOptions so;
   so.sim_seed = static_cast<std::int64_t>(o.seed);
   so.stop = o.stop;

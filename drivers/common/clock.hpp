@@ -17,6 +17,9 @@ class Clock {
   virtual double now_s() const = 0;
   /// Blocks until now_s() >= deadline_s (a simulated clock jumps and returns at once).
   virtual void sleep_until(double deadline_s) = 0;
+  /// Blocks until `fd` is readable (true) or the deadline passes (false). A simulated clock
+  /// returns false at once: simulated inputs change only between ticks.
+  virtual bool wait_readable(int fd, double deadline_s) = 0;
 };
 
 /// CLOCK_MONOTONIC, with clock_nanosleep(TIMER_ABSTIME) so deadlines do not drift.
@@ -24,6 +27,7 @@ class MonotonicClock final : public Clock {
  public:
   double now_s() const override;
   void sleep_until(double deadline_s) override;
+  bool wait_readable(int fd, double deadline_s) override;
 };
 
 }  // namespace station::drivers

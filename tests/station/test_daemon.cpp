@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <thread>
 
 #include "sim_devices/sim_world.hpp"
 #include "station/sim_run.hpp"
@@ -150,4 +151,33 @@ TEST(Daemon, AProtocolBeyondTheLimitsIsClampedAndTheClampLogged) {
   for (const auto& s : store.samples(run, "SIM-0001", false))
     max_sp = std::max(max_sp, s.setpoint_c.value_or(-1e9));
   EXPECT_NEAR(max_sp, 85.0, 1e-9);  // the default limit (config [limits] max_setpoint_c)
+}
+
+// On the wall clock the loop waits on the GPIO bank's event fd between ticks: a door opened
+// 300 ms after a tick puts the rig in safe hold then, not at the next tick.
+TEST(Daemon, InterlockBetweenTicksIsActedOnAtOnce) {
+  const auto db = fresh_db("between");
+  auto o = quiet(db, kData + "/wall_hold.toml");
+  o.gyros = 1;
+  o.wall_clock = true;
+  std::thread opener;
+  o.on_world_tick = [&opener](double t_s, station::sim::SimWorld& w) {
+    if (t_s != 1) return;
+    auto chips = w.gpio_chips();
+    opener = std::thread([chips] {
+      std::this_thread::sleep_for(std::chrono::milliseconds(300));
+      chips->set_input("DOOR_SW", false);
+      std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+      chips->set_input("DOOR_SW", true);  // closed again: the protocol can finish
+    });
+  };
+  const auto r = station::run_simulated(o);
+  if (opener.joinable()) opener.join();
+  station::Store store(db);
+  const auto events = store.events(r["run_id"].get<std::int64_t>());
+  bool between = false;
+  for (const auto& e : events)
+    between = between || (e.rfind("safe_hold: enter", 0) == 0 &&
+                          e.find("(between ticks)") != std::string::npos);
+  EXPECT_TRUE(between) << ::testing::PrintToString(events);
 }
