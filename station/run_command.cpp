@@ -6,8 +6,11 @@
 #include <atomic>
 #include <csignal>
 #include <cstdlib>
+#include <fstream>
 #include <iostream>
+#include <optional>
 
+#include "drivers/can/candump_log.hpp"
 #include "drivers/common/clock.hpp"
 #include "station/commands.hpp"
 #include "station/logging.hpp"
@@ -35,7 +38,7 @@ void install_signal_handlers() {
 
 struct RunOptions {
   bool sim = false, json = false, fresh = false;
-  std::string config, protocol = "paper", db, operator_name, log_file;
+  std::string config, protocol = "paper", db, operator_name, log_file, record_can;
   int gyros = 4;
   std::uint64_t seed = 1;
   double latitude_deg = 39.9;
@@ -54,7 +57,15 @@ int run_real(const RunOptions& o) {
     }
     protocol = *resume_decision.protocol;
   }
-  Rig rig = build_rig(config);
+  RigOptions ro;
+  std::ofstream can_log;
+  std::optional<drivers::can::CandumpTap> can_tap;
+  if (!o.record_can.empty()) {
+    can_log.open(o.record_can, std::ios::app);
+    if (!can_log) throw InputError(fmt::format("{}: cannot write the CAN log", o.record_can));
+    ro.tap = &can_tap.emplace(can_log, "can0");
+  }
+  Rig rig = build_rig(config, ro);
   drivers::MonotonicClock clock;
   SequencerOptions so;
   so.operator_name = o.operator_name;
@@ -81,6 +92,7 @@ int run_sim(const RunOptions& o) {
   so.db_path = o.db;
   so.fresh = o.fresh;
   so.stop = &g_stop;
+  so.record_can_path = o.record_can;
   const auto report = run_simulated(so);
   if (o.json) {
     std::cout << report.dump(2) << '\n';
@@ -109,6 +121,8 @@ void add_run_command(CLI::App& app, CommandStatus& status) {
   cmd->add_option("--latitude", o->latitude_deg, "simulated site latitude, deg")
       ->capture_default_str();
   cmd->add_option("--log-file", o->log_file, "rotating log file");
+  cmd->add_option("--record-can", o->record_can,
+                  "write every CAN frame in can-utils' candump format to this file");
   cmd->add_flag("--json", o->json, "print one JSON object at the end (--sim)");
   cmd->callback([o, &status] {
     LogOptions lo;

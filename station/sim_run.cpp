@@ -4,8 +4,10 @@
 #include <fmt/format.h>
 
 #include <chrono>
+#include <fstream>
 
 #include "compensation/earth_rate.hpp"
+#include "drivers/can/candump_log.hpp"
 #include "sim_devices/gpio_sim.hpp"
 #include "sim_devices/sim_clock.hpp"
 #include "sim_devices/sim_world.hpp"
@@ -72,6 +74,13 @@ nlohmann::json run_simulated(const SimRunOptions& o) {
   sim::SimWorld world(wc);
   const StationConfig config = parse_station_config(sim_config_text(world, o), "sim:station.toml");
   RigOptions ro;
+  std::ofstream can_log;
+  std::optional<drivers::can::CandumpTap> can_tap;
+  if (!o.record_can_path.empty()) {
+    can_log.open(o.record_can_path);
+    if (!can_log) throw InputError(fmt::format("{}: cannot write the CAN log", o.record_can_path));
+    ro.tap = &can_tap.emplace(can_log, "can0");
+  }
   auto chips = world.gpio_chips();
   ro.gpio_factory = [chips](const drivers::gpio::GpioConfig& g) {
     return std::make_unique<sim::GpioSimBank>(g, chips);

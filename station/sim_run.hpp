@@ -25,6 +25,7 @@ struct SimRunOptions {
   bool fresh = false;              ///< ignore an unfinished run in the database
   bool progress = true;            ///< progress lines on stderr
   bool wall_clock = false;         ///< run at 1 Hz on CLOCK_MONOTONIC instead of simulated time
+  std::string record_can_path;     ///< write every CAN frame in candump format here (empty: no)
   /// Test hooks: open the door interlock at this simulated time for this long.
   double interlock_open_at_s = -1, interlock_open_for_s = 0;
   const std::atomic<bool>* stop = nullptr;

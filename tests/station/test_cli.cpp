@@ -8,6 +8,8 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "drivers/can/candump_log.hpp"
+
 namespace {
 
 struct Outcome {
@@ -143,4 +145,26 @@ TEST(Cli, SimRunThenFitAllAndExport) {
   const auto missing = run_station("export --db " + db + " --serial NOPE");
   EXPECT_EQ(missing.status, 2);
   EXPECT_NE(missing.out.find("no fit stored for serial 'NOPE'"), std::string::npos) << missing.out;
+}
+
+TEST(Cli, SimRunRecordsEveryCanFrameInCandumpFormat) {
+  const std::string db = testing::TempDir() + "cli_rec.db";
+  const std::string log = testing::TempDir() + "cli_rec.log";
+  for (const char* ext : {"", "-wal", "-shm"}) std::remove((db + ext).c_str());
+  std::remove(log.c_str());
+  const auto run = run_station("run --sim --gyros 2 --new --json --db " + db + " --record-can " +
+                                   log + " --protocol " + STATION_TEST_DATA_DIR "/short_cycle.toml",
+                               false);
+  ASSERT_EQ(run.status, 0) << run.out;
+  const auto ticks = nlohmann::json::parse(run.out)["sim_s"].get<double>() + 1;  // t = 0 .. sim_s
+  const auto records = station::drivers::can::read_candump_log(log);
+  int syncs = 0, counts_node1 = 0, counts_node2 = 0;
+  for (const auto& r : records) {
+    if (r.frame.can_id == 0x080) ++syncs;
+    if (r.frame.can_id == 0x281) ++counts_node1;
+    if (r.frame.can_id == 0x282) ++counts_node2;
+  }
+  EXPECT_EQ(syncs, static_cast<int>(ticks));  // one SYNC per tick
+  EXPECT_EQ(counts_node1, syncs);             // every latch answered
+  EXPECT_EQ(counts_node2, syncs);
 }
