@@ -10,20 +10,26 @@ namespace station {
 
 namespace sc = station::compensation;
 
+std::vector<sc::Bin> bin_samples(const std::vector<SampleRow>& rows, double bin_s) {
+  std::vector<double> t, rate, temp, grad;
+  for (const auto& s : rows) {
+    if (!s.recording || !s.rate_dph || !s.temp_c || !s.temp2_c || (s.flags & kUnfitFlags) != 0) {
+      continue;
+    }
+    t.push_back(s.t_s);
+    rate.push_back(*s.rate_dph);
+    temp.push_back(*s.temp_c);
+    grad.push_back(*s.temp2_c - *s.temp_c);  // gradient = second sensor - first (analyze's rule)
+  }
+  sc::BinConfig cfg;
+  cfg.width_s = bin_s;
+  cfg.sample_period_s = 1.0;  // the sequencer's tick
+  return sc::make_bins({t, rate, temp, grad, {}}, cfg);
+}
+
 void bin_run(Store& store, std::int64_t run_id, double bin_s) {
   for (const auto& slot : store.run_slots(run_id)) {
-    std::vector<double> t, rate, temp, grad;
-    for (const auto& s : store.samples(run_id, slot.serial, true)) {
-      if (!s.rate_dph || !s.temp_c || !s.temp2_c || (s.flags & kUnfitFlags) != 0) continue;
-      t.push_back(s.t_s);
-      rate.push_back(*s.rate_dph);
-      temp.push_back(*s.temp_c);
-      grad.push_back(*s.temp2_c - *s.temp_c);  // gradient = second sensor - first (analyze's rule)
-    }
-    sc::BinConfig cfg;
-    cfg.width_s = bin_s;
-    cfg.sample_period_s = 1.0;  // the sequencer's tick
-    const auto bins = sc::make_bins({t, rate, temp, grad, {}}, cfg);
+    const auto bins = bin_samples(store.samples(run_id, slot.serial, true), bin_s);
     store.replace_bins(run_id, slot.serial, bins, slot.earth_rate_dph);
   }
 }

@@ -11,6 +11,9 @@
 
 namespace station {
 
+/// Bins one gyro's samples of the record window (recording = true) at bin_s.
+std::vector<compensation::Bin> bin_samples(const std::vector<SampleRow>& rows, double bin_s);
+
 /// Bins every slot's recorded samples of `run_id` (bin width bin_s) and stores them.
 /// The gradient is temp2 - temp per sample; samples without rate or temperatures, or flagged
 /// safe-hold or board fault (kUnfitFlags), are skipped, so their bins come out incomplete.

@@ -21,5 +21,7 @@ void add_probe_command(CLI::App& app, CommandStatus& status);
 void add_run_command(CLI::App& app, CommandStatus& status);
 /// `station fit` and `station export`: per-serial fits from the database and their export.
 void add_fit_commands(CLI::App& app, CommandStatus& status);
+/// `station replay LOG --db PATH --run ID`: a recorded session through the driver again.
+void add_replay_command(CLI::App& app, CommandStatus& status);
 
 }  // namespace station

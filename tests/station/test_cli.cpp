@@ -7,6 +7,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "drivers/can/candump_log.hpp"
 
@@ -167,4 +168,38 @@ TEST(Cli, SimRunRecordsEveryCanFrameInCandumpFormat) {
   EXPECT_EQ(syncs, static_cast<int>(ticks));  // one SYNC per tick
   EXPECT_EQ(counts_node1, syncs);             // every latch answered
   EXPECT_EQ(counts_node2, syncs);
+}
+
+// gpsd-style regression: a recorded session replayed through the same driver gives the stored
+// fit exactly; a log missing one COUNTS frame inside the record window does not.
+TEST(Cli, ReplayOfARecordedRunReproducesItsFitAndCatchesATamperedLog) {
+  const std::string db = testing::TempDir() + "cli_replay.db";
+  const std::string log = testing::TempDir() + "cli_replay.log";
+  for (const char* ext : {"", "-wal", "-shm"}) std::remove((db + ext).c_str());
+  std::remove(log.c_str());
+  ASSERT_EQ(run_station("run --sim --gyros 2 --new --db " + db + " --record-can " + log +
+                        " --protocol " + STATION_TEST_DATA_DIR "/short_cycle.toml")
+                .status,
+            0);
+  const auto same = run_station("replay " + log + " --db " + db + " --run 1 --json", false);
+  ASSERT_EQ(same.status, 0) << same.out;
+  const auto j = nlohmann::json::parse(same.out);
+  EXPECT_TRUE(j["identical"].get<bool>());
+  EXPECT_EQ(j["gyros"].size(), 2u);
+
+  // Drop the first COUNTS frame of node 1 past 80 % of the log (inside the record window).
+  std::ifstream in(log);
+  std::vector<std::string> lines;
+  for (std::string l; std::getline(in, l);) lines.push_back(l);
+  in.close();
+  std::size_t drop = lines.size() * 8 / 10;
+  while (drop < lines.size() && lines[drop].find(" 281#") == std::string::npos) ++drop;
+  ASSERT_LT(drop, lines.size());
+  lines.erase(lines.begin() + static_cast<std::ptrdiff_t>(drop));
+  std::ofstream out(log);
+  for (const auto& l : lines) out << l << '\n';
+  out.close();
+  const auto tampered = run_station("replay " + log + " --db " + db + " --run 1 --json", false);
+  EXPECT_EQ(tampered.status, 1) << tampered.out;
+  EXPECT_FALSE(nlohmann::json::parse(tampered.out)["identical"].get<bool>());
 }
