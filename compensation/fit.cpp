@@ -2,6 +2,7 @@
 #include "compensation/fit.hpp"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <numeric>
 #include <stdexcept>
@@ -73,6 +74,25 @@ Eigen::MatrixXd design_matrix(const ModelInput& in, const ModelSpec& spec) {
     for (Eigen::Index i = 0; i < n; ++i) x(i, j + 1) = regressor(t, src[i], spec.ref_temp_c);
   }
   return x;
+}
+
+/// Newey & West (1987) heteroskedasticity- and autocorrelation-consistent covariance of the
+/// scaled coefficients: n/(n-p) A S A, A = (X'X)^-1 = R^-1 R^-T, S = sum_l w_l (G_l + G_l'),
+/// G_l = sum_t e_t e_(t-l) x_t x_(t-l)', w_l = 1 - l/(L+1) (Bartlett). Rows in time order.
+Eigen::VectorXd hac_variances(const Eigen::MatrixXd& x, const Eigen::VectorXd& resid,
+                              const Eigen::MatrixXd& r_inv, std::size_t lag) {
+  const Eigen::MatrixXd u = x.array().colwise() * resid.array();
+  Eigen::MatrixXd s = u.transpose() * u;
+  const auto n = u.rows();
+  for (std::size_t l = 1; l <= lag && static_cast<Eigen::Index>(l) < n; ++l) {
+    const auto li = static_cast<Eigen::Index>(l);
+    const double w = 1.0 - static_cast<double>(l) / static_cast<double>(lag + 1);
+    const Eigen::MatrixXd g = u.bottomRows(n - li).transpose() * u.topRows(n - li);
+    s += w * (g + g.transpose());
+  }
+  const Eigen::MatrixXd a = r_inv * r_inv.transpose();
+  const double dof_correction = static_cast<double>(n) / static_cast<double>(n - x.cols());
+  return (a * s * a).diagonal() * dof_correction;
 }
 
 }  // namespace
@@ -168,11 +188,16 @@ FitResult fit_model(const ModelInput& in, const ModelSpec& spec) {
   const Eigen::MatrixXd r_inv =
       r.triangularView<Eigen::Upper>().solve(Eigen::MatrixXd::Identity(pi, pi));
   const Eigen::VectorXd var_scaled = (r_inv * r_inv.transpose()).diagonal() * s2;
+  // Lag rule of Newey & West (1994): L = floor(4 (n/100)^(2/9)).
+  res.hac_lag = static_cast<std::size_t>(
+      std::floor(4.0 * std::pow(static_cast<double>(n) / 100.0, 2.0 / 9.0)));
+  const Eigen::VectorXd var_hac = hac_variances(x, resid, r_inv, res.hac_lag);
   res.names.emplace_back("B0");
   for (Term t : spec.terms) res.names.emplace_back(info(t).coefficient);
   for (Eigen::Index j = 0; j < pi; ++j) {
     res.coefficients.push_back(beta_scaled(j) / scale(j));
     res.std_errors.push_back(std::sqrt(var_scaled(j)) / scale(j));
+    res.std_errors_hac.push_back(std::sqrt(std::max(var_hac(j), 0.0)) / scale(j));
   }
   const double mean_y = y.mean();
   const double tss = (y.array() - mean_y).square().sum();

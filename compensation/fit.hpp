@@ -53,8 +53,12 @@ ModelData model_data_from_bins(std::span<const Bin> bins, double earth_rate_dph)
 struct FitResult {
   ModelSpec spec;
   std::vector<std::string> names;
-  std::vector<double> coefficients;   ///< deg/h, deg/h/C^i, deg/h/C, deg/h/(C/h), ...
-  std::vector<double> std_errors;     ///< one standard error per coefficient
+  std::vector<double> coefficients;  ///< deg/h, deg/h/C^i, deg/h/C, deg/h/(C/h), ...
+  std::vector<double> std_errors;    ///< one standard error per coefficient (OLS, iid)
+  /// Newey-West (HAC) standard errors: honest when the residuals of neighbouring bins are
+  /// correlated (bias instability over hours). Bartlett weights up to hac_lag bins.
+  std::vector<double> std_errors_hac;
+  std::size_t hac_lag = 0;
   std::size_t n_points = 0;           ///< bins used
   std::size_t dof = 0;                ///< n_points - coefficients
   double r2 = 0;                      ///< coefficient of determination

@@ -106,7 +106,9 @@ nlohmann::json to_json(const Analysis& a) {
           {"r2", a.fit.r2},
           {"residual_rms_dph", a.fit.residual_rms_dph},
           {"condition_number", a.fit.condition_number},
-          {"warnings", a.warnings}};
+          {"warnings", a.warnings},
+          {"std_errors_hac", std_errors_hac_json(a.fit)},
+          {"hac_lag", a.fit.hac_lag}};
 }
 
 void print_table(const AnalyzeOptions& o, const Analysis& a) {
@@ -124,10 +126,10 @@ void print_table(const AnalyzeOptions& o, const Analysis& a) {
         return s;
       }(),
       o.ref_temp_c);
-  fmt::print("  {:<4} {:>14} {:>12}\n", "term", "value", "std error");
+  fmt::print("  {:<4} {:>14} {:>12} {:>14}\n", "term", "value", "std error", "Newey-West");
   for (std::size_t i = 0; i < a.fit.names.size(); ++i) {
-    fmt::print("  {:<4} {:>14.6e} {:>12.3e}\n", a.fit.names[i], a.fit.coefficients[i],
-               a.fit.std_errors[i]);
+    fmt::print("  {:<4} {:>14.6e} {:>12.3e} {:>14.3e}\n", a.fit.names[i], a.fit.coefficients[i],
+               a.fit.std_errors[i], a.fit.std_errors_hac[i]);
   }
   fmt::print("\nstd before {:.5f} deg/h, after {:.5f} deg/h, ratio {:.3f} ({:.1f} % better)\n",
              a.eval.std_before_dph, a.eval.std_after_dph, a.eval.std_ratio, a.eval.improvement_pct);

@@ -42,6 +42,7 @@ nlohmann::json fit_json(const SerialFit& f) {
           {"runs", f.runs},
           {"coefficients", coef},
           {"std_errors", se},
+          {"std_errors_hac", std_errors_hac_json(f.fit)},
           {"bins", f.fit.n_points},
           {"r2", f.fit.r2},
           {"std_before_dph", f.eval.std_before_dph},

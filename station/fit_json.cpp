@@ -20,4 +20,8 @@ nlohmann::json std_errors_json(const compensation::FitResult& fit) {
   return keyed(fit, fit.std_errors);
 }
 
+nlohmann::json std_errors_hac_json(const compensation::FitResult& fit) {
+  return keyed(fit, fit.std_errors_hac);
+}
+
 }  // namespace station

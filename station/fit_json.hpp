@@ -12,5 +12,7 @@ namespace station {
 nlohmann::json coefficients_json(const compensation::FitResult& fit);
 /// {"B0": std error, "k1": std error, ...}
 nlohmann::json std_errors_json(const compensation::FitResult& fit);
+/// {"B0": Newey-West std error, ...}
+nlohmann::json std_errors_hac_json(const compensation::FitResult& fit);
 
 }  // namespace station

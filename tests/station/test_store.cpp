@@ -56,7 +56,7 @@ TEST(Store, TicksAndProgressRoundTrip) {
     r.rate_dph = 10.5 + t;
     r.temp_c = 20.0;
     r.recording = t >= 2;
-    station::RunProgress p{2, 1.0, static_cast<double>(t), t >= 2, 2.0};
+    station::RunProgress p{2, 1.0, static_cast<double>(t), t >= 2, 2.0, std::nullopt};
     s.append_tick(run, {r}, p);
   }
   EXPECT_EQ(s.sample_count(run), 5);
