@@ -6,7 +6,6 @@
 #include <chrono>
 #include <cmath>
 
-#include "compensation/earth_rate.hpp"
 #include "drivers/gpio/gpio_bank.hpp"
 #include "station/logging.hpp"
 
