@@ -10,16 +10,13 @@
 #include "sim_devices/sim_world.hpp"
 #include "station/sim_run.hpp"
 #include "station/store.hpp"
+#include "tests/station/temp_db.hpp"
 
 namespace {
 
 const std::string kData = STATION_TEST_DATA_DIR;
 
-std::string fresh_db(const std::string& name) {
-  const std::string path = testing::TempDir() + name + "-" + std::to_string(getpid()) + ".db";
-  for (const char* ext : {"", "-wal", "-shm"}) std::remove((path + ext).c_str());
-  return path;
-}
+using station::testing_support::fresh_db;
 
 station::SimRunOptions quiet(const std::string& db, const std::string& protocol) {
   station::SimRunOptions o;

@@ -15,6 +15,7 @@
 #include <tuple>
 
 #include "station/store.hpp"
+#include "tests/station/temp_db.hpp"
 
 extern char** environ;
 
@@ -23,11 +24,7 @@ namespace {
 const std::string kStation = std::string(STATION_BINARY_DIR) + "/station/station";
 const std::string kProtocol = std::string(STATION_TEST_DATA_DIR) + "/short_cycle.toml";
 
-std::string fresh_db(const std::string& name) {
-  const std::string path = testing::TempDir() + name + "-" + std::to_string(getpid()) + ".db";
-  for (const char* ext : {"", "-wal", "-shm"}) std::remove((path + ext).c_str());
-  return path;
-}
+using station::testing_support::fresh_db;
 
 // Starts `station run --sim` on `db`; output discarded.
 pid_t spawn_run(const std::string& db) {

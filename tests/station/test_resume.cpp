@@ -6,14 +6,11 @@
 #include <cstdio>
 
 #include "station/resume.hpp"
+#include "tests/station/temp_db.hpp"
 
 namespace {
 
-std::string fresh_db(const std::string& name) {
-  const std::string path = testing::TempDir() + name + "-" + std::to_string(getpid()) + ".db";
-  for (const char* ext : {"", "-wal", "-shm"}) std::remove((path + ext).c_str());
-  return path;
-}
+using station::testing_support::fresh_db;
 
 station::StationConfig config_with(const std::string& serial2) {
   return station::parse_station_config(

@@ -6,16 +6,11 @@
 #include <string>
 
 #include "station/store.hpp"
+#include "tests/station/temp_db.hpp"
 
 namespace {
 
-std::string fresh_db(const std::string& name) {
-  const std::string path = testing::TempDir() + name + "-" + std::to_string(getpid()) + ".db";
-  std::remove(path.c_str());
-  std::remove((path + "-wal").c_str());
-  std::remove((path + "-shm").c_str());
-  return path;
-}
+using station::testing_support::fresh_db;
 
 station::RunInfo info() {
   return {"paper", "[[step]]", "[station]", "0.1.0", "rig", "alice", 42};
