@@ -53,6 +53,11 @@ void Sequencer::emit(double t_s, const std::string& severity, const std::string&
 }
 
 void Sequencer::connect_devices() {
+  const auto has_line = [this](std::string_view role) {
+    return rig_.gpio != nullptr && dr::gpio::find_role(rig_.gpio->config(), role) != nullptr;
+  };
+  has_gpio_interlock_ = has_line(dr::gpio::roles::interlock);
+  has_gpio_estop_ = has_line(dr::gpio::roles::estop);
   if (auto r = rig_.chamber->connect(); !r)
     emit(0, "warn", "chamber", "connect", r.error().message);
   if (rig_.turntable) {
@@ -158,11 +163,7 @@ void Sequencer::apply_safety(double t_s, TickData& d) {
   // positive readings, and inputs unreadable for kSafetyBlindTicks count as open.
   constexpr int kSafetyBlindTicks = 5;
   const bool has_table = rig_.turntable != nullptr;
-  const auto has_line = [this](std::string_view role) {
-    return rig_.gpio != nullptr && dr::gpio::find_role(rig_.gpio->config(), role) != nullptr;
-  };
-  const bool has_gpio = has_line(dr::gpio::roles::interlock);
-  const bool has_estop = has_line(dr::gpio::roles::estop);
+  const bool has_gpio = has_gpio_interlock_, has_estop = has_gpio_estop_;
   const bool blind = (has_table && !d.table_interlock_open) ||
                      (has_gpio && !d.gpio_interlock_closed) || (has_estop && !d.gpio_estop_pressed);
   safety_blind_ticks_ = blind ? safety_blind_ticks_ + 1 : 0;

@@ -101,6 +101,7 @@ class Sequencer {
   /// kSafetyBlindTicks in a row counts as open (fail safe).
   bool interlock_open_ = false, estop_ = false;
   int safety_blind_ticks_ = 0;
+  bool has_gpio_interlock_ = false, has_gpio_estop_ = false;  ///< lines configured (set at connect)
   std::optional<double> hold_air_c_;  ///< where the chamber is held during a safe hold
   std::optional<double> last_air_c_;  ///< last chamber air reading
   bool hold_commanded_ = false, table_stopped_ = false;
