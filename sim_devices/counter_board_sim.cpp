@@ -131,20 +131,41 @@ int CounterBoardBus::service(std::chrono::milliseconds timeout) {
     auto sync = wire::decode_sync(f);
     if (!sync) continue;  // board frames from elsewhere on the bus are not for us
     ++syncs;
-    const std::lock_guard lock(mutex_);
-    for (auto& b : boards_) send_all(b->on_sync(sync.value().latch_seq));
+    std::vector<BoardRecord> answers;
+    {
+      const std::lock_guard lock(mutex_);
+      for (auto& b : boards_) {
+        auto r = b->on_sync(sync.value().latch_seq);
+        answers.insert(answers.end(), r.begin(), r.end());
+      }
+    }
+    send_all(answers);  // the whole bus's answers in one burst, as they follow on a real bus
   }
   return syncs;
 }
 
 void CounterBoardBus::send_all(const std::vector<BoardRecord>& records) {
-  for (const auto& r : records) {
-    const std::size_t len = r.short_record ? 8 : sizeof(can_frame);
-    if (::send(fd_, &r.frame, len, MSG_NOSIGNAL | MSG_DONTWAIT) >= 0) continue;
+  // One sendmmsg for the burst (one wake-up of the reader); each record stays its own datagram.
+  std::vector<iovec> iov(records.size());
+  std::vector<mmsghdr> msgs(records.size());
+  for (std::size_t i = 0; i < records.size(); ++i) {
+    iov[i] = {const_cast<can_frame*>(&records[i].frame),
+              records[i].short_record ? 8 : sizeof(can_frame)};
+    msgs[i] = {};
+    msgs[i].msg_hdr.msg_iov = &iov[i];
+    msgs[i].msg_hdr.msg_iovlen = 1;
+  }
+  std::size_t sent = 0;
+  while (sent < msgs.size()) {
+    const int n = ::sendmmsg(fd_, msgs.data() + sent, static_cast<unsigned>(msgs.size() - sent),
+                             MSG_NOSIGNAL | MSG_DONTWAIT);
+    if (n > 0) {
+      sent += static_cast<std::size_t>(n);
+      continue;
+    }
     pollfd p{fd_, POLLOUT, 0};
-    if (errno != EAGAIN || ::poll(&p, 1, 100) <= 0)
-      return;  // peer not reading: drop, like a full tx queue
-    if (::send(fd_, &r.frame, len, MSG_NOSIGNAL | MSG_DONTWAIT) < 0) return;
+    if (n < 0 && errno != EAGAIN) return;
+    if (::poll(&p, 1, 100) <= 0) return;  // peer not reading: drop, like a full tx queue
   }
 }
 
