@@ -8,6 +8,7 @@
 #include <sys/socket.h>
 #include <sys/un.h>
 
+#include <array>
 #include <cerrno>
 #include <charconv>
 #include <cstring>
@@ -45,12 +46,26 @@ class FdCanTransport final : public CanTransport {
  private:
   Result<void> wait(short events, std::chrono::milliseconds timeout, const char* what);
   Result<can_frame> read_one();
+  Result<void> fill();
+  Result<can_frame> take(const mmsghdr& m);
   void tap(TapDirection dir, const can_frame& f, double t, std::string detail = {}) const;
+
+  // Received records are read in batches (one recvmmsg for a burst of board answers) and handed
+  // out one by one; each keeps its own length, flags and kernel timestamp.
+  static constexpr std::size_t kBatch = 32;
+  struct RxSlot {
+    alignas(can_frame) std::uint8_t buf[2 * sizeof(can_frame) + 64];
+    alignas(cmsghdr) char control[CMSG_SPACE(sizeof(timeval))];
+    iovec iov;
+  };
 
   UniqueFd fd_;
   CanOpenOptions options_;
   std::string name_;
   double last_rx_time_s_ = 0;
+  std::array<RxSlot, kBatch> rx_{};
+  std::array<mmsghdr, kBatch> rx_msgs_{};
+  std::size_t rx_next_ = 0, rx_count_ = 0;
 };
 
 Result<void> FdCanTransport::wait(short events, std::chrono::milliseconds timeout,
@@ -92,20 +107,36 @@ Result<can_frame> FdCanTransport::receive(std::chrono::milliseconds timeout) {
   return read_one();
 }
 
+Result<void> FdCanTransport::fill() {
+  for (std::size_t i = 0; i < kBatch; ++i) {
+    rx_[i].iov = {rx_[i].buf, sizeof rx_[i].buf};
+    rx_msgs_[i] = {};
+    rx_msgs_[i].msg_hdr.msg_iov = &rx_[i].iov;
+    rx_msgs_[i].msg_hdr.msg_iovlen = 1;
+    rx_msgs_[i].msg_hdr.msg_control = rx_[i].control;
+    rx_msgs_[i].msg_hdr.msg_controllen = sizeof rx_[i].control;
+  }
+  const int n = ::recvmmsg(fd_.get(), rx_msgs_.data(), kBatch, MSG_DONTWAIT, nullptr);
+  if (n < 0) return errno_error(name_, "recvmmsg", errno);
+  rx_next_ = 0;
+  rx_count_ = static_cast<std::size_t>(n);
+  if (n == 0) return make_error(ErrorKind::disconnected, name_ + ": peer closed");
+  return {};
+}
+
 Result<can_frame> FdCanTransport::read_one() {
-  alignas(can_frame) std::uint8_t buf[2 * sizeof(can_frame) + 64];
-  alignas(cmsghdr) char control[CMSG_SPACE(sizeof(timeval))];
-  iovec iov{buf, sizeof buf};
-  msghdr msg{};
-  msg.msg_iov = &iov;
-  msg.msg_iovlen = 1;
-  msg.msg_control = control;
-  msg.msg_controllen = sizeof control;
-  const ssize_t n = ::recvmsg(fd_.get(), &msg, MSG_DONTWAIT);
-  if (n < 0) return errno_error(name_, "recvmsg", errno);
+  if (rx_next_ >= rx_count_) {
+    if (auto r = fill(); !r) return r.error();
+  }
+  return take(rx_msgs_[rx_next_++]);
+}
+
+Result<can_frame> FdCanTransport::take(const mmsghdr& m) {
+  const auto n = static_cast<ssize_t>(m.msg_len);
+  const msghdr& msg = m.msg_hdr;
   if (n == 0) return make_error(ErrorKind::disconnected, name_ + ": peer closed");
   last_rx_time_s_ = tap_wall_time_s();
-  for (cmsghdr* c = CMSG_FIRSTHDR(&msg); c; c = CMSG_NXTHDR(&msg, c)) {
+  for (cmsghdr* c = CMSG_FIRSTHDR(&msg); c; c = CMSG_NXTHDR(const_cast<msghdr*>(&msg), c)) {
     if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SO_TIMESTAMP) {
       timeval tv;
       std::memcpy(&tv, CMSG_DATA(c), sizeof tv);
@@ -120,7 +151,7 @@ Result<can_frame> FdCanTransport::read_one() {
         fmt::format("{}: read {} bytes, a can_frame record is {}", name_, n, sizeof(can_frame)));
   }
   can_frame f;
-  std::memcpy(&f, buf, sizeof f);
+  std::memcpy(&f, msg.msg_iov->iov_base, sizeof f);
   tap(TapDirection::rx, f, last_rx_time_s_);
   return f;
 }
