@@ -92,23 +92,12 @@ Analysis analyze(const AnalyzeOptions& o) {
 }
 
 nlohmann::json to_json(const Analysis& a) {
-  const nlohmann::json coef = coefficients_json(a.fit), se = std_errors_json(a.fit);
-  return {{"coefficients", coef},
-          {"std_errors", se},
-          {"bins", a.bins_used},
-          {"bins_flagged", a.bins_flagged},
-          {"samples", a.samples},
-          {"earth_rate_dph", a.earth_rate_dph},
-          {"std_before_dph", a.eval.std_before_dph},
-          {"std_after_dph", a.eval.std_after_dph},
-          {"std_ratio", a.eval.std_ratio},
-          {"improvement_pct", a.eval.improvement_pct},
-          {"r2", a.fit.r2},
-          {"residual_rms_dph", a.fit.residual_rms_dph},
-          {"condition_number", a.fit.condition_number},
-          {"warnings", a.warnings},
-          {"std_errors_hac", std_errors_hac_json(a.fit)},
-          {"hac_lag", a.fit.hac_lag}};
+  nlohmann::json j = fit_summary_json(a.fit, a.eval);
+  j["bins_flagged"] = a.bins_flagged;
+  j["samples"] = a.samples;
+  j["earth_rate_dph"] = a.earth_rate_dph;
+  j["warnings"] = a.warnings;  // the fit's and the command's own
+  return j;
 }
 
 void print_table(const AnalyzeOptions& o, const Analysis& a) {

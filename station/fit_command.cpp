@@ -36,20 +36,11 @@ std::string unit_of(const std::string& name) {
 }
 
 nlohmann::json fit_json(const SerialFit& f) {
-  const nlohmann::json coef = coefficients_json(f.fit), se = std_errors_json(f.fit);
-  return {{"serial", f.serial},
-          {"fit_id", f.fit_id},
-          {"runs", f.runs},
-          {"coefficients", coef},
-          {"std_errors", se},
-          {"std_errors_hac", std_errors_hac_json(f.fit)},
-          {"bins", f.fit.n_points},
-          {"r2", f.fit.r2},
-          {"std_before_dph", f.eval.std_before_dph},
-          {"std_after_dph", f.eval.std_after_dph},
-          {"std_ratio", f.eval.std_ratio},
-          {"improvement_pct", f.eval.improvement_pct},
-          {"warnings", f.fit.warnings}};
+  nlohmann::json j = fit_summary_json(f.fit, f.eval);
+  j["serial"] = f.serial;
+  j["fit_id"] = f.fit_id;
+  j["runs"] = f.runs;
+  return j;
 }
 
 void print_fit(const SerialFit& f) {

@@ -14,5 +14,10 @@ nlohmann::json coefficients_json(const compensation::FitResult& fit);
 nlohmann::json std_errors_json(const compensation::FitResult& fit);
 /// {"B0": Newey-West std error, ...}
 nlohmann::json std_errors_hac_json(const compensation::FitResult& fit);
+/// The fit and its evaluation as every command reports them: coefficients, std_errors,
+/// std_errors_hac, hac_lag, bins, r2, residual_rms_dph, condition_number, std_before_dph,
+/// std_after_dph, std_ratio, improvement_pct, warnings (the fit's).
+nlohmann::json fit_summary_json(const compensation::FitResult& fit,
+                                const compensation::Evaluation& eval);
 
 }  // namespace station

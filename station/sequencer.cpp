@@ -184,11 +184,11 @@ void Sequencer::apply_safety(double t_s, TickData& d) {
   if (safety_blind_ticks_ >= kSafetyBlindTicks) interlock = true;
   interlock_open_ = interlock;
   estop_ = estop;
+  const bool was_holding = safety_.holding();
   const auto change = safety_.update(interlock, estop);
-  if (change && safety_.holding() && change->rfind("enter", 0) == 0)
-    enter_safe_hold(t_s, d, *change);
+  if (change && safety_.holding() && !was_holding) enter_safe_hold(t_s, d, *change);
   if (safety_.holding()) keep_safe_hold(t_s, d);
-  if (change && !safety_.holding()) {
+  if (change && was_holding && !safety_.holding()) {
     emit(t_s, "info", "safety", "safe_hold_cleared", *change + ": resuming the protocol step");
     runner_->reenter(hold_air_c_);
   }

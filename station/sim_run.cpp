@@ -108,14 +108,9 @@ nlohmann::json run_simulated(const SimRunOptions& o) {
   so.stop = o.stop;
   // Resuming a simulation replays it deterministically from t = 0 up to the last stored tick.
   if (resume) so.replay_until_t_s = resume->progress.t_s;
-  so.before_tick = [&world, &o, chips](double t_s) {
+  so.before_tick = [&world, &o](double t_s) {
     world.advance_to(t_s);
     if (o.on_world_tick) o.on_world_tick(t_s, world);
-    if (o.interlock_open_at_s >= 0) {
-      const bool open =
-          t_s >= o.interlock_open_at_s && t_s < o.interlock_open_at_s + o.interlock_open_for_s;
-      chips->set_input("DOOR_SW", !open);
-    }
   };
   const double nominal_s = protocol.nominal_duration_s(wc.initial_c);
   double next_report_s = 0;

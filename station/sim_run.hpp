@@ -26,8 +26,6 @@ struct SimRunOptions {
   bool progress = true;            ///< progress lines on stderr
   bool wall_clock = false;         ///< run at 1 Hz on CLOCK_MONOTONIC instead of simulated time
   std::string record_can_path;     ///< write every CAN frame in candump format here (empty: no)
-  /// Test hooks: open the door interlock at this simulated time for this long.
-  double interlock_open_at_s = -1, interlock_open_for_s = 0;
   const std::atomic<bool>* stop = nullptr;
   /// Test hook: called with each tick's time and the world, after it advanced (fault injection).
   std::function<void(double t_s, sim::SimWorld& world)> on_world_tick;

@@ -56,8 +56,11 @@ TEST(Daemon, InterlockOpeningMidRunReachesTheSafeStateAndIsRecorded) {
   const auto db = fresh_db("interlock");
   auto o = quiet(db, kData + "/short_cycle.toml");
   o.gyros = 2;
-  o.interlock_open_at_s = 4000;  // during the recorded ramp
-  o.interlock_open_for_s = 300;
+  // The door opens during the recorded ramp, at 4000 s, for 300 s.
+  o.on_world_tick = [](double t_s, station::sim::SimWorld& w) {
+    if (t_s == 4000) w.gpio_chips()->set_input("DOOR_SW", false);
+    if (t_s == 4300) w.gpio_chips()->set_input("DOOR_SW", true);
+  };
   const auto r = station::run_simulated(o);
   EXPECT_EQ(r["state"], "completed");
   station::Store store(db);
