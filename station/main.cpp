@@ -5,8 +5,8 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 
-#include "station/commands.hpp"
-#include "station/csv_table.hpp"
+#include "station/cli/commands.hpp"
+#include "station/cli/csv_table.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"Gyro thermal-calibration test station"};

@@ -6,8 +6,8 @@
 #include <cstdio>
 #include <string>
 
-#include "station/logging.hpp"
-#include "station/sim_run.hpp"
+#include "station/common/logging.hpp"
+#include "station/sim/sim_run.hpp"
 
 namespace {
 

@@ -6,7 +6,7 @@
 #include <fstream>
 #include <string>
 
-#include "station/config.hpp"
+#include "station/config/config.hpp"
 
 namespace {
 

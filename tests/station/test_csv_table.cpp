@@ -7,7 +7,7 @@
 #include <fstream>
 #include <string>
 
-#include "station/csv_table.hpp"
+#include "station/cli/csv_table.hpp"
 
 namespace {
 

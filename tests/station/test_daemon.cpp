@@ -8,8 +8,8 @@
 #include <thread>
 
 #include "sim_devices/sim_world.hpp"
-#include "station/sim_run.hpp"
-#include "station/store.hpp"
+#include "station/sim/sim_run.hpp"
+#include "station/store/store.hpp"
 #include "tests/station/temp_db.hpp"
 
 namespace {

@@ -14,7 +14,7 @@
 #include <thread>
 #include <tuple>
 
-#include "station/store.hpp"
+#include "station/store/store.hpp"
 #include "tests/station/temp_db.hpp"
 
 extern char** environ;

@@ -6,8 +6,8 @@
 #include <cstdlib>
 #include <string>
 
-#include "station/protocol.hpp"
-#include "station/protocol_runner.hpp"
+#include "station/config/protocol.hpp"
+#include "station/daemon/protocol_runner.hpp"
 
 namespace {
 

@@ -5,7 +5,7 @@
 
 #include <cstdio>
 
-#include "station/resume.hpp"
+#include "station/daemon/resume.hpp"
 #include "tests/station/temp_db.hpp"
 
 namespace {

@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <string>
 
-#include "station/store.hpp"
+#include "station/store/store.hpp"
 #include "tests/station/temp_db.hpp"
 
 namespace {

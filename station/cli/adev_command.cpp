@@ -1,0 +1,127 @@
+// `station adev`: overlapping Allan deviation of one CSV column, with the IEEE 952 noise terms.
+#include <fmt/format.h>
+
+#include <cmath>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "compensation/allan.hpp"
+#include "station/cli/commands.hpp"
+#include "station/cli/csv_table.hpp"
+
+namespace station {
+namespace {
+
+namespace sc = station::compensation;
+
+struct AdevOptions {
+  std::string file, col;
+  double rate_hz = 1.0;
+  std::string taus = "octave";
+  bool json = false;
+};
+
+/// Averaging factors from "octave", "decade", "all" or a list of tau values in seconds.
+std::vector<std::size_t> factors_from(const AdevOptions& o, std::size_t n) {
+  if (o.taus == "octave") return sc::tau_factors(n, sc::TauSpacing::octave);
+  if (o.taus == "decade") return sc::tau_factors(n, sc::TauSpacing::decade);
+  if (o.taus == "all") return sc::tau_factors(n, sc::TauSpacing::all);
+  std::vector<std::size_t> ms;
+  std::size_t start = 0;
+  while (start <= o.taus.size()) {
+    const auto comma = o.taus.find(',', start);
+    const std::string word =
+        o.taus.substr(start, comma == std::string::npos ? comma : comma - start);
+    double tau_s = 0;
+    try {
+      tau_s = std::stod(word);
+    } catch (const std::exception&) {
+      throw InputError(fmt::format("--taus: '{}' is not octave, decade, all or a number", word));
+    }
+    const double m = tau_s * o.rate_hz;
+    if (!(m >= 1) || std::abs(m - std::round(m)) > 1e-9) {
+      throw InputError(
+          fmt::format("--taus: {} s is not a whole multiple of 1/{} s", word, o.rate_hz));
+    }
+    ms.push_back(static_cast<std::size_t>(std::llround(m)));
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return ms;
+}
+
+nlohmann::json noise_json(const sc::NoiseTerms& nt) {
+  auto opt = [](const std::optional<double>& v) {
+    return v ? nlohmann::json(*v) : nlohmann::json();
+  };
+  return {{"quantization_arcsec", opt(nt.quantization_arcsec)},
+          {"angle_random_walk_deg_rth", opt(nt.angle_random_walk_deg_rth)},
+          {"bias_instability_dph", opt(nt.bias_instability_dph)},
+          {"bias_instability_tau_s", opt(nt.bias_instability_tau_s)},
+          {"rate_random_walk_dph_rth", opt(nt.rate_random_walk_dph_rth)}};
+}
+
+void print_table(const AdevOptions& o, std::size_t n, const std::vector<sc::AdevPoint>& pts,
+                 const sc::NoiseTerms& nt) {
+  fmt::print(
+      "{}: column '{}', {} samples at {:g} Hz, overlapping ADEV (IEEE 952 / NIST SP 1065)\n\n",
+      o.file, o.col, n, o.rate_hz);
+  fmt::print("  {:>12} {:>9} {:>13} {:>13} {:>13} {:>9}\n", "tau_s", "m", "adev", "ci_low",
+             "ci_high", "n");
+  for (const auto& p : pts) {
+    fmt::print("  {:>12g} {:>9} {:>13.5e} {:>13.5e} {:>13.5e} {:>9}\n", p.tau_s, p.m, p.adev,
+               p.ci_low, p.ci_high, p.n);
+  }
+  auto line = [](const char* what, const std::optional<double>& v, const char* unit) {
+    if (v)
+      fmt::print("  {:<26} {:.4e} {}\n", what, *v, unit);
+    else
+      fmt::print("  {:<26} (not reached by the curve)\n", what);
+  };
+  fmt::print("\nnoise terms (units assume the column is in deg/h):\n");
+  line("quantization Q", nt.quantization_arcsec, "arcsec");
+  line("angle random walk N", nt.angle_random_walk_deg_rth, "deg/sqrt(h)");
+  line("bias instability B", nt.bias_instability_dph, "deg/h");
+  line("rate random walk K", nt.rate_random_walk_dph_rth, "deg/h/sqrt(h)");
+}
+
+}  // namespace
+
+void add_adev_command(CLI::App& app, CommandStatus& status) {
+  auto o = std::make_shared<AdevOptions>();
+  auto* cmd = app.add_subcommand("adev", "Overlapping Allan deviation of a CSV column");
+  cmd->add_option("file", o->file, "CSV with a header row")->required();
+  cmd->add_option("--col", o->col, "column holding the rate series")->required();
+  cmd->add_option("--rate-hz", o->rate_hz, "sample rate, Hz")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--taus", o->taus, "octave|decade|all|LIST of tau in s")->capture_default_str();
+  cmd->add_flag("--json", o->json, "print one JSON object");
+  cmd->callback([o, &status] {
+    const CsvColumns csv = read_csv_columns(o->file, {o->col});
+    const auto& rate = csv[0];
+    if (rate.size() < 3) {
+      throw InputError(fmt::format("{}: {} samples; ADEV needs at least 3", o->file, rate.size()));
+    }
+    const auto ms = factors_from(*o, rate.size());
+    const auto pts = sc::overlapping_adev(rate, o->rate_hz, ms);
+    const auto nt = sc::noise_terms(pts);
+    if (o->json) {
+      nlohmann::json rows = nlohmann::json::array();
+      for (const auto& p : pts) {
+        rows.push_back({{"tau_s", p.tau_s},
+                        {"m", p.m},
+                        {"adev", p.adev},
+                        {"ci_low", p.ci_low},
+                        {"ci_high", p.ci_high},
+                        {"n", p.n}});
+      }
+      std::cout << nlohmann::json{{"rows", rows}, {"noise", noise_json(nt)}}.dump(2) << '\n';
+    } else {
+      print_table(*o, rate.size(), pts, nt);
+    }
+    status.exit_code = 0;
+  });
+}
+
+}  // namespace station

@@ -1,0 +1,166 @@
+// `station analyze`: the engineer's offline tool and batch calibration from another rig's CSV.
+#include <fmt/format.h>
+
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <optional>
+
+#include "compensation/binning.hpp"
+#include "compensation/earth_rate.hpp"
+#include "compensation/fit.hpp"
+#include "station/cli/commands.hpp"
+#include "station/cli/csv_table.hpp"
+#include "station/store/fit_json.hpp"
+
+namespace station {
+namespace {
+
+namespace sc = station::compensation;
+
+struct AnalyzeOptions {
+  std::string file;
+  std::string time_col = "time_s", rate_col = "rate_dph", temp_col = "temp_c";
+  std::string grad_col, temp2_col;
+  double bin_s = 600.0;
+  double ref_temp_c = 25.0;
+  std::string terms = "dT,gradT";
+  std::optional<double> earth_rate_dph, latitude_deg;
+  std::string axis = "up";
+  bool json = false;
+};
+
+/// Earth rate from the options: explicit value, or latitude + axis ("up", ..., "heading:DEG").
+double earth_rate_from(const AnalyzeOptions& o, std::vector<std::string>& warnings) {
+  if (o.earth_rate_dph) return *o.earth_rate_dph;
+  if (!o.latitude_deg) {
+    warnings.emplace_back(
+        "no --earth-rate-dph or --latitude: Earth rate not removed (B0 holds it)");
+    return 0.0;
+  }
+  std::optional<sc::EnuAxis> axis = sc::axis_from_name(o.axis);
+  if (!axis && o.axis.rfind("heading:", 0) == 0) {
+    axis = sc::horizontal_axis(std::stod(o.axis.substr(8)));
+  }
+  if (!axis) throw InputError(fmt::format("--axis: unknown axis '{}'", o.axis));
+  return sc::earth_rate_along_axis_dph(*o.latitude_deg, *axis);
+}
+
+struct Analysis {
+  std::size_t samples = 0, bins_used = 0, bins_flagged = 0;
+  double earth_rate_dph = 0;
+  sc::FitResult fit;
+  sc::Evaluation eval;
+  std::vector<std::string> warnings;
+};
+
+Analysis analyze(const AnalyzeOptions& o) {
+  const std::vector<sc::Term> terms = sc::parse_terms(o.terms);
+  std::vector<std::string> cols{o.time_col, o.rate_col, o.temp_col};
+  const std::string grad_source = !o.grad_col.empty() ? o.grad_col : o.temp2_col;
+  if (!grad_source.empty()) cols.push_back(grad_source);
+  const bool wants_grad = std::find(terms.begin(), terms.end(), sc::Term::gradT) != terms.end();
+  if (wants_grad && grad_source.empty()) {
+    throw InputError("term gradT needs --grad-col NAME or --temp2-col NAME");
+  }
+  const CsvColumns csv = read_csv_columns(o.file, cols);
+  require_increasing(csv, 0);
+  std::vector<double> grad;
+  if (!grad_source.empty()) {
+    grad = csv[3];
+    // With two sensors the gradient is temp2 - temp, sample by sample.
+    if (o.grad_col.empty()) {
+      for (std::size_t i = 0; i < grad.size(); ++i) grad[i] -= csv[2][i];
+    }
+  }
+  Analysis a;
+  a.samples = csv.lines.size();
+  a.earth_rate_dph = earth_rate_from(o, a.warnings);
+  sc::BinConfig bin_cfg;
+  bin_cfg.width_s = o.bin_s;
+  const auto bins = sc::make_bins({csv[0], csv[1], csv[2], grad, {}}, bin_cfg);
+  const sc::ModelData data = sc::model_data_from_bins(bins, a.earth_rate_dph);
+  a.bins_used = data.bias_dph.size();
+  a.bins_flagged = bins.size() - a.bins_used;
+  try {
+    a.fit = sc::fit_model(data.view(), sc::ModelSpec{terms, o.ref_temp_c});
+  } catch (const std::invalid_argument& e) {
+    throw InputError(fmt::format("{}: {}", o.file, e.what()));
+  }
+  a.eval = sc::evaluate(data.bias_dph, sc::compensate(a.fit, data.view()));
+  a.warnings.insert(a.warnings.end(), a.fit.warnings.begin(), a.fit.warnings.end());
+  return a;
+}
+
+nlohmann::json to_json(const Analysis& a) {
+  nlohmann::json j = fit_summary_json(a.fit, a.eval);
+  j["bins_flagged"] = a.bins_flagged;
+  j["samples"] = a.samples;
+  j["earth_rate_dph"] = a.earth_rate_dph;
+  j["warnings"] = a.warnings;  // the fit's and the command's own
+  return j;
+}
+
+void print_table(const AnalyzeOptions& o, const Analysis& a) {
+  fmt::print(
+      "{}: {} samples, {} bins of {:g} s used, {} flagged; Earth rate {:.5f} deg/h removed\n",
+      o.file, a.samples, a.bins_used, o.bin_s, a.bins_flagged, a.earth_rate_dph);
+  fmt::print(
+      "model: B = B0{}, T_ref = {:g} C\n\n",
+      [&] {
+        std::string s;
+        for (std::size_t i = 1; i < a.fit.names.size(); ++i) {
+          s += fmt::format(" + {}*{}", a.fit.names[i],
+                           sc::term_option_name(a.fit.spec.terms[i - 1]));
+        }
+        return s;
+      }(),
+      o.ref_temp_c);
+  fmt::print("  {:<4} {:>14} {:>12} {:>14}\n", "term", "value", "std error", "Newey-West");
+  for (std::size_t i = 0; i < a.fit.names.size(); ++i) {
+    fmt::print("  {:<4} {:>14.6e} {:>12.3e} {:>14.3e}\n", a.fit.names[i], a.fit.coefficients[i],
+               a.fit.std_errors[i], a.fit.std_errors_hac[i]);
+  }
+  fmt::print("\nstd before {:.5f} deg/h, after {:.5f} deg/h, ratio {:.3f} ({:.1f} % better)\n",
+             a.eval.std_before_dph, a.eval.std_after_dph, a.eval.std_ratio, a.eval.improvement_pct);
+  fmt::print("R^2 {:.4f}, residual RMS {:.5f} deg/h, condition number {:.1f}\n", a.fit.r2,
+             a.fit.residual_rms_dph, a.fit.condition_number);
+  for (const auto& w : a.warnings) fmt::print("warning: {}\n", w);
+}
+
+}  // namespace
+
+void add_analyze_command(CLI::App& app, CommandStatus& status) {
+  auto o = std::make_shared<AnalyzeOptions>();
+  auto* cmd =
+      app.add_subcommand("analyze", "Bin, fit and evaluate the thermal bias model of a CSV");
+  cmd->add_option("file", o->file, "CSV with a header row")->required();
+  cmd->add_option("--time-col", o->time_col, "time column, s")->capture_default_str();
+  cmd->add_option("--rate-col", o->rate_col, "gyro rate column, deg/h")->capture_default_str();
+  cmd->add_option("--temp-col", o->temp_col, "gyro temperature column, C")->capture_default_str();
+  auto* g = cmd->add_option("--grad-col", o->grad_col, "temperature-gradient column, C");
+  cmd->add_option("--temp2-col", o->temp2_col, "second sensor column: gradient = temp2 - temp")
+      ->excludes(g);
+  cmd->add_option("--bin-s", o->bin_s, "bin width, s")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--ref-temp-c", o->ref_temp_c, "reference temperature T_ref, C")
+      ->capture_default_str();
+  cmd->add_option("--terms", o->terms, "dT,dT2,dT3,dT4,gradT,dTdt (B0 always)")
+      ->capture_default_str();
+  auto* er = cmd->add_option("--earth-rate-dph", o->earth_rate_dph, "Earth rate along the axis");
+  cmd->add_option("--latitude", o->latitude_deg, "site latitude, deg")->excludes(er);
+  cmd->add_option("--axis", o->axis, "up|down|north|south|east|west|heading:DEG")
+      ->capture_default_str();
+  cmd->add_flag("--json", o->json, "print one JSON object");
+  cmd->callback([o, &status] {
+    const Analysis a = analyze(*o);
+    if (o->json) {
+      std::cout << to_json(a).dump(2) << '\n';
+    } else {
+      print_table(*o, a);
+    }
+    status.exit_code = 0;
+  });
+}
+
+}  // namespace station

@@ -1,0 +1,286 @@
+// `station probe`: reads each configured device once (chamber, turntable, one counter-board
+// SYNC, GPIO inputs) and prints what it got; a device that fails is one typed error line.
+#include <fmt/format.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <optional>
+
+#include "drivers/counters/counter_frames.hpp"
+#include "station/cli/commands.hpp"
+#include "station/cli/probe.hpp"
+
+namespace station {
+namespace {
+
+namespace dr = station::drivers;
+namespace dc = station::drivers::counters;
+using nlohmann::json;
+
+/// What one device (or one counter-board slot) gave.
+struct DeviceReport {
+  std::string device;              ///< "chamber", "turntable", "can", "slot 1", "gpio"
+  std::string where;               ///< endpoint, transport or chip
+  std::optional<dr::Error> error;  ///< set when the device failed
+  std::string summary;             ///< the values read, one line of text
+  json fields = json::object();    ///< the same values for --json
+};
+
+DeviceReport failed(std::string device, std::string where, dr::Error e) {
+  return {std::move(device), std::move(where), std::move(e), {}, json::object()};
+}
+
+const char* yes_no(bool b) {
+  return b ? "yes" : "no";
+}
+
+std::string alarm_text(const dr::AlarmBits& a) {
+  if (!a.any()) return "none";
+  std::string s;
+  auto add = [&s](bool on, const char* name) {
+    if (on) s += (s.empty() ? "" : ",") + std::string(name);
+  };
+  add(a.deviation, "deviation");
+  add(a.sensor_break, "sensor_break");
+  add(a.door_open, "door_open");
+  add(a.high_limit_trip, "high_limit_trip");
+  return s;
+}
+
+DeviceReport probe_chamber(dr::Chamber& chamber, const StationConfig& c) {
+  auto r = chamber.read();
+  if (!r) return failed("chamber", c.chamber.endpoint, r.error());
+  const dr::ChamberState& s = r.value();
+  DeviceReport d{"chamber", c.chamber.endpoint, {}, {}, json::object()};
+  d.summary = fmt::format(
+      "air {:.1f} C, product {:.1f} C, setpoint {:.1f} C, ramp {:.2f} C/min, mode {}, "
+      "alarms {}, run {}",
+      s.air_c, s.product_c, s.setpoint_c, s.ramp_c_per_min, dr::to_string(s.mode),
+      alarm_text(s.alarms), s.run_enabled ? "on" : "off");
+  // NaN (sensor break) is not JSON: it becomes null.
+  d.fields = {{"air_c", std::isfinite(s.air_c) ? json(s.air_c) : json(nullptr)},
+              {"product_c", s.product_c},
+              {"setpoint_c", s.setpoint_c},
+              {"ramp_c_per_min", s.ramp_c_per_min},
+              {"mode", dr::to_string(s.mode)},
+              {"alarms", alarm_text(s.alarms)},
+              {"run_enabled", s.run_enabled}};
+  return d;
+}
+
+const char* mode_text(dr::TurntableMode m) {
+  switch (m) {
+    case dr::TurntableMode::off:
+      return "off";
+    case dr::TurntableMode::position:
+      return "position";
+    case dr::TurntableMode::rate:
+      return "rate";
+  }
+  return "unknown";
+}
+
+DeviceReport probe_turntable(dr::Turntable& table, const StationConfig& c) {
+  auto r = table.read();
+  if (!r) return failed("turntable", c.turntable->endpoint, r.error());
+  const dr::TurntableState& s = r.value();
+  DeviceReport d{"turntable", c.turntable->endpoint, {}, {}, json::object()};
+  d.summary = fmt::format(
+      "mode {}, angle {:.4f} deg, rate {:.4f} deg/s, in_position {}, at_rate {}, fault {}, "
+      "interlock_open {}",
+      mode_text(s.mode), s.angle_deg, s.rate_dps, yes_no(s.in_position), yes_no(s.at_rate),
+      yes_no(s.fault), yes_no(s.interlock_open));
+  d.fields = {
+      {"mode", mode_text(s.mode)},         {"angle_deg", s.angle_deg}, {"rate_dps", s.rate_dps},
+      {"in_position", s.in_position},      {"at_rate", s.at_rate},     {"fault", s.fault},
+      {"interlock_open", s.interlock_open}};
+  return d;
+}
+
+std::string flag_text(std::uint8_t f) {
+  if (f == 0) return "none";
+  std::string s;
+  auto add = [&s, f](std::uint8_t bit, const char* name) {
+    if (f & bit) s += (s.empty() ? "" : ",") + std::string(name);
+  };
+  add(dc::kFlagLaserFault, "laser_fault");
+  add(dc::kFlagTempSensorFault, "temp_sensor_fault");
+  add(dc::kFlagCounterReset, "counter_reset");
+  add(dc::kFlagDitherFault, "dither_fault");
+  return s;
+}
+
+DeviceReport slot_report(std::size_t index, const dc::CounterReading& r, std::uint8_t seq,
+                         const StationConfig& c) {
+  const std::string device = fmt::format("slot {}", index + 1);
+  const std::string where = fmt::format("node {} {}", r.node, r.serial);
+  if (!r.answered) {
+    return failed(device, where,
+                  {dr::ErrorKind::timeout, fmt::format("node {}: no complete answer to latch {} "
+                                                       "within {} ms",
+                                                       r.node, seq, c.can_tick_timeout_ms)});
+  }
+  std::string temps = r.temps_missing ? "missing" : "";
+  for (double t : r.temps_c) temps += fmt::format("{}{:.2f}", temps.empty() ? "" : " ", t);
+  const std::string discharge =
+      r.discharge_ua ? fmt::format("{}/{} uA", (*r.discharge_ua)[0], (*r.discharge_ua)[1])
+                     : (r.discharge_missing ? "missing" : "n/a");
+  const std::string counts =
+      r.has_delta ? fmt::format("{} net pulses", r.net_pulses) : "n/a (first latch)";
+  DeviceReport d{device, where, {}, {}, json::object()};
+  d.summary = fmt::format(
+      "answered, counts delta {}, temps [{}] C, flags 0x{:02x} ({}), "
+      "discharge {}",
+      counts, temps, r.status_flags, flag_text(r.status_flags), discharge);
+  d.fields = {{"node", r.node},
+              {"serial", r.serial},
+              {"answered", true},
+              {"net_pulses", r.has_delta ? json(r.net_pulses) : json(nullptr)},
+              {"temps_c", r.temps_c},
+              {"status_flags", r.status_flags},
+              {"flags", flag_text(r.status_flags)},
+              {"discharge_ua", r.discharge_ua ? json(*r.discharge_ua) : json(nullptr)}};
+  return d;
+}
+
+std::vector<DeviceReport> probe_counters(dc::CounterBoards& boards, const StationConfig& c) {
+  constexpr std::uint8_t kSeq = 1;
+  auto tick = boards.tick(kSeq);
+  if (!tick) return {failed("can", c.can_transport, tick.error())};
+  const dc::TickResult& t = tick.value();
+  std::vector<DeviceReport> out;
+  DeviceReport bus{"can", c.can_transport, {}, {}, json::object()};
+  std::size_t answered = 0;
+  for (const auto& r : t.readings) answered += r.answered ? 1 : 0;
+  bus.summary = fmt::format("latch {}: {}/{} boards answered, {} corrupt, {} unknown frames{}",
+                            t.latch_seq, answered, t.readings.size(), t.corrupt_frames,
+                            t.unknown_frames, t.last_error.empty() ? "" : "; " + t.last_error);
+  bus.fields = {{"latch_seq", t.latch_seq},
+                {"answered", answered},
+                {"corrupt_frames", t.corrupt_frames},
+                {"unknown_frames", t.unknown_frames}};
+  out.push_back(std::move(bus));
+  for (std::size_t i = 0; i < t.readings.size(); ++i)
+    out.push_back(slot_report(i, t.readings[i], t.latch_seq, c));
+  return out;
+}
+
+/// Reads every input line once. Opening drives outputs to their safe levels (as the daemon does).
+std::vector<DeviceReport> probe_gpio(dr::gpio::GpioBank& bank, const StationConfig& c) {
+  if (auto ok = bank.open(); !ok) return {failed("gpio", c.gpio->chip, ok.error())};
+  std::vector<DeviceReport> out;
+  for (const auto& line : bank.config().lines) {
+    if (line.direction != dr::gpio::GpioDirection::input) continue;
+    const std::string device = "gpio " + line.role;
+    auto v = bank.read(line.role);
+    if (!v) {
+      out.push_back(failed(device, line.where(), v.error()));
+      continue;
+    }
+    DeviceReport d{device, line.where(), {}, {}, json::object()};
+    d.summary = v.value() ? "active" : "inactive";
+    d.fields = {{"active", v.value()}};
+    out.push_back(std::move(d));
+  }
+  bank.close();
+  return out;
+}
+
+/// build_rig() throws InputError when the CAN transport cannot be opened. For commissioning that
+/// is a device failure, not a config error: build the rest on a placeholder bus and report it.
+Rig build_probe_rig(const StationConfig& c, const RigOptions& o, std::optional<dr::Error>& can) {
+  try {
+    return build_rig(c, o);
+  } catch (const InputError& e) {
+    can = dr::Error{dr::ErrorKind::disconnected, e.what()};
+  }
+  int sv[2];
+  if (socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, sv) != 0)
+    throw std::runtime_error("probe: socketpair failed");
+  StationConfig copy = c;
+  copy.can_transport = fmt::format("fd:{}", sv[0]);  // owned by the placeholder transport
+  Rig rig = build_rig(copy, o);
+  rig.counters.reset();
+  ::close(sv[1]);
+  return rig;
+}
+
+void print_text(std::ostream& out, const StationConfig& c, const std::vector<DeviceReport>& rs) {
+  out << fmt::format("probe of '{}' ({})\n", c.name, c.path);
+  std::size_t bad = 0;
+  for (const auto& r : rs) {
+    if (r.error) {
+      ++bad;
+      out << fmt::format("{:<16} {:<28} error {}: {}\n", r.device, r.where,
+                         dr::to_string(r.error->kind), r.error->message);
+    } else {
+      out << fmt::format("{:<16} {:<28} ok: {}\n", r.device, r.where, r.summary);
+    }
+  }
+  out << (bad == 0 ? std::string("all devices answered\n")
+                   : fmt::format("{} of {} failed\n", bad, rs.size()));
+}
+
+void print_json(std::ostream& out, const StationConfig& c, const std::vector<DeviceReport>& rs) {
+  json devices = json::array();
+  bool ok = true;
+  for (const auto& r : rs) {
+    json d = {{"device", r.device}, {"where", r.where}, {"ok", !r.error}};
+    if (r.error) {
+      ok = false;
+      d["error"] = {{"kind", dr::to_string(r.error->kind)}, {"message", r.error->message}};
+    } else {
+      d["values"] = r.fields;
+    }
+    devices.push_back(std::move(d));
+  }
+  out << json{{"station", c.name}, {"config", c.path}, {"ok", ok}, {"devices", devices}}.dump(2)
+      << '\n';
+}
+
+}  // namespace
+
+int probe_rig(const StationConfig& config, const RigOptions& options, std::ostream& out,
+              bool json_out) {
+  std::optional<dr::Error> can_error;
+  Rig rig = build_probe_rig(config, options, can_error);
+  std::vector<DeviceReport> reports;
+  reports.push_back(probe_chamber(*rig.chamber, config));
+  if (rig.turntable) reports.push_back(probe_turntable(*rig.turntable, config));
+  if (rig.counters) {
+    for (auto& r : probe_counters(*rig.counters, config)) reports.push_back(std::move(r));
+  } else {
+    reports.push_back(failed("can", config.can_transport, *can_error));
+  }
+  if (rig.gpio) {
+    for (auto& r : probe_gpio(*rig.gpio, config)) reports.push_back(std::move(r));
+  }
+  if (json_out) {
+    print_json(out, config, reports);
+  } else {
+    print_text(out, config, reports);
+  }
+  for (const auto& r : reports)
+    if (r.error) return 1;
+  return 0;
+}
+
+void add_probe_command(CLI::App& app, CommandStatus& status) {
+  struct Options {
+    std::string config;
+    bool json = false;
+  };
+  auto o = std::make_shared<Options>();
+  auto* cmd = app.add_subcommand("probe", "Read every configured device once (commissioning)");
+  cmd->add_option("--config", o->config, "station configuration file (TOML)")->required();
+  cmd->add_flag("--json", o->json, "print one JSON object");
+  cmd->callback([o, &status] {
+    const StationConfig config = load_station_config(o->config);
+    status.exit_code = probe_rig(config, RigOptions{}, std::cout, o->json);
+  });
+}
+
+}  // namespace station

@@ -1,0 +1,134 @@
+// `station replay LOG --db PATH --run ID`: a recorded session (the run's CAN log from
+// `run --record-can`, and its database) goes through the same counter-board driver and the same
+// binning and fit again; the result is compared with the stored fit (gpsd-style regression).
+#include <fmt/format.h>
+
+#include <cmath>
+#include <iostream>
+#include <map>
+#include <nlohmann/json.hpp>
+
+#include "drivers/can/replay_transport.hpp"
+#include "drivers/counters/counter_boards.hpp"
+#include "station/store/calibration.hpp"
+#include "station/cli/commands.hpp"
+#include "station/config/config.hpp"
+#include "station/store/fit_json.hpp"
+
+namespace station {
+namespace {
+
+namespace dr = station::drivers;
+namespace sc = station::compensation;
+
+struct ReplayOptions {
+  std::string log, db;
+  std::int64_t run = 1;
+  bool json = false;
+};
+
+/// Per serial: the stored samples (tick times, record window, flags) of the run.
+using StoredSamples = std::map<std::string, std::vector<SampleRow>>;
+
+/// Re-derives every serial's samples from the log: rate and temperatures from the replayed
+/// driver, tick time / window / flags from the stored run.
+StoredSamples replay_samples(const ReplayOptions& o, const std::vector<RunSlot>& slots,
+                             const StoredSamples& stored) {
+  auto records = dr::can::read_candump_log(o.log);
+  const auto syncs = dr::can::logged_syncs(records);
+  const std::size_t ticks = stored.at(slots.front().serial).size();
+  if (syncs.size() != ticks) {
+    throw InputError(fmt::format("{}: {} SYNC frames, but run {} has {} ticks", o.log, syncs.size(),
+                                 o.run, ticks));
+  }
+  dr::counters::CounterBoardsConfig cfg;
+  cfg.tick_timeout = std::chrono::milliseconds(1);
+  for (const auto& s : slots)
+    cfg.slots.push_back({static_cast<std::uint8_t>(s.node), s.serial, s.pulse_weight_arcsec});
+  dr::counters::CounterBoards boards(
+      std::make_unique<dr::can::ReplayCanTransport>(std::move(records)), cfg);
+  StoredSamples out;
+  for (std::size_t k = 0; k < ticks; ++k) {
+    auto tick = boards.tick(syncs[k]);
+    if (!tick) throw InputError(fmt::format("{}: tick {}: {}", o.log, k, tick.error().message));
+    for (const auto& rd : tick.value().readings) {
+      SampleRow r = stored.at(rd.serial)[k];  // time, window, flags as recorded
+      r.rate_dph.reset();
+      r.temp_c.reset();
+      r.temp2_c.reset();
+      if (rd.answered && rd.has_delta) r.rate_dph = rd.rate_dph;
+      if (rd.temps_c.size() >= 2) {
+        r.temp_c = rd.temps_c[0];
+        r.temp2_c = rd.temps_c[1];
+      }
+      out[rd.serial].push_back(std::move(r));
+    }
+  }
+  return out;
+}
+
+int run_replay(const ReplayOptions& o) {
+  Store store(o.db);
+  const auto run = store.find_run(o.run);
+  if (!run) throw InputError(fmt::format("{}: no run {}", o.db, o.run));
+  const auto slots = store.run_slots(o.run);
+  if (slots.empty()) throw InputError(fmt::format("{}: run {} has no slots", o.db, o.run));
+  const double bin_s =
+      parse_station_config(run->config_text, fmt::format("{}:run {} config", o.db, o.run)).bin_s;
+  StoredSamples stored;
+  for (const auto& s : slots) stored[s.serial] = store.samples(o.run, s.serial, false);
+  const StoredSamples replayed = replay_samples(o, slots, stored);
+  nlohmann::json report{{"run_id", o.run}, {"log", o.log}, {"gyros", nlohmann::json::array()}};
+  bool identical = true;
+  for (const auto& slot : slots) {
+    const auto fit = store.latest_fit(slot.serial);
+    if (!fit || fit->runs != std::vector<std::int64_t>{o.run}) continue;
+    const auto data =
+        sc::model_data_from_bins(bin_samples(replayed.at(slot.serial), bin_s), slot.earth_rate_dph);
+    const auto again = sc::fit_model(data.view(), fit->fit.spec);
+    double worst = 0;  // largest |replayed - stored| in units of the stored standard error
+    for (std::size_t i = 0; i < again.coefficients.size(); ++i) {
+      worst = std::max(worst, std::abs(again.coefficients[i] - fit->fit.coefficients[i]) /
+                                  fit->fit.std_errors[i]);
+    }
+    identical = identical && worst <= 1e-9;
+    report["gyros"].push_back({{"serial", slot.serial},
+                               {"stored", coefficients_json(fit->fit)},
+                               {"replayed", coefficients_json(again)},
+                               {"max_diff_in_std_errors", worst}});
+  }
+  report["identical"] = identical;
+  if (o.json) {
+    std::cout << report.dump(2) << '\n';
+  } else {
+    for (const auto& g : report["gyros"]) {
+      fmt::print("{}: replayed fit {} the stored one (max difference {:.2e} std errors)\n",
+                 g["serial"].get<std::string>(),
+                 g["max_diff_in_std_errors"].get<double>() <= 1e-9 ? "equals" : "DIFFERS FROM",
+                 g["max_diff_in_std_errors"].get<double>());
+    }
+  }
+  return identical ? 0 : 1;
+}
+
+}  // namespace
+
+void add_replay_command(CLI::App& app, CommandStatus& status) {
+  auto o = std::make_shared<ReplayOptions>();
+  auto* cmd =
+      app.add_subcommand("replay", "Replay a run's recorded CAN log through the driver and refit");
+  cmd->add_option("log", o->log, "candump log written by run --record-can")->required();
+  cmd->add_option("--db", o->db, "the run's database")->required();
+  cmd->add_option("--run", o->run, "run id")->capture_default_str();
+  cmd->add_flag("--json", o->json, "print one JSON object");
+  cmd->callback([o, &status] {
+    try {
+      status.exit_code = run_replay(*o);
+    } catch (const std::runtime_error& e) {
+      if (dynamic_cast<const InputError*>(&e) != nullptr) throw;
+      throw InputError(e.what());  // a malformed log line: "path:line: what"
+    }
+  });
+}
+
+}  // namespace station

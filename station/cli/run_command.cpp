@@ -1,0 +1,141 @@
+// `station run`: the daemon. --sim runs the embedded simulated rig; otherwise a real rig from
+// --config. SIGTERM/SIGINT end the run cleanly; under systemd it notifies READY and the watchdog.
+#include <fmt/format.h>
+#include <systemd/sd-daemon.h>
+
+#include <atomic>
+#include <csignal>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <optional>
+
+#include "drivers/can/candump_log.hpp"
+#include "drivers/common/clock.hpp"
+#include "station/cli/commands.hpp"
+#include "station/common/logging.hpp"
+#include "station/daemon/resume.hpp"
+#include "station/daemon/rig.hpp"
+#include "station/daemon/sequencer.hpp"
+#include "station/sim/sim_run.hpp"
+
+namespace station {
+namespace {
+
+std::atomic<bool> g_stop{false};
+
+void on_signal(int) {
+  g_stop.store(true);
+}
+
+void install_signal_handlers() {
+  struct sigaction sa {};
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGTERM, &sa, nullptr);
+  sigaction(SIGINT, &sa, nullptr);
+}
+
+struct RunOptions {
+  bool sim = false, json = false, fresh = false;
+  std::string config, protocol = "paper", db, operator_name, log_file, record_can;
+  int gyros = 4;
+  std::uint64_t seed = 1;
+  double latitude_deg = 39.9;
+};
+
+int run_real(const RunOptions& o) {
+  const StationConfig config = load_station_config(o.config);
+  Protocol protocol = load_protocol(o.protocol);
+  Store store(o.db);
+  const ResumeDecision resume_decision = decide_resume(store, config, o.fresh, false);
+  const std::optional<RunRecord>& resume = resume_decision.run;
+  if (resume_decision.protocol) {
+    if (resume_decision.protocol->text != protocol.text) {
+      log("seq")->warn("run {} continues with the protocol stored with it, not {}", resume->id,
+                       o.protocol);
+    }
+    protocol = *resume_decision.protocol;
+  }
+  RigOptions ro;
+  std::ofstream can_log;
+  std::optional<drivers::can::CandumpTap> can_tap;
+  if (!o.record_can.empty()) {
+    can_log.open(o.record_can, std::ios::app);
+    if (!can_log) throw InputError(fmt::format("{}: cannot write the CAN log", o.record_can));
+    ro.tap = &can_tap.emplace(can_log, "can0");
+  }
+  Rig rig = build_rig(config, ro);
+  drivers::MonotonicClock clock;
+  SequencerOptions so;
+  so.operator_name = o.operator_name;
+  so.stop = &g_stop;
+  std::uint64_t watchdog_usec = 0;
+  if (sd_watchdog_enabled(0, &watchdog_usec) > 0) {
+    so.watchdog = [] { sd_notify(0, "WATCHDOG=1"); };
+  }
+  Sequencer seq(config, protocol, rig, store, clock, so);
+  sd_notify(0, "READY=1");
+  const RunOutcome out = seq.run(resume);
+  sd_notify(0, "STOPPING=1");
+  fmt::print("run {} {} at t = {:.0f} s after {} ticks\n", out.run_id, out.state, out.t_s,
+             out.ticks);
+  return 0;
+}
+
+int run_sim(const RunOptions& o) {
+  SimRunOptions so;
+  so.gyros = o.gyros;
+  so.seed = o.seed;
+  so.latitude_deg = o.latitude_deg;
+  so.protocol = o.protocol;
+  so.db_path = o.db;
+  so.fresh = o.fresh;
+  so.stop = &g_stop;
+  so.record_can_path = o.record_can;
+  const auto report = run_simulated(so);
+  if (o.json) {
+    std::cout << report.dump(2) << '\n';
+  } else {
+    print_sim_report(report);
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_run_command(CLI::App& app, CommandStatus& status) {
+  auto o = std::make_shared<RunOptions>();
+  auto* cmd = app.add_subcommand("run", "Run a test protocol on a rig (or on the simulated rig)");
+  auto* sim = cmd->add_flag("--sim", o->sim, "simulated rig on the simulated clock");
+  cmd->add_option("--config", o->config, "station configuration (TOML)")->excludes(sim);
+  cmd->add_option("--protocol", o->protocol, "protocol file or shipped name")
+      ->capture_default_str();
+  cmd->add_option("--db", o->db, "SQLite database (default with --sim: station-sim.db)");
+  cmd->add_option("--operator", o->operator_name, "operator recorded with the run");
+  cmd->add_flag("--new", o->fresh, "start a new run even if one was left unfinished");
+  cmd->add_option("--gyros", o->gyros, "simulated gyros")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 16));
+  cmd->add_option("--seed", o->seed, "simulation seed")->capture_default_str();
+  cmd->add_option("--latitude", o->latitude_deg, "simulated site latitude, deg")
+      ->capture_default_str();
+  cmd->add_option("--log-file", o->log_file, "rotating log file");
+  cmd->add_option("--record-can", o->record_can,
+                  "write every CAN frame in can-utils' candump format to this file");
+  cmd->add_flag("--json", o->json, "print one JSON object at the end (--sim)");
+  cmd->callback([o, &status] {
+    LogOptions lo;
+    lo.console_level = o->sim ? spdlog::level::warn : spdlog::level::info;
+    lo.file = o->log_file;
+    lo.journald = std::getenv("JOURNAL_STREAM") != nullptr;
+    setup_logging(lo);
+    install_signal_handlers();
+    if (!o->sim && (o->config.empty() || o->db.empty())) {
+      throw InputError("run: give --config FILE and --db PATH, or --sim");
+    }
+    status.exit_code = o->sim ? run_sim(*o) : run_real(*o);
+  });
+}
+
+}  // namespace station

@@ -1,0 +1,187 @@
+// Station configuration: TOML to StationConfig, strictly (unknown keys rejected).
+#include "station/config/config.hpp"
+
+#include <fmt/format.h>
+
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "drivers/can/can_transport.hpp"
+#include "drivers/chamber/chamber_map.hpp"
+#include "drivers/modbus/endpoint.hpp"
+#include "drivers/turntable/turntable_map.hpp"
+#include "station/config/toml_reader.hpp"
+
+namespace station {
+namespace {
+
+namespace mb = drivers::modbus;
+
+// Runs a parser that throws std::invalid_argument and re-throws it at `key`'s line.
+template <typename F>
+auto at_key(const TomlView& v, std::string_view key, F&& f) {
+  try {
+    return f();
+  } catch (const std::invalid_argument& e) {
+    throw v.error(key, e.what());
+  }
+}
+
+mb::PointOverride read_override(const TomlView& v) {
+  v.allow_only(
+      {"name", "address", "type", "scale", "order", "function", "unit_id", "one_based", "access"});
+  mb::PointOverride o;
+  o.name = v.get_string("name");
+  if (auto a = v.opt_integer("address")) {
+    if (*a < 0 || *a > 65535) throw v.error("address", "must be 0..65535");
+    o.address = static_cast<std::uint16_t>(*a);
+  }
+  if (auto s = v.opt_string("type"))
+    o.type = at_key(v, "type", [&] { return mb::parse_point_type(*s); });
+  if (auto s = v.opt_number("scale")) {
+    if (*s == 0) throw v.error("scale", "must not be zero");
+    o.scale = *s;
+  }
+  if (auto s = v.opt_string("order"))
+    o.order = at_key(v, "order", [&] { return mb::parse_word_order(*s); });
+  if (auto s = v.opt_string("function")) {
+    o.function = at_key(v, "function", [&] { return mb::parse_function_code(*s); });
+  }
+  if (auto u = v.opt_integer("unit_id")) o.unit_id = static_cast<int>(*u);
+  o.one_based = v.opt_bool("one_based");
+  if (auto s = v.opt_string("access"))
+    o.access = at_key(v, "access", [&] { return mb::parse_access(*s); });
+  return o;
+}
+
+ModbusDeviceConfig read_modbus_device(const TomlView& v, bool is_chamber) {
+  v.allow_only({"endpoint", "preset", "unit_id", "timeout_s", "point"});
+  ModbusDeviceConfig d;
+  d.endpoint = v.get_string("endpoint");
+  at_key(v, "endpoint", [&] { return mb::parse_endpoint(d.endpoint); });
+  d.preset = v.opt_string("preset").value_or(is_chamber ? "watlow_f4" : "default");
+  d.unit_id = static_cast<int>(v.opt_integer("unit_id").value_or(1));
+  if (d.unit_id < 0 || d.unit_id > 247) throw v.error("unit_id", "must be 0..247");
+  d.timeout_s = v.opt_number("timeout_s").value_or(0.5);
+  if (!(d.timeout_s > 0 && d.timeout_s <= 10)) throw v.error("timeout_s", "must be in (0, 10] s");
+  for (const auto& p : v.table_array("point")) d.overrides.push_back(read_override(p));
+  // Build the map now so a bad preset or override fails before anything moves.
+  at_key(v, is_chamber ? "preset" : "point", [&] {
+    auto map = is_chamber ? drivers::chamber_map::preset(d.preset, d.unit_id)
+                          : drivers::turntable_map::default_map(d.unit_id);
+    mb::apply_overrides(map, d.overrides);
+    return 0;
+  });
+  return d;
+}
+
+SlotConfig read_slot(const TomlView& v) {
+  v.allow_only({"node", "serial", "pulse_weight_arcsec", "axis", "relay"});
+  SlotConfig s;
+  s.node = static_cast<int>(v.get_integer("node"));
+  if (s.node < 1 || s.node > 16) throw v.error("node", "CAN node must be 1..16");
+  s.serial = v.get_string("serial");
+  if (s.serial.empty()) throw v.error("serial", "must not be empty");
+  s.pulse_weight_arcsec = v.opt_number("pulse_weight_arcsec").value_or(1.5);
+  if (!(s.pulse_weight_arcsec > 0 && s.pulse_weight_arcsec < 100)) {
+    throw v.error("pulse_weight_arcsec", "must be in (0, 100) arcsec");
+  }
+  s.axis = v.opt_string("axis").value_or("up");
+  if (auto named = compensation::axis_from_name(s.axis)) {
+    s.enu = *named;
+  } else if (s.axis.rfind("heading:", 0) == 0) {
+    s.enu = at_key(v, "axis",
+                   [&] { return compensation::horizontal_axis(std::stod(s.axis.substr(8))); });
+  } else {
+    throw v.error("axis", "expected up, down, north, south, east, west or heading:DEG");
+  }
+  s.relay = v.opt_string("relay").value_or("");
+  return s;
+}
+
+LimitsConfig read_limits(const TomlView& v) {
+  v.allow_only({"min_setpoint_c", "max_setpoint_c", "max_ramp_c_per_min"});
+  LimitsConfig l;
+  l.min_setpoint_c = v.opt_number("min_setpoint_c").value_or(l.min_setpoint_c);
+  l.max_setpoint_c = v.opt_number("max_setpoint_c").value_or(l.max_setpoint_c);
+  l.max_ramp_c_per_min = v.opt_number("max_ramp_c_per_min").value_or(l.max_ramp_c_per_min);
+  if (!(l.min_setpoint_c < l.max_setpoint_c)) {
+    throw v.error("max_setpoint_c", "must be above min_setpoint_c");
+  }
+  if (!(l.max_ramp_c_per_min > 0)) throw v.error("max_ramp_c_per_min", "must be positive");
+  return l;
+}
+
+GpioConfig read_gpio(const TomlView& v) {
+  v.allow_only({"chip", "interlock", "estop", "tower_green", "tower_amber", "tower_red"});
+  GpioConfig g;
+  g.chip = v.opt_string("chip").value_or(g.chip);
+  for (const char* role : {"interlock", "estop", "tower_green", "tower_amber", "tower_red"}) {
+    if (auto line = v.opt_string(role)) g.lines[role] = *line;
+  }
+  return g;
+}
+
+void check_slots_unique(const TomlView& root, const std::vector<SlotConfig>& slots) {
+  std::set<int> nodes;
+  std::set<std::string> serials;
+  for (std::size_t i = 0; i < slots.size(); ++i) {
+    const auto key = fmt::format("slot[{}]", i);
+    if (!nodes.insert(slots[i].node).second) throw root.error("slot", key + ": node used twice");
+    if (!serials.insert(slots[i].serial).second)
+      throw root.error("slot", key + ": serial used twice");
+  }
+}
+
+}  // namespace
+
+StationConfig parse_station_config(const std::string& text, const std::string& path) {
+  const toml::table tbl = TomlView::parse_text(text, path);
+  const TomlView root(tbl, path);
+  root.allow_only({"station", "limits", "chamber", "turntable", "can", "gpio", "slot"});
+  StationConfig c;
+  c.path = path;
+  c.text = text;
+  if (auto st = root.opt_table("station")) {
+    st->allow_only({"name", "latitude_deg", "ref_temp_c", "bin_s"});
+    c.name = st->opt_string("name").value_or(c.name);
+    c.latitude_deg = st->get_number("latitude_deg");
+    if (c.latitude_deg < -90 || c.latitude_deg > 90)
+      throw st->error("latitude_deg", "must be -90..90");
+    c.ref_temp_c = st->opt_number("ref_temp_c").value_or(c.ref_temp_c);
+    c.bin_s = st->opt_number("bin_s").value_or(c.bin_s);
+    if (!(c.bin_s >= 1)) throw st->error("bin_s", "must be at least 1 s");
+  } else {
+    throw root.error("station", "missing [station] table (latitude_deg is required)");
+  }
+  if (auto l = root.opt_table("limits")) c.limits = read_limits(*l);
+  auto chamber = root.opt_table("chamber");
+  if (!chamber) throw root.error("chamber", "missing [chamber] table");
+  c.chamber = read_modbus_device(*chamber, true);
+  if (auto t = root.opt_table("turntable")) c.turntable = read_modbus_device(*t, false);
+  auto can = root.opt_table("can");
+  if (!can) throw root.error("can", "missing [can] table");
+  can->allow_only({"transport", "tick_timeout_ms"});
+  c.can_transport = can->get_string("transport");
+  at_key(*can, "transport", [&] { return drivers::can::parse_can_spec(c.can_transport); });
+  c.can_tick_timeout_ms = static_cast<int>(can->opt_integer("tick_timeout_ms").value_or(200));
+  if (c.can_tick_timeout_ms < 10 || c.can_tick_timeout_ms > 900) {
+    throw can->error("tick_timeout_ms", "must be 10..900 ms (it must fit in the 1 s tick)");
+  }
+  if (auto g = root.opt_table("gpio")) c.gpio = read_gpio(*g);
+  for (const auto& s : root.table_array("slot")) c.slots.push_back(read_slot(s));
+  if (c.slots.empty()) throw root.error("slot", "no [[slot]] entries: the rig has no gyros");
+  check_slots_unique(root, c.slots);
+  return c;
+}
+
+StationConfig load_station_config(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(fmt::format("{}: cannot open file", path));
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return parse_station_config(ss.str(), path);
+}
+
+}  // namespace station

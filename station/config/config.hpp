@@ -1,0 +1,72 @@
+// The station configuration file (TOML): devices, limits, slots. Validated completely before
+// anything moves; every error names the file, the line and the key. Schema:
+// schemas/station_config.schema.json.
+#pragma once
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "compensation/earth_rate.hpp"
+#include "drivers/modbus/map_overrides.hpp"
+#include "station/common/input_error.hpp"
+
+namespace station {
+
+/// A Modbus device: endpoint, register-map preset and point overrides.
+struct ModbusDeviceConfig {
+  std::string endpoint;    ///< tcp://HOST:PORT or rtu:/dev/ttyX?baud=...
+  std::string preset;      ///< register-map preset name
+  int unit_id = 1;         ///< Modbus unit id 0..247
+  double timeout_s = 0.5;  ///< response timeout of one transaction, s
+  std::vector<drivers::modbus::PointOverride> overrides;
+};
+
+/// One gyro position on the rig.
+struct SlotConfig {
+  int node = 1;                      ///< CAN node id of its counter board, 1..16
+  std::string serial;                ///< gyro serial number
+  double pulse_weight_arcsec = 1.5;  ///< angle per net pulse, arcsec
+  std::string axis = "up";    ///< input axis: up, down, north, south, east, west, heading:DEG
+  compensation::EnuAxis enu;  ///< the axis as a unit vector
+  std::string relay;          ///< GPIO line powering this gyro (optional)
+};
+
+/// The station's hard limits, enforced by the safety layer whatever a protocol asks.
+struct LimitsConfig {
+  double min_setpoint_c = -45.0;
+  double max_setpoint_c = 85.0;
+  double max_ramp_c_per_min = 3.0;
+};
+
+/// GPIO lines by role; empty when the rig has none.
+struct GpioConfig {
+  std::string chip = "gpiochip0";
+  std::map<std::string, std::string>
+      lines;  ///< role ("interlock", "estop", "tower_red", ...) -> line name
+};
+
+/// Everything in a station configuration file.
+struct StationConfig {
+  std::string path;  ///< file it came from
+  std::string text;  ///< its full text (snapshot stored with each run)
+  std::string name = "station";
+  double latitude_deg = 0;   ///< geodetic latitude of the site, deg
+  double ref_temp_c = 25.0;  ///< T_ref of the model
+  double bin_s = 600.0;      ///< bin width, s
+  ModbusDeviceConfig chamber;
+  std::optional<ModbusDeviceConfig> turntable;
+  std::string can_transport;  ///< socketcan:can0 | unix:PATH | fd:N
+  int can_tick_timeout_ms = 200;
+  std::optional<GpioConfig> gpio;
+  LimitsConfig limits;
+  std::vector<SlotConfig> slots;
+};
+
+/// Reads and validates a configuration file; throws InputError ("FILE:LINE: key 'k': ...").
+StationConfig load_station_config(const std::string& path);
+/// The same from text labelled as `path`.
+StationConfig parse_station_config(const std::string& text, const std::string& path);
+
+}  // namespace station

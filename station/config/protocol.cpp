@@ -1,0 +1,156 @@
+// Protocol files: strict TOML parsing into steps; shipped protocols embedded by name.
+#include "station/config/protocol.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "station/builtin_protocols.hpp"
+#include "station/config/toml_reader.hpp"
+
+namespace station {
+namespace {
+
+struct KindName {
+  StepKind kind;
+  const char* name;
+};
+constexpr KindName kKinds[] = {{StepKind::set_temperature, "set_temperature"},
+                               {StepKind::soak, "soak"},
+                               {StepKind::hold, "hold"},
+                               {StepKind::record_start, "record_start"},
+                               {StepKind::record_stop, "record_stop"},
+                               {StepKind::lock_turntable, "lock_turntable"}};
+
+StepKind kind_of(const TomlView& v) {
+  const std::string type = v.get_string("type");
+  for (const auto& k : kKinds) {
+    if (type == k.name) return k.kind;
+  }
+  throw v.error("type", fmt::format("unknown step type '{}' (set_temperature, soak, hold, "
+                                    "record_start, record_stop, lock_turntable)",
+                                    type));
+}
+
+double non_negative(const TomlView& v, const char* key, double fallback) {
+  const double x = v.opt_number(key).value_or(fallback);
+  if (!(x >= 0) || !std::isfinite(x)) throw v.error(key, "must be a non-negative number");
+  return x;
+}
+
+void read_set_temperature(const TomlView& v, Step& s) {
+  v.allow_only({"type", "label", "setpoint_c", "to_start", "ramp_c_per_h", "wait", "tolerance_c",
+                "timeout_s"});
+  s.setpoint_c = v.opt_number("setpoint_c");
+  s.to_start = v.opt_bool("to_start").value_or(false);
+  if (s.setpoint_c.has_value() == s.to_start) {
+    throw v.error("setpoint_c", "give exactly one of setpoint_c or to_start = true");
+  }
+  s.ramp_c_per_h = non_negative(v, "ramp_c_per_h", 0.0);
+  s.wait = v.opt_bool("wait").value_or(true);
+  s.tolerance_c = non_negative(v, "tolerance_c", 1.0);
+}
+
+Step read_step(const TomlView& v) {
+  Step s;
+  s.kind = kind_of(v);
+  s.line = static_cast<int>(v.table().source().begin.line);
+  s.label = v.opt_string("label").value_or(to_string(s.kind));
+  switch (s.kind) {
+    case StepKind::set_temperature:
+      read_set_temperature(v, s);
+      break;
+    case StepKind::soak:
+      v.allow_only({"type", "label", "tolerance_c", "duration_s", "timeout_s"});
+      s.tolerance_c = non_negative(v, "tolerance_c", 0.5);
+      s.duration_s = non_negative(v, "duration_s", 1800.0);
+      break;
+    case StepKind::hold:
+      v.allow_only({"type", "label", "duration_s"});
+      s.duration_s = v.get_number("duration_s");
+      if (!(s.duration_s > 0)) throw v.error("duration_s", "must be positive");
+      break;
+    case StepKind::lock_turntable:
+      v.allow_only({"type", "label", "position_deg"});
+      s.position_deg = v.opt_number("position_deg").value_or(0.0);
+      break;
+    default:
+      v.allow_only({"type", "label"});
+  }
+  s.timeout_s = v.opt_number("timeout_s").value_or(0.0);
+  if (s.timeout_s < 0) throw v.error("timeout_s", "must not be negative");
+  return s;
+}
+
+}  // namespace
+
+const char* to_string(StepKind k) {
+  for (const auto& kn : kKinds) {
+    if (kn.kind == k) return kn.name;
+  }
+  return "unknown";
+}
+
+Protocol parse_protocol(const std::string& text, const std::string& path) {
+  const toml::table tbl = TomlView::parse_text(text, path);
+  const TomlView root(tbl, path);
+  root.allow_only({"name", "description", "step"});
+  Protocol p;
+  p.name = root.get_string("name");
+  p.description = root.opt_string("description").value_or("");
+  p.path = path;
+  p.text = text;
+  for (const auto& sv : root.table_array("step")) p.steps.push_back(read_step(sv));
+  if (p.steps.empty()) throw root.error("step", "a protocol needs at least one [[step]]");
+  bool recording = false;
+  for (std::size_t i = 0; i < p.steps.size(); ++i) {
+    const auto& s = p.steps[i];
+    const bool start = s.kind == StepKind::record_start, stop = s.kind == StepKind::record_stop;
+    if ((start && recording) || (stop && !recording)) {
+      throw InputError(fmt::format("{}:{}: key 'step[{}].type': {} while the record window is {}",
+                                   path, s.line, i, to_string(s.kind),
+                                   recording ? "open" : "closed"));
+    }
+    if (start || stop) recording = start;
+  }
+  return p;
+}
+
+Protocol load_protocol(const std::string& file_or_name) {
+  for (const auto& [name, text] : builtin::kProtocols) {
+    if (name == file_or_name)
+      return parse_protocol(std::string(text), "builtin:" + std::string(name));
+  }
+  std::ifstream in(file_or_name);
+  if (!in) {
+    throw InputError(fmt::format("{}: no such protocol file or shipped protocol (shipped: {})",
+                                 file_or_name, fmt::join(builtin_protocol_names(), ", ")));
+  }
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return parse_protocol(ss.str(), file_or_name);
+}
+
+std::vector<std::string> builtin_protocol_names() {
+  std::vector<std::string> out;
+  for (const auto& [name, text] : builtin::kProtocols) out.emplace_back(name);
+  return out;
+}
+
+double Protocol::nominal_duration_s(double start_c) const {
+  double t = 0, temp = start_c;
+  for (const auto& s : steps) {
+    if (s.kind == StepKind::set_temperature) {
+      const double target = s.to_start ? start_c : *s.setpoint_c;
+      if (s.ramp_c_per_h > 0) t += std::abs(target - temp) / s.ramp_c_per_h * 3600.0;
+      temp = target;
+    } else if (s.kind == StepKind::soak || s.kind == StepKind::hold) {
+      t += s.duration_s;
+    }
+  }
+  return t;
+}
+
+}  // namespace station

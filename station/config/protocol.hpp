@@ -1,0 +1,56 @@
+// Test protocols: TOML files of steps (schemas/protocol.schema.json), parsed and checked before
+// anything moves; the shipped protocols live in protocols/ and are embedded in the binary.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "station/common/input_error.hpp"
+
+namespace station {
+
+/// What a step does.
+enum class StepKind {
+  set_temperature,  ///< command setpoint (with ramp); wait until the air reaches it (optional)
+  soak,             ///< wait until chamber and gyro temperatures stay within a band for a time
+  hold,             ///< wait a fixed time
+  record_start,     ///< open the record window
+  record_stop,      ///< close the record window
+  lock_turntable,   ///< position the table and engage the lock
+};
+
+/// One protocol step. Fields not used by its kind are ignored.
+struct Step {
+  StepKind kind = StepKind::hold;
+  std::string label;                 ///< for logs and events
+  int line = 0;                      ///< line in the protocol file
+  std::optional<double> setpoint_c;  ///< set_temperature: target, deg C
+  bool to_start = false;             ///< set_temperature: target is the run's start temperature
+  double ramp_c_per_h = 0;           ///< set_temperature: ramp rate, 0 = step
+  bool wait = true;                  ///< set_temperature: wait for the air to arrive
+  double tolerance_c = 1.0;          ///< set_temperature/soak: band around the setpoint
+  double duration_s = 0;             ///< soak: time stable; hold: time
+  double timeout_s = 0;              ///< 0 = none; past it the step ends with a warning
+  double position_deg = 0;           ///< lock_turntable
+};
+
+/// A parsed protocol with its source text.
+struct Protocol {
+  std::string name, description, path, text;
+  std::vector<Step> steps;
+  /// Sum of the nominal durations (ramps at their rate from `start_c`), s: for progress.
+  double nominal_duration_s(double start_c) const;
+};
+
+/// Parses protocol text labelled `path`; throws InputError ("FILE:LINE: key 'step[3].x': ...").
+Protocol parse_protocol(const std::string& text, const std::string& path);
+/// Reads a file, or a shipped protocol by name ("paper", "soak_ladder", "ramp_10", ...).
+Protocol load_protocol(const std::string& file_or_name);
+/// Names of the shipped protocols.
+std::vector<std::string> builtin_protocol_names();
+
+/// Human name of a step kind ("set_temperature", ...).
+const char* to_string(StepKind k);
+
+}  // namespace station

@@ -1,0 +1,83 @@
+// Rig construction from the configuration: register maps with overrides, transports, banks.
+#include "station/daemon/rig.hpp"
+
+#include <fmt/format.h>
+
+#include "drivers/can/can_transport.hpp"
+#include "drivers/chamber/chamber_map.hpp"
+#include "drivers/chamber/modbus_chamber.hpp"
+#include "drivers/counters/counter_frames.hpp"
+#include "drivers/gpio/libgpiod_bank.hpp"
+#include "drivers/modbus/endpoint.hpp"
+#include "drivers/turntable/modbus_turntable.hpp"
+#include "drivers/turntable/turntable_map.hpp"
+
+namespace station {
+
+namespace dr = station::drivers;
+
+drivers::gpio::GpioConfig gpio_config_of(const StationConfig& config) {
+  std::map<std::string, std::string> roles;
+  for (const auto& [role, line] : config.gpio->lines) {
+    std::string r = role;
+    if (r.rfind("tower_", 0) == 0) r = "tower." + r.substr(6);
+    roles[r] = line;
+  }
+  for (std::size_t i = 0; i < config.slots.size(); ++i) {
+    if (!config.slots[i].relay.empty())
+      roles[dr::gpio::roles::relay(static_cast<int>(i + 1))] = config.slots[i].relay;
+  }
+  return dr::gpio::make_gpio_config(roles, config.gpio->chip);
+}
+
+namespace {
+
+std::unique_ptr<dr::counters::CounterBoards> open_counters(const StationConfig& c,
+                                                           const RigOptions& o) {
+  dr::can::CanOpenOptions can_opts;
+  can_opts.filters = dr::counters::board_frame_filters();
+  can_opts.tap = o.tap;
+  can_opts.tap_device = "can";
+  auto transport = dr::can::open_can_transport(dr::can::parse_can_spec(c.can_transport), can_opts);
+  if (!transport) {
+    throw InputError(fmt::format("{}: can.transport '{}': {}", c.path, c.can_transport,
+                                 transport.error().message));
+  }
+  dr::counters::CounterBoardsConfig cc;
+  cc.tick_timeout = std::chrono::milliseconds(c.can_tick_timeout_ms);
+  for (const auto& s : c.slots) {
+    cc.slots.push_back({static_cast<std::uint8_t>(s.node), s.serial, s.pulse_weight_arcsec});
+  }
+  return std::make_unique<dr::counters::CounterBoards>(std::move(transport).value(), cc);
+}
+
+}  // namespace
+
+Rig build_rig(const StationConfig& c, const RigOptions& o) {
+  Rig rig;
+  auto chamber_map = dr::chamber_map::preset(c.chamber.preset, c.chamber.unit_id);
+  dr::modbus::apply_overrides(chamber_map, c.chamber.overrides);
+  auto chamber = std::make_unique<dr::ModbusChamber>(
+      "chamber", dr::modbus::parse_endpoint(c.chamber.endpoint), chamber_map, c.chamber.timeout_s);
+  chamber->set_tap(o.tap);
+  rig.chamber = std::move(chamber);
+  if (c.turntable) {
+    auto map = dr::turntable_map::default_map(c.turntable->unit_id);
+    dr::modbus::apply_overrides(map, c.turntable->overrides);
+    auto table = std::make_unique<dr::ModbusTurntable>(
+        "turntable", dr::modbus::parse_endpoint(c.turntable->endpoint), map, dr::TurntableLimits{},
+        c.turntable->timeout_s);
+    table->set_tap(o.tap);
+    rig.turntable = std::move(table);
+  }
+  rig.counters = open_counters(c, o);
+  if (c.gpio) {
+    const auto gcfg = gpio_config_of(c);
+    rig.gpio =
+        o.gpio_factory ? o.gpio_factory(gcfg) : std::make_unique<dr::gpio::LibgpiodBank>(gcfg);
+    rig.gpio->set_tap(o.tap);
+  }
+  return rig;
+}
+
+}  // namespace station

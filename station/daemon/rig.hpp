@@ -1,0 +1,42 @@
+// The devices of one rig, built from the station configuration behind their interfaces (real
+// or simulated hardware chosen by config, ros2_control's idea).
+#pragma once
+
+#include <functional>
+#include <memory>
+
+#include "drivers/chamber/chamber.hpp"
+#include "drivers/common/tap.hpp"
+#include "drivers/counters/counter_boards.hpp"
+#include "drivers/gpio/gpio_bank.hpp"
+#include "drivers/turntable/turntable.hpp"
+#include "station/config/config.hpp"
+
+namespace station {
+
+/// Makes the GPIO bank for a config (default: libgpiod; --sim injects the simulated bank).
+using GpioFactory =
+    std::function<std::unique_ptr<drivers::gpio::GpioBank>(const drivers::gpio::GpioConfig&)>;
+
+/// How to build a rig.
+struct RigOptions {
+  drivers::Tap* tap = nullptr;  ///< every exchange of every device passes here when set
+  GpioFactory gpio_factory;     ///< empty: LibgpiodBank
+};
+
+/// The rig's devices. Turntable and GPIO are absent when the config has none.
+struct Rig {
+  std::unique_ptr<drivers::Chamber> chamber;
+  std::unique_ptr<drivers::Turntable> turntable;
+  std::unique_ptr<drivers::counters::CounterBoards> counters;
+  std::unique_ptr<drivers::gpio::GpioBank> gpio;
+};
+
+/// Builds the drivers (no Modbus I/O) and opens the CAN transport. Throws InputError when the
+/// CAN transport cannot be opened (nothing can be measured without it).
+Rig build_rig(const StationConfig& config, const RigOptions& options = {});
+
+/// The GPIO line map of a config: roles interlock, estop, tower.*, relay.N (slot N, 1-based).
+drivers::gpio::GpioConfig gpio_config_of(const StationConfig& config);
+
+}  // namespace station

@@ -1,0 +1,116 @@
+// The 1 Hz loop (gpsd's main loop, small): each tick SYNC the counter boards, read chamber and
+// turntable, assemble one sample per gyro, store the tick in one transaction, advance the
+// protocol through the safety layer, sleep to the next absolute deadline. One device failing
+// never stops the loop: it is reported, retried, and the safety layer owns the safe state.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "drivers/common/clock.hpp"
+#include "station/config/config.hpp"
+#include "station/config/protocol.hpp"
+#include "station/daemon/protocol_runner.hpp"
+#include "station/daemon/rig.hpp"
+#include "station/daemon/safety.hpp"
+#include "station/store/store.hpp"
+
+namespace station {
+
+/// One tick's summary for progress lines and hooks.
+struct TickReport {
+  double t_s = 0;
+  int step_index = 0;
+  int steps = 0;
+  bool recording = false;
+  bool safe_hold = false;
+  std::optional<double> air_c;
+};
+
+/// How to run.
+struct SequencerOptions {
+  double period_s = 1.0;
+  std::string operator_name;
+  std::optional<std::int64_t> sim_seed;            ///< recorded with the run
+  std::function<void(double t_s)> before_tick;     ///< simulation: advance the world to t_s
+  std::function<void(const TickReport&)> on_tick;  ///< progress / tests
+  std::function<void()> watchdog;                  ///< systemd WATCHDOG=1 each tick
+  const std::atomic<bool>* stop = nullptr;         ///< set by SIGTERM/SIGINT
+  /// Deterministic simulation resume: replay ticks up to this time without storing them.
+  std::optional<double> replay_until_t_s;
+};
+
+/// How a run ended.
+struct RunOutcome {
+  std::int64_t run_id = 0;
+  std::string state;  ///< completed | stopped
+  double t_s = 0;     ///< last tick
+  std::int64_t ticks = 0;
+};
+
+/// Runs one protocol on one rig. Not thread-safe.
+class Sequencer {
+ public:
+  Sequencer(const StationConfig& config, const Protocol& protocol, Rig& rig, Store& store,
+            drivers::Clock& clock, SequencerOptions options);
+
+  /// Starts a new run, or continues `resume` (a run left 'running' by a killed daemon).
+  RunOutcome run(const std::optional<RunRecord>& resume = std::nullopt);
+
+ private:
+  /// Everything one tick read.
+  struct TickData {
+    std::optional<drivers::counters::TickResult> counts;
+    std::optional<drivers::ChamberState> chamber;
+    std::optional<drivers::TurntableState> table;
+    // Safety inputs as read this tick (empty: not readable this tick).
+    std::optional<bool> table_interlock_open, gpio_interlock_closed, gpio_estop_pressed;
+    std::vector<SampleRow> rows;
+    Observation obs;
+  };
+  void connect_devices();
+  void tick(double t_s, TickData& d);
+  void read_devices(double t_s, TickData& d);
+  void apply_safety(double t_s, TickData& d);
+  void read_gpio(double t_s, TickData& d);
+  void watch_inputs_until(double deadline_s, double t_s);
+  void enter_safe_hold(double t_s, const TickData& d, const std::string& why);
+  void keep_safe_hold(double t_s, const TickData& d);
+  void apply_actions(double t_s, const Actions& a);
+  void assemble_samples(double t_s, TickData& d);
+  void finish(const std::string& state, double t_s);
+  void emit(double t_s, const std::string& severity, const std::string& source,
+            const std::string& kind, const std::string& message);
+
+  const StationConfig& config_;
+  Protocol protocol_;  ///< the protocol as clamped to the station's limits
+  Rig& rig_;
+  Store& store_;
+  drivers::Clock& clock_;
+  SequencerOptions options_;
+  Safety safety_;
+  std::optional<ProtocolRunner> runner_;
+  std::int64_t run_id_ = 0;
+  std::uint8_t latch_seq_ = 0;
+  bool replaying_ = false;
+  int chamber_failures_ = 0, counter_failures_ = 0, command_failures_ = 0;
+  /// Last known safety inputs: a failed read keeps the last value; unreadable for
+  /// kSafetyBlindTicks in a row counts as open (fail safe).
+  bool interlock_open_ = false, estop_ = false;
+  int safety_blind_ticks_ = 0;
+  bool has_gpio_interlock_ = false, has_gpio_estop_ = false;  ///< lines configured (set at connect)
+  std::optional<double> hold_air_c_;  ///< where the chamber is held during a safe hold
+  std::optional<double> last_air_c_;  ///< last chamber air reading
+  bool hold_commanded_ = false, table_stopped_ = false;
+  /// Time spent per tick phase (wall seconds, summed), logged at the end of a run.
+  struct PhaseTimes {
+    double world = 0, can = 0, chamber = 0, table = 0, gpio = 0, store = 0;
+  } phase_s_;
+  std::optional<drivers::ChamberCommand> pending_chamber_;
+  std::optional<drivers::TurntableCommand> pending_table_;
+};
+
+}  // namespace station

@@ -1,0 +1,139 @@
+// The sequencer's outer loop: new or resumed run, absolute 1 Hz deadlines, clean end.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "compensation/earth_rate.hpp"
+#include "drivers/common/tap.hpp"
+#include "station/store/calibration.hpp"
+#include "station/common/logging.hpp"
+#include "station/daemon/sequencer.hpp"
+
+#ifndef STATION_VERSION
+#define STATION_VERSION "dev"
+#endif
+
+namespace station {
+
+namespace {
+
+std::vector<RunSlot> run_slots_of(const StationConfig& c) {
+  std::vector<RunSlot> out;
+  for (std::size_t i = 0; i < c.slots.size(); ++i) {
+    const auto& s = c.slots[i];
+    out.push_back({static_cast<int>(i), s.node, s.serial, s.axis, s.pulse_weight_arcsec,
+                   compensation::earth_rate_along_axis_dph(c.latitude_deg, s.enu)});
+  }
+  return out;
+}
+
+}  // namespace
+
+void Sequencer::finish(const std::string& state, double t_s) {
+  bin_run(store_, run_id_, config_.bin_s);
+  for (const auto& slot : config_.slots) {
+    try {
+      const auto f =
+          fit_serial(store_, slot.serial, {run_id_},
+                     compensation::ModelSpec{{compensation::Term::dT, compensation::Term::gradT},
+                                             config_.ref_temp_c});
+      emit(t_s, "info", "seq", "fit",
+           fmt::format("{}: k1 {:.4e} deg/h/C, k0 {:.4e} deg/h/C, std ratio {:.3f} over {} bins",
+                       slot.serial, f.fit.coefficients[1], f.fit.coefficients[2], f.eval.std_ratio,
+                       f.fit.n_points));
+    } catch (const InputError& e) {
+      emit(t_s, "warn", "seq", "fit_skipped", e.what());
+    }
+  }
+  store_.finish_run(run_id_, state);
+  emit(t_s, "info", "seq", "run_end", fmt::format("run {} {}", run_id_, state));
+}
+
+RunOutcome Sequencer::run(const std::optional<RunRecord>& resume) {
+  const double period = options_.period_s;
+  RunProgress progress;
+  double t_first = 0;
+  if (resume) {
+    run_id_ = resume->id;
+    if (!options_.replay_until_t_s) {
+      // Real hardware: continue the protocol where the record stops, at the real elapsed time,
+      // so the outage shows as a gap (incomplete bins), not as continuous data.
+      progress = resume->progress;
+      const double elapsed_s = drivers::tap_wall_time_s() - resume->t0_wall_s;
+      t_first = std::max(resume->progress.t_s + period, std::floor(elapsed_s / period) * period);
+      if (t_first > resume->progress.t_s + period) {
+        emit(resume->progress.t_s, "warn", "seq", "resume_gap",
+             fmt::format("no samples from t = {:.0f} s to {:.0f} s (daemon down)",
+                         resume->progress.t_s, t_first));
+      }
+    }
+    emit(resume->progress.t_s, "warn", "seq", "resume",
+         fmt::format("resuming run {} at step {} after t = {:.0f} s", run_id_,
+                     resume->progress.step_index, resume->progress.t_s));
+  } else {
+    RunInfo info{
+        protocol_.name, protocol_.text,         config_.text,      STATION_VERSION,
+        config_.name,   options_.operator_name, options_.sim_seed, drivers::tap_wall_time_s()};
+    run_id_ = store_.create_run(info, run_slots_of(config_));
+    emit(0, "info", "seq", "run_start",
+         fmt::format("run {} protocol '{}' with {} gyros", run_id_, protocol_.name,
+                     config_.slots.size()));
+  }
+  // The safety layer's limits apply to the whole protocol before anything moves.
+  std::vector<std::string> notes;
+  protocol_ = safety_.clamp_protocol(protocol_, notes);
+  if (!resume) {
+    for (const auto& n : notes) emit(0, "warn", "safety", "clamp", n);
+  }
+  runner_.emplace(protocol_, progress);
+  connect_devices();
+  const double start = clock_.now_s();
+  std::int64_t ticks = 0;
+  for (std::int64_t k = 0;; ++k) {
+    const double deadline = start + static_cast<double>(k) * period;
+    if (k > 0) {
+      const auto due = static_cast<std::int64_t>(std::floor((clock_.now_s() - start) / period));
+      if (due > k) {  // absolute deadlines: a late tick skips, it never shifts the schedule
+        log("seq")->warn("overrun: {} tick(s) skipped at t_s={:.0f}", due - k,
+                         t_first + k * period);
+        rig_.counters->note_skipped_ticks(static_cast<int>(due - k));  // next delta spans them
+        k = due;
+      } else {
+        watch_inputs_until(deadline, t_first + static_cast<double>(k - 1) * period);
+      }
+    }
+    const double t_s = t_first + static_cast<double>(k) * period;
+    replaying_ = options_.replay_until_t_s && t_s <= *options_.replay_until_t_s;
+    if (options_.before_tick) {
+      const auto w0 = std::chrono::steady_clock::now();
+      options_.before_tick(t_s);
+      phase_s_.world +=
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
+    }
+    TickData d;
+    tick(t_s, d);
+    ++ticks;
+    if (options_.watchdog) options_.watchdog();
+    if (options_.on_tick) {
+      options_.on_tick({t_s, runner_->progress().step_index,
+                        static_cast<int>(protocol_.steps.size()), runner_->progress().recording,
+                        safety_.holding(), d.obs.air_c});
+    }
+    const bool stop = options_.stop != nullptr && options_.stop->load();
+    if (runner_->done() || stop) {
+      const std::string state = runner_->done() ? "completed" : "stopped";
+      const double n = static_cast<double>(ticks) / 1e6;  // -> microseconds per tick
+      log("seq")->info(
+          "tick phases, mean us: world {:.0f} can {:.0f} chamber {:.0f} table {:.0f} gpio {:.0f} "
+          "store {:.0f}",
+          phase_s_.world / n, phase_s_.can / n, phase_s_.chamber / n, phase_s_.table / n,
+          phase_s_.gpio / n, phase_s_.store / n);
+      finish(state, t_s);
+      return {run_id_, state, t_s, ticks};
+    }
+  }
+}
+
+}  // namespace station

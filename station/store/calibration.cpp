@@ -1,0 +1,57 @@
+// Binning stored runs and fitting per serial number with the compensation core.
+#include "station/store/calibration.hpp"
+
+#include <fmt/format.h>
+
+#include "compensation/binning.hpp"
+#include "station/common/input_error.hpp"
+
+namespace station {
+
+namespace sc = station::compensation;
+
+std::vector<sc::Bin> bin_samples(const std::vector<SampleRow>& rows, double bin_s) {
+  std::vector<double> t, rate, temp, grad;
+  for (const auto& s : rows) {
+    if (!s.recording || !s.rate_dph || !s.temp_c || !s.temp2_c || (s.flags & kUnfitFlags) != 0) {
+      continue;
+    }
+    t.push_back(s.t_s);
+    rate.push_back(*s.rate_dph);
+    temp.push_back(*s.temp_c);
+    grad.push_back(*s.temp2_c - *s.temp_c);  // gradient = second sensor - first (analyze's rule)
+  }
+  sc::BinConfig cfg;
+  cfg.width_s = bin_s;
+  cfg.sample_period_s = 1.0;  // the sequencer's tick
+  return sc::make_bins({t, rate, temp, grad, {}}, cfg);
+}
+
+void bin_run(Store& store, std::int64_t run_id, double bin_s) {
+  for (const auto& slot : store.run_slots(run_id)) {
+    const auto bins = bin_samples(store.samples(run_id, slot.serial, true), bin_s);
+    store.replace_bins(run_id, slot.serial, bins, slot.earth_rate_dph);
+  }
+}
+
+SerialFit fit_serial(Store& store, const std::string& serial, std::vector<std::int64_t> runs,
+                     const sc::ModelSpec& spec) {
+  if (runs.empty()) runs = store.runs_of_serial(serial);
+  if (runs.empty())
+    throw InputError(fmt::format("{}: no run recorded serial '{}'", store.db().path(), serial));
+  SerialFit out;
+  out.serial = serial;
+  out.runs = runs;
+  const sc::ModelData data = store.model_data(serial, runs);
+  try {
+    out.fit = sc::fit_model(data.view(), spec);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(fmt::format("{}: serial '{}', runs {}: {}", store.db().path(), serial,
+                                 fmt::join(runs, ","), e.what()));
+  }
+  out.eval = sc::evaluate(data.bias_dph, sc::compensate(out.fit, data.view()));
+  out.fit_id = store.save_fit(serial, runs, out.fit, out.eval);
+  return out;
+}
+
+}  // namespace station

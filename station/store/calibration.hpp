@@ -1,0 +1,36 @@
+// From stored samples to stored coefficients: 600 s bins per gyro (Earth rate removed per slot),
+// then the thermal model fitted per serial number over one or several runs.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "compensation/fit.hpp"
+#include "station/store/store.hpp"
+
+namespace station {
+
+/// Bins one gyro's samples of the record window (recording = true) at bin_s.
+std::vector<compensation::Bin> bin_samples(const std::vector<SampleRow>& rows, double bin_s);
+
+/// Bins every slot's recorded samples of `run_id` (bin width bin_s) and stores them.
+/// The gradient is temp2 - temp per sample; samples without rate or temperatures, or flagged
+/// safe-hold or board fault (kUnfitFlags), are skipped, so their bins come out incomplete.
+void bin_run(Store& store, std::int64_t run_id, double bin_s);
+
+/// One serial's fit as stored.
+struct SerialFit {
+  std::string serial;
+  std::vector<std::int64_t> runs;
+  compensation::FitResult fit;
+  compensation::Evaluation eval;
+  std::int64_t fit_id = 0;
+};
+
+/// Fits `spec` to the complete bins of `serial` over `runs` (all its runs when empty), stores the
+/// fit with its statistics and the runs used. Throws InputError when there is nothing to fit.
+SerialFit fit_serial(Store& store, const std::string& serial, std::vector<std::int64_t> runs,
+                     const compensation::ModelSpec& spec);
+
+}  // namespace station

@@ -1,0 +1,44 @@
+// Fit coefficients as JSON objects.
+#include "station/store/fit_json.hpp"
+
+namespace station {
+namespace {
+
+nlohmann::json keyed(const compensation::FitResult& fit, const std::vector<double>& values) {
+  nlohmann::json j = nlohmann::json::object();
+  for (std::size_t i = 0; i < fit.names.size(); ++i) j[fit.names[i]] = values[i];
+  return j;
+}
+
+}  // namespace
+
+nlohmann::json coefficients_json(const compensation::FitResult& fit) {
+  return keyed(fit, fit.coefficients);
+}
+
+nlohmann::json std_errors_json(const compensation::FitResult& fit) {
+  return keyed(fit, fit.std_errors);
+}
+
+nlohmann::json std_errors_hac_json(const compensation::FitResult& fit) {
+  return keyed(fit, fit.std_errors_hac);
+}
+
+nlohmann::json fit_summary_json(const compensation::FitResult& fit,
+                                const compensation::Evaluation& eval) {
+  return {{"coefficients", coefficients_json(fit)},
+          {"std_errors", std_errors_json(fit)},
+          {"std_errors_hac", std_errors_hac_json(fit)},
+          {"hac_lag", fit.hac_lag},
+          {"bins", fit.n_points},
+          {"r2", fit.r2},
+          {"residual_rms_dph", fit.residual_rms_dph},
+          {"condition_number", fit.condition_number},
+          {"std_before_dph", eval.std_before_dph},
+          {"std_after_dph", eval.std_after_dph},
+          {"std_ratio", eval.std_ratio},
+          {"improvement_pct", eval.improvement_pct},
+          {"warnings", fit.warnings}};
+}
+
+}  // namespace station

@@ -1,0 +1,138 @@
+// SQLite RAII wrappers; every C error code is translated here, with the statement text.
+#include "station/store/sqlite.hpp"
+
+#include <fmt/format.h>
+
+#include "schemas/migrations.hpp"
+
+namespace station {
+
+Statement::Statement(sqlite3* db, std::string_view sql, std::string db_path)
+    : db_(db), db_path_(std::move(db_path)) {
+  sqlite3_stmt* raw = nullptr;
+  if (sqlite3_prepare_v2(db, sql.data(), static_cast<int>(sql.size()), &raw, nullptr) !=
+      SQLITE_OK) {
+    throw SqliteError(
+        fmt::format("{}: cannot prepare '{}': {}", db_path_, sql, sqlite3_errmsg(db)));
+  }
+  stmt_.reset(raw);
+}
+
+void Statement::fail(const char* what) const {
+  throw SqliteError(fmt::format("{}: {} '{}': {}", db_path_, what, sqlite3_sql(stmt_.get()),
+                                sqlite3_errmsg(db_)));
+}
+
+Statement& Statement::bind(int i, double v) {
+  if (sqlite3_bind_double(stmt_.get(), i, v) != SQLITE_OK) fail("bind");
+  return *this;
+}
+
+Statement& Statement::bind(int i, std::int64_t v) {
+  if (sqlite3_bind_int64(stmt_.get(), i, v) != SQLITE_OK) fail("bind");
+  return *this;
+}
+
+Statement& Statement::bind(int i, std::string_view v) {
+  if (sqlite3_bind_text(stmt_.get(), i, v.data(), static_cast<int>(v.size()), SQLITE_TRANSIENT) !=
+      SQLITE_OK) {
+    fail("bind");
+  }
+  return *this;
+}
+
+Statement& Statement::bind(int i, std::optional<double> v) {
+  return v ? bind(i, *v) : bind_null(i);
+}
+
+Statement& Statement::bind_null(int i) {
+  if (sqlite3_bind_null(stmt_.get(), i) != SQLITE_OK) fail("bind");
+  return *this;
+}
+
+bool Statement::step() {
+  const int rc = sqlite3_step(stmt_.get());
+  if (rc == SQLITE_ROW) return true;
+  if (rc == SQLITE_DONE) return false;
+  fail("step");
+}
+
+void Statement::reset() {
+  sqlite3_reset(stmt_.get());
+  sqlite3_clear_bindings(stmt_.get());
+}
+
+std::string Statement::column_text(int c) const {
+  const auto* p = sqlite3_column_text(stmt_.get(), c);
+  return p != nullptr ? std::string(reinterpret_cast<const char*>(p)) : std::string();
+}
+
+Database::Database(const std::string& path) : path_(path) {
+  sqlite3* raw = nullptr;
+  const int rc =
+      sqlite3_open_v2(path.c_str(), &raw, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr);
+  db_.reset(raw);
+  if (rc != SQLITE_OK) {
+    throw SqliteError(fmt::format("{}: cannot open: {}", path,
+                                  raw != nullptr ? sqlite3_errmsg(raw) : sqlite3_errstr(rc)));
+  }
+  // Every wait on a lock is bounded (5 s). WAL with synchronous=NORMAL: a commit survives the
+  // process being killed at any instant (only an OS crash can lose the last commits; SQLite
+  // docs, "Write-Ahead Logging" and PRAGMA synchronous).
+  sqlite3_busy_timeout(db_.get(), 5000);
+  exec("PRAGMA journal_mode=WAL; PRAGMA synchronous=NORMAL; PRAGMA foreign_keys=ON;");
+}
+
+void Database::exec(std::string_view sql) {
+  char* err = nullptr;
+  const std::string text(sql);
+  if (sqlite3_exec(db_.get(), text.c_str(), nullptr, nullptr, &err) != SQLITE_OK) {
+    const std::string msg = err != nullptr ? err : "unknown error";
+    sqlite3_free(err);
+    throw SqliteError(fmt::format("{}: {}", path_, msg));
+  }
+}
+
+int Database::schema_version() {
+  auto st = prepare("PRAGMA user_version");
+  st.step();
+  return static_cast<int>(st.column_int(0));
+}
+
+void Database::migrate() {
+  const int known = static_cast<int>(schemas::kMigrations.size());
+  if (schema_version() == known) return;  // the common case: no write lock needed
+  // Version check and migrations in one write transaction: two processes opening a new file at
+  // once (a daemon and `station fit`) must not both migrate it.
+  Transaction tx(*this);
+  const int have = schema_version();
+  if (have > known) {
+    throw SqliteError(
+        fmt::format("{}: schema version {} is newer than this software ({})", path_, have, known));
+  }
+  for (int v = have; v < known; ++v) {
+    exec(schemas::kMigrations[static_cast<std::size_t>(v)].second);
+    exec(fmt::format("PRAGMA user_version = {}", v + 1));
+  }
+  tx.commit();
+}
+
+Transaction::Transaction(Database& db) : db_(db) {
+  db_.exec("BEGIN IMMEDIATE");
+}
+
+Transaction::~Transaction() {
+  if (!done_) {
+    try {
+      db_.exec("ROLLBACK");
+    } catch (...) {  // NOLINT(bugprone-empty-catch): nothing better to do in a destructor
+    }
+  }
+}
+
+void Transaction::commit() {
+  db_.exec("COMMIT");
+  done_ = true;
+}
+
+}  // namespace station

@@ -1,0 +1,338 @@
+// Store: typed reads and writes over the migrated SQLite schema (schemas/migrations).
+#include "station/store/store.hpp"
+
+#include <fmt/chrono.h>
+#include <fmt/format.h>
+
+#include <chrono>
+#include <nlohmann/json.hpp>
+
+#include "station/store/fit_json.hpp"
+
+namespace station {
+
+namespace sc = station::compensation;
+using nlohmann::json;
+
+std::string utc_now_iso() {
+  const auto now = std::chrono::system_clock::now();
+  const auto ms =
+      std::chrono::duration_cast<std::chrono::milliseconds>(now.time_since_epoch()) % 1000;
+  return fmt::format("{:%Y-%m-%dT%H:%M:%S}.{:03d}Z",
+                     fmt::gmtime(std::chrono::system_clock::to_time_t(now)),
+                     static_cast<int>(ms.count()));
+}
+
+Store::Store(const std::string& path) : db_(path) {
+  db_.migrate();
+}
+
+std::int64_t Store::create_run(const RunInfo& info, const std::vector<RunSlot>& slots) {
+  flush();
+  Transaction tx(db_);
+  auto st = db_.prepare(
+      "INSERT INTO runs (started_utc, state, protocol_name, protocol_text, config_text, "
+      "software_version, station, operator, sim_seed, t0_wall_s) "
+      "VALUES (?,'running',?,?,?,?,?,?,?,?)");
+  st.bind(1, utc_now_iso()).bind(2, info.protocol_name).bind(3, info.protocol_text);
+  st.bind(4, info.config_text).bind(5, info.software_version).bind(6, info.station);
+  st.bind(7, info.operator_name);
+  if (info.sim_seed)
+    st.bind(8, *info.sim_seed);
+  else
+    st.bind_null(8);
+  st.bind(9, info.t0_wall_s);
+  st.step();
+  const std::int64_t id = db_.last_insert_id();
+  auto gyro = db_.prepare("INSERT OR IGNORE INTO gyros (serial, first_seen_utc) VALUES (?, ?)");
+  auto slot = db_.prepare("INSERT INTO run_slots VALUES (?,?,?,?,?,?,?)");
+  for (const auto& s : slots) {
+    gyro.bind(1, s.serial).bind(2, utc_now_iso());
+    gyro.step();
+    gyro.reset();
+    slot.bind(1, id).bind(2, s.slot).bind(3, s.node).bind(4, s.serial);
+    slot.bind(5, s.pulse_weight_arcsec).bind(6, s.axis).bind(7, s.earth_rate_dph);
+    slot.step();
+    slot.reset();
+  }
+  tx.commit();
+  return id;
+}
+
+namespace {
+constexpr const char* kRunColumns =
+    "SELECT id, state, protocol_name, protocol_text, config_text, station, sim_seed, step_index, "
+    "step_started_s, t_s, recording, record_start_s, start_temp_c, t0_wall_s FROM runs ";
+
+RunRecord read_run(const Statement& st) {
+  RunRecord r;
+  r.id = st.column_int(0);
+  r.state = st.column_text(1);
+  r.protocol_name = st.column_text(2);
+  r.protocol_text = st.column_text(3);
+  r.config_text = st.column_text(4);
+  r.station = st.column_text(5);
+  if (!st.column_is_null(6)) r.sim_seed = st.column_int(6);
+  r.progress.step_index = static_cast<int>(st.column_int(7));
+  r.progress.step_started_s = st.column_double(8);
+  r.progress.t_s = st.column_double(9);
+  r.progress.recording = st.column_int(10) != 0;
+  if (!st.column_is_null(11)) r.progress.record_start_s = st.column_double(11);
+  if (!st.column_is_null(12)) r.progress.start_temp_c = st.column_double(12);
+  r.t0_wall_s = st.column_double(13);
+  return r;
+}
+}  // namespace
+
+std::optional<RunRecord> Store::find_run(std::int64_t id) {
+  auto st = db_.prepare(std::string(kRunColumns) + "WHERE id = ?");
+  st.bind(1, id);
+  if (!st.step()) return std::nullopt;
+  return read_run(st);
+}
+
+std::optional<RunRecord> Store::find_unfinished_run() {
+  auto st =
+      db_.prepare(std::string(kRunColumns) + "WHERE state = 'running' ORDER BY id DESC LIMIT 1");
+  if (!st.step()) return std::nullopt;
+  return read_run(st);
+}
+
+std::vector<RunSlot> Store::run_slots(std::int64_t run_id) {
+  auto st = db_.prepare(
+      "SELECT slot, node, serial, pulse_weight_arcsec, axis, earth_rate_dph FROM run_slots "
+      "WHERE run_id = ? ORDER BY slot");
+  st.bind(1, run_id);
+  std::vector<RunSlot> out;
+  while (st.step()) {
+    out.push_back({static_cast<int>(st.column_int(0)), static_cast<int>(st.column_int(1)),
+                   st.column_text(2), st.column_text(4), st.column_double(3), st.column_double(5)});
+  }
+  return out;
+}
+
+void Store::finish_run(std::int64_t run_id, const std::string& state) {
+  flush();
+  auto st = db_.prepare("UPDATE runs SET state = ?, ended_utc = ? WHERE id = ?");
+  st.bind(1, state).bind(2, utc_now_iso()).bind(3, run_id);
+  st.step();
+}
+
+void Store::append_tick(std::int64_t run_id, const std::vector<SampleRow>& rows,
+                        const RunProgress& p) {
+  if (!insert_sample_) {
+    insert_sample_.emplace(
+        db_.prepare("INSERT OR REPLACE INTO samples VALUES (?,?,?,?,?,?,?,?,?,?,?,?)"));
+    update_progress_.emplace(
+        db_.prepare("UPDATE runs SET step_index = ?, step_started_s = ?, t_s = ?, recording = ?, "
+                    "record_start_s = ?, start_temp_c = ? WHERE id = ?"));
+  }
+  if (!batch_) batch_.emplace(db_);
+  try {
+    write_tick(run_id, rows, p);
+  } catch (...) {
+    batch_.reset();  // rolls back the whole batch: no half tick is ever committed
+    batch_ticks_ = 0;
+    throw;
+  }
+  if (++batch_ticks_ >= ticks_per_commit_) flush();
+}
+
+void Store::write_tick(std::int64_t run_id, const std::vector<SampleRow>& rows,
+                       const RunProgress& p) {
+  auto& ins = *insert_sample_;
+  for (const auto& r : rows) {
+    ins.reset();
+    ins.bind(1, run_id).bind(2, r.serial).bind(3, r.t_s);
+    if (r.net_pulses)
+      ins.bind(4, *r.net_pulses);
+    else
+      ins.bind_null(4);
+    ins.bind(5, r.interval_s).bind(6, r.rate_dph).bind(7, r.temp_c).bind(8, r.temp2_c);
+    ins.bind(9, r.air_c).bind(10, r.setpoint_c).bind(11, r.flags).bind(12, r.recording ? 1 : 0);
+    ins.step();
+  }
+  ins.reset();
+  auto& up = *update_progress_;
+  up.reset();
+  up.bind(1, p.step_index).bind(2, p.step_started_s).bind(3, p.t_s).bind(4, p.recording ? 1 : 0);
+  up.bind(5, p.record_start_s).bind(6, p.start_temp_c).bind(7, run_id);
+  up.step();
+  up.reset();
+}
+
+void Store::flush() {
+  if (!batch_) return;
+  batch_->commit();
+  batch_.reset();
+  batch_ticks_ = 0;
+}
+
+Store::~Store() {
+  try {
+    flush();
+  } catch (...) {  // NOLINT(bugprone-empty-catch): the batch rolls back; nothing else to do here
+  }
+}
+
+std::vector<SampleRow> Store::samples(std::int64_t run_id, const std::string& serial,
+                                      bool recording_only) {
+  auto st = db_.prepare(fmt::format(
+      "SELECT t_s, net_pulses, interval_s, rate_dph, temp_c, temp2_c, air_c, setpoint_c, flags, "
+      "recording FROM samples WHERE run_id = ? AND serial = ? {} ORDER BY t_s",
+      recording_only ? "AND recording = 1" : ""));
+  st.bind(1, run_id).bind(2, serial);
+  std::vector<SampleRow> out;
+  auto opt = [&](int c) {
+    return st.column_is_null(c) ? std::nullopt : std::optional(st.column_double(c));
+  };
+  while (st.step()) {
+    SampleRow r;
+    r.serial = serial;
+    r.t_s = st.column_double(0);
+    if (!st.column_is_null(1)) r.net_pulses = st.column_int(1);
+    r.interval_s = opt(2);
+    r.rate_dph = opt(3);
+    r.temp_c = opt(4);
+    r.temp2_c = opt(5);
+    r.air_c = opt(6);
+    r.setpoint_c = opt(7);
+    r.flags = static_cast<int>(st.column_int(8));
+    r.recording = st.column_int(9) != 0;
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
+std::int64_t Store::sample_count(std::int64_t run_id) {
+  auto st = db_.prepare("SELECT count(*) FROM samples WHERE run_id = ?");
+  st.bind(1, run_id);
+  st.step();
+  return st.column_int(0);
+}
+
+void Store::replace_bins(std::int64_t run_id, const std::string& serial,
+                         const std::vector<sc::Bin>& bins, double earth_rate_dph) {
+  flush();
+  Transaction tx(db_);
+  auto del = db_.prepare("DELETE FROM bins WHERE run_id = ? AND serial = ?");
+  del.bind(1, run_id).bind(2, serial);
+  del.step();
+  auto ins = db_.prepare("INSERT INTO bins VALUES (?,?,?,?,?,?,?,?,?,?)");
+  for (const auto& b : bins) {
+    ins.bind(1, run_id)
+        .bind(2, serial)
+        .bind(3, b.t_start_s)
+        .bind(4, static_cast<std::int64_t>(b.n));
+    ins.bind(5, b.rate_dph).bind(6, b.rate_dph - earth_rate_dph).bind(7, b.temp_c);
+    ins.bind(8, b.grad_c).bind(9, b.dtdt_c_per_h).bind(10, b.complete ? 1 : 0);
+    ins.step();
+    ins.reset();
+  }
+  tx.commit();
+}
+
+sc::ModelData Store::model_data(const std::string& serial, const std::vector<std::int64_t>& runs) {
+  sc::ModelData d;
+  auto st = db_.prepare(
+      "SELECT bias_dph, temp_c, grad_c, dtdt_c_per_h, t_start_s FROM bins WHERE run_id = ? "
+      "AND serial = ? AND complete = 1 ORDER BY t_start_s");
+  for (const auto run : runs) {
+    st.bind(1, run).bind(2, serial);
+    while (st.step()) {
+      d.bias_dph.push_back(st.column_double(0));
+      d.temp_c.push_back(st.column_double(1));
+      d.grad_c.push_back(st.column_double(2));
+      d.dtdt_c_per_h.push_back(st.column_double(3));
+      d.channel.push_back(0.0);
+      d.t_mid_s.push_back(st.column_double(4));
+    }
+    st.reset();
+  }
+  return d;
+}
+
+std::vector<std::int64_t> Store::runs_of_serial(const std::string& serial) {
+  auto st = db_.prepare("SELECT DISTINCT run_id FROM run_slots WHERE serial = ? ORDER BY run_id");
+  st.bind(1, serial);
+  std::vector<std::int64_t> out;
+  while (st.step()) out.push_back(st.column_int(0));
+  return out;
+}
+
+std::int64_t Store::save_fit(const std::string& serial, const std::vector<std::int64_t>& runs,
+                             const sc::FitResult& fit, const sc::Evaluation& eval) {
+  const json coef = coefficients_json(fit), se = std_errors_json(fit);
+  std::string terms;
+  for (auto t : fit.spec.terms)
+    terms += (terms.empty() ? "" : ",") + std::string(sc::term_option_name(t));
+  auto st = db_.prepare(
+      "INSERT INTO fits (serial, created_utc, runs_json, terms, ref_temp_c, coefficients_json, "
+      "std_errors_json, n_bins, r2, residual_rms_dph, condition_number, std_before_dph, "
+      "std_after_dph, std_ratio, warnings_json) VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)");
+  st.bind(1, serial).bind(2, utc_now_iso()).bind(3, json(runs).dump()).bind(4, terms);
+  st.bind(5, fit.spec.ref_temp_c).bind(6, coef.dump()).bind(7, se.dump());
+  st.bind(8, static_cast<std::int64_t>(fit.n_points))
+      .bind(9, fit.r2)
+      .bind(10, fit.residual_rms_dph);
+  st.bind(11, fit.condition_number).bind(12, eval.std_before_dph).bind(13, eval.std_after_dph);
+  st.bind(14, eval.std_ratio).bind(15, json(fit.warnings).dump());
+  st.step();
+  return db_.last_insert_id();
+}
+
+std::optional<FitRecord> Store::latest_fit(const std::string& serial) {
+  auto st = db_.prepare(
+      "SELECT id, created_utc, runs_json, terms, ref_temp_c, coefficients_json, std_errors_json, "
+      "n_bins, r2, residual_rms_dph, condition_number, std_before_dph, std_after_dph, std_ratio, "
+      "warnings_json FROM fits WHERE serial = ? ORDER BY id DESC LIMIT 1");
+  st.bind(1, serial);
+  if (!st.step()) return std::nullopt;
+  FitRecord r;
+  r.id = st.column_int(0);
+  r.serial = serial;
+  r.created_utc = st.column_text(1);
+  r.runs = json::parse(st.column_text(2)).get<std::vector<std::int64_t>>();
+  r.terms = st.column_text(3);
+  r.fit.spec = sc::ModelSpec{sc::parse_terms(r.terms), st.column_double(4)};
+  const json coef = json::parse(st.column_text(5)), se = json::parse(st.column_text(6));
+  r.fit.names.emplace_back("B0");
+  for (auto t : r.fit.spec.terms) r.fit.names.emplace_back(sc::term_coefficient_name(t));
+  for (const auto& n : r.fit.names) {
+    r.fit.coefficients.push_back(coef.at(n).get<double>());
+    r.fit.std_errors.push_back(se.at(n).get<double>());
+  }
+  r.fit.n_points = static_cast<std::size_t>(st.column_int(7));
+  r.fit.r2 = st.column_double(8);
+  r.fit.residual_rms_dph = st.column_double(9);
+  r.fit.condition_number = st.column_double(10);
+  r.eval = {st.column_double(11), st.column_double(12), st.column_double(13),
+            100.0 * (1.0 - st.column_double(13))};
+  r.fit.warnings = json::parse(st.column_text(14)).get<std::vector<std::string>>();
+  return r;
+}
+
+void Store::add_event(std::optional<std::int64_t> run_id, double t_s, const std::string& severity,
+                      const std::string& source, const std::string& kind,
+                      const std::string& message) {
+  auto st = db_.prepare(
+      "INSERT INTO events (run_id, t_s, wall_utc, severity, source, kind, message) "
+      "VALUES (?,?,?,?,?,?,?)");
+  if (run_id)
+    st.bind(1, *run_id);
+  else
+    st.bind_null(1);
+  st.bind(2, t_s).bind(3, utc_now_iso()).bind(4, severity).bind(5, source).bind(6, kind);
+  st.bind(7, message);
+  st.step();
+}
+
+std::vector<std::string> Store::events(std::int64_t run_id) {
+  auto st = db_.prepare("SELECT kind, message FROM events WHERE run_id = ? ORDER BY id");
+  st.bind(1, run_id);
+  std::vector<std::string> out;
+  while (st.step()) out.push_back(st.column_text(0) + ": " + st.column_text(1));
+  return out;
+}
+
+}  // namespace station

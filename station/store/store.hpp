@@ -1,0 +1,140 @@
+// The station's record: runs, gyros, 1 Hz samples, bins, fits and events in one SQLite file.
+// Each tick is one transaction, so a kill at any instant loses nothing committed and the run
+// resumes from its last committed step.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "compensation/binning.hpp"
+#include "compensation/fit.hpp"
+#include "station/store/sqlite.hpp"
+
+namespace station {
+
+/// What a new run records about itself.
+struct RunInfo {
+  std::string protocol_name, protocol_text, config_text, software_version, station, operator_name;
+  std::optional<std::int64_t> sim_seed;
+  double t0_wall_s = 0;  ///< wall-clock seconds (Unix) at t_s = 0
+};
+
+/// Where a run is in its protocol (updated with every tick).
+struct RunProgress {
+  int step_index = 0;
+  double step_started_s = 0;
+  double t_s = 0;
+  bool recording = false;
+  std::optional<double> record_start_s;
+  std::optional<double> start_temp_c;  ///< chamber air at the run's first tick
+};
+
+/// A run as stored.
+struct RunRecord {
+  std::int64_t id = 0;
+  std::string state, protocol_name, protocol_text, config_text, station;
+  std::optional<std::int64_t> sim_seed;
+  double t0_wall_s = 0;
+  RunProgress progress;
+};
+
+/// One gyro on a run.
+struct RunSlot {
+  int slot = 0, node = 0;
+  std::string serial, axis;
+  double pulse_weight_arcsec = 0, earth_rate_dph = 0;
+};
+
+/// Flag bits stored with every sample (column samples.flags).
+enum SampleFlag : int {
+  kLatchLost = 1 << 0,       ///< no counter answer this tick (the next delta spans the gap)
+  kChamberMissing = 1 << 1,  ///< the chamber did not answer
+  kTempsMissing = 1 << 2,    ///< the gyro's temperatures did not arrive or failed
+  kBoardFault = 1 << 3,      ///< the board reported a fault flag
+  kSafeHold = 1 << 4,        ///< the rig was in safe hold (door open / e-stop)
+};
+/// Samples with these flags are recorded but left out of the bins.
+inline constexpr int kUnfitFlags = kBoardFault | kSafeHold;
+
+/// One gyro's 1 Hz sample.
+struct SampleRow {
+  std::string serial;
+  double t_s = 0;
+  std::optional<std::int64_t> net_pulses;  ///< empty when the latch was lost
+  std::optional<double> interval_s, rate_dph, temp_c, temp2_c, air_c, setpoint_c;
+  int flags = 0;
+  bool recording = false;
+};
+
+/// A stored fit.
+struct FitRecord {
+  std::int64_t id = 0;
+  std::string serial, created_utc, terms;
+  std::vector<std::int64_t> runs;
+  compensation::FitResult fit;
+  compensation::Evaluation eval;
+};
+
+/// Typed access to the station database. Not thread-safe: one writer (the sequencer).
+class Store {
+ public:
+  /// Opens and migrates `path`; throws SqliteError.
+  explicit Store(const std::string& path);
+
+  std::int64_t create_run(const RunInfo& info, const std::vector<RunSlot>& slots);
+  std::optional<RunRecord> find_run(std::int64_t id);
+  /// The newest run still in state 'running' (a daemon killed mid-run), if any.
+  std::optional<RunRecord> find_unfinished_run();
+  std::vector<RunSlot> run_slots(std::int64_t run_id);
+  void finish_run(std::int64_t run_id, const std::string& state);
+
+  /// One tick: its samples and the run's progress, committed together with the ticks of its
+  /// batch (see set_ticks_per_commit); a kill loses only ticks not yet committed.
+  void append_tick(std::int64_t run_id, const std::vector<SampleRow>& rows, const RunProgress& p);
+  /// Ticks per transaction: 1 (default) on real hardware, where a tick is a second; the
+  /// simulated clock batches, as a commit costs more than a simulated tick.
+  void set_ticks_per_commit(int n) { ticks_per_commit_ = n < 1 ? 1 : n; }
+  /// Commits an open batch of ticks.
+  void flush();
+  ~Store();
+  /// Samples of one serial in a run, by time (recording window only when asked).
+  std::vector<SampleRow> samples(std::int64_t run_id, const std::string& serial,
+                                 bool recording_only);
+  /// Number of samples stored for a run.
+  std::int64_t sample_count(std::int64_t run_id);
+
+  void replace_bins(std::int64_t run_id, const std::string& serial,
+                    const std::vector<compensation::Bin>& bins, double earth_rate_dph);
+  /// Complete bins of a serial over runs, as model data (bias = rate - Earth rate).
+  compensation::ModelData model_data(const std::string& serial,
+                                     const std::vector<std::int64_t>& runs);
+  /// Run ids that recorded `serial`.
+  std::vector<std::int64_t> runs_of_serial(const std::string& serial);
+
+  std::int64_t save_fit(const std::string& serial, const std::vector<std::int64_t>& runs,
+                        const compensation::FitResult& fit, const compensation::Evaluation& eval);
+  std::optional<FitRecord> latest_fit(const std::string& serial);
+
+  void add_event(std::optional<std::int64_t> run_id, double t_s, const std::string& severity,
+                 const std::string& source, const std::string& kind, const std::string& message);
+  /// Events of a run as "kind: message" in order.
+  std::vector<std::string> events(std::int64_t run_id);
+
+  Database& db() { return db_; }
+
+ private:
+  void write_tick(std::int64_t run_id, const std::vector<SampleRow>& rows, const RunProgress& p);
+
+  Database db_;
+  // The 1 Hz path's statements, prepared once (preparing costs more than the inserts).
+  std::optional<Statement> insert_sample_, update_progress_;
+  std::optional<Transaction> batch_;
+  int ticks_per_commit_ = 1, batch_ticks_ = 0;
+};
+
+/// Current UTC time as ISO-8601 with milliseconds.
+std::string utc_now_iso();
+
+}  // namespace station
