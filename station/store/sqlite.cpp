@@ -101,20 +101,39 @@ int Database::schema_version() {
 
 void Database::migrate() {
   const int known = static_cast<int>(schemas::kMigrations.size());
-  if (schema_version() == known) return;  // the common case: no write lock needed
-  // Version check and migrations in one write transaction: two processes opening a new file at
-  // once (a daemon and `station fit`) must not both migrate it.
-  Transaction tx(*this);
-  const int have = schema_version();
-  if (have > known) {
-    throw SqliteError(
-        fmt::format("{}: schema version {} is newer than this software ({})", path_, have, known));
+  if (check_schema_version(schema_version(), known) == known) return;  // common: no write lock
+  // Foreign keys off around the migrations: a migration may rebuild a table (SQLite's
+  // "generalized ALTER TABLE" procedure, lang_altertable.html section 7). The pragma is a no-op
+  // inside a transaction, so it is set before BEGIN and restored after.
+  exec("PRAGMA foreign_keys=OFF");
+  try {
+    // Version check and migrations in one write transaction: two processes opening a new file at
+    // once (a daemon and `station fit`) must not both migrate it.
+    Transaction tx(*this);
+    const int have = check_schema_version(schema_version(), known);
+    for (int v = have; v < known; ++v) {
+      exec(schemas::kMigrations[static_cast<std::size_t>(v)].second);
+      exec(fmt::format("PRAGMA user_version = {}", v + 1));
+    }
+    auto fk = prepare("PRAGMA foreign_key_check");
+    if (fk.step()) {
+      throw SqliteError(fmt::format("{}: migration left a foreign key violation in table '{}'",
+                                    path_, fk.column_text(0)));
+    }
+    tx.commit();
+  } catch (...) {
+    exec("PRAGMA foreign_keys=ON");
+    throw;
   }
-  for (int v = have; v < known; ++v) {
-    exec(schemas::kMigrations[static_cast<std::size_t>(v)].second);
-    exec(fmt::format("PRAGMA user_version = {}", v + 1));
+  exec("PRAGMA foreign_keys=ON");
+}
+
+int Database::check_schema_version(int have, int known) const {
+  if (have < 0 || have > known) {
+    throw SqliteError(fmt::format("{}: schema version {} is not one this software knows (0..{}){}",
+                                  path_, have, known, have > known ? ": newer software wrote it" : ""));
   }
-  tx.commit();
+  return have;
 }
 
 Transaction::Transaction(Database& db) : db_(db) {

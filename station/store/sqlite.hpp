@@ -72,6 +72,9 @@ class Database {
   const std::string& path() const { return path_; }
 
  private:
+  /// `have` when it is a version this software can migrate from; throws otherwise (a negative
+  /// or future user_version must never index the migration table).
+  int check_schema_version(int have, int known) const;
   std::unique_ptr<sqlite3, SqliteClose> db_;
   std::string path_;
 };
