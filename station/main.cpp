@@ -7,6 +7,7 @@
 
 #include "station/cli/commands.hpp"
 #include "station/cli/csv_table.hpp"
+#include "station/store/sqlite.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"Gyro thermal-calibration test station"};
@@ -23,6 +24,10 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     const int rc = app.exit(e);
     return rc == 0 ? 0 : 2;
+  } catch (const station::SqliteError& e) {
+    // Names the database file; a storage fault is the user's file to look at, like bad input.
+    fmt::print(stderr, "station: {}\n", e.what());
+    return 2;
   } catch (const station::InputError& e) {
     fmt::print(stderr, "station: {}\n", e.what());
     return 2;

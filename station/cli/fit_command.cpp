@@ -56,7 +56,7 @@ void print_fit(const SerialFit& f) {
 }
 
 void run_fit(const FitOptions& o) {
-  Store store(o.db);
+  Store store(o.db, OpenMode::existing);  // stores the fit; never creates a database
   const sc::ModelSpec spec{sc::parse_terms(o.terms), o.ref_temp_c};
   std::vector<SerialFit> fits;
   if (o.all) {
@@ -77,7 +77,7 @@ void run_fit(const FitOptions& o) {
 }
 
 void run_export(const FitOptions& o) {
-  Store store(o.db);
+  Store store(o.db, OpenMode::read_only);
   const auto rec = store.latest_fit(o.serial);
   if (!rec)
     throw InputError(

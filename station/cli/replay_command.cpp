@@ -68,7 +68,7 @@ StoredSamples replay_samples(const ReplayOptions& o, const std::vector<RunSlot>&
 }
 
 int run_replay(const ReplayOptions& o) {
-  Store store(o.db);
+  Store store(o.db, OpenMode::read_only);
   const auto run = store.find_run(o.run);
   if (!run) throw InputError(fmt::format("{}: no run {}", o.db, o.run));
   const auto slots = store.run_slots(o.run);

@@ -14,6 +14,7 @@
 #include "drivers/common/clock.hpp"
 #include "station/cli/commands.hpp"
 #include "station/common/logging.hpp"
+#include "station/common/process_lock.hpp"
 #include "station/daemon/resume.hpp"
 #include "station/daemon/rig.hpp"
 #include "station/daemon/sequencer.hpp"
@@ -44,9 +45,23 @@ struct RunOptions {
   double latitude_deg = 39.9;
 };
 
+/// One daemon per database (and, on a real rig, per device): held until the process ends.
+std::vector<ProcessLock> lock_db_and_devices(const std::string& db, const StationConfig* config) {
+  std::vector<ProcessLock> locks;
+  locks.push_back(ProcessLock::acquire(db + ".lock", fmt::format("database {}", db)));
+  if (config == nullptr) return locks;
+  std::vector<std::string> endpoints{config->chamber.endpoint, config->can_transport};
+  if (config->turntable) endpoints.push_back(config->turntable->endpoint);
+  for (const auto& e : endpoints) {
+    locks.push_back(ProcessLock::acquire(device_lock_path(e), fmt::format("device {}", e)));
+  }
+  return locks;
+}
+
 int run_real(const RunOptions& o) {
   const StationConfig config = load_station_config(o.config);
   Protocol protocol = load_protocol(o.protocol);
+  const auto locks = lock_db_and_devices(o.db, &config);
   Store store(o.db);
   const ResumeDecision resume_decision = decide_resume(store, config, o.fresh, false);
   const std::optional<RunRecord>& resume = resume_decision.run;
@@ -84,12 +99,14 @@ int run_real(const RunOptions& o) {
 }
 
 int run_sim(const RunOptions& o) {
+  const std::string db = o.db.empty() ? "station-sim.db" : o.db;
+  const auto locks = lock_db_and_devices(db, nullptr);
   SimRunOptions so;
   so.gyros = o.gyros;
   so.seed = o.seed;
   so.latitude_deg = o.latitude_deg;
   so.protocol = o.protocol;
-  so.db_path = o.db;
+  so.db_path = db;
   so.fresh = o.fresh;
   so.stop = &g_stop;
   so.record_can_path = o.record_can;

@@ -1,5 +1,6 @@
-// Choosing whether a start continues a run a killed daemon left 'running': only the same rig
-// (same slots) continues, with the protocol stored with the run; anything else is refused or,
+// Choosing whether a start continues a run a killed daemon left 'running': only a run whose
+// samples would mean the same (same slots, pulse weights, axes, latitude, reference temperature,
+// bin length) continues, with the protocol stored with the run; anything else is refused or,
 // with --new, marks the old run 'aborted'.
 #pragma once
 
@@ -18,7 +19,13 @@ struct ResumeDecision {
   std::optional<Protocol> protocol;  ///< its stored protocol (continue with this one)
 };
 
-/// Why `run` cannot be continued on `config` (different slots), or empty when it can.
+/// What gives every sample of a run on `config` its meaning, as JSON text: latitude, reference
+/// temperature, bin length and per slot node, serial, pulse weight, axis and Earth rate. Stored
+/// with the run (runs.resolved_json) and compared on resume.
+std::string resolved_meaning_json(const StationConfig& config);
+
+/// Why `run` cannot be continued on `config`, as one line naming each difference
+/// ("slots/1/pulse_weight_arcsec 1.5 -> 3"), or empty when it can.
 std::string resume_mismatch(Store& store, const RunRecord& run, const StationConfig& config);
 
 /// The unfinished run of `store`, if it can continue on `config`. With `fresh`, or when

@@ -43,13 +43,14 @@ Sequencer::Sequencer(const StationConfig& config, const Protocol& protocol, Rig&
       safety_(config.limits) {}
 
 void Sequencer::emit(double t_s, const std::string& severity, const std::string& source,
-                     const std::string& kind, const std::string& message) {
+                     const std::string& kind, const std::string& message,
+                     const std::string& data_json) {
   if (replaying_) return;
   const auto lvl = severity == "error"  ? spdlog::level::err
                    : severity == "warn" ? spdlog::level::warn
                                         : spdlog::level::info;
   log(source)->log(lvl, "{} t_s={:.0f} run={} {}", kind, t_s, run_id_, message);
-  store_.add_event(run_id_, t_s, severity, source, kind, message);
+  store_.add_event(run_id_, t_s, severity, source, kind, message, data_json);
 }
 
 void Sequencer::connect_devices() {
@@ -278,7 +279,7 @@ void Sequencer::tick(double t_s, TickData& d) {
   apply_actions(t_s, a);
   if (!replaying_) {
     PhaseTimer timer(phase_s_.store);
-    store_.append_tick(run_id_, d.rows, runner_->progress());
+    store_.append_tick(run_id_, t_s, d.rows, runner_->progress());
   }
 }
 

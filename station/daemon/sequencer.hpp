@@ -71,6 +71,8 @@ class Sequencer {
     std::vector<SampleRow> rows;
     Observation obs;
   };
+  /// The first tick of a resumed run, strictly after its last committed one; logs the resume.
+  double resume_first_tick(const RunRecord& resume);
   void connect_devices();
   void tick(double t_s, TickData& d);
   void read_devices(double t_s, TickData& d);
@@ -83,7 +85,7 @@ class Sequencer {
   void assemble_samples(double t_s, TickData& d);
   void finish(const std::string& state, double t_s);
   void emit(double t_s, const std::string& severity, const std::string& source,
-            const std::string& kind, const std::string& message);
+            const std::string& kind, const std::string& message, const std::string& data_json = {});
 
   const StationConfig& config_;
   Protocol protocol_;  ///< the protocol as clamped to the station's limits

@@ -4,12 +4,14 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <nlohmann/json.hpp>
 
 #include "compensation/earth_rate.hpp"
 #include "drivers/common/tap.hpp"
-#include "station/store/calibration.hpp"
 #include "station/common/logging.hpp"
+#include "station/daemon/resume.hpp"
 #include "station/daemon/sequencer.hpp"
+#include "station/store/calibration.hpp"
 
 #ifndef STATION_VERSION
 #define STATION_VERSION "dev"
@@ -51,31 +53,52 @@ void Sequencer::finish(const std::string& state, double t_s) {
   emit(t_s, "info", "seq", "run_end", fmt::format("run {} {}", run_id_, state));
 }
 
+double Sequencer::resume_first_tick(const RunRecord& resume) {
+  const double period = options_.period_s;
+  const double last_s = resume.last_tick_s.value_or(-period);
+  double t_first = last_s + period;
+  if (options_.replay_until_t_s) {
+    // A simulation replays deterministically from t = 0; ticks up to the last committed one are
+    // recomputed, not stored again.
+    t_first = 0;
+  } else {
+    // Real hardware: continue the protocol at the real elapsed time, so the outage shows as a
+    // gap (incomplete bins), not as continuous data; but always strictly after the last
+    // committed tick, whatever the wall clock did while the daemon was down (a step backwards
+    // must not land on stored ticks).
+    const double elapsed_s = drivers::tap_wall_time_s() - resume.t0_wall_s;
+    if (std::isfinite(elapsed_s))
+      t_first = std::max(t_first, std::floor(elapsed_s / period) * period);
+    if (t_first > last_s + period) {
+      emit(last_s, "warn", "seq", "resume_gap",
+           fmt::format("no samples from t = {:.0f} s to {:.0f} s (daemon down)", last_s, t_first),
+           nlohmann::json{{"from_s", last_s}, {"to_s", t_first}}.dump());
+    }
+  }
+  emit(std::max(last_s, 0.0), "warn", "seq", "resume",
+       fmt::format("resuming run {} at step {} after t = {:.0f} s (next tick t = {:.0f} s)",
+                   run_id_, resume.progress.step_index, last_s, t_first));
+  return t_first;
+}
+
 RunOutcome Sequencer::run(const std::optional<RunRecord>& resume) {
   const double period = options_.period_s;
-  RunProgress progress;
+  // Real hardware resumes at the stored protocol position; a simulation replays from t = 0.
+  RunProgress progress = resume && !options_.replay_until_t_s ? resume->progress : RunProgress{};
   double t_first = 0;
   if (resume) {
     run_id_ = resume->id;
-    if (!options_.replay_until_t_s) {
-      // Real hardware: continue the protocol where the record stops, at the real elapsed time,
-      // so the outage shows as a gap (incomplete bins), not as continuous data.
-      progress = resume->progress;
-      const double elapsed_s = drivers::tap_wall_time_s() - resume->t0_wall_s;
-      t_first = std::max(resume->progress.t_s + period, std::floor(elapsed_s / period) * period);
-      if (t_first > resume->progress.t_s + period) {
-        emit(resume->progress.t_s, "warn", "seq", "resume_gap",
-             fmt::format("no samples from t = {:.0f} s to {:.0f} s (daemon down)",
-                         resume->progress.t_s, t_first));
-      }
-    }
-    emit(resume->progress.t_s, "warn", "seq", "resume",
-         fmt::format("resuming run {} at step {} after t = {:.0f} s", run_id_,
-                     resume->progress.step_index, resume->progress.t_s));
+    t_first = resume_first_tick(*resume);
   } else {
-    RunInfo info{
-        protocol_.name, protocol_.text,         config_.text,      STATION_VERSION,
-        config_.name,   options_.operator_name, options_.sim_seed, drivers::tap_wall_time_s()};
+    RunInfo info{protocol_.name,
+                 protocol_.text,
+                 config_.text,
+                 STATION_VERSION,
+                 config_.name,
+                 options_.operator_name,
+                 options_.sim_seed,
+                 drivers::tap_wall_time_s(),
+                 resolved_meaning_json(config_)};
     run_id_ = store_.create_run(info, run_slots_of(config_));
     emit(0, "info", "seq", "run_start",
          fmt::format("run {} protocol '{}' with {} gyros", run_id_, protocol_.name,

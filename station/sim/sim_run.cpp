@@ -95,7 +95,7 @@ nlohmann::json run_simulated(const SimRunOptions& o) {
   std::optional<RunRecord> resume = rd.run;
   if (resume && (resume->sim_seed != static_cast<std::int64_t>(o.seed) ||
                  rd.protocol->text != protocol.text)) {
-    store.add_event(resume->id, resume->progress.t_s, "warn", "seq", "aborted",
+    store.add_event(resume->id, resume->last_tick_s.value_or(0), "warn", "seq", "aborted",
                     "superseded by a simulation with another seed or protocol");
     store.finish_run(resume->id, "aborted");
     resume.reset();
@@ -107,7 +107,7 @@ nlohmann::json run_simulated(const SimRunOptions& o) {
   so.sim_seed = static_cast<std::int64_t>(o.seed);
   so.stop = o.stop;
   // Resuming a simulation replays it deterministically from t = 0 up to the last stored tick.
-  if (resume) so.replay_until_t_s = resume->progress.t_s;
+  if (resume) so.replay_until_t_s = resume->last_tick_s.value_or(-1.0);
   so.before_tick = [&world, &o](double t_s) {
     world.advance_to(t_s);
     if (o.on_world_tick) o.on_world_tick(t_s, world);

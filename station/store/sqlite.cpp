@@ -67,20 +67,55 @@ std::string Statement::column_text(int c) const {
   return p != nullptr ? std::string(reinterpret_cast<const char*>(p)) : std::string();
 }
 
-Database::Database(const std::string& path) : path_(path) {
+Database::Database(const std::string& path, OpenMode mode) : path_(path), mode_(mode) {
+  const int flags = mode == OpenMode::create     ? SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE
+                    : mode == OpenMode::existing ? SQLITE_OPEN_READWRITE
+                                                 : SQLITE_OPEN_READONLY;
   sqlite3* raw = nullptr;
-  const int rc =
-      sqlite3_open_v2(path.c_str(), &raw, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr);
+  const int rc = sqlite3_open_v2(path.c_str(), &raw, flags, nullptr);
   db_.reset(raw);
   if (rc != SQLITE_OK) {
-    throw SqliteError(fmt::format("{}: cannot open: {}", path,
+    throw SqliteError(fmt::format("{}: cannot open{}: {}", path,
+                                  mode == OpenMode::create ? "" : " (it must exist)",
                                   raw != nullptr ? sqlite3_errmsg(raw) : sqlite3_errstr(rc)));
   }
-  // Every wait on a lock is bounded (5 s). WAL with synchronous=NORMAL: a commit survives the
-  // process being killed at any instant (only an OS crash can lose the last commits; SQLite
-  // docs, "Write-Ahead Logging" and PRAGMA synchronous).
+  // Every wait on a lock is bounded (5 s).
   sqlite3_busy_timeout(db_.get(), 5000);
+  // Nothing is written to a file before it passes the check (a corrupt record must not grow).
+  quick_check();
+  if (mode != OpenMode::create && schema_version() == 0) {
+    throw SqliteError(
+        fmt::format("{}: not a station database (empty, or schema version 0); "
+                    "nothing was written to it",
+                    path_));
+  }
+  if (mode == OpenMode::read_only) {
+    exec("PRAGMA query_only=ON;");
+    return;
+  }
+  // WAL with synchronous=NORMAL: a commit survives the process being killed at any instant (only
+  // an OS crash can lose the last commits; SQLite docs, "Write-Ahead Logging", PRAGMA synchronous).
   exec("PRAGMA journal_mode=WAL; PRAGMA synchronous=NORMAL; PRAGMA foreign_keys=ON;");
+}
+
+void Database::quick_check() {
+  // quick_check is integrity_check without the index-content cross-checks: O(N) in the file
+  // size, well under a second for a 13 h, 16-gyro run (sqlite.org/pragma.html#pragma_quick_check).
+  std::string verdict;
+  try {
+    auto st = prepare("PRAGMA quick_check(1)");
+    verdict = st.step() ? st.column_text(0) : "no answer";
+  } catch (const SqliteError&) {
+    throw SqliteError(
+        fmt::format("{}: not a readable station database ({}); nothing was written "
+                    "to it",
+                    path_, sqlite3_errmsg(db_.get())));
+  }
+  if (verdict != "ok") {
+    throw SqliteError(fmt::format(
+        "{}: the database is corrupt (PRAGMA quick_check: {}); nothing was written to it", path_,
+        verdict));
+  }
 }
 
 void Database::exec(std::string_view sql) {
@@ -101,7 +136,18 @@ int Database::schema_version() {
 
 void Database::migrate() {
   const int known = static_cast<int>(schemas::kMigrations.size());
-  if (check_schema_version(schema_version(), known) == known) return;  // common: no write lock
+  const int have = check_schema_version(schema_version(), known);
+  if (have == known) return;  // the common case: no write lock needed
+  if (mode_ != OpenMode::create && have == 0) {
+    throw SqliteError(
+        fmt::format("{}: not a station database (empty, or schema version 0)", path_));
+  }
+  if (mode_ == OpenMode::read_only) {
+    throw SqliteError(fmt::format(
+        "{}: schema version {} is older than this software ({}); a writing command (station run "
+        "or station fit) migrates it",
+        path_, have, known));
+  }
   // Foreign keys off around the migrations: a migration may rebuild a table (SQLite's
   // "generalized ALTER TABLE" procedure, lang_altertable.html section 7). The pragma is a no-op
   // inside a transaction, so it is set before BEGIN and restored after.
@@ -110,8 +156,7 @@ void Database::migrate() {
     // Version check and migrations in one write transaction: two processes opening a new file at
     // once (a daemon and `station fit`) must not both migrate it.
     Transaction tx(*this);
-    const int have = check_schema_version(schema_version(), known);
-    for (int v = have; v < known; ++v) {
+    for (int v = check_schema_version(schema_version(), known); v < known; ++v) {
       exec(schemas::kMigrations[static_cast<std::size_t>(v)].second);
       exec(fmt::format("PRAGMA user_version = {}", v + 1));
     }
@@ -131,7 +176,8 @@ void Database::migrate() {
 int Database::check_schema_version(int have, int known) const {
   if (have < 0 || have > known) {
     throw SqliteError(fmt::format("{}: schema version {} is not one this software knows (0..{}){}",
-                                  path_, have, known, have > known ? ": newer software wrote it" : ""));
+                                  path_, have, known,
+                                  have > known ? ": newer software wrote it" : ""));
   }
   return have;
 }

@@ -53,11 +53,20 @@ class Statement {
   std::string db_path_;
 };
 
-/// A database file. Opens in WAL mode with a busy timeout; applies migrations on request.
+/// How a command may touch its database file.
+enum class OpenMode {
+  create,     ///< the daemon: create the file when missing, migrate it
+  existing,   ///< writers that must not create (fit): the file must exist and be a station DB
+  read_only,  ///< readers (export, replay, report): SQLITE_OPEN_READONLY, never written
+};
+
+/// A database file. Checked with PRAGMA quick_check before anything else touches it; opened in
+/// WAL mode with a busy timeout when writable; applies migrations on request.
 class Database {
  public:
-  /// Opens (creating if needed) `path`; throws SqliteError.
-  explicit Database(const std::string& path);
+  /// Opens `path` as `mode` allows; throws SqliteError naming the path (missing, not a
+  /// database, corrupt).
+  explicit Database(const std::string& path, OpenMode mode = OpenMode::create);
   /// Runs one or more statements without results.
   void exec(std::string_view sql);
   /// Prepares a statement.
@@ -70,13 +79,17 @@ class Database {
   /// PRAGMA user_version.
   int schema_version();
   const std::string& path() const { return path_; }
+  OpenMode mode() const { return mode_; }
 
  private:
+  /// PRAGMA quick_check: throws SqliteError with the first problem it reports.
+  void quick_check();
   /// `have` when it is a version this software can migrate from; throws otherwise (a negative
   /// or future user_version must never index the migration table).
   int check_schema_version(int have, int known) const;
   std::unique_ptr<sqlite3, SqliteClose> db_;
   std::string path_;
+  OpenMode mode_;
 };
 
 /// BEGIN IMMEDIATE now; ROLLBACK in the destructor unless commit() ran.

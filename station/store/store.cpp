@@ -23,7 +23,7 @@ std::string utc_now_iso() {
                      static_cast<int>(ms.count()));
 }
 
-Store::Store(const std::string& path) : db_(path) {
+Store::Store(const std::string& path, OpenMode mode) : db_(path, mode) {
   db_.migrate();
 }
 
@@ -32,8 +32,8 @@ std::int64_t Store::create_run(const RunInfo& info, const std::vector<RunSlot>& 
   Transaction tx(db_);
   auto st = db_.prepare(
       "INSERT INTO runs (started_utc, state, protocol_name, protocol_text, config_text, "
-      "software_version, station, operator, sim_seed, t0_wall_s) "
-      "VALUES (?,'running',?,?,?,?,?,?,?,?)");
+      "software_version, station, operator, sim_seed, t0_wall_s, resolved_json) "
+      "VALUES (?,'running',?,?,?,?,?,?,?,?,?)");
   st.bind(1, utc_now_iso()).bind(2, info.protocol_name).bind(3, info.protocol_text);
   st.bind(4, info.config_text).bind(5, info.software_version).bind(6, info.station);
   st.bind(7, info.operator_name);
@@ -41,11 +41,13 @@ std::int64_t Store::create_run(const RunInfo& info, const std::vector<RunSlot>& 
     st.bind(8, *info.sim_seed);
   else
     st.bind_null(8);
-  st.bind(9, info.t0_wall_s);
+  st.bind(9, info.t0_wall_s).bind(10, info.resolved_json.empty() ? "{}" : info.resolved_json);
   st.step();
   const std::int64_t id = db_.last_insert_id();
   auto gyro = db_.prepare("INSERT OR IGNORE INTO gyros (serial, first_seen_utc) VALUES (?, ?)");
-  auto slot = db_.prepare("INSERT INTO run_slots VALUES (?,?,?,?,?,?,?)");
+  auto slot = db_.prepare(
+      "INSERT INTO run_slots (run_id, slot, node, serial, pulse_weight_arcsec, axis, "
+      "earth_rate_dph) VALUES (?,?,?,?,?,?,?)");
   for (const auto& s : slots) {
     gyro.bind(1, s.serial).bind(2, utc_now_iso());
     gyro.step();
@@ -62,7 +64,8 @@ std::int64_t Store::create_run(const RunInfo& info, const std::vector<RunSlot>& 
 namespace {
 constexpr const char* kRunColumns =
     "SELECT id, state, protocol_name, protocol_text, config_text, station, sim_seed, step_index, "
-    "step_started_s, t_s, recording, record_start_s, start_temp_c, t0_wall_s FROM runs ";
+    "step_started_s, t_s, recording, record_start_s, start_temp_c, t0_wall_s, resolved_json "
+    "FROM runs ";
 
 RunRecord read_run(const Statement& st) {
   RunRecord r;
@@ -75,11 +78,12 @@ RunRecord read_run(const Statement& st) {
   if (!st.column_is_null(6)) r.sim_seed = st.column_int(6);
   r.progress.step_index = static_cast<int>(st.column_int(7));
   r.progress.step_started_s = st.column_double(8);
-  r.progress.t_s = st.column_double(9);
+  if (!st.column_is_null(9)) r.last_tick_s = st.column_double(9);
   r.progress.recording = st.column_int(10) != 0;
   if (!st.column_is_null(11)) r.progress.record_start_s = st.column_double(11);
   if (!st.column_is_null(12)) r.progress.start_temp_c = st.column_double(12);
   r.t0_wall_s = st.column_double(13);
+  r.resolved_json = st.column_text(14);
   return r;
 }
 }  // namespace
@@ -118,18 +122,21 @@ void Store::finish_run(std::int64_t run_id, const std::string& state) {
   st.step();
 }
 
-void Store::append_tick(std::int64_t run_id, const std::vector<SampleRow>& rows,
+void Store::append_tick(std::int64_t run_id, double t_s, const std::vector<SampleRow>& rows,
                         const RunProgress& p) {
   if (!insert_sample_) {
-    insert_sample_.emplace(
-        db_.prepare("INSERT OR REPLACE INTO samples VALUES (?,?,?,?,?,?,?,?,?,?,?,?)"));
+    // A committed sample is never replaced: a second tick at the same time is a bug that
+    // must surface (the primary key fails), not be hidden.
+    insert_sample_.emplace(db_.prepare(
+        "INSERT INTO samples (run_id, serial, t_s, net_pulses, interval_s, rate_dph, temp_c, "
+        "temp2_c, air_c, setpoint_c, flags, recording) VALUES (?,?,?,?,?,?,?,?,?,?,?,?)"));
     update_progress_.emplace(
         db_.prepare("UPDATE runs SET step_index = ?, step_started_s = ?, t_s = ?, recording = ?, "
                     "record_start_s = ?, start_temp_c = ? WHERE id = ?"));
   }
   if (!batch_) batch_.emplace(db_);
   try {
-    write_tick(run_id, rows, p);
+    write_tick(run_id, t_s, rows, p);
   } catch (...) {
     batch_.reset();  // rolls back the whole batch: no half tick is ever committed
     batch_ticks_ = 0;
@@ -138,7 +145,7 @@ void Store::append_tick(std::int64_t run_id, const std::vector<SampleRow>& rows,
   if (++batch_ticks_ >= ticks_per_commit_) flush();
 }
 
-void Store::write_tick(std::int64_t run_id, const std::vector<SampleRow>& rows,
+void Store::write_tick(std::int64_t run_id, double t_s, const std::vector<SampleRow>& rows,
                        const RunProgress& p) {
   auto& ins = *insert_sample_;
   for (const auto& r : rows) {
@@ -155,7 +162,7 @@ void Store::write_tick(std::int64_t run_id, const std::vector<SampleRow>& rows,
   ins.reset();
   auto& up = *update_progress_;
   up.reset();
-  up.bind(1, p.step_index).bind(2, p.step_started_s).bind(3, p.t_s).bind(4, p.recording ? 1 : 0);
+  up.bind(1, p.step_index).bind(2, p.step_started_s).bind(3, t_s).bind(4, p.recording ? 1 : 0);
   up.bind(5, p.record_start_s).bind(6, p.start_temp_c).bind(7, run_id);
   up.step();
   up.reset();
@@ -218,7 +225,9 @@ void Store::replace_bins(std::int64_t run_id, const std::string& serial,
   auto del = db_.prepare("DELETE FROM bins WHERE run_id = ? AND serial = ?");
   del.bind(1, run_id).bind(2, serial);
   del.step();
-  auto ins = db_.prepare("INSERT INTO bins VALUES (?,?,?,?,?,?,?,?,?,?)");
+  auto ins = db_.prepare(
+      "INSERT INTO bins (run_id, serial, t_start_s, n, rate_dph, bias_dph, temp_c, grad_c, "
+      "dtdt_c_per_h, complete) VALUES (?,?,?,?,?,?,?,?,?,?)");
   for (const auto& b : bins) {
     ins.bind(1, run_id)
         .bind(2, serial)
@@ -314,16 +323,20 @@ std::optional<FitRecord> Store::latest_fit(const std::string& serial) {
 
 void Store::add_event(std::optional<std::int64_t> run_id, double t_s, const std::string& severity,
                       const std::string& source, const std::string& kind,
-                      const std::string& message) {
+                      const std::string& message, const std::string& data_json) {
   auto st = db_.prepare(
-      "INSERT INTO events (run_id, t_s, wall_utc, severity, source, kind, message) "
-      "VALUES (?,?,?,?,?,?,?)");
+      "INSERT INTO events (run_id, t_s, wall_utc, severity, source, kind, message, data_json) "
+      "VALUES (?,?,?,?,?,?,?,?)");
   if (run_id)
     st.bind(1, *run_id);
   else
     st.bind_null(1);
   st.bind(2, t_s).bind(3, utc_now_iso()).bind(4, severity).bind(5, source).bind(6, kind);
   st.bind(7, message);
+  if (data_json.empty())
+    st.bind_null(8);
+  else
+    st.bind(8, data_json);
   st.step();
 }
 

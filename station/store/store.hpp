@@ -18,14 +18,14 @@ namespace station {
 struct RunInfo {
   std::string protocol_name, protocol_text, config_text, software_version, station, operator_name;
   std::optional<std::int64_t> sim_seed;
-  double t0_wall_s = 0;  ///< wall-clock seconds (Unix) at t_s = 0
+  double t0_wall_s = 0;       ///< wall-clock seconds (Unix) at t_s = 0
+  std::string resolved_json;  ///< what gives a sample its meaning (resume.hpp), compared on resume
 };
 
 /// Where a run is in its protocol (updated with every tick).
 struct RunProgress {
   int step_index = 0;
   double step_started_s = 0;
-  double t_s = 0;
   bool recording = false;
   std::optional<double> record_start_s;
   std::optional<double> start_temp_c;  ///< chamber air at the run's first tick
@@ -37,7 +37,9 @@ struct RunRecord {
   std::string state, protocol_name, protocol_text, config_text, station;
   std::optional<std::int64_t> sim_seed;
   double t0_wall_s = 0;
+  std::string resolved_json;
   RunProgress progress;
+  std::optional<double> last_tick_s;  ///< the last committed tick; empty before the first
 };
 
 /// One gyro on a run.
@@ -80,8 +82,8 @@ struct FitRecord {
 /// Typed access to the station database. Not thread-safe: one writer (the sequencer).
 class Store {
  public:
-  /// Opens and migrates `path`; throws SqliteError.
-  explicit Store(const std::string& path);
+  /// Opens `path` as `mode` allows and migrates it (not in read_only); throws SqliteError.
+  explicit Store(const std::string& path, OpenMode mode = OpenMode::create);
 
   std::int64_t create_run(const RunInfo& info, const std::vector<RunSlot>& slots);
   std::optional<RunRecord> find_run(std::int64_t id);
@@ -90,9 +92,11 @@ class Store {
   std::vector<RunSlot> run_slots(std::int64_t run_id);
   void finish_run(std::int64_t run_id, const std::string& state);
 
-  /// One tick: its samples and the run's progress, committed together with the ticks of its
-  /// batch (see set_ticks_per_commit); a kill loses only ticks not yet committed.
-  void append_tick(std::int64_t run_id, const std::vector<SampleRow>& rows, const RunProgress& p);
+  /// Tick `t_s`: its samples, the run's progress and t_s as the run's last tick, committed
+  /// together with the ticks of its batch (see set_ticks_per_commit); a kill loses only ticks
+  /// not yet committed. Samples are plain INSERTs: a tick stored twice throws, never replaces.
+  void append_tick(std::int64_t run_id, double t_s, const std::vector<SampleRow>& rows,
+                   const RunProgress& p);
   /// Ticks per transaction: 1 (default) on real hardware, where a tick is a second; the
   /// simulated clock batches, as a commit costs more than a simulated tick.
   void set_ticks_per_commit(int n) { ticks_per_commit_ = n < 1 ? 1 : n; }
@@ -117,15 +121,18 @@ class Store {
                         const compensation::FitResult& fit, const compensation::Evaluation& eval);
   std::optional<FitRecord> latest_fit(const std::string& serial);
 
+  /// One event; `data_json` is structured detail (e.g. an outage's start, end, ticks lost).
   void add_event(std::optional<std::int64_t> run_id, double t_s, const std::string& severity,
-                 const std::string& source, const std::string& kind, const std::string& message);
+                 const std::string& source, const std::string& kind, const std::string& message,
+                 const std::string& data_json = {});
   /// Events of a run as "kind: message" in order.
   std::vector<std::string> events(std::int64_t run_id);
 
   Database& db() { return db_; }
 
  private:
-  void write_tick(std::int64_t run_id, const std::vector<SampleRow>& rows, const RunProgress& p);
+  void write_tick(std::int64_t run_id, double t_s, const std::vector<SampleRow>& rows,
+                  const RunProgress& p);
 
   Database db_;
   // The 1 Hz path's statements, prepared once (preparing costs more than the inserts).

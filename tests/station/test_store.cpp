@@ -3,8 +3,11 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <string>
 
+#include "schemas/migrations.hpp"
 #include "station/store/store.hpp"
 #include "tests/station/temp_db.hpp"
 
@@ -13,7 +16,7 @@ namespace {
 using station::testing_support::fresh_db;
 
 station::RunInfo info() {
-  return {"paper", "[[step]]", "[station]", "0.1.0", "rig", "alice", 42};
+  return {"paper", "[[step]]", "[station]", "0.1.0", "rig", "alice", 42, 0.0, {}};
 }
 
 }  // namespace
@@ -51,8 +54,8 @@ TEST(Store, TicksAndProgressRoundTrip) {
     r.rate_dph = 10.5 + t;
     r.temp_c = 20.0;
     r.recording = t >= 2;
-    station::RunProgress p{2, 1.0, static_cast<double>(t), t >= 2, 2.0, std::nullopt};
-    s.append_tick(run, {r}, p);
+    station::RunProgress p{2, 1.0, t >= 2, 2.0, std::nullopt};
+    s.append_tick(run, t, {r}, p);
   }
   EXPECT_EQ(s.sample_count(run), 5);
   const auto rec = s.samples(run, "SN1", true);
@@ -64,7 +67,8 @@ TEST(Store, TicksAndProgressRoundTrip) {
   ASSERT_TRUE(unfinished.has_value());
   EXPECT_EQ(unfinished->id, run);
   EXPECT_EQ(unfinished->progress.step_index, 2);
-  EXPECT_DOUBLE_EQ(unfinished->progress.t_s, 4.0);
+  ASSERT_TRUE(unfinished->last_tick_s.has_value());
+  EXPECT_DOUBLE_EQ(*unfinished->last_tick_s, 4.0);
   EXPECT_EQ(unfinished->sim_seed, 42);
   s.finish_run(run, "completed");
   EXPECT_FALSE(s.find_unfinished_run().has_value());
@@ -77,11 +81,11 @@ TEST(Store, FailedTickRollsBackWhole) {
   const auto run = s.create_run(info(), {});
   station::SampleRow ok;
   ok.serial = "A";
-  s.append_tick(run, {ok}, {});
+  s.append_tick(run, 0, {ok}, {});
   // A row for a run that does not exist violates the foreign key: the whole tick is undone.
   station::SampleRow second = ok;
   second.t_s = 1;
-  EXPECT_THROW(s.append_tick(run + 100, {second}, {}), station::SqliteError);
+  EXPECT_THROW(s.append_tick(run + 100, 1, {second}, {}), station::SqliteError);
   EXPECT_EQ(s.sample_count(run), 1);
   EXPECT_EQ(s.sample_count(run + 100), 0);
 }
@@ -127,4 +131,161 @@ TEST(Store, BinsBecomeModelData) {
   EXPECT_DOUBLE_EQ(d.bias_dph[0], 0.5);
   EXPECT_DOUBLE_EQ(d.bias_dph[1], 2.5);
   EXPECT_EQ(s.runs_of_serial("SN1"), std::vector<std::int64_t>{run});
+}
+
+TEST(Store, ANewRunHasNoLastTickUntilOneIsCommitted) {
+  station::Store s(fresh_db("no-tick"));
+  const auto run = s.create_run(info(), {{0, 1, "SN1", "up", 1.5, 9.6}});
+  EXPECT_FALSE(s.find_run(run)->last_tick_s.has_value());
+  station::SampleRow r;
+  r.serial = "SN1";
+  r.t_s = 0;
+  s.append_tick(run, 0, {r}, {});
+  EXPECT_DOUBLE_EQ(s.find_run(run)->last_tick_s.value(), 0.0);
+}
+
+TEST(Store, ACommittedSampleIsNeverReplaced) {
+  // Issue 7.1: INSERT OR REPLACE turned "9.0|7|10.47" into "9.0|NULL|NULL" on a quick restart.
+  const auto path = fresh_db("no-replace");
+  station::Store s(path);
+  const auto run = s.create_run(info(), {{0, 1, "SN1", "up", 1.5, 9.6}});
+  station::SampleRow r;
+  r.serial = "SN1";
+  r.t_s = 9;
+  r.net_pulses = 7;
+  r.rate_dph = 10.47;
+  s.append_tick(run, 9, {r}, {});
+  station::SampleRow again;
+  again.serial = "SN1";
+  again.t_s = 9;  // same tick, nothing measured
+  EXPECT_THROW(s.append_tick(run, 9, {again}, {}), station::SqliteError);
+  const auto got = s.samples(run, "SN1", false);
+  ASSERT_EQ(got.size(), 1u);
+  EXPECT_EQ(got[0].net_pulses, 7);
+  EXPECT_DOUBLE_EQ(got[0].rate_dph.value(), 10.47);
+}
+
+TEST(Store, ReadOnlyAndExistingModesNeverCreateAFile) {
+  const auto path = fresh_db("missing");
+  EXPECT_THROW(station::Store(path, station::OpenMode::read_only), station::SqliteError);
+  EXPECT_THROW(station::Store(path, station::OpenMode::existing), station::SqliteError);
+  EXPECT_NE(access(path.c_str(), F_OK), 0) << "a read command created " << path;
+}
+
+TEST(Store, AnEmptyFileIsNotMigratedByAReadCommand) {
+  const auto path = fresh_db("empty");
+  { std::ofstream(path).flush(); }
+  for (const auto mode : {station::OpenMode::read_only, station::OpenMode::existing}) {
+    try {
+      station::Store s(path, mode);
+      ADD_FAILURE() << "an empty file was accepted";
+    } catch (const station::SqliteError& e) {
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("not a station database"), std::string::npos)
+          << e.what();
+    }
+  }
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  EXPECT_EQ(in.tellg(), 0) << "the empty file was written to";
+}
+
+TEST(Store, ReadOnlyOpenServesReadsAndRefusesWrites) {
+  const auto path = fresh_db("ro");
+  std::int64_t run = 0;
+  {
+    station::Store s(path);
+    run = s.create_run(info(), {{0, 1, "SN1", "up", 1.5, 9.6}});
+  }
+  station::Store ro(path, station::OpenMode::read_only);
+  EXPECT_EQ(ro.run_slots(run).size(), 1u);
+  EXPECT_THROW(ro.finish_run(run, "completed"), station::SqliteError);
+}
+
+namespace {
+
+/// A station database with enough samples to span many pages, then page 3 overwritten.
+std::string corrupt_db(const std::string& name) {
+  const auto path = fresh_db(name);
+  {
+    station::Store s(path);
+    const auto run = s.create_run(info(), {{0, 1, "SN1", "up", 1.5, 9.6}});
+    s.set_ticks_per_commit(500);
+    for (int t = 0; t < 2000; ++t) {
+      station::SampleRow r;
+      r.serial = "SN1";
+      r.t_s = t;
+      r.rate_dph = 10.0 + t;
+      s.append_tick(run, t, {r}, {});
+    }
+    s.flush();
+    s.db().exec("PRAGMA wal_checkpoint(TRUNCATE)");
+  }
+  std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary | std::ios::ate);
+  const auto pages = static_cast<long>(f.tellg()) / 4096;
+  f.seekp(4096 * (pages / 2));           // a page in the middle (4 KiB pages): samples b-tree data
+  const std::string junk(2000, '\xA5');  // its page header and first cells
+  f.write(junk.data(), static_cast<std::streamsize>(junk.size()));
+  return path;
+}
+
+std::string file_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+}  // namespace
+
+TEST(Store, ACorruptDatabaseIsRefusedInEveryModeAndNotWritten) {
+  const auto path = corrupt_db("corrupt");
+  const std::string before = file_bytes(path);
+  for (const auto mode :
+       {station::OpenMode::create, station::OpenMode::existing, station::OpenMode::read_only}) {
+    try {
+      station::Store s(path, mode);
+      ADD_FAILURE() << "a corrupt database was accepted";
+    } catch (const station::SqliteError& e) {
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_EQ(file_bytes(path), before) << "the corrupt file was written to";
+}
+
+TEST(Store, AUserVersionOutsideTheKnownRangeIsRefused) {
+  // Issue 7.6: a negative user_version indexed the migration table out of bounds.
+  for (const int v : {-1, -2147483647, 99}) {
+    const auto path = fresh_db("version" + std::to_string(v < 0 ? -v : v));
+    {
+      station::Database db(path);
+      db.exec("PRAGMA user_version = " + std::to_string(v));
+    }
+    try {
+      station::Store s(path);
+      ADD_FAILURE() << "user_version " << v << " was accepted";
+    } catch (const station::SqliteError& e) {
+      EXPECT_NE(std::string(e.what()).find("schema version " + std::to_string(v)),
+                std::string::npos)
+          << e.what();
+    }
+  }
+}
+
+TEST(Store, MigratesAVersion1DatabaseKeepingItsRunsAndLastTick) {
+  const auto path = fresh_db("v1");
+  {
+    station::Database db(path);
+    db.exec(station::schemas::kMigrations[0].second);
+    db.exec("PRAGMA user_version = 1");
+    db.exec(
+        "INSERT INTO runs (id, started_utc, state, protocol_name, protocol_text, config_text, "
+        "software_version, station) VALUES (1, 'x', 'running', 'p', '', '', '0.1', 'rig');"
+        "INSERT INTO samples (run_id, serial, t_s, flags, recording) VALUES (1, 'A', 41, 0, 0);");
+  }
+  station::Store s(path);
+  const auto run = s.find_run(1);
+  ASSERT_TRUE(run.has_value());
+  EXPECT_EQ(run->state, "running");
+  EXPECT_DOUBLE_EQ(run->last_tick_s.value(), 41.0);
+  EXPECT_EQ(run->resolved_json, "{}");
+  s.finish_run(1, "incomplete");  // allowed by version 2
+  EXPECT_EQ(s.find_run(1)->state, "incomplete");
 }

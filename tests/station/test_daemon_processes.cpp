@@ -1,0 +1,106 @@
+// The daemon as processes on a real-transport rig (simrig on the wall clock): one daemon per
+// database, a SIGKILL and an immediate restart never overwrite or lose a committed sample, even
+// when the wall clock went backwards while it was down.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <map>
+#include <optional>
+
+#include "station/store/store.hpp"
+#include "tests/station/rig_process.hpp"
+#include "tests/station/temp_db.hpp"
+
+namespace {
+
+namespace ts = station::testing_support;
+const std::string kHold150 = std::string(STATION_TEST_DATA_DIR) + "/hold_150.toml";
+
+/// Every stored sample of run 1 by (serial, t_s): pulses and rate.
+using Samples = std::map<std::pair<std::string, double>,
+                         std::pair<std::optional<std::int64_t>, std::optional<double>>>;
+
+Samples samples_of(const std::string& db) {
+  Samples out;
+  try {
+    station::Store s(db, station::OpenMode::read_only);
+    for (const auto& slot : s.run_slots(1))
+      for (const auto& r : s.samples(1, slot.serial, false))
+        out[{slot.serial, r.t_s}] = {r.net_pulses, r.rate_dph};
+  } catch (const std::exception&) {  // not created yet
+  }
+  return out;
+}
+
+std::size_t ticks_of(const std::string& db) {
+  return samples_of(db).size() / 2;  // two gyros
+}
+
+pid_t start_daemon(const ts::SimrigProcess& rig, const std::string& db, const std::string& tag) {
+  return ts::spawn_process(
+      {ts::kStationBin, "run", "--config", rig.config_path, "--protocol", kHold150, "--db", db},
+      db + "." + tag + ".out", db + "." + tag + ".err");
+}
+
+}  // namespace
+
+TEST(DaemonProcesses, ASecondDaemonOnTheSameDatabaseExits2NamingTheHolder) {
+  ts::SimrigProcess rig;
+  ASSERT_TRUE(rig.start("lock")) << ts::slurp(rig.err);
+  const auto db = ts::fresh_db("lock");
+  const pid_t first = start_daemon(rig, db, "first");
+  ASSERT_TRUE(ts::wait_until([&] { return ticks_of(db) >= 2; }, std::chrono::seconds(10)))
+      << ts::slurp(db + ".first.err");
+  const pid_t second = start_daemon(rig, db, "second");
+  const int status = ts::wait_bounded(second, std::chrono::seconds(5));
+  ASSERT_NE(status, -1) << "the second daemon did not exit at once";
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 2) << status;
+  const std::string said = ts::slurp(db + ".second.err");
+  EXPECT_NE(said.find("pid " + std::to_string(first)), std::string::npos) << said;
+  // The first is untouched: alive, still committing ticks.
+  const std::size_t before = ticks_of(db);
+  EXPECT_TRUE(ts::wait_until([&] { return ticks_of(db) >= before + 2; }, std::chrono::seconds(5)));
+  EXPECT_EQ(waitpid(first, nullptr, WNOHANG), 0) << "the first daemon died";
+  kill(first, SIGTERM);
+  ts::wait_bounded(first, std::chrono::seconds(10));
+}
+
+TEST(DaemonProcesses, AQuickRestartAfterSigkillNeitherReplacesNorLosesASample) {
+  ts::SimrigProcess rig;
+  ASSERT_TRUE(rig.start("quick")) << ts::slurp(rig.err);
+  const auto db = ts::fresh_db("quick");
+  pid_t pid = start_daemon(rig, db, "a");
+  ASSERT_TRUE(ts::wait_until([&] { return ticks_of(db) >= 6; }, std::chrono::seconds(15)))
+      << ts::slurp(db + ".a.err");
+  kill(pid, SIGKILL);
+  waitpid(pid, nullptr, 0);
+  const Samples before_kill = samples_of(db);
+  double last_s = 0;
+  for (const auto& [key, value] : before_kill) last_s = std::max(last_s, key.second);
+  {
+    // While the daemon was down the wall clock stepped back an hour: t0 now lies in the future.
+    station::Store s(db, station::OpenMode::existing);
+    s.db().exec("UPDATE runs SET t0_wall_s = t0_wall_s + 3600 WHERE id = 1");
+  }
+  pid = start_daemon(rig, db, "b");  // at once: the first tick could land on the last one
+  ASSERT_TRUE(ts::wait_until([&] { return ticks_of(db) >= before_kill.size() / 2 + 3; },
+                             std::chrono::seconds(15)))
+      << ts::slurp(db + ".b.err");
+  kill(pid, SIGTERM);
+  ASSERT_NE(ts::wait_bounded(pid, std::chrono::seconds(15)), -1);
+  const Samples after = samples_of(db);
+  for (const auto& [key, value] : before_kill) {
+    ASSERT_TRUE(after.count(key)) << key.first << " t=" << key.second << " lost";
+    EXPECT_EQ(after.at(key), value) << key.first << " t=" << key.second << " changed";
+  }
+  station::Store s(db, station::OpenMode::read_only);
+  bool resumed_after_last = false;
+  for (const auto& e : s.events(1)) {
+    if (e.rfind("resume: ", 0) == 0) {
+      resumed_after_last = e.find(fmt::format("after t = {:.0f} s (next tick t = {:.0f} s)", last_s,
+                                              last_s + 1)) != std::string::npos;
+      EXPECT_TRUE(resumed_after_last) << e;
+    }
+  }
+  EXPECT_TRUE(resumed_after_last);
+}
