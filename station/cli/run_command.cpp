@@ -15,6 +15,7 @@
 #include "station/cli/commands.hpp"
 #include "station/common/logging.hpp"
 #include "station/common/process_lock.hpp"
+#include "station/daemon/preflight.hpp"
 #include "station/daemon/resume.hpp"
 #include "station/daemon/rig.hpp"
 #include "station/daemon/sequencer.hpp"
@@ -62,6 +63,22 @@ int run_real(const RunOptions& o) {
   const StationConfig config = load_station_config(o.config);
   Protocol protocol = load_protocol(o.protocol);
   const auto locks = lock_db_and_devices(o.db, &config);
+  RigOptions ro;
+  std::ofstream can_log;
+  std::optional<drivers::can::CandumpTap> can_tap;
+  if (!o.record_can.empty()) {
+    can_log.open(o.record_can, std::ios::app);
+    if (!can_log) throw InputError(fmt::format("{}: cannot write the CAN log", o.record_can));
+    ro.tap = &can_tap.emplace(can_log, "can0");
+  }
+  Rig rig = build_rig(config, ro);
+  // Nothing moves and nothing is written before every device has answered once.
+  if (const auto down = preflight(rig, config); !down.empty()) {
+    std::string msg =
+        fmt::format("{}: {} device(s) unreachable, nothing started:", o.config, down.size());
+    for (const auto& d : down) msg += "\n  " + d;
+    throw InputError(msg);
+  }
   Store store(o.db);
   const ResumeDecision resume_decision = decide_resume(store, config, o.fresh, false);
   const std::optional<RunRecord>& resume = resume_decision.run;
@@ -72,15 +89,6 @@ int run_real(const RunOptions& o) {
     }
     protocol = *resume_decision.protocol;
   }
-  RigOptions ro;
-  std::ofstream can_log;
-  std::optional<drivers::can::CandumpTap> can_tap;
-  if (!o.record_can.empty()) {
-    can_log.open(o.record_can, std::ios::app);
-    if (!can_log) throw InputError(fmt::format("{}: cannot write the CAN log", o.record_can));
-    ro.tap = &can_tap.emplace(can_log, "can0");
-  }
-  Rig rig = build_rig(config, ro);
   drivers::MonotonicClock clock;
   SequencerOptions so;
   so.operator_name = o.operator_name;

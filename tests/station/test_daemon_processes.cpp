@@ -104,3 +104,38 @@ TEST(DaemonProcesses, AQuickRestartAfterSigkillNeitherReplacesNorLosesASample) {
   }
   EXPECT_TRUE(resumed_after_last);
 }
+
+TEST(DaemonProcesses, RunRefusesAnUnreachableRigBeforeWritingAnything) {
+  // Issue 7.8: with a chamber that does not exist, run "completed" with every sample flagged.
+  ts::SimrigProcess rig;
+  ASSERT_TRUE(rig.start("preflight")) << ts::slurp(rig.err);
+  const std::string good = ts::slurp(rig.config_path);
+  const auto endpoint_at = good.find("endpoint = \"tcp://127.0.0.1:") + 12;
+  ASSERT_NE(endpoint_at, std::string::npos);
+  const auto endpoint_end = good.find('"', endpoint_at);
+  const std::string chamber = good.substr(endpoint_at, endpoint_end - endpoint_at);
+  struct Case {
+    std::string from, to, says;
+  };
+  const std::vector<Case> cases{
+      {chamber, "tcp://127.0.0.1:1", "chamber tcp://127.0.0.1:1"},
+      {chamber, "tcp://no-such-host.invalid:502", "chamber tcp://no-such-host.invalid:502"},
+      {chamber, "rtu:/dev/nonexistent?baud=9600", "chamber rtu:/dev/nonexistent"},
+      {"unix:" + rig.can_socket, "fd:99999", "fd:99999"},
+  };
+  for (const auto& c : cases) {
+    std::string text = good;
+    text.replace(text.rfind(c.from), c.from.size(), c.to);  // the key, not the header comment
+    const std::string config = rig.config_path + ".bad.toml";
+    std::ofstream(config) << text;
+    const auto db = ts::fresh_db("preflight");
+    const pid_t pid = ts::spawn_process(
+        {ts::kStationBin, "run", "--config", config, "--protocol", kHold150, "--db", db},
+        db + ".out", db + ".err");
+    const int status = ts::wait_bounded(pid, std::chrono::seconds(20));
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 2) << c.to << " status " << status;
+    const std::string said = ts::slurp(db + ".err");
+    EXPECT_NE(said.find(c.says), std::string::npos) << said;
+    EXPECT_NE(access(db.c_str(), F_OK), 0) << c.to << ": a database was created";
+  }
+}
