@@ -15,10 +15,15 @@
 #include <stdexcept>
 #include <utility>
 
+#include "sim_devices/rtu_framing.hpp"
+
 namespace station::sim {
 namespace {
 
 constexpr int kPollMs = 100;
+// End of an RTU frame: 3.5 characters are 2 ms at 19200 baud; a pty delivers a frame written at
+// once within microseconds, so a few ms of silence delimit frames without splitting one.
+constexpr int kRtuSilenceMs = 5;
 
 [[noreturn]] void sys_fail(const std::string& what) {
   throw std::runtime_error("modbus server: " + what + ": " + std::strerror(errno));
@@ -233,11 +238,17 @@ void ModbusServer::run_tcp() {
   for (int c : clients) close(c);
 }
 
+// RTU frames are read here, not by modbus_receive(): libmodbus 3.1.6 stops reading a frame for
+// another unit after its header and takes the rest of it for the next frame, after which it
+// ignores its own unit's requests too (seen on a multidrop line with two units).
 void ModbusServer::run_rtu() {
+  std::uint8_t frame[MODBUS_RTU_MAX_ADU_LENGTH];
+  modbus_set_socket(ctx_.get(), pty_master_);
   while (!stop_) {
     pollfd pfd{pty_master_, POLLIN, 0};
     if (poll(&pfd, 1, kPollMs) <= 0 || !(pfd.revents & POLLIN)) continue;
-    if (!serve_one(pty_master_)) modbus_flush(ctx_.get());  // resynchronise on a bad frame
+    const int len = read_rtu_frame(pty_master_, frame, sizeof frame, kRtuSilenceMs);
+    if (rtu_frame_for({frame, static_cast<std::size_t>(len)}, unit_id_)) handle(frame, len);
   }
 }
 
@@ -266,7 +277,8 @@ bool ModbusServer::handle(const std::uint8_t* query, int len) {
   const int header = modbus_get_header_length(ctx_.get());
   const int crc = pty_master_ != -1 ? 2 : 0;  // RTU frames end with a CRC
   if (len < header + crc + 1) return true;
-  const std::span<const std::uint8_t> pdu(query + header, static_cast<std::size_t>(len - header - crc));
+  const std::span<const std::uint8_t> pdu(query + header,
+                                          static_cast<std::size_t>(len - header - crc));
   if (const std::uint8_t e = strict_exception(pdu); e != 0)
     return modbus_reply_exception(ctx_.get(), query, e) != -1;
   model_.publish(*mapping_);

@@ -108,8 +108,7 @@ TEST(ModbusChamber, GapBridgingBlockReadIsRefusedByAStrictChamber) {
   auto s = chamber.read();
   ASSERT_FALSE(s);
   EXPECT_EQ(s.error().kind, ErrorKind::exception);
-  EXPECT_NE(s.error().message.find("Illegal data address"), std::string::npos)
-      << s.error().message;
+  EXPECT_NE(s.error().message.find("Illegal data address"), std::string::npos) << s.error().message;
 }
 
 // F4T: no two read points are adjacent (floats at 2800, 2880, 2160, 2168; words elsewhere).
