@@ -86,6 +86,22 @@ void ChamberSim::set_hold(bool hold) {
   hold_ = hold;
 }
 
+void ChamberSim::set_setpoint_c(double setpoint_c) {
+  std::lock_guard lock(mutex_);
+  if (std::isfinite(setpoint_c))
+    setpoint_c_ = std::clamp(setpoint_c, cfg_.setpoint_low_c, cfg_.setpoint_high_c);
+}
+
+double ChamberSim::setpoint_c() const {
+  std::lock_guard lock(mutex_);
+  return setpoint_c_;
+}
+
+unsigned ChamberSim::alarms() const {
+  std::lock_guard lock(mutex_);
+  return alarms_locked();
+}
+
 void ChamberSim::set_run_locked(bool run) {
   // A Watlow ramp starts from the process value when the output is enabled.
   if (run && !run_) effective_sp_c_ = air_c_;
@@ -122,6 +138,16 @@ void ChamberSim::publish(modbus_mapping_t& regs) {
   put_point(regs, map_.at(cm::kSetpointLow), cfg_.setpoint_low_c);
   put_point(regs, map_.at(cm::kSetpointHigh), cfg_.setpoint_high_c);
   put_point(regs, map_.at(cm::kRun), run_ ? 1 : 0);
+}
+
+std::uint8_t ChamberSim::check_write(const RegisterWrite& write) const {
+  const auto run = write.value_of(map_.at(cm::kRun));
+  if (run && *run != 0 && *run != 1) return kIllegalDataValue;
+  const auto ramp = write.value_of(map_.at(cm::kRamp));
+  if (ramp && !(std::isfinite(*ramp) && *ramp >= 0)) return kIllegalDataValue;
+  const auto sp = write.value_of(map_.at(cm::kSetpoint));
+  if (sp && !std::isfinite(*sp)) return kIllegalDataValue;
+  return 0;
 }
 
 void ChamberSim::on_write(const modbus_mapping_t& regs, std::uint16_t pdu_address, int count) {

@@ -53,7 +53,18 @@ class ChamberSim final : public ModbusDeviceModel {
   void set_high_limit_trip(bool tripped);
   /// Holds the setpoint ramp where it is (status "hold").
   void set_hold(bool hold);
+  /// Someone at the front panel (or another master) sets the setpoint, deg C; clamped to the
+  /// controller's limits like a Modbus write.
+  void set_setpoint_c(double setpoint_c);
+  /// Target setpoint, deg C.
+  double setpoint_c() const;
+  /// Alarm bits as the alarm register shows them (chamber_map::AlarmBit). Injected alarms stay
+  /// until cleared by their setter: the model never rewrites them.
+  unsigned alarms() const;
 
+  const drivers::modbus::RegisterMap& register_map() const override { return map_; }
+  /// Run enable not 0/1, a negative or non-finite ramp or a non-finite setpoint: 03.
+  std::uint8_t check_write(const RegisterWrite& write) const override;
   int register_count() const override;
   void publish(modbus_mapping_t& regs) override;
   void on_write(const modbus_mapping_t& regs, std::uint16_t pdu_address, int count) override;

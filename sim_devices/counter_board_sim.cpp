@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
+#include <utility>
 
 #include "drivers/counters/counter_frames.hpp"
 
@@ -16,20 +17,32 @@ namespace station::sim {
 namespace wire = station::drivers::counters;
 
 CounterBoardSim::CounterBoardSim(const BoardConfig& config)
-    : config_(config), gyro_(config.gyro), fault_rng_(config.gyro.seed ^ 0x9E3779B97F4A7C15ULL) {
+    : config_(config),
+      gyro_(config.gyro),
+      fault_rng_(config.gyro.seed ^ 0x9E3779B97F4A7C15ULL),
+      clock_offset_us_(config.board_time_offset_us) {
   if (config.node < 1 || config.node > wire::kMaxNode)
     throw std::invalid_argument("counter board sim: node out of range 1..16");
 }
 
 std::uint32_t CounterBoardSim::up_count() const {
   // Dither runs both counters; positive rotation adds to up only (schemas/can_frames.md).
+  // Unsigned arithmetic is mod 2^32, as the board's 32-bit counters are.
   return config_.initial_up + static_cast<std::uint32_t>(gyro_.dither_pulses()) +
-         static_cast<std::uint32_t>(gyro_.up_pulses());
+         static_cast<std::uint32_t>(gyro_.up_pulses()) - up_at_reset_;
 }
 
 std::uint32_t CounterBoardSim::down_count() const {
   return config_.initial_down + static_cast<std::uint32_t>(gyro_.dither_pulses()) +
-         static_cast<std::uint32_t>(gyro_.down_pulses());
+         static_cast<std::uint32_t>(gyro_.down_pulses()) - down_at_reset_;
+}
+
+void CounterBoardSim::reset() {
+  up_at_reset_ += up_count();
+  down_at_reset_ += down_count();
+  reset_at_s_ = gyro_.time_s();
+  clock_offset_us_ = 0;  // the board clock starts again from 0
+  reset_pending_ = true;
 }
 
 namespace {
@@ -53,9 +66,10 @@ std::vector<can_frame> CounterBoardSim::build_frames(std::uint8_t latch_seq) {
   const std::uint8_t node = config_.node;
   const int failed_temp = failed_temp_.load();  // one value for STATUS and TEMPS alike
   wire::StatusFrame st{node, latch_seq, extra_flags_.load(), 0, wire::kFollowsCounts};
-  st.board_time_us =
-      config_.board_time_offset_us + static_cast<std::uint32_t>(std::llround(gyro_.time_s() * 1e6));
+  st.board_time_us = clock_offset_us_ +
+                     static_cast<std::uint32_t>(std::llround((gyro_.time_s() - reset_at_s_) * 1e6));
   if (failed_temp >= 0) st.flags |= wire::kFlagTempSensorFault;
+  if (std::exchange(reset_pending_, false)) st.flags |= wire::kFlagCounterReset;
   if (config_.temp_channels > 0) st.follows |= wire::kFollowsTemps;
   if (config_.send_discharge) st.follows |= wire::kFollowsDischarge;
   std::vector<can_frame> out{wire::encode(st),
@@ -73,20 +87,27 @@ std::vector<can_frame> CounterBoardSim::build_frames(std::uint8_t latch_seq) {
   return out;
 }
 
+void corrupt_record(BoardRecord& r, CorruptKind kind, std::mt19937_64& rng) {
+  switch (kind) {
+    case CorruptKind::bad_dlc:
+      r.frame.can_dlc = 3;
+      return;
+    case CorruptKind::short_record:
+      r.short_record = true;
+      return;
+    case CorruptKind::garbage_id:
+      r.frame.can_id = 0x700 + wire::node_bits(r.frame.can_id);
+      for (auto& b : r.frame.data) b = static_cast<std::uint8_t>(rng());
+      return;
+  }
+}
+
 std::vector<BoardRecord> CounterBoardSim::apply_faults(const std::vector<can_frame>& frames) {
   std::vector<BoardRecord> out;
   for (const can_frame& f : frames) {
     if (take_one(drop_)) continue;
     BoardRecord r{f, false};
-    if (take_one(corrupt_)) {
-      const CorruptKind kind = corrupt_kind_.load();
-      if (kind == CorruptKind::bad_dlc) r.frame.can_dlc = 3;
-      if (kind == CorruptKind::short_record) r.short_record = true;
-      if (kind == CorruptKind::garbage_id) {
-        r.frame.can_id = 0x700 + config_.node;
-        for (auto& b : r.frame.data) b = static_cast<std::uint8_t>(fault_rng_());
-      }
-    }
+    if (take_one(corrupt_)) corrupt_record(r, corrupt_kind_.load(), fault_rng_);
     out.push_back(r);
     if (take_one(duplicate_)) out.push_back(r);
   }
@@ -111,6 +132,61 @@ CounterBoardSim& CounterBoardBus::board(std::uint8_t node) {
   for (auto& b : boards_)
     if (b->node() == node) return *b;
   throw std::out_of_range("counter board bus: no board with that node");
+}
+
+void CounterBoardBus::drop_frames(int n) {
+  const std::lock_guard lock(mutex_);
+  drop_ = n;
+}
+
+void CounterBoardBus::duplicate_frames(int n) {
+  const std::lock_guard lock(mutex_);
+  duplicate_ = n;
+}
+
+void CounterBoardBus::corrupt_frames(int n, CorruptKind kind) {
+  const std::lock_guard lock(mutex_);
+  corrupt_ = n;
+  corrupt_kind_ = kind;
+}
+
+void CounterBoardBus::set_fault_rates(const BusFaultRates& rates, std::uint64_t seed) {
+  const std::lock_guard lock(mutex_);
+  rates_ = rates;
+  rng_.seed(seed);
+}
+
+void CounterBoardBus::clear_faults() {
+  const std::lock_guard lock(mutex_);
+  drop_ = duplicate_ = corrupt_ = 0;
+  rates_ = {};
+}
+
+void CounterBoardBus::reset_board(std::uint8_t node) {
+  const std::lock_guard lock(mutex_);
+  for (auto& b : boards_) {
+    if (b->node() == node) return b->reset();
+  }
+  throw std::out_of_range("counter board bus: no board with that node");
+}
+
+// Called with mutex_ held: the counts first (deterministic), then the rates.
+std::vector<BoardRecord> CounterBoardBus::apply_bus_faults(
+    const std::vector<BoardRecord>& records) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<BoardRecord> out;
+  for (BoardRecord r : records) {
+    if (drop_ > 0 ? (--drop_, true) : u(rng_) < rates_.drop) continue;
+    if (corrupt_ > 0) {
+      --corrupt_;
+      corrupt_record(r, corrupt_kind_, rng_);
+    } else if (u(rng_) < rates_.corrupt) {
+      corrupt_record(r, static_cast<CorruptKind>(rng_() % 3), rng_);
+    }
+    out.push_back(r);
+    if (duplicate_ > 0 ? (--duplicate_, true) : u(rng_) < rates_.duplicate) out.push_back(r);
+  }
+  return out;
 }
 
 void CounterBoardBus::step_to(double sim_time_s, double chamber_air_c) {
@@ -138,6 +214,7 @@ int CounterBoardBus::service(std::chrono::milliseconds timeout) {
         auto r = b->on_sync(sync.value().latch_seq);
         answers.insert(answers.end(), r.begin(), r.end());
       }
+      answers = apply_bus_faults(answers);
     }
     send_all(answers);  // the whole bus's answers in one burst, as they follow on a real bus
   }

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <random>
 #include <thread>
 #include <vector>
 
@@ -27,6 +28,16 @@ enum class CorruptKind : std::uint8_t {
 struct BoardRecord {
   can_frame frame{};
   bool short_record = false;  ///< send only the first 8 bytes (injected transport corruption)
+};
+
+/// Damages `r` as `kind` says; garbage bytes come from `rng` (the node stays the frame's own).
+void corrupt_record(BoardRecord& r, CorruptKind kind, std::mt19937_64& rng);
+
+/// Probabilities, per frame on the bus, of the bus-level faults (each 0..1; all 0 = healthy).
+struct BusFaultRates {
+  double drop = 0;       ///< the frame is lost
+  double duplicate = 0;  ///< the frame arrives twice
+  double corrupt = 0;    ///< the frame is damaged (a CorruptKind drawn at random)
 };
 
 /// One simulated board: node id, its gyro and what it reports.
@@ -77,6 +88,10 @@ class CounterBoardSim {
   void set_extra_flags(std::uint8_t flags) { extra_flags_ = flags; }
   /// Stops (false) or resumes (true) answering SYNCs.
   void set_answering(bool answering) { answering_ = answering; }
+  /// Board reset (a power cycle): up/down counters and the board clock restart from 0, and the
+  /// first STATUS after it flags kFlagCounterReset. Not thread-safe: while a bus serves the
+  /// board, call CounterBoardBus::reset_board instead.
+  void reset();
 
  private:
   std::vector<can_frame> build_frames(std::uint8_t latch_seq);
@@ -85,6 +100,11 @@ class CounterBoardSim {
   BoardConfig config_;
   RlgGyroModel gyro_;
   std::mt19937_64 fault_rng_;
+  // Counts and board time at the last reset(): what the counters read is counted from there.
+  std::uint32_t clock_offset_us_ = 0;  ///< board clock at reset_at_s_, µs
+  std::uint32_t up_at_reset_ = 0, down_at_reset_ = 0;
+  double reset_at_s_ = 0;
+  bool reset_pending_ = false;
   // Written by the test thread, read by the bus thread in on_sync().
   std::atomic<int> drop_{0}, duplicate_{0}, corrupt_{0}, failed_temp_{-1};
   std::atomic<CorruptKind> corrupt_kind_{CorruptKind::bad_dlc};
@@ -109,6 +129,17 @@ class CounterBoardBus {
   void step_to(double sim_time_s, double chamber_air_c);
   /// Waits up to timeout for frames, answers every pending SYNC; returns SYNCs handled.
   int service(std::chrono::milliseconds timeout);
+  /// Bus-level faults on the next `n` frames any board sends (thread-safe).
+  void drop_frames(int n);
+  void duplicate_frames(int n);
+  void corrupt_frames(int n, CorruptKind kind);
+  /// Bus-level fault probabilities from now on (thread-safe); `seed` makes them repeatable.
+  void set_fault_rates(const BusFaultRates& rates, std::uint64_t seed);
+  /// Ends every bus-level fault (counts and rates).
+  void clear_faults();
+  /// Resets the board with this node id (CounterBoardSim::reset) under the bus lock; throws
+  /// std::out_of_range if none.
+  void reset_board(std::uint8_t node);
   /// Background mode: a thread calls service() until stop() or the peer closes (~50 ms).
   void start();
   void stop();
@@ -117,10 +148,16 @@ class CounterBoardBus {
 
  private:
   void send_all(const std::vector<BoardRecord>& records);
+  std::vector<BoardRecord> apply_bus_faults(const std::vector<BoardRecord>& records);
 
   int fd_;
   std::mutex mutex_;
   std::vector<std::unique_ptr<CounterBoardSim>> boards_;
+  // Bus-level faults, guarded by mutex_.
+  int drop_ = 0, duplicate_ = 0, corrupt_ = 0;
+  CorruptKind corrupt_kind_ = CorruptKind::bad_dlc;
+  BusFaultRates rates_;
+  std::mt19937_64 rng_{1};
   std::atomic<bool> running_{false};
   std::atomic<bool> peer_closed_{false};
   std::thread thread_;

@@ -13,18 +13,20 @@
 #include <cerrno>
 #include <cstring>
 #include <stdexcept>
+#include <utility>
+
+#include "sim_devices/rtu_framing.hpp"
 
 namespace station::sim {
 namespace {
 
 constexpr int kPollMs = 100;
+// End of an RTU frame: 3.5 characters are 2 ms at 19200 baud; a pty delivers a frame written at
+// once within microseconds, so a few ms of silence delimit frames without splitting one.
+constexpr int kRtuSilenceMs = 5;
 
 [[noreturn]] void sys_fail(const std::string& what) {
   throw std::runtime_error("modbus server: " + what + ": " + std::strerror(errno));
-}
-
-std::uint16_t be16(const std::uint8_t* p) {
-  return static_cast<std::uint16_t>(p[0] << 8 | p[1]);
 }
 
 std::uint16_t* table(const modbus_mapping_t& regs, const drivers::modbus::Point& p) {
@@ -149,13 +151,41 @@ void ModbusServer::inject_drop(int n) {
   drops_ = n;
 }
 
+namespace {
+std::chrono::steady_clock::time_point wall_after(double seconds) {
+  const std::chrono::duration<double> d(std::max(0.0, seconds));
+  return std::chrono::steady_clock::now() +
+         std::chrono::duration_cast<std::chrono::steady_clock::duration>(d);
+}
+}  // namespace
+
+void ModbusServer::stall_for(double seconds) {
+  std::lock_guard lock(fault_mutex_);
+  stall_until_ = wall_after(seconds);
+}
+
+void ModbusServer::disconnect_for(double seconds) {
+  std::lock_guard lock(fault_mutex_);
+  down_until_ = wall_after(seconds);
+  kick_clients_ = true;
+}
+
+void ModbusServer::clear_faults() {
+  std::lock_guard lock(fault_mutex_);
+  timeouts_ = exceptions_ = drops_ = 0;
+  stall_until_ = down_until_ = {};
+}
+
 ModbusServer::Fault ModbusServer::take_fault(int& code) {
   std::lock_guard lock(fault_mutex_);
+  const auto now = std::chrono::steady_clock::now();
+  if (now < stall_until_ || now < down_until_) return Fault::timeout;  // RTU down: a silent line
   if (timeouts_ > 0) return --timeouts_, Fault::timeout;
   if (drops_ > 0) return --drops_, Fault::drop;
-  if (exceptions_ > 0) {
+  if (exceptions_ != 0) {
     code = exception_code_;
-    return --exceptions_, Fault::exception;
+    if (exceptions_ > 0) --exceptions_;
+    return Fault::exception;
   }
   return Fault::none;
 }
@@ -165,9 +195,36 @@ void ModbusServer::accept_client(std::vector<int>& clients) {
   if (fd != -1) clients.push_back(fd);
 }
 
+// Applies an injected disconnect: drops the clients and the listener, and listens again on the
+// same port once the down time is over. False while the link is down.
+bool ModbusServer::tcp_link_up(std::vector<int>& clients) {
+  SteadyTime down_until;
+  bool kick = false;
+  {
+    std::lock_guard lock(fault_mutex_);
+    kick = std::exchange(kick_clients_, false);
+    down_until = down_until_;
+  }
+  if (kick) {
+    for (int c : clients) close(c);
+    clients.clear();
+    if (listen_fd_ != -1) close(listen_fd_);
+    listen_fd_ = -1;
+  }
+  if (listen_fd_ != -1) return true;
+  if (std::chrono::steady_clock::now() < down_until) return false;
+  ctx_.reset(modbus_new_tcp("127.0.0.1", port_));
+  if (ctx_) listen_fd_ = modbus_tcp_listen(ctx_.get(), 8);
+  return listen_fd_ != -1;
+}
+
 void ModbusServer::run_tcp() {
   std::vector<int> clients;
   while (!stop_) {
+    if (!tcp_link_up(clients)) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      continue;
+    }
     std::vector<pollfd> fds{{listen_fd_, POLLIN, 0}};
     for (int c : clients) fds.push_back({c, POLLIN, 0});
     if (poll(fds.data(), fds.size(), kPollMs) <= 0) continue;
@@ -181,11 +238,17 @@ void ModbusServer::run_tcp() {
   for (int c : clients) close(c);
 }
 
+// RTU frames are read here, not by modbus_receive(): libmodbus 3.1.6 stops reading a frame for
+// another unit after its header and takes the rest of it for the next frame, after which it
+// ignores its own unit's requests too (seen on a multidrop line with two units).
 void ModbusServer::run_rtu() {
+  std::uint8_t frame[MODBUS_RTU_MAX_ADU_LENGTH];
+  modbus_set_socket(ctx_.get(), pty_master_);
   while (!stop_) {
     pollfd pfd{pty_master_, POLLIN, 0};
     if (poll(&pfd, 1, kPollMs) <= 0 || !(pfd.revents & POLLIN)) continue;
-    if (!serve_one(pty_master_)) modbus_flush(ctx_.get());  // resynchronise on a bad frame
+    const int len = read_rtu_frame(pty_master_, frame, sizeof frame, kRtuSilenceMs);
+    if (rtu_frame_for({frame, static_cast<std::size_t>(len)}, unit_id_)) handle(frame, len);
   }
 }
 
@@ -207,37 +270,35 @@ bool ModbusServer::handle(const std::uint8_t* query, int len) {
     case Fault::drop:
       return pty_master_ != -1;  // TCP: close; RTU: just stay silent
     case Fault::exception:
-      modbus_reply_exception(ctx_.get(), query, static_cast<unsigned>(code));
-      return true;
+      return modbus_reply_exception(ctx_.get(), query, static_cast<unsigned>(code)) != -1;
     case Fault::none:
       break;
   }
+  const int header = modbus_get_header_length(ctx_.get());
+  const int crc = pty_master_ != -1 ? 2 : 0;  // RTU frames end with a CRC
+  if (len < header + crc + 1) return true;
+  const std::span<const std::uint8_t> pdu(query + header,
+                                          static_cast<std::size_t>(len - header - crc));
+  if (const std::uint8_t e = strict_exception(pdu); e != 0)
+    return modbus_reply_exception(ctx_.get(), query, e) != -1;
   model_.publish(*mapping_);
   // Apply a write to the model BEFORE the reply leaves, so a client that has its reply sees the
   // model already changed (no race with the next step_to()).
-  apply_writes(query, len);
+  apply_writes(pdu);
   return modbus_reply(ctx_.get(), query, len, mapping_.get()) != -1;
 }
 
-void ModbusServer::apply_writes(const std::uint8_t* query, int len) {
-  int header = modbus_get_header_length(ctx_.get());
-  const std::uint8_t* pdu = query + header;
-  int pdu_len = len - header - (pty_master_ != -1 ? 2 : 0);  // RTU frames end with a CRC
-  if (pdu_len < 5) return;
-  std::uint16_t addr = be16(pdu + 1);
-  int count = 0;
-  const std::uint8_t* values = nullptr;
-  if (pdu[0] == MODBUS_FC_WRITE_SINGLE_REGISTER) {
-    count = 1;
-    values = pdu + 3;
-  } else if (pdu[0] == MODBUS_FC_WRITE_MULTIPLE_REGISTERS && pdu_len >= 6) {
-    count = be16(pdu + 3);
-    values = pdu + 6;
-    if (pdu_len < 6 + 2 * count || pdu[5] != 2 * count) return;  // libmodbus will reject it
-  }
-  if (count <= 0 || addr + count > mapping_->nb_registers) return;
-  for (int i = 0; i < count; ++i) mapping_->tab_registers[addr + i] = be16(values + 2 * i);
-  model_.on_write(*mapping_, addr, count);
+std::uint8_t ModbusServer::strict_exception(std::span<const std::uint8_t> pdu) const {
+  if (const std::uint8_t e = request_exception(model_.register_map(), pdu); e != 0) return e;
+  const auto w = parse_write(pdu);
+  return w ? model_.check_write(*w) : 0;
+}
+
+void ModbusServer::apply_writes(std::span<const std::uint8_t> pdu) {
+  const auto w = parse_write(pdu);
+  if (!w || w->address + w->count() > mapping_->nb_registers) return;
+  for (int i = 0; i < w->count(); ++i) mapping_->tab_registers[w->address + i] = w->word(i);
+  model_.on_write(*mapping_, w->address, w->count());
 }
 
 }  // namespace station::sim

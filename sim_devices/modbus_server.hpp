@@ -5,14 +5,17 @@
 #include <modbus/modbus.h>
 
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <span>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "drivers/modbus/register_map.hpp"
+#include "sim_devices/modbus_strict.hpp"
 
 namespace station::sim {
 
@@ -29,6 +32,10 @@ bool point_written(const drivers::modbus::Point& p, std::uint16_t pdu_address, i
 class ModbusDeviceModel {
  public:
   virtual ~ModbusDeviceModel() = default;
+  /// The map the device serves: a request outside it gets an exception (request_exception).
+  virtual const drivers::modbus::RegisterMap& register_map() const = 0;
+  /// Exception code (kIllegalDataValue) for a write of a value the device refuses, else 0.
+  virtual std::uint8_t check_write(const RegisterWrite& /*write*/) const { return 0; }
   /// Registers needed (holding and input tables each): highest PDU address + 1.
   virtual int register_count() const = 0;
   /// Copies the model's current state into the register tables (before every reply).
@@ -37,8 +44,9 @@ class ModbusDeviceModel {
   virtual void on_write(const modbus_mapping_t& regs, std::uint16_t pdu_address, int count) = 0;
 };
 
-/// Serves one model. start_*() spawns the thread; the destructor stops and joins it (the loop
-/// polls with a 100 ms timeout, so shutdown never hangs).
+/// Serves one model as a strict device: requests outside its map get exception 01/02/03, and on
+/// RTU a request for another unit id gets no answer at all. start_*() spawns the thread; the
+/// destructor stops and joins it (the loop polls with a 100 ms timeout, so shutdown never hangs).
 class ModbusServer {
  public:
   /// Stores the model (not owned; must outlive the server) and unit id; no I/O.
@@ -66,14 +74,23 @@ class ModbusServer {
   /// The next `n` requests get no reply at all (the client times out).
   void inject_timeouts(int n);
   /// The next `n` requests get exception reply `code` (e.g.
-  /// MODBUS_EXCEPTION_SLAVE_OR_SERVER_FAILURE).
+  /// MODBUS_EXCEPTION_SLAVE_OR_SERVER_FAILURE); n < 0: every request until clear_faults().
   void inject_exception(int code, int n = 1);
   /// The next `n` requests make the server close the connection without replying (TCP; on RTU
   /// this is a missing reply).
   void inject_drop(int n = 1);
+  /// Every request received in the next `seconds` (wall clock) gets no reply; 0 ends a stall.
+  void stall_for(double seconds);
+  /// Closes every client connection now and stops listening for `seconds` (wall clock): a
+  /// connect meanwhile is refused, as by a device that is powered off. On RTU the line is silent
+  /// for that time. Then it listens again on the same port.
+  void disconnect_for(double seconds);
+  /// Ends every injected fault (timeouts, exceptions, drops, stall, disconnect).
+  void clear_faults();
 
  private:
   enum class Fault { none, timeout, exception, drop };
+  using SteadyTime = std::chrono::steady_clock::time_point;
   struct FreeServerCtx {
     void operator()(modbus_t* c) const noexcept;
   };
@@ -84,10 +101,12 @@ class ModbusServer {
   void make_mapping();
   void run_tcp();
   void run_rtu();
+  bool tcp_link_up(std::vector<int>& clients);
   void accept_client(std::vector<int>& clients);
   bool serve_one(int fd);
   bool handle(const std::uint8_t* query, int len);
-  void apply_writes(const std::uint8_t* query, int len);
+  std::uint8_t strict_exception(std::span<const std::uint8_t> pdu) const;
+  void apply_writes(std::span<const std::uint8_t> pdu);
   Fault take_fault(int& code);
 
   ModbusDeviceModel& model_;
@@ -105,6 +124,8 @@ class ModbusServer {
   std::thread thread_;
   std::mutex fault_mutex_;
   int timeouts_ = 0, exceptions_ = 0, exception_code_ = 0, drops_ = 0;
+  SteadyTime stall_until_{}, down_until_{};
+  bool kick_clients_ = false;
 };
 
 }  // namespace station::sim

@@ -108,6 +108,70 @@ void SimWorld::add_boards() {
     b.board_time_offset_us = static_cast<std::uint32_t>(i * 123457u);
     bus_->add_board(b);
   }
+  // A station that reconnects meets fresh boards, but the faults a person injected stay.
+  bus_->set_fault_rates(can_rates_, config_.seed);
+  for (const auto& [node, channel] : failed_temp_) bus_->board(node).fail_temp_sensor(channel);
+  for (std::uint8_t node : silent_boards_) bus_->board(node).set_answering(false);
+}
+
+void SimWorld::check_node(std::uint8_t node) const {
+  if (node < 1 || node > gyros_.size())
+    throw std::invalid_argument(fmt::format("no board {} (nodes 1..{})", node, gyros_.size()));
+}
+
+void SimWorld::set_door_open(bool open) {
+  door_open_ = open;
+  gpio_->set_input("DOOR_SW", !open);
+  chamber_->set_door_open(open);
+}
+
+void SimWorld::set_estop(bool pressed) {
+  estop_ = pressed;
+  gpio_->set_input("ESTOP", pressed);
+  table_->set_interlock_open(pressed);
+}
+
+void SimWorld::set_can_fault_rates(const BusFaultRates& rates) {
+  can_rates_ = rates;
+  if (bus_) bus_->set_fault_rates(rates, config_.seed);
+}
+
+void SimWorld::set_gyro_temp_failed(std::uint8_t node, int channel, bool failed) {
+  check_node(node);
+  if (channel < 0 || channel > 2)
+    throw std::invalid_argument(fmt::format("no temperature channel {} (0..2)", channel));
+  if (failed) {
+    failed_temp_[node] = channel;
+  } else {
+    failed_temp_.erase(node);
+  }
+  if (bus_) bus_->board(node).fail_temp_sensor(channel, failed);
+}
+
+void SimWorld::set_board_answering(std::uint8_t node, bool answering) {
+  check_node(node);
+  if (answering) {
+    silent_boards_.erase(node);
+  } else {
+    silent_boards_.insert(node);
+  }
+  if (bus_) bus_->board(node).set_answering(answering);
+}
+
+void SimWorld::clear_faults() {
+  set_door_open(false);
+  set_estop(false);
+  chamber_->set_high_limit_trip(false);
+  chamber_->set_air_sensor_failed(false);
+  table_->set_fault(false);
+  chamber_server_->clear_faults();
+  table_server_->clear_faults();
+  can_rates_ = {};
+  if (bus_) bus_->clear_faults();
+  for (const auto& g : gyros_) {
+    set_gyro_temp_failed(g.node, 0, false);
+    set_board_answering(g.node, true);
+  }
 }
 
 bool SimWorld::accept_station(int timeout_ms) {

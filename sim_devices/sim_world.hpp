@@ -4,7 +4,9 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <memory>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -60,6 +62,25 @@ class SimWorld {
   /// GPIO line names: DOOR_SW, ESTOP, TOWER_G/A/R, GYRO_PWR1..N.
   std::shared_ptr<GpioSimChips> gpio_chips() const { return gpio_; }
 
+  /// Injected faults that stay until changed (sim_devices/fault_commands.hpp drives them).
+  /// The door: GPIO DOOR_SW (high = closed) and the chamber's door-open alarm bit.
+  void set_door_open(bool open);
+  /// The e-stop: GPIO ESTOP (high = pressed) and the turntable's interlock (the e-stop chain
+  /// disables the drive). simrig's config has no [gpio]: a station on simrig sees the table bit.
+  void set_estop(bool pressed);
+  bool door_open() const { return door_open_; }
+  bool estop_pressed() const { return estop_; }
+  /// CAN fault probabilities per frame, for this and every later station connection.
+  void set_can_fault_rates(const BusFaultRates& rates);
+  const BusFaultRates& can_fault_rates() const { return can_rates_; }
+  /// Gyro `node`'s temperature channel reads the sensor's sentinel (or recovers); kept across
+  /// station connections. Throws std::invalid_argument for an unknown node or channel.
+  void set_gyro_temp_failed(std::uint8_t node, int channel, bool failed);
+  /// Board `node` stops or resumes answering SYNCs; kept across station connections.
+  void set_board_answering(std::uint8_t node, bool answering);
+  /// Ends every injected fault: door closed, e-stop released, alarms, Modbus and CAN faults.
+  void clear_faults();
+
   /// Advances chamber, table and every gyro to t_s (air temperature feeds the gyros).
   void advance_to(double t_s);
   double now_s() const { return now_s_; }
@@ -73,6 +94,7 @@ class SimWorld {
 
  private:
   void add_boards();
+  void check_node(std::uint8_t node) const;
 
   SimWorldConfig config_;
   std::vector<SimGyro> gyros_;
@@ -84,6 +106,10 @@ class SimWorld {
   std::string can_transport_;
   int listen_fd_ = -1;
   double now_s_ = 0;
+  bool door_open_ = false, estop_ = false;
+  BusFaultRates can_rates_;
+  std::map<std::uint8_t, int> failed_temp_;  // node -> channel
+  std::set<std::uint8_t> silent_boards_;
 };
 
 /// Distinct, realistic true coefficients for gyro `index` of a world seeded with `seed`

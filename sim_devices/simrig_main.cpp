@@ -8,8 +8,14 @@
 #include <csignal>
 #include <cstdio>
 #include <exception>
+#include <memory>
+#include <string>
+#include <string_view>
 #include <thread>
+#include <vector>
 
+#include "sim_devices/control_socket.hpp"
+#include "sim_devices/fault_commands.hpp"
 #include "sim_devices/sim_world.hpp"
 
 namespace {
@@ -29,6 +35,8 @@ struct Options {
   int turntable_port = 0;
   std::string can_socket = "/tmp/simrig-can.sock";
   double latitude_deg = 39.9;
+  std::string control;            // fault-injection control socket, "" = none
+  std::vector<std::string> send;  // client mode: commands for a running simrig's control socket
 };
 
 /// Earth rate along a local-vertical input axis, deg/h: Omega * sin(lat) with the WGS-84
@@ -50,6 +58,8 @@ void print_config(const sim::SimWorld& world, const Options& o) {
       "[can]\ntransport = \"{}\"\ntick_timeout_ms = 200\n",
       o.seed, o.gyros, world.chamber_endpoint(), world.turntable_endpoint(), world.can_transport(),
       o.latitude_deg, world.chamber_endpoint(), world.turntable_endpoint(), world.can_transport());
+  if (!o.control.empty())
+    fmt::print("# fault commands: simrig --control {} --send 'help'\n", o.control);
   for (const auto& g : world.gyros()) {
     fmt::print("\n[[slot]]\nnode = {}\nserial = \"{}\"\npulse_weight_arcsec = {}\naxis = \"up\"\n",
                g.node, g.serial, g.pulse_weight_arcsec);
@@ -57,10 +67,20 @@ void print_config(const sim::SimWorld& world, const Options& o) {
   std::fflush(stdout);
 }
 
+/// Waits up to `ms` for fault commands on the control socket (if any) and answers them.
+void wait_for_commands(sim::ControlSocket* control, int ms) {
+  if (control != nullptr) {
+    control->service(ms);
+  } else {
+    std::this_thread::sleep_for(std::chrono::milliseconds(ms));
+  }
+}
+
 /// Steps the world to the wall clock every 100 ms until SIGINT/SIGTERM; accepts the station's
 /// CAN connection meanwhile (accept_station polls, so a connect is served at once), and a new
-/// one after a station leaves (e.g. `station probe`, then `station run`).
-void serve(sim::SimWorld& world, const std::string& can) {
+/// one after a station leaves (e.g. `station probe`, then `station run`). Fault commands are
+/// answered between steps, on this thread.
+void serve(sim::SimWorld& world, const std::string& can, sim::ControlSocket* control) {
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
   bool connected = false;
@@ -71,14 +91,30 @@ void serve(sim::SimWorld& world, const std::string& can) {
       fmt::print(stderr, "simrig: station disconnected; waiting for the next one\n");
     }
     if (!connected) {
-      connected = world.accept_station(100);
+      connected = world.accept_station(50);
       if (connected) fmt::print(stderr, "simrig: station connected\n");
+      wait_for_commands(control, connected ? 0 : 50);
     } else {
-      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      wait_for_commands(control, 100);
     }
     world.advance_to(std::chrono::duration<double>(Clock::now() - t0).count());
   }
   fmt::print(stderr, "simrig: stopping at t = {:.1f} s\n", world.now_s());
+}
+
+/// `simrig --control PATH --send CMD...`: prints each reply; 0 when all are "ok", else 1.
+int send_commands(const Options& o) {
+  if (o.control.empty()) {
+    fmt::print(stderr, "simrig: --send needs --control PATH (the running simrig's socket)\n");
+    return 2;
+  }
+  const auto replies = sim::send_control_commands(o.control, o.send);
+  bool ok = true;
+  for (const auto& r : replies) {
+    fmt::print("{}\n", r);
+    ok = ok && r.starts_with("ok");
+  }
+  return ok ? 0 : 1;
 }
 
 }  // namespace
@@ -101,7 +137,22 @@ int main(int argc, char** argv) {
   app.add_option("--latitude", o.latitude_deg, "site latitude, deg (Earth rate in the gyros)")
       ->capture_default_str()
       ->check(CLI::Range(-90.0, 90.0));
+  app.add_option("--control", o.control,
+                 "unix stream socket for fault commands, one per line, one reply line each");
+  app.add_option("--send", o.send,
+                 "send these commands to a running simrig's --control socket, print the replies");
+  app.footer(
+      "Fault commands (--control; e.g. simrig --control /tmp/simrig.ctl --send 'door open'):\n" +
+      sim::fault_command_help() + "Details: docs/SIMRIG.md");
   CLI11_PARSE(app, argc, argv);
+  if (!o.send.empty()) {
+    try {
+      return send_commands(o);
+    } catch (const std::exception& e) {
+      fmt::print(stderr, "simrig: {}\n", e.what());
+      return 2;
+    }
+  }
 
   struct sigaction sa {};
   sa.sa_handler = on_signal;
@@ -117,8 +168,15 @@ int main(int argc, char** argv) {
     c.can_unix_path = o.can_socket;
     c.earth_rate_dph = earth_rate_up_dph(o.latitude_deg);
     sim::SimWorld world(c);
+    std::unique_ptr<sim::ControlSocket> control;
+    if (!o.control.empty()) {
+      control = std::make_unique<sim::ControlSocket>(o.control, [&world](std::string_view line) {
+        return sim::run_fault_command(world, line);
+      });
+    }
     print_config(world, o);
-    serve(world, world.can_transport());
+    if (control) fmt::print(stderr, "simrig: fault commands on {}\n", o.control);
+    serve(world, world.can_transport(), control.get());
   } catch (const std::exception& e) {
     fmt::print(stderr, "simrig: {}\n", e.what());
     return 1;

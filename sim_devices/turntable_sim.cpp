@@ -110,6 +110,20 @@ void TurntableSim::publish(modbus_mapping_t& regs) {
   put_point(regs, map_.at(tm::kModeActual), mode_);
 }
 
+std::uint8_t TurntableSim::check_write(const RegisterWrite& write) const {
+  const auto mode = write.value_of(map_.at(tm::kModeDemand));
+  if (mode && *mode != 0 && *mode != 1 && *mode != 2) return kIllegalDataValue;
+  for (const char* flag : {tm::kLock, tm::kStop}) {
+    const auto v = write.value_of(map_.at(flag));
+    if (v && *v != 0 && *v != 1) return kIllegalDataValue;
+  }
+  for (const char* demand : {tm::kPositionDemand, tm::kRateDemand}) {
+    const auto v = write.value_of(map_.at(demand));
+    if (v && !std::isfinite(*v)) return kIllegalDataValue;
+  }
+  return 0;
+}
+
 void TurntableSim::on_write(const modbus_mapping_t& regs, std::uint16_t pdu_address, int count) {
   std::lock_guard lock(mutex_);
   auto written = [&](const char* name, auto&& apply) {

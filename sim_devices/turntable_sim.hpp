@@ -36,6 +36,9 @@ class TurntableSim final : public ModbusDeviceModel {
   /// Fault: drive fault bit (drive disabled like the interlock).
   void set_fault(bool fault);
 
+  const drivers::modbus::RegisterMap& register_map() const override { return map_; }
+  /// Mode demand not 0..2, lock or stop not 0/1, a non-finite demand: 03.
+  std::uint8_t check_write(const RegisterWrite& write) const override;
   int register_count() const override;
   void publish(modbus_mapping_t& regs) override;
   void on_write(const modbus_mapping_t& regs, std::uint16_t pdu_address, int count) override;

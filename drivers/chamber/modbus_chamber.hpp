@@ -14,8 +14,10 @@ namespace station::drivers {
 /// A Watlow-style chamber controller on Modbus. Constructor does no I/O.
 class ModbusChamber final : public Chamber {
  public:
-  /// Default largest run of unused registers read() fetches to merge two points into one read.
-  static constexpr int kDefaultMaxReadGap = 16;
+  /// Default largest run of unused registers read() fetches to merge two points into one read:
+  /// none. A strict controller (the Watlow F4 among them) answers a block that covers an
+  /// unimplemented register with exception 02, so only adjacent points share a read.
+  static constexpr int kDefaultMaxReadGap = 0;
 
   /// `name` for logs; `map` must define every chamber_map point (checked here, throws
   /// std::invalid_argument otherwise); `response_timeout_s` bounds each transaction.
@@ -33,9 +35,9 @@ class ModbusChamber final : public Chamber {
 
   /// Sets the tap every Modbus exchange passes (nullptr: none).
   void set_tap(Tap* tap) { client_.set_tap(tap); }
-  /// Largest run of unused registers read() may fetch to merge two points (default 16; 0 = only
-  /// adjacent points, -1 = one transaction per point, for controllers that reject reads of
-  /// unimplemented registers with an exception).
+  /// Largest run of unused registers read() may fetch to merge two points (default 0 = only
+  /// adjacent points; -1 = one transaction per point; > 0 only for a controller known to serve
+  /// reads of unimplemented registers).
   void set_max_read_gap(int registers);
   /// Block reads one read() performs (for diagnostics and tests).
   const std::vector<modbus::ReadBlock>& read_plan() const { return read_plan_; }

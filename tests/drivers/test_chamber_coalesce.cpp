@@ -81,28 +81,41 @@ TEST(ReadPlan, NeverAsksForMoreThan125Registers) {
   EXPECT_EQ(blocks[1].start, 125);
 }
 
-// Watlow F4: 100 air, 104 product, 110 alarms | 200 status | 300 setpoint, 310 ramp | 2000 run:
-// 4 requests instead of 7, and the same state as point by point.
-TEST(ModbusChamber, ReadCoalescesWatlowF4IntoFourRequests) {
+// Watlow F4: 100 air, 104 product, 110 alarms | 200 status | 300 setpoint, 310 ramp | 2000 run.
+// The simulated F4 is strict like the real one (a block over the unimplemented 101..103 is
+// exception 02), so the default plan merges only adjacent points: 7 requests, none refused.
+TEST(ModbusChamber, DefaultReadNeverSpansUnmappedRegistersOfAStrictF4) {
   const auto map = cm::watlow_f4();
   const Counted block = count_one_read(map, ModbusChamber::kDefaultMaxReadGap);
   const Counted single = count_one_read(map, -1);
-  EXPECT_EQ(block.requests, 4u);
+  EXPECT_EQ(block.requests, 7u);
   EXPECT_EQ(single.requests, 7u);
   EXPECT_DOUBLE_EQ(block.state.air_c, single.state.air_c);
   EXPECT_DOUBLE_EQ(block.state.product_c, single.state.product_c);
   EXPECT_DOUBLE_EQ(block.state.setpoint_c, single.state.setpoint_c);
-  EXPECT_DOUBLE_EQ(block.state.ramp_c_per_min, single.state.ramp_c_per_min);
   EXPECT_EQ(block.state.mode, single.state.mode);
   EXPECT_EQ(block.state.run_enabled, single.state.run_enabled);
-  EXPECT_EQ(block.state.alarms.any(), single.state.alarms.any());
 }
 
-// F4T: only setpoint 2160..2161 and ramp 2168..2169 lie within 16 registers: 6 requests.
-TEST(ModbusChamber, ReadCoalescesF4tFloatPointsIntoSixRequests) {
+// The old default (gap 16) asked for 100..110 in one read: a strict F4 refuses it with 02.
+TEST(ModbusChamber, GapBridgingBlockReadIsRefusedByAStrictChamber) {
+  const auto map = cm::watlow_f4();
+  ChamberSim sim(map);
+  ModbusServer server(sim);
+  server.start_tcp();
+  ModbusChamber chamber("chamber", mb::parse_endpoint(server.endpoint()), map, 0.5);
+  chamber.set_max_read_gap(16);
+  auto s = chamber.read();
+  ASSERT_FALSE(s);
+  EXPECT_EQ(s.error().kind, ErrorKind::exception);
+  EXPECT_NE(s.error().message.find("Illegal data address"), std::string::npos) << s.error().message;
+}
+
+// F4T: no two read points are adjacent (floats at 2800, 2880, 2160, 2168; words elsewhere).
+TEST(ModbusChamber, ReadOfF4tFloatPointsSucceedsAgainstAStrictChamber) {
   const auto map = cm::f4t();
   const Counted block = count_one_read(map, ModbusChamber::kDefaultMaxReadGap);
-  EXPECT_EQ(block.requests, 6u);
+  EXPECT_EQ(block.requests, 7u);
   EXPECT_DOUBLE_EQ(block.state.air_c, count_one_read(map, -1).state.air_c);
 }
 
