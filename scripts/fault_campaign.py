@@ -1,0 +1,355 @@
+#!/usr/bin/env python3
+"""Fault campaign: the daemon on a real-transport rig (simrig, wall clock) under faults.
+
+Two rigs run the same short protocol side by side: a reference left alone, and a victim that
+gets, at seeded random instants, SIGKILL + restart of the daemon, Modbus stalls and disconnects
+of chamber and turntable, door open, e-stop, dropped and corrupted CAN frames. A second phase
+restarts the simulator itself under a running daemon. Checked:
+
+  * zero committed samples lost or changed (a snapshot of the database after every kill, and
+    before every simulator restart, is compared with the final file);
+  * safe state reached for every door / e-stop fault (a safe_hold event), and how fast
+    (event wall time - injection time);
+  * every fault leaves its event (resume, safe_hold, outage ...), counted per fault;
+  * the victim's final fit equals the reference's within the noise: for every coefficient
+    |k_victim - k_reference| <= 5 * sqrt(se_victim^2 + se_reference^2) (two independent
+    estimates of the same gyro; 5 sigma because OLS errors are optimistic for correlated bins).
+
+Usage: scripts/fault_campaign.py --build build [--duration-s 150] [--seed 1] [--faults N]
+                                 [--json OUT] [--keep DIR]
+Exit 0 when every check holds, 1 otherwise (the table says which), 2 on bad usage.
+"""
+import argparse
+import json
+import math
+import os
+import random
+import signal
+import socket
+import sqlite3
+import subprocess
+import sys
+import tempfile
+import time
+from datetime import datetime, timezone
+
+FAULTS = ["kill9", "door", "estop", "chamber_stall", "chamber_disconnect", "table_stall",
+          "table_disconnect", "can_drop", "can_corrupt"]
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class Rig:
+    """A simrig process with fixed ports (so it can be restarted under a running daemon)."""
+
+    def __init__(self, build, work, name, seed):
+        self.build, self.work, self.name, self.seed = build, work, name, seed
+        self.ports = (free_port(), free_port())
+        self.can = os.path.join(work, name + ".can")
+        self.control = os.path.join(work, name + ".ctl")
+        self.config = os.path.join(work, name + ".toml")
+        self.proc = None
+
+    def start(self):
+        out = open(os.path.join(self.work, self.name + ".simrig.out"), "w")
+        err = open(os.path.join(self.work, self.name + ".simrig.err"), "a")
+        self.proc = subprocess.Popen(
+            [os.path.join(self.build, "sim_devices", "simrig"), "--gyros", "2", "--seed",
+             str(self.seed), "--chamber-port", str(self.ports[0]), "--turntable-port",
+             str(self.ports[1]), "--can-socket", self.can, "--control", self.control],
+            stdout=out, stderr=err)
+        deadline = time.time() + 10
+        text = ""
+        while time.time() < deadline and "SIM-0002" not in text:
+            time.sleep(0.05)
+            text = open(out.name).read()
+        time.sleep(0.2)
+        text = open(out.name).read()
+        # Short bins so a run of minutes gives a fit (the campaign is about the daemon, not the
+        # paper's 600 s pulse-quantization argument).
+        text = text.replace("bin_s = 600", "bin_s = 10")
+        open(self.config, "w").write(text)
+
+    def send(self, *commands):
+        with socket.socket(socket.AF_UNIX, socket.SOCK_STREAM) as s:
+            s.settimeout(5)
+            s.connect(self.control)
+            f = s.makefile("rw")
+            replies = []
+            for c in commands:
+                f.write(c + "\n")
+                f.flush()
+                replies.append(f.readline().strip())
+            return replies
+
+    def stop(self):
+        if self.proc and self.proc.poll() is None:
+            self.proc.terminate()
+            try:
+                self.proc.wait(10)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait()
+
+
+class Daemon:
+    def __init__(self, build, rig, db, protocol):
+        self.build, self.rig, self.db, self.protocol = build, rig, db, protocol
+        self.proc = None
+        self.starts = 0
+
+    def start(self):
+        self.starts += 1
+        log = open(self.db + ".daemon.log", "a")
+        self.proc = subprocess.Popen(
+            [os.path.join(self.build, "station", "station"), "run", "--config", self.rig.config,
+             "--protocol", self.protocol, "--db", self.db], stdout=log, stderr=log)
+
+    def kill9(self):
+        self.proc.send_signal(signal.SIGKILL)
+        self.proc.wait()
+
+    def wait(self, timeout):
+        try:
+            return self.proc.wait(timeout)
+        except subprocess.TimeoutExpired:
+            self.proc.terminate()
+            return self.proc.wait(30)
+
+
+def ro(db):
+    return sqlite3.connect("file:%s?mode=ro" % db, uri=True, timeout=5)
+
+
+def snapshot(db):
+    try:
+        with ro(db) as c:
+            return {(r[0], r[1]): r[2:] for r in c.execute(
+                "SELECT serial, t_s, net_pulses, rate_dph, temp_c, air_c, flags FROM samples "
+                "WHERE run_id = 1")}
+    except sqlite3.Error:
+        return {}
+
+
+def events(db):
+    with ro(db) as c:
+        return c.execute("SELECT t_s, wall_utc, severity, source, kind, message FROM events "
+                         "WHERE run_id = 1 ORDER BY id").fetchall()
+
+
+def fits(db):
+    out = {}
+    with ro(db) as c:
+        for serial, coef, se in c.execute(
+                "SELECT serial, coefficients_json, std_errors_json FROM fits ORDER BY id"):
+            out[serial] = (json.loads(coef), json.loads(se))
+    return out
+
+
+def wall(utc):
+    return datetime.strptime(utc, "%Y-%m-%dT%H:%M:%S.%fZ").replace(
+        tzinfo=timezone.utc).timestamp()
+
+
+def write_protocol(work, duration_s):
+    path = os.path.join(work, "campaign.toml")
+    open(path, "w").write(
+        "# Fault campaign: record while the chamber heats 25 -> 31 C at 3 C/min, then hold.\n"
+        'name = "campaign"\n\n[[step]]\ntype = "record_start"\n\n[[step]]\n'
+        'type = "set_temperature"\nsetpoint_c = 31.0\nramp_c_per_h = 180.0\nwait = false\n\n'
+        '[[step]]\ntype = "hold"\nduration_s = %d\n' % duration_s)
+    return path
+
+
+def inject(kind, rig, daemon, db, rng, log):
+    """Injects one fault; returns (snapshot or None, injection wall time, expected event kinds)."""
+    t0 = time.time()
+    snap = None
+    if kind == "kill9":
+        daemon.kill9()
+        snap = snapshot(db)
+        time.sleep(rng.uniform(0, 2))
+        daemon.start()
+        return snap, t0, {"resume"}
+    commands = {
+        "door": (["door open"], ["door close"], {"safe_hold"}),
+        "estop": (["estop press"], ["estop release"], {"safe_hold"}),
+        "chamber_stall": (["chamber stall 3"], [], {"outage", "read_failed"}),
+        "chamber_disconnect": (["chamber disconnect 2"], [], {"outage", "read_failed"}),
+        "table_stall": (["table stall 3"], [], {"outage", "read_failed", "safe_hold",
+                                               "inputs_unreadable"}),
+        "table_disconnect": (["table disconnect 2"], [], {"outage", "read_failed", "safe_hold",
+                                                         "inputs_unreadable"}),
+        "can_drop": (["can drop 6"], [], {"outage", "tick_failed"}),
+        "can_corrupt": (["can corrupt 6"], [], {"outage", "tick_failed"}),
+    }[kind]
+    replies = rig.send(*commands[0])
+    log.append("%s -> %s" % (commands[0], replies))
+    time.sleep(3.5)
+    if commands[1]:
+        rig.send(*commands[1])
+    return snap, t0, commands[2]
+
+
+def check_kept(before, after):
+    lost = changed = 0
+    for key, value in before.items():
+        if key not in after:
+            lost += 1
+        elif after[key] != value:
+            changed += 1
+    return lost, changed
+
+
+def compare_fits(victim, reference):
+    worst = {}
+    for serial, (coef, se) in reference.items():
+        if serial not in victim:
+            worst[serial] = math.inf
+            continue
+        vcoef, vse = victim[serial]
+        worst[serial] = max(abs(vcoef[k] - coef[k]) / math.hypot(vse[k], se[k]) for k in coef)
+    return worst
+
+
+def campaign(args, work):
+    rng = random.Random(args.seed)
+    protocol = write_protocol(work, args.duration_s)
+    ref_rig, rig = Rig(args.build, work, "reference", 7), Rig(args.build, work, "victim", 7)
+    ref_rig.start()
+    rig.start()
+    ref_db, db = os.path.join(work, "reference.db"), os.path.join(work, "victim.db")
+    ref, victim = Daemon(args.build, ref_rig, ref_db, protocol), Daemon(args.build, rig, db, protocol)
+    ref.start()
+    victim.start()
+    begin = time.time()
+    kinds = (FAULTS * (args.faults // len(FAULTS) + 1))[:args.faults]
+    rng.shuffle(kinds)
+    slots = sorted(rng.uniform(8, args.duration_s - 15) for _ in kinds)
+    log, rows, snaps = [], [], []
+    for kind, at in zip(kinds, slots):
+        time.sleep(max(0, begin + at - time.time()))
+        if victim.proc.poll() is not None:
+            rows.append({"fault": kind, "error": "daemon not running (exit %s)" %
+                         victim.proc.returncode})
+            victim.start()
+            continue
+        n_events = len(events(db)) if os.path.exists(db) else 0
+        snap, t0, expect = inject(kind, rig, victim, db, rng, log)
+        if snap is not None:
+            snaps.append(snap)
+        time.sleep(2)
+        new = events(db)[n_events:]
+        seen = {e[4] for e in new}
+        row = {"fault": kind, "at_s": round(t0 - begin, 1), "events": sorted(seen),
+               "event_expected": bool(seen & expect)}
+        holds = [wall(e[1]) - t0 for e in new if e[4] == "safe_hold"]
+        if kind in ("door", "estop"):
+            row["time_to_safe_s"] = round(min(holds), 3) if holds else None
+        rows.append(row)
+    rc_v, rc_r = victim.wait(args.duration_s + 120), ref.wait(args.duration_s + 120)
+    final = snapshot(db)
+    lost = changed = 0
+    for s in snaps:
+        lo, ch = check_kept(s, final)
+        lost, changed = lost + lo, changed + ch
+    worst = compare_fits(fits(db), fits(ref_db))
+    ref_rig.stop()
+    rig.stop()
+    return {"faults": rows, "victim_exit": rc_v, "reference_exit": rc_r,
+            "snapshots": len(snaps), "samples_checked": sum(len(s) for s in snaps),
+            "samples_lost": lost, "samples_changed": changed,
+            "fit_max_diff_in_combined_se": worst, "log": log}
+
+
+def simulator_restart(args, work):
+    """Phase 2: the simulator restarted under a running daemon: the links must come back."""
+    protocol = write_protocol(work, 45)
+    rig = Rig(args.build, work, "restart", 9)
+    rig.start()
+    db = os.path.join(work, "restart.db")
+    d = Daemon(args.build, rig, db, protocol)
+    d.start()
+    time.sleep(12)
+    before = snapshot(db)
+    rig.stop()
+    t_down = time.time()
+    time.sleep(2)
+    rig.start()
+    down_s = time.time() - t_down
+    rc = d.wait(180)
+    rig.stop()
+    after = snapshot(db)
+    lost, changed = check_kept(before, after)
+    t_last_before = max((k[1] for k in before), default=0)
+    later = [v for k, v in after.items() if k[1] > t_last_before + 8]
+    return {"daemon_exit": rc, "samples_lost": lost, "samples_changed": changed,
+            "chamber_back": any(v[3] is not None for v in later),
+            "can_back": any(v[1] is not None for v in later),
+            "simulator_down_s": round(down_s, 1),
+            "events": sorted({e[4] for e in events(db)})}
+
+
+def verdict(result, restart):
+    problems = []
+    if result["victim_exit"] != 0 or result["reference_exit"] != 0:
+        problems.append("a daemon did not exit 0")
+    if result["samples_lost"] or result["samples_changed"]:
+        problems.append("committed samples lost or changed")
+    for r in result["faults"]:
+        if "error" in r or not r["event_expected"]:
+            problems.append("fault %s left no expected event" % r["fault"])
+        if r["fault"] in ("door", "estop") and r.get("time_to_safe_s") is None:
+            problems.append("fault %s: no safe hold" % r["fault"])
+    for serial, w in result["fit_max_diff_in_combined_se"].items():
+        if not w <= 5:
+            problems.append("fit of %s differs from the reference by %.1f SE" % (serial, w))
+    if restart["daemon_exit"] != 0 or restart["samples_lost"] or restart["samples_changed"]:
+        problems.append("simulator restart: daemon failed or samples lost")
+    if not restart["chamber_back"] or not restart["can_back"]:
+        problems.append("simulator restart: a link did not come back (chamber %s, CAN %s)" % (
+            restart["chamber_back"], restart["can_back"]))
+    return problems
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("--build", default="build")
+    p.add_argument("--duration-s", type=int, default=150)
+    p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--faults", type=int, default=9)
+    p.add_argument("--json")
+    p.add_argument("--keep")
+    args = p.parse_args()
+    if args.duration_s < 60 or args.faults < 1 or args.faults * 8 > args.duration_s:
+        print("fault_campaign: need --duration-s >= 60 and about 8 s per fault", file=sys.stderr)
+        return 2
+    work = args.keep or tempfile.mkdtemp(prefix="fault-campaign-")
+    os.makedirs(work, exist_ok=True)
+    result = campaign(args, work)
+    result["simulator_restart"] = simulator_restart(args, work)
+    problems = verdict(result, result["simulator_restart"])
+    result["problems"] = problems
+    for r in result["faults"]:
+        print("%-20s at %6s s  events %-45s safe in %s s" % (
+            r["fault"], r.get("at_s"), ",".join(r.get("events", [])) or r.get("error"),
+            r.get("time_to_safe_s", "-")))
+    print("snapshots %d, samples checked %d, lost %d, changed %d; fit max diff %s SE" % (
+        result["snapshots"], result["samples_checked"], result["samples_lost"],
+        result["samples_changed"],
+        {k: round(v, 2) for k, v in result["fit_max_diff_in_combined_se"].items()}))
+    print("simulator restart: %s" % json.dumps(result["simulator_restart"]))
+    print("work dir: %s" % work)
+    if args.json:
+        json.dump(result, open(args.json, "w"), indent=2, default=str)
+    for pr in problems:
+        print("PROBLEM: " + pr)
+    return 1 if problems else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
