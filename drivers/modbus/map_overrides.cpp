@@ -28,6 +28,9 @@ void check_point(const RegisterMap& map, const Point& p) {
     throw std::invalid_argument(where + "unit_id " + std::to_string(p.unit_id) + " not in 0..247");
   if (p.one_based && p.address == 0)
     throw std::invalid_argument(where + "address 0 with one-based addressing");
+  // A float32 at PDU address 65535 would need register 65536: no Modbus request can read it.
+  if (p.pdu_address() + p.word_count() > 65536)
+    throw std::invalid_argument(where + "registers past 65535 (the last register is 65535)");
   if (p.access == Access::rw && p.function == FunctionCode::input)
     throw std::invalid_argument(where + "input registers (function 4) cannot be rw");
 }
