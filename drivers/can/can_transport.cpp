@@ -20,8 +20,10 @@ namespace {
 // Translates an errno from `op` on transport `name` into a typed Error (the one place we do so).
 Error errno_error(const std::string& name, const char* op, int err) {
   // EAGAIN on a non-blocking call means "nothing now": the caller's wait decides about time.
-  const ErrorKind kind = (err == EPIPE || err == ECONNRESET || err == ENOTCONN || err == EBADF)
-                             ? ErrorKind::disconnected
+  // A vanished interface (USB adapter unplugged, link set down) is a lost link too.
+  const bool lost = err == EPIPE || err == ECONNRESET || err == ENOTCONN || err == EBADF ||
+                    err == ENETDOWN || err == ENODEV || err == ENXIO;
+  const ErrorKind kind = lost                                    ? ErrorKind::disconnected
                          : (err == EAGAIN || err == EWOULDBLOCK) ? ErrorKind::timeout
                                                                  : ErrorKind::io;
   return make_error(kind, fmt::format("{}: {} failed: {} ({})", name, op, std::strerror(err),
@@ -195,7 +197,8 @@ Result<UniqueFd> open_unix(const CanSpec& spec, std::string& name) {
   if (spec.target.size() >= sizeof addr.sun_path)
     return make_error(ErrorKind::range, name + ": socket path too long");
   std::memcpy(addr.sun_path, spec.target.data(), spec.target.size());
-  UniqueFd fd(::socket(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0));
+  // Non-blocking, so a peer whose accept backlog is full cannot stall a tick in connect().
+  UniqueFd fd(::socket(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC | SOCK_NONBLOCK, 0));
   if (!fd.valid()) return errno_error(name, "socket(AF_UNIX, SOCK_SEQPACKET)", errno);
   if (::connect(fd.get(), reinterpret_cast<sockaddr*>(&addr), sizeof addr) < 0)
     return errno_error(name, "connect", errno);

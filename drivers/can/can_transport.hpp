@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "drivers/can/unique_fd.hpp"
+#include "drivers/common/clock.hpp"
 #include "drivers/common/result.hpp"
 #include "drivers/common/tap.hpp"
 
@@ -45,6 +46,7 @@ struct CanOpenOptions {
   Tap* tap = nullptr;               ///< every frame in/out is reported here when set
   std::string tap_device = "can";   ///< device name in tap records
   std::chrono::milliseconds send_timeout{100};  ///< longest wait for send buffer space
+  const Clock* clock = nullptr;  ///< time of the reconnect back-off (nullptr: steady clock)
 };
 
 /// Parses a spec string; throws std::invalid_argument naming the spec when malformed (config).

@@ -83,6 +83,13 @@ Result<void> CounterBoards::send_sync(std::uint8_t latch_seq) {
   return transport_->send(encode(SyncFrame{latch_seq}));
 }
 
+void CounterBoards::forget_latches() {
+  for (auto& s : state_) {
+    s.has_prev = false;
+    s.ticks_since_prev = 0;
+  }
+}
+
 void CounterBoards::note_skipped_ticks(int n) {
   if (n <= 0) return;
   for (auto& s : state_) s.ticks_since_prev += n;
@@ -93,8 +100,11 @@ Result<TickResult> CounterBoards::collect(std::chrono::milliseconds timeout) {
   out.latch_seq = latch_seq_;
   const auto deadline = Clock::now() + timeout;
   while (!all_complete()) {
-    const auto left = std::chrono::ceil<std::chrono::milliseconds>(deadline - Clock::now());
-    if (left.count() <= 0) break;
+    auto left = std::chrono::ceil<std::chrono::milliseconds>(deadline - Clock::now());
+    if (!config_.wall_clock_deadline)
+      left = std::chrono::milliseconds(0);  // the log decides
+    else if (left.count() <= 0)
+      break;
     auto f = transport_->receive(left);
     if (f) {
       handle(f.value(), out);
@@ -180,19 +190,34 @@ void CounterBoards::handle(const can_frame& f, TickResult& out) {
 
 namespace {
 
-// Fills net pulses, angle, interval and rate of a reading whose deltas are set.
-void fill_delta(CounterReading& r, std::uint32_t prev_time_us, double nominal_s,
-                double pulse_weight_arcsec) {
+// Half the period of a wrapping u32 microsecond clock, s: gaps shorter than this tell "went
+// backwards" from "wrapped" unambiguously.
+constexpr double kHalfClockPeriodS = 2147.483648;
+
+// Decides whether this latch chains to the previous good one. Counts are cumulative, so a delta
+// is only meaningful when the board provably kept counting: no counter-reset flag, neither the
+// counters nor the board clock went backwards (a restart), and the board clock advanced by the
+// nominal span (nominal interval * intervals spanned) to within half of it. The clock wraps every
+// 2^32 us (71.6 min), so a gap that long cannot be proven continuous: it is re-baselined.
+LatchChain chain_of(const CounterReading& r, std::uint32_t prev_time_us, double nominal_s) {
+  const double span_s = nominal_s * r.intervals_spanned;
+  const std::uint32_t dt_us = r.board_time_us - prev_time_us;
+  const bool backwards = static_cast<std::int32_t>(dt_us) < 0 ||
+                         static_cast<std::int32_t>(r.delta_up) < 0 ||
+                         static_cast<std::int32_t>(r.delta_down) < 0;
+  if ((r.status_flags & kFlagCounterReset) || (span_s < kHalfClockPeriodS && backwards))
+    return LatchChain::reset;
+  const double board_s = dt_us * 1e-6;
+  return std::abs(board_s - span_s) < 0.5 * span_s ? LatchChain::continuous : LatchChain::unproven;
+}
+
+// Fills net pulses, angle, interval and rate of a chained reading whose deltas are set.
+void fill_delta(CounterReading& r, std::uint32_t prev_time_us, double pulse_weight_arcsec) {
   r.has_delta = true;
   r.net_pulses = static_cast<std::int64_t>(r.delta_up) - static_cast<std::int64_t>(r.delta_down);
   r.angle_arcsec = static_cast<double>(r.net_pulses) * pulse_weight_arcsec;
-  const double nominal = nominal_s * r.intervals_spanned;
-  const double board_s = static_cast<std::uint32_t>(r.board_time_us - prev_time_us) * 1e-6;
-  // Board time wraps every 2^32 µs (71.6 min) and restarts on a board reset: trust it only
-  // when it agrees with the nominal span (nominal interval * intervals spanned) to within half
-  // of that span.
-  r.interval_from_board_time = std::abs(board_s - nominal) < 0.5 * nominal;
-  r.interval_s = r.interval_from_board_time ? board_s : nominal;
+  r.interval_from_board_time = true;
+  r.interval_s = static_cast<std::uint32_t>(r.board_time_us - prev_time_us) * 1e-6;
   r.rate_dph = r.angle_arcsec / r.interval_s;  // arcsec/s == deg/h
 }
 
@@ -231,9 +256,11 @@ void CounterBoards::fill_reading(SlotState& s, const CounterSlot& slot, CounterR
   r.delta_up = s.counts->up - s.prev_up;
   r.delta_down = s.counts->down - s.prev_down;
   r.intervals_spanned = s.ticks_since_prev;
-  // A counter reset breaks the cumulative chain: re-baseline instead of reporting garbage.
-  if (s.has_prev && !(r.status_flags & kFlagCounterReset))
-    fill_delta(r, s.prev_time_us, config_.nominal_interval_s, slot.pulse_weight_arcsec);
+  // A reset or an unprovable gap breaks the cumulative chain: re-baseline, report no delta.
+  if (s.has_prev) {
+    r.chain = chain_of(r, s.prev_time_us, config_.nominal_interval_s);
+    if (r.chain == LatchChain::continuous) fill_delta(r, s.prev_time_us, slot.pulse_weight_arcsec);
+  }
   if (!r.has_delta) r.delta_up = r.delta_down = 0, r.intervals_spanned = 0;
   s.has_prev = true;
   s.prev_up = s.counts->up;

@@ -25,7 +25,18 @@ struct CounterSlot {
 struct CounterBoardsConfig {
   std::vector<CounterSlot> slots;
   std::chrono::milliseconds tick_timeout{200};  ///< longest wait for all answers of one latch
-  double nominal_interval_s = 1.0;              ///< latch interval when board time is unusable
+  double nominal_interval_s = 1.0;              ///< expected latch interval, s
+  /// false for a replayed log: collect() ends when the transport has no more frames for the
+  /// latch (ErrorKind::timeout), however much wall time that took; tick_timeout is then unused.
+  bool wall_clock_deadline = true;
+};
+
+/// How a good latch relates to the board's previous good latch.
+enum class LatchChain : std::uint8_t {
+  first,       ///< no previous good latch: the baseline, no delta
+  continuous,  ///< the board clock advanced by the span since the previous latch: delta valid
+  reset,       ///< the board restarted (counter-reset flag, counts or clock went backwards)
+  unproven,    ///< the board clock disagrees with the span (e.g. a long outage): re-baselined
 };
 
 /// One board's reading for one latch.
@@ -36,15 +47,16 @@ struct CounterBoardsConfig {
 struct CounterReading {
   std::uint8_t node = 0;
   std::string serial;
-  bool answered = false;         ///< STATUS and COUNTS for this latch arrived
-  bool has_delta = false;        ///< a previous good latch exists, so the deltas mean something
-  bool latch_lost = false;       ///< no (complete) answer this tick; nothing is invented
-  std::uint32_t delta_up = 0;    ///< up pulses since the previous good latch (mod 2^32)
-  std::uint32_t delta_down = 0;  ///< down pulses since the previous good latch (mod 2^32)
-  std::int64_t net_pulses = 0;   ///< delta_up - delta_down
-  int intervals_spanned = 0;     ///< ticks covered by the delta (>1 after lost latches)
-  double interval_s = 0;         ///< time covered by the delta, s
-  bool interval_from_board_time = false;  ///< interval from board µs clock, else nominal
+  bool answered = false;   ///< STATUS and COUNTS for this latch arrived
+  bool has_delta = false;  ///< chained to a previous good latch, so the deltas mean something
+  LatchChain chain = LatchChain::first;   ///< why there is (or is not) a delta
+  bool latch_lost = false;                ///< no (complete) answer this tick; nothing is invented
+  std::uint32_t delta_up = 0;             ///< up pulses since the previous good latch (mod 2^32)
+  std::uint32_t delta_down = 0;           ///< down pulses since the previous good latch (mod 2^32)
+  std::int64_t net_pulses = 0;            ///< delta_up - delta_down
+  int intervals_spanned = 0;              ///< ticks covered by the delta (>1 after lost latches)
+  double interval_s = 0;                  ///< time covered by the delta (board µs clock), s
+  bool interval_from_board_time = false;  ///< always true with a delta (kept for callers)
   double angle_arcsec = 0;                ///< net_pulses * pulse weight, arcsec
   double rate_dph = 0;                    ///< angle_arcsec / interval_s (1 arcsec/s == 1 deg/h)
   std::uint8_t status_flags = 0;          ///< kFlag* bits from STATUS
@@ -83,6 +95,9 @@ class CounterBoards {
   Result<TickResult> collect(std::chrono::milliseconds timeout);
   /// The caller skipped `n` ticks (no SYNC sent, e.g. on overrun); no I/O, n <= 0 ignored.
   void note_skipped_ticks(int n);
+  /// Forgets every board's previous latch (e.g. after a commissioning probe): the next good
+  /// latch is a new baseline (LatchChain::first). No I/O.
+  void forget_latches();
   /// The configuration in use.
   const CounterBoardsConfig& config() const { return config_; }
 

@@ -44,6 +44,10 @@ Error translate_modbus_error(int err, const std::string& what) {
     case EBADF:
     case ENOENT:
     case EHOSTUNREACH:
+    case ENETUNREACH:
+    case EIO:  // a serial adapter that vanished (USB unplugged, pty master closed)
+    case ENXIO:
+    case ENODEV:
       return make_error(ErrorKind::disconnected, msg);
     case EINVAL:
       return make_error(ErrorKind::range, msg);
@@ -60,7 +64,9 @@ Result<void> ModbusClient::connect() {
   try {
     ctx_ = make_context(endpoint_);
   } catch (const std::exception& e) {
-    return make_error(ErrorKind::io, device_ + ": " + e.what());
+    backoff_.failed();
+    last_connect_error_ = device_ + ": " + e.what();
+    return make_error(ErrorKind::io, last_connect_error_);
   }
   double whole = std::floor(timeout_s_);
   auto sec = static_cast<std::uint32_t>(whole);
@@ -73,8 +79,11 @@ Result<void> ModbusClient::connect() {
     auto e = translate_modbus_error(err, device_ + " connect " + to_string(endpoint_));
     if (e.kind != ErrorKind::timeout) e.kind = ErrorKind::disconnected;
     tap(TapDirection::event, "error", {}, e.message);
+    backoff_.failed();
+    last_connect_error_ = e.message;
     return e;
   }
+  backoff_.succeeded();
   connected_ = true;
   tap(TapDirection::event, "connect", {}, to_string(endpoint_));
   return {};
@@ -88,6 +97,11 @@ void ModbusClient::disconnect() {
 
 Result<void> ModbusClient::ensure_connected() {
   if (connected_) return {};
+  if (!backoff_.due()) {
+    return make_error(ErrorKind::disconnected,
+                      fmt::format("{}: not connected, next attempt in {:.1f} s ({})", device_,
+                                  backoff_.wait_s(), last_connect_error_));
+  }
   return connect();
 }
 

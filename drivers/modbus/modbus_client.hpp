@@ -1,6 +1,7 @@
 // A small Modbus client: reads and writes register-map points as one bounded transaction each,
 // translating libmodbus/errno failures into ErrorKind in one place and reconnecting after loss
-// (a lost connection, or kTimeoutsBeforeReconnect timeouts in a row on TCP).
+// (a lost connection, or kTimeoutsBeforeReconnect timeouts in a row on TCP) with bounded
+// exponential back-off between failed attempts.
 #pragma once
 
 #include <cstdint>
@@ -8,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "drivers/common/backoff.hpp"
 #include "drivers/common/result.hpp"
 #include "drivers/common/tap.hpp"
 #include "drivers/modbus/endpoint.hpp"
@@ -28,13 +30,19 @@ class ModbusClient {
 
   /// Sets the tap every exchange passes (nullptr: none). Not owned.
   void set_tap(Tap* tap) { tap_ = tap; }
-  /// Opens the transport (TCP connect / open the serial line); blocks up to the timeout.
+  /// Sets the time source of the reconnect back-off (nullptr: steady clock). Not owned.
+  void set_clock(const Clock* clock) { backoff_.set_clock(clock); }
+  /// Opens the transport (TCP connect / open the serial line) now, whatever the back-off says;
+  /// blocks up to the timeout.
   Result<void> connect();
   /// Closes the transport; the next read/write reconnects.
   void disconnect();
   /// True while the transport is open.
   bool connected() const { return connected_; }
 
+  /// Every read and write below first reopens a lost transport: at once after the loss, then
+  /// after 0.5, 1, 2, 4, 8, 8 ... s of failed attempts (Backoff); while no attempt is due they
+  /// return ErrorKind::disconnected without I/O.
   /// Reads one point's engineering value; blocks up to the response timeout.
   Result<double> read(const Point& p);
   /// Writes one rw point (function 6 for one word, 16 for two); blocks up to the timeout.
@@ -66,6 +74,8 @@ class ModbusClient {
   bool connected_ = false;
   Tap* tap_ = nullptr;
   int consecutive_timeouts_ = 0;  ///< timeouts in a row since the last answer of any kind
+  Backoff backoff_;               ///< when the next connect attempt is due
+  std::string last_connect_error_;
 };
 
 /// Consecutive timeouts after which a TCP client drops its connection (a half-open socket to a

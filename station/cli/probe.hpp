@@ -3,6 +3,8 @@
 #pragma once
 
 #include <ostream>
+#include <string>
+#include <vector>
 
 #include "station/config/config.hpp"
 #include "station/daemon/rig.hpp"
@@ -14,5 +16,10 @@ namespace station {
 /// every device answered, 1 when any failed. Blocks at most the sum of the devices' timeouts.
 /// Throws InputError / std::invalid_argument only for configuration problems.
 int probe_rig(const StationConfig& config, const RigOptions& options, std::ostream& out, bool json);
+
+/// Probes every device of `rig` once, as probe_rig does (reads only, nothing moves), and returns
+/// one line per device that did not answer: "CONFIG: DEVICE WHERE unreachable: ERROR". The
+/// counter boards keep no baseline from the probe. Blocks at most the devices' timeouts.
+std::vector<std::string> unreachable_devices(const StationConfig& config, Rig& rig);
 
 }  // namespace station

@@ -1,8 +1,6 @@
 // `station probe`: reads each configured device once (chamber, turntable, one counter-board
 // SYNC, GPIO inputs) and prints what it got; a device that fails is one typed error line.
 #include <fmt/format.h>
-#include <sys/socket.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <iostream>
@@ -189,25 +187,6 @@ std::vector<DeviceReport> probe_gpio(dr::gpio::GpioBank& bank, const StationConf
   return out;
 }
 
-/// build_rig() throws InputError when the CAN transport cannot be opened. For commissioning that
-/// is a device failure, not a config error: build the rest on a placeholder bus and report it.
-Rig build_probe_rig(const StationConfig& c, const RigOptions& o, std::optional<dr::Error>& can) {
-  try {
-    return build_rig(c, o);
-  } catch (const InputError& e) {
-    can = dr::Error{dr::ErrorKind::disconnected, e.what()};
-  }
-  int sv[2];
-  if (socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, sv) != 0)
-    throw std::runtime_error("probe: socketpair failed");
-  StationConfig copy = c;
-  copy.can_transport = fmt::format("fd:{}", sv[0]);  // owned by the placeholder transport
-  Rig rig = build_rig(copy, o);
-  rig.counters.reset();
-  ::close(sv[1]);
-  return rig;
-}
-
 void print_text(std::ostream& out, const StationConfig& c, const std::vector<DeviceReport>& rs) {
   out << fmt::format("probe of '{}' ({})\n", c.name, c.path);
   std::size_t bad = 0;
@@ -241,23 +220,24 @@ void print_json(std::ostream& out, const StationConfig& c, const std::vector<Dev
       << '\n';
 }
 
+std::vector<DeviceReport> probe_all(const StationConfig& config, Rig& rig) {
+  std::vector<DeviceReport> reports;
+  reports.push_back(probe_chamber(*rig.chamber, config));
+  if (rig.turntable) reports.push_back(probe_turntable(*rig.turntable, config));
+  for (auto& r : probe_counters(*rig.counters, config)) reports.push_back(std::move(r));
+  rig.counters->forget_latches();  // the probe's latch is no baseline for a run
+  if (rig.gpio) {
+    for (auto& r : probe_gpio(*rig.gpio, config)) reports.push_back(std::move(r));
+  }
+  return reports;
+}
+
 }  // namespace
 
 int probe_rig(const StationConfig& config, const RigOptions& options, std::ostream& out,
               bool json_out) {
-  std::optional<dr::Error> can_error;
-  Rig rig = build_probe_rig(config, options, can_error);
-  std::vector<DeviceReport> reports;
-  reports.push_back(probe_chamber(*rig.chamber, config));
-  if (rig.turntable) reports.push_back(probe_turntable(*rig.turntable, config));
-  if (rig.counters) {
-    for (auto& r : probe_counters(*rig.counters, config)) reports.push_back(std::move(r));
-  } else {
-    reports.push_back(failed("can", config.can_transport, *can_error));
-  }
-  if (rig.gpio) {
-    for (auto& r : probe_gpio(*rig.gpio, config)) reports.push_back(std::move(r));
-  }
+  Rig rig = build_rig(config, options);
+  const std::vector<DeviceReport> reports = probe_all(config, rig);
   if (json_out) {
     print_json(out, config, reports);
   } else {
@@ -266,6 +246,16 @@ int probe_rig(const StationConfig& config, const RigOptions& options, std::ostre
   for (const auto& r : reports)
     if (r.error) return 1;
   return 0;
+}
+
+std::vector<std::string> unreachable_devices(const StationConfig& config, Rig& rig) {
+  std::vector<std::string> out;
+  for (const auto& r : probe_all(config, rig)) {
+    if (r.error)
+      out.push_back(fmt::format("{}: {} {} unreachable: {}", config.path, r.device, r.where,
+                                r.error->message));
+  }
+  return out;
 }
 
 void add_probe_command(CLI::App& app, CommandStatus& status) {

@@ -1,6 +1,7 @@
 // `station run`: the daemon. --sim runs the embedded simulated rig; otherwise a real rig from
 // --config. SIGTERM/SIGINT end the run cleanly; under systemd it notifies READY and the watchdog.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <systemd/sd-daemon.h>
 
 #include <atomic>
@@ -13,9 +14,9 @@
 #include "drivers/can/candump_log.hpp"
 #include "drivers/common/clock.hpp"
 #include "station/cli/commands.hpp"
+#include "station/cli/probe.hpp"
 #include "station/common/logging.hpp"
 #include "station/common/process_lock.hpp"
-#include "station/daemon/preflight.hpp"
 #include "station/daemon/resume.hpp"
 #include "station/daemon/rig.hpp"
 #include "station/daemon/sequencer.hpp"
@@ -59,26 +60,25 @@ std::vector<ProcessLock> lock_db_and_devices(const std::string& db, const Statio
   return locks;
 }
 
+/// Forwards to a tap attached later (the CAN log starts after the probe: its SYNC is no tick).
+struct DeferredTap final : drivers::Tap {
+  drivers::Tap* target = nullptr;
+  void on_exchange(const drivers::TapRecord& r) noexcept override {
+    if (target != nullptr) target->on_exchange(r);
+  }
+};
+
 int run_real(const RunOptions& o) {
   const StationConfig config = load_station_config(o.config);
   Protocol protocol = load_protocol(o.protocol);
   const auto locks = lock_db_and_devices(o.db, &config);
+  // Every device must answer before anything moves or the database is touched.
+  DeferredTap tap;
   RigOptions ro;
-  std::ofstream can_log;
-  std::optional<drivers::can::CandumpTap> can_tap;
-  if (!o.record_can.empty()) {
-    can_log.open(o.record_can, std::ios::app);
-    if (!can_log) throw InputError(fmt::format("{}: cannot write the CAN log", o.record_can));
-    ro.tap = &can_tap.emplace(can_log, "can0");
-  }
+  ro.tap = &tap;
   Rig rig = build_rig(config, ro);
-  // Nothing moves and nothing is written before every device has answered once.
-  if (const auto down = preflight(rig, config); !down.empty()) {
-    std::string msg =
-        fmt::format("{}: {} device(s) unreachable, nothing started:", o.config, down.size());
-    for (const auto& d : down) msg += "\n  " + d;
-    throw InputError(msg);
-  }
+  if (const auto bad = unreachable_devices(config, rig); !bad.empty())
+    throw InputError(fmt::format("{}", fmt::join(bad, "\n")));
   Store store(o.db);
   const ResumeDecision resume_decision = decide_resume(store, config, o.fresh, false);
   const std::optional<RunRecord>& resume = resume_decision.run;
@@ -88,6 +88,13 @@ int run_real(const RunOptions& o) {
                        o.protocol);
     }
     protocol = *resume_decision.protocol;
+  }
+  std::ofstream can_log;
+  std::optional<drivers::can::CandumpTap> can_tap;
+  if (!o.record_can.empty()) {
+    can_log.open(o.record_can, std::ios::app);
+    if (!can_log) throw InputError(fmt::format("{}: cannot write the CAN log", o.record_can));
+    tap.target = &can_tap.emplace(can_log, "can0");
   }
   drivers::MonotonicClock clock;
   SequencerOptions so;

@@ -144,7 +144,7 @@ StationConfig parse_station_config(const std::string& text, const std::string& p
   c.path = path;
   c.text = text;
   if (auto st = root.opt_table("station")) {
-    st->allow_only({"name", "latitude_deg", "ref_temp_c", "bin_s"});
+    st->allow_only({"name", "latitude_deg", "ref_temp_c", "bin_s", "max_lost_share"});
     c.name = st->opt_string("name").value_or(c.name);
     c.latitude_deg = st->get_number("latitude_deg");
     if (c.latitude_deg < -90 || c.latitude_deg > 90)
@@ -152,6 +152,9 @@ StationConfig parse_station_config(const std::string& text, const std::string& p
     c.ref_temp_c = st->opt_number("ref_temp_c").value_or(c.ref_temp_c);
     c.bin_s = st->opt_number("bin_s").value_or(c.bin_s);
     if (!(c.bin_s >= 1)) throw st->error("bin_s", "must be at least 1 s");
+    c.max_lost_share = st->opt_number("max_lost_share").value_or(c.max_lost_share);
+    if (!(c.max_lost_share >= 0 && c.max_lost_share <= 1))
+      throw st->error("max_lost_share", "must be 0..1 (a share of the record window's ticks)");
   } else {
     throw root.error("station", "missing [station] table (latitude_deg is required)");
   }

@@ -55,6 +55,9 @@ struct StationConfig {
   double latitude_deg = 0;   ///< geodetic latitude of the site, deg
   double ref_temp_c = 25.0;  ///< T_ref of the model
   double bin_s = 600.0;      ///< bin width, s
+  /// Largest share of a slot's record-window ticks that may lack a rate (link outages) before
+  /// the run ends 'incomplete', 0..1.
+  double max_lost_share = 0.05;
   ModbusDeviceConfig chamber;
   std::optional<ModbusDeviceConfig> turntable;
   std::string can_transport;  ///< socketcan:can0 | unix:PATH | fd:N

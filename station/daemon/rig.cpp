@@ -3,7 +3,7 @@
 
 #include <fmt/format.h>
 
-#include "drivers/can/can_transport.hpp"
+#include "drivers/can/reconnecting_transport.hpp"
 #include "drivers/chamber/chamber_map.hpp"
 #include "drivers/chamber/modbus_chamber.hpp"
 #include "drivers/counters/counter_frames.hpp"
@@ -38,17 +38,15 @@ std::unique_ptr<dr::counters::CounterBoards> open_counters(const StationConfig& 
   can_opts.filters = dr::counters::board_frame_filters();
   can_opts.tap = o.tap;
   can_opts.tap_device = "can";
-  auto transport = dr::can::open_can_transport(dr::can::parse_can_spec(c.can_transport), can_opts);
-  if (!transport) {
-    throw InputError(fmt::format("{}: can.transport '{}': {}", c.path, c.can_transport,
-                                 transport.error().message));
-  }
+  can_opts.clock = o.clock;
+  auto transport = std::make_unique<dr::can::ReconnectingCanTransport>(
+      dr::can::parse_can_spec(c.can_transport), can_opts);
   dr::counters::CounterBoardsConfig cc;
   cc.tick_timeout = std::chrono::milliseconds(c.can_tick_timeout_ms);
   for (const auto& s : c.slots) {
     cc.slots.push_back({static_cast<std::uint8_t>(s.node), s.serial, s.pulse_weight_arcsec});
   }
-  return std::make_unique<dr::counters::CounterBoards>(std::move(transport).value(), cc);
+  return std::make_unique<dr::counters::CounterBoards>(std::move(transport), cc);
 }
 
 }  // namespace
@@ -60,6 +58,7 @@ Rig build_rig(const StationConfig& c, const RigOptions& o) {
   auto chamber = std::make_unique<dr::ModbusChamber>(
       "chamber", dr::modbus::parse_endpoint(c.chamber.endpoint), chamber_map, c.chamber.timeout_s);
   chamber->set_tap(o.tap);
+  chamber->client().set_clock(o.clock);
   rig.chamber = std::move(chamber);
   if (c.turntable) {
     auto map = dr::turntable_map::default_map(c.turntable->unit_id);

@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "drivers/chamber/chamber.hpp"
+#include "drivers/common/clock.hpp"
 #include "drivers/common/tap.hpp"
 #include "drivers/counters/counter_boards.hpp"
 #include "drivers/gpio/gpio_bank.hpp"
@@ -22,6 +23,9 @@ using GpioFactory =
 struct RigOptions {
   drivers::Tap* tap = nullptr;  ///< every exchange of every device passes here when set
   GpioFactory gpio_factory;     ///< empty: LibgpiodBank
+  /// Time of the links' reconnect back-off (nullptr: the steady clock; a simulation passes its
+  /// clock so reconnects happen at the same simulated ticks every time). Not owned.
+  const drivers::Clock* clock = nullptr;
 };
 
 /// The rig's devices. Turntable and GPIO are absent when the config has none.
@@ -32,8 +36,9 @@ struct Rig {
   std::unique_ptr<drivers::gpio::GpioBank> gpio;
 };
 
-/// Builds the drivers (no Modbus I/O) and opens the CAN transport. Throws InputError when the
-/// CAN transport cannot be opened (nothing can be measured without it).
+/// Builds the drivers; no I/O. Every link (Modbus, CAN) opens on first use and reopens after a
+/// loss with bounded back-off, so an unreachable device is found by probing it
+/// (unreachable_devices in station/cli/probe.hpp), not here. Throws only on config errors.
 Rig build_rig(const StationConfig& config, const RigOptions& options = {});
 
 /// The GPIO line map of a config: roles interlock, estop, tower.*, relay.N (slot N, 1-based).

@@ -44,7 +44,7 @@ Sequencer::Sequencer(const StationConfig& config, const Protocol& protocol, Rig&
 
 void Sequencer::emit(double t_s, const std::string& severity, const std::string& source,
                      const std::string& kind, const std::string& message,
-                     const std::string& data_json) {
+                     const std::optional<std::string>& data_json) {
   if (replaying_) return;
   const auto lvl = severity == "error"  ? spdlog::level::err
                    : severity == "warn" ? spdlog::level::warn
@@ -75,24 +75,12 @@ void Sequencer::read_devices(double t_s, TickData& d) {
   // reads measured slower on 2 cores: the simulators' threads compete for them.)
   std::optional<PhaseTimer> timer(std::in_place, phase_s_.can);
   auto counts = rig_.counters->tick(latch_seq_++);
-  if (counts) {
-    d.counts = std::move(counts).value();
-    counter_failures_ = 0;
-  } else if (counter_failures_++ % 60 == 0) {
-    emit(t_s, "warn", "can", "tick_failed", counts.error().message);
-  }
+  if (counts) d.counts = std::move(counts).value();
+  note_counters(t_s, d, counts ? std::string() : counts.error().message);
   timer.emplace(phase_s_.chamber);
   auto chamber = rig_.chamber->read();
-  if (chamber) {
-    if (chamber_failures_ > 0) {
-      emit(t_s, "info", "chamber", "recovered",
-           fmt::format("after {} failed reads", chamber_failures_));
-    }
-    d.chamber = chamber.value();
-    chamber_failures_ = 0;
-  } else if (chamber_failures_++ % 60 == 0) {
-    emit(t_s, "warn", "chamber", "read_failed", chamber.error().message);
-  }
+  if (chamber) d.chamber = chamber.value();
+  note_link(t_s, "chamber", chamber.ok(), chamber ? std::string() : chamber.error().message);
   timer.emplace(phase_s_.table);
   if (rig_.turntable) {
     auto table = rig_.turntable->read();
@@ -100,9 +88,82 @@ void Sequencer::read_devices(double t_s, TickData& d) {
       d.table = table.value();
       d.table_interlock_open = d.table->interlock_open;
     }
+    note_link(t_s, "turntable", table.ok(), table ? std::string() : table.error().message);
   }
   timer.emplace(phase_s_.gpio);
   read_gpio(t_s, d);
+}
+
+void Sequencer::note_link(double t_s, const std::string& device, std::optional<bool> answered,
+                          const std::string& error) {
+  const auto news = outages_.observe(device, t_s, answered, error);
+  if (!news) return;
+  const Outage& o = news->outage;
+  switch (news->change) {
+    case OutageChange::started:
+      emit(t_s, "warn", device, "outage_start", fmt::format("not answering: {}", o.error));
+      return;
+    case OutageChange::ended:
+      emit(t_s, "warn", device, "outage",
+           fmt::format("back after {} lost ticks (down since t = {:.0f} s: {})", o.ticks_lost,
+                       o.start_s, o.error),
+           outage_json(o));
+      return;
+  }
+}
+
+void Sequencer::note_counters(double t_s, const TickData& d, const std::string& error) {
+  bool any = false;
+  if (d.counts)
+    for (const auto& r : d.counts->readings) any = any || r.answered;
+  note_link(t_s, "can", any, d.counts ? "no counter board answered" : error);
+  for (std::size_t i = 0; i < config_.slots.size(); ++i) {
+    const std::string device = fmt::format("can node {}", config_.slots[i].node);
+    // Behind a lost bus a board has no news of its own: the bus outage covers it.
+    const auto* r = any ? &d.counts->readings[i] : nullptr;
+    note_link(t_s, device, r ? std::optional<bool>(r->answered) : std::nullopt,
+              "no complete answer to the latch");
+    if (r == nullptr || !r->answered) continue;
+    switch (r->chain) {
+      case dr::counters::LatchChain::reset:
+        emit(t_s, "warn", device, "board_reset",
+             fmt::format("{}: counters restarted (reset flag, or counts or board clock went "
+                         "backwards): re-baselined, no rate for this latch",
+                         r->serial));
+        break;
+      case dr::counters::LatchChain::unproven:
+        emit(t_s, "warn", device, "counts_rebaselined",
+             fmt::format("{}: board clock disagrees with the time since its last good latch: "
+                         "continuity unproven, re-baselined, no rate for this latch",
+                         r->serial));
+        break;
+      case dr::counters::LatchChain::first:
+      case dr::counters::LatchChain::continuous:
+        break;
+    }
+  }
+}
+
+std::map<std::string, std::string> Sequencer::close_outages(double t_s) {
+  for (const auto& o : outages_.close_all(t_s)) {
+    emit(t_s, "error", o.device, "outage",
+         fmt::format("still down at the end of the run: {} lost ticks since t = {:.0f} s ({})",
+                     o.ticks_lost, o.start_s, o.error),
+         outage_json(o));
+  }
+  std::map<std::string, std::string> out;
+  for (const auto& slot : config_.slots) {
+    const auto loss =
+        record_window_loss(store_.samples(run_id_, slot.serial, true), options_.period_s);
+    if (loss.share() <= config_.max_lost_share) continue;
+    out[slot.serial] = fmt::format(
+        "run {} incomplete: {} has no rate for {} of its {} record-window ticks ({:.1f} %, "
+        "max_lost_share {:.1f} %)",
+        run_id_, slot.serial, loss.lost, loss.ticks, 100 * loss.share(),
+        100 * config_.max_lost_share);
+    emit(t_s, "warn", "seq", "incomplete", out[slot.serial]);
+  }
+  return out;
 }
 
 void Sequencer::read_gpio(double t_s, TickData& d) {

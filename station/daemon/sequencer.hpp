@@ -7,12 +7,14 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
 
 #include "drivers/common/clock.hpp"
 #include "station/config/config.hpp"
 #include "station/config/protocol.hpp"
+#include "station/daemon/outages.hpp"
 #include "station/daemon/protocol_runner.hpp"
 #include "station/daemon/rig.hpp"
 #include "station/daemon/safety.hpp"
@@ -83,9 +85,20 @@ class Sequencer {
   void keep_safe_hold(double t_s, const TickData& d);
   void apply_actions(double t_s, const Actions& a);
   void assemble_samples(double t_s, TickData& d);
-  void finish(const std::string& state, double t_s);
+  /// Ends the run: closes open outages, bins and fits; returns the final state ('incomplete'
+  /// instead of 'completed' when a slot lost more than max_lost_share of its record window).
+  std::string finish(const std::string& state, double t_s);
   void emit(double t_s, const std::string& severity, const std::string& source,
-            const std::string& kind, const std::string& message, const std::string& data_json = {});
+            const std::string& kind, const std::string& message,
+            const std::optional<std::string>& data_json = std::nullopt);
+  /// Outage bookkeeping: one tick's news about a device (see OutageTracker::observe).
+  void note_link(double t_s, const std::string& device, std::optional<bool> answered,
+                 const std::string& error);
+  /// The bus and every board, and board resets / re-baselines, from one counter tick.
+  void note_counters(double t_s, const TickData& d, const std::string& error);
+  /// Ends open outages at the run's last tick and judges every slot's record window: per slot
+  /// that lost more than max_lost_share, a warning (also an event) for its fit.
+  std::map<std::string, std::string> close_outages(double t_s);
 
   const StationConfig& config_;
   Protocol protocol_;  ///< the protocol as clamped to the station's limits
@@ -98,7 +111,8 @@ class Sequencer {
   std::int64_t run_id_ = 0;
   std::uint8_t latch_seq_ = 0;
   bool replaying_ = false;
-  int chamber_failures_ = 0, counter_failures_ = 0, command_failures_ = 0;
+  int command_failures_ = 0;
+  OutageTracker outages_;  ///< link outages per device
   /// Last known safety inputs: a failed read keeps the last value; unreadable for
   /// kSafetyBlindTicks in a row counts as open (fail safe).
   bool interlock_open_ = false, estop_ = false;

@@ -33,14 +33,18 @@ std::vector<RunSlot> run_slots_of(const StationConfig& c) {
 
 }  // namespace
 
-void Sequencer::finish(const std::string& state, double t_s) {
+std::string Sequencer::finish(const std::string& end_state, double t_s) {
+  const auto lossy = close_outages(t_s);  // serial -> why its record window is incomplete
+  const std::string state = end_state == "completed" && !lossy.empty() ? "incomplete" : end_state;
   bin_run(store_, run_id_, config_.bin_s);
   for (const auto& slot : config_.slots) {
     try {
+      const auto it = lossy.find(slot.serial);
       const auto f =
           fit_serial(store_, slot.serial, {run_id_},
                      compensation::ModelSpec{{compensation::Term::dT, compensation::Term::gradT},
-                                             config_.ref_temp_c});
+                                             config_.ref_temp_c},
+                     it == lossy.end() ? std::vector<std::string>{} : std::vector{it->second});
       emit(t_s, "info", "seq", "fit",
            fmt::format("{}: k1 {:.4e} deg/h/C, k0 {:.4e} deg/h/C, std ratio {:.3f} over {} bins",
                        slot.serial, f.fit.coefficients[1], f.fit.coefficients[2], f.eval.std_ratio,
@@ -51,6 +55,7 @@ void Sequencer::finish(const std::string& state, double t_s) {
   }
   store_.finish_run(run_id_, state);
   emit(t_s, "info", "seq", "run_end", fmt::format("run {} {}", run_id_, state));
+  return state;
 }
 
 double Sequencer::resume_first_tick(const RunRecord& resume) {
@@ -153,8 +158,7 @@ RunOutcome Sequencer::run(const std::optional<RunRecord>& resume) {
           "store {:.0f}",
           phase_s_.world / n, phase_s_.can / n, phase_s_.chamber / n, phase_s_.table / n,
           phase_s_.gpio / n, phase_s_.store / n);
-      finish(state, t_s);
-      return {run_id_, state, t_s, ticks};
+      return {run_id_, finish(state, t_s), t_s, ticks};
     }
   }
 }

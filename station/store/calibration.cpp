@@ -35,7 +35,7 @@ void bin_run(Store& store, std::int64_t run_id, double bin_s) {
 }
 
 SerialFit fit_serial(Store& store, const std::string& serial, std::vector<std::int64_t> runs,
-                     const sc::ModelSpec& spec) {
+                     const sc::ModelSpec& spec, std::vector<std::string> warnings) {
   if (runs.empty()) runs = store.runs_of_serial(serial);
   if (runs.empty())
     throw InputError(fmt::format("{}: no run recorded serial '{}'", store.db().path(), serial));
@@ -50,6 +50,15 @@ SerialFit fit_serial(Store& store, const std::string& serial, std::vector<std::i
                                  fmt::join(runs, ","), e.what()));
   }
   out.eval = sc::evaluate(data.bias_dph, sc::compensate(out.fit, data.view()));
+  for (const auto id : runs) {
+    const auto run = store.find_run(id);
+    if (run && run->state == "incomplete")
+      warnings.push_back(
+          fmt::format("run {} ended incomplete: its record window lost more "
+                      "than the configured share of ticks (see its events)",
+                      id));
+  }
+  out.fit.warnings.insert(out.fit.warnings.end(), warnings.begin(), warnings.end());
   out.fit_id = store.save_fit(serial, runs, out.fit, out.eval);
   return out;
 }

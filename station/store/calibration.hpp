@@ -29,8 +29,9 @@ struct SerialFit {
 };
 
 /// Fits `spec` to the complete bins of `serial` over `runs` (all its runs when empty), stores the
-/// fit with its statistics and the runs used. Throws InputError when there is nothing to fit.
+/// fit with its statistics and the runs used. `warnings` are stored with the fit's own; a run
+/// that ended 'incomplete' adds one. Throws InputError when there is nothing to fit.
 SerialFit fit_serial(Store& store, const std::string& serial, std::vector<std::int64_t> runs,
-                     const compensation::ModelSpec& spec);
+                     const compensation::ModelSpec& spec, std::vector<std::string> warnings = {});
 
 }  // namespace station

@@ -323,7 +323,7 @@ std::optional<FitRecord> Store::latest_fit(const std::string& serial) {
 
 void Store::add_event(std::optional<std::int64_t> run_id, double t_s, const std::string& severity,
                       const std::string& source, const std::string& kind,
-                      const std::string& message, const std::string& data_json) {
+                      const std::string& message, const std::optional<std::string>& data_json) {
   auto st = db_.prepare(
       "INSERT INTO events (run_id, t_s, wall_utc, severity, source, kind, message, data_json) "
       "VALUES (?,?,?,?,?,?,?,?)");
@@ -333,10 +333,10 @@ void Store::add_event(std::optional<std::int64_t> run_id, double t_s, const std:
     st.bind_null(1);
   st.bind(2, t_s).bind(3, utc_now_iso()).bind(4, severity).bind(5, source).bind(6, kind);
   st.bind(7, message);
-  if (data_json.empty())
-    st.bind_null(8);
+  if (data_json)
+    st.bind(8, *data_json);
   else
-    st.bind(8, data_json);
+    st.bind_null(8);
   st.step();
 }
 

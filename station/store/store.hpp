@@ -121,10 +121,11 @@ class Store {
                         const compensation::FitResult& fit, const compensation::Evaluation& eval);
   std::optional<FitRecord> latest_fit(const std::string& serial);
 
-  /// One event; `data_json` is structured detail (e.g. an outage's start, end, ticks lost).
+  /// One event; `data_json` (column events.data_json, migration 2) is structured detail, e.g. an
+  /// outage's {"device","start_s","end_s","ticks_lost"}.
   void add_event(std::optional<std::int64_t> run_id, double t_s, const std::string& severity,
                  const std::string& source, const std::string& kind, const std::string& message,
-                 const std::string& data_json = {});
+                 const std::optional<std::string>& data_json = std::nullopt);
   /// Events of a run as "kind: message" in order.
   std::vector<std::string> events(std::int64_t run_id);
 
