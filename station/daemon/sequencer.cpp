@@ -126,7 +126,11 @@ void Sequencer::assemble_samples(double t_s, TickData& d) {
   const bool recording = runner_->progress().recording;
   d.obs.t_s = t_s;
   d.obs.has_turntable = rig_.turntable != nullptr;
-  if (d.table) d.obs.table_in_position = d.table->in_position;
+  if (d.table) {
+    d.obs.table_in_position = d.table->in_position;
+    d.obs.table_angle_deg = d.table->angle_deg;
+    d.obs.table_locked = d.table->locked;
+  }
   if (d.chamber && std::isfinite(d.chamber->air_c)) d.obs.air_c = d.chamber->air_c;
   if (d.obs.air_c) last_air_c_ = d.obs.air_c;
   for (const auto& slot : config_.slots) {
