@@ -48,6 +48,9 @@ Result<TurntableState> ModbusTurntable::read() {
   s.at_rate = (bits & tm::kAtRate) != 0;
   s.fault = (bits & tm::kFault) != 0;
   s.interlock_open = (bits & tm::kInterlockOpen) != 0;
+  auto lock = client_.read(map_.at(tm::kLock));
+  if (!lock) return lock.error();
+  s.locked = lock.value() != 0;
   return s;
 }
 
@@ -62,8 +65,10 @@ Result<void> ModbusTurntable::check(const TurntableCommand& c) const {
 
 Result<void> ModbusTurntable::command(const TurntableCommand& c) {
   if (auto ok = check(c); !ok) return ok;
-  if (c.lock) {
-    if (auto ok = client_.write(map_.at(tm::kLock), *c.lock ? 1 : 0); !ok) return ok;
+  // A release goes out before the demands; an engage after them (a locked axis does not move, and
+  // the drive engages the lock only at rest: the caller waits for in-position before locking).
+  if (c.lock && !*c.lock) {
+    if (auto ok = client_.write(map_.at(tm::kLock), 0); !ok) return ok;
   }
   if (c.position_deg) {
     double wrapped = std::fmod(std::fmod(*c.position_deg, 360.0) + 360.0, 360.0);
@@ -72,7 +77,10 @@ Result<void> ModbusTurntable::command(const TurntableCommand& c) {
   if (c.rate_dps) {
     if (auto ok = client_.write(map_.at(tm::kRateDemand), *c.rate_dps); !ok) return ok;
   }
-  return client_.write(map_.at(tm::kModeDemand), static_cast<double>(c.mode));
+  if (auto ok = client_.write(map_.at(tm::kModeDemand), static_cast<double>(c.mode)); !ok)
+    return ok;
+  if (c.lock && *c.lock) return client_.write(map_.at(tm::kLock), 1);
+  return {};
 }
 
 Result<void> ModbusTurntable::stop() {

@@ -20,6 +20,7 @@ struct TurntableState {
   bool at_rate = false;         ///< rate mode and at the demanded rate
   bool fault = false;           ///< drive fault
   bool interlock_open = false;  ///< safety interlock open (drive disabled)
+  bool locked = false;          ///< axis lock engaged (read back from the lock register)
 };
 
 /// A demand to the table; unset optionals are left alone.

@@ -38,6 +38,8 @@ struct LimitsConfig {
   double min_setpoint_c = -45.0;
   double max_setpoint_c = 85.0;
   double max_ramp_c_per_min = 3.0;
+  /// Air temperature this far beyond the setpoint limits is a fault (safe hold), °C.
+  double air_margin_c = 5.0;
 };
 
 /// GPIO lines by role; empty when the rig has none.

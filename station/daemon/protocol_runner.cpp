@@ -50,9 +50,12 @@ void ProtocolRunner::enter(const Step& s, const Observation& obs, Actions& a) {
       break;
     case StepKind::lock_turntable:
       if (obs.has_turntable) {
+        // Release and move first; lock_table() locks once a later reading shows it there.
         a.table = drivers::TurntableCommand{drivers::TurntableMode::position, s.position_deg,
-                                            std::nullopt, true};
+                                            std::nullopt, false};
       }
+      move_sent_s_ = obs.t_s;
+      lock_sent_s_.reset();
       break;
     case StepKind::record_start:
       progress_.recording = true;
@@ -69,6 +72,21 @@ void ProtocolRunner::enter(const Step& s, const Observation& obs, Actions& a) {
       break;
   }
   resume_from_c_.reset();
+}
+
+bool ProtocolRunner::table_at(const Step& s, const Observation& obs) {
+  constexpr double kAngleTolerance_deg = 0.1;
+  return obs.table_in_position.value_or(false) && obs.table_angle_deg &&
+         std::abs(std::remainder(*obs.table_angle_deg - s.position_deg, 360.0)) <=
+             kAngleTolerance_deg;
+}
+
+void ProtocolRunner::lock_table(const Step& s, const Observation& obs, Actions& a) {
+  if (!obs.has_turntable || lock_sent_s_ || !move_sent_s_ || obs.t_s <= *move_sent_s_) return;
+  if (!table_at(s, obs)) return;
+  a.table =
+      drivers::TurntableCommand{drivers::TurntableMode::position, std::nullopt, std::nullopt, true};
+  lock_sent_s_ = obs.t_s;
 }
 
 void ProtocolRunner::ramp(const Step& s, const Observation& obs, Actions& a) {
@@ -106,7 +124,9 @@ bool ProtocolRunner::finished(const Step& s, const Observation& obs) {
     case StepKind::hold:
       return in_step_s >= s.duration_s;
     case StepKind::lock_turntable:
-      return !obs.has_turntable || obs.table_in_position.value_or(false);
+      // Done on a reading taken after the lock command that shows the table there and locked.
+      return !obs.has_turntable || (lock_sent_s_ && obs.t_s > *lock_sent_s_ && table_at(s, obs) &&
+                                    obs.table_locked.value_or(false));
     default:
       return true;
   }
@@ -132,6 +152,7 @@ Actions ProtocolRunner::tick(const Observation& obs) {
     const Step& s = protocol_.steps[static_cast<std::size_t>(progress_.step_index)];
     if (!entered_) enter(s, obs, a);
     if (s.kind == StepKind::set_temperature && s.ramp_c_per_h > 0) ramp(s, obs, a);
+    if (s.kind == StepKind::lock_turntable) lock_table(s, obs, a);
     if (finished(s, obs)) {
       advance(obs, a, "step_done", "info");
       continue;

@@ -20,6 +20,8 @@ struct Observation {
   std::vector<double> gyro_temps_c;       ///< every valid gyro temperature this tick
   std::optional<bool> table_in_position;  ///< empty when there is no turntable or no answer
   bool has_turntable = false;
+  std::optional<double> table_angle_deg;  ///< empty when there is no turntable or no answer
+  std::optional<bool> table_locked;       ///< axis lock read back
 };
 
 /// A note for the event log.
@@ -69,6 +71,8 @@ class ProtocolRunner {
   double target_of(const Step& s) const;
   /// Target of the last set_temperature step before the current one, if any.
   std::optional<double> previous_target() const;
+  static bool table_at(const Step& s, const Observation& obs);
+  void lock_table(const Step& s, const Observation& obs, Actions& a);
   void ramp(const Step& s, const Observation& obs, Actions& a);
 
   const Protocol& protocol_;
@@ -79,6 +83,8 @@ class ProtocolRunner {
   std::optional<double> ramp_sent_c_;    ///< last ramp setpoint commanded
   std::optional<double> resume_from_c_;  ///< set by reenter(): restart the ramp from here
   std::optional<double> stable_since_s_;
+  /// lock_turntable: when the move and the lock were commanded (readings must come after).
+  std::optional<double> move_sent_s_, lock_sent_s_;
 };
 
 }  // namespace station

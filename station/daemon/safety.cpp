@@ -1,9 +1,11 @@
-// Safety layer: clamping and the interlock / e-stop safe hold.
+// Safety layer: clamping, judging device readings against the limits, and the safe hold.
 #include "station/daemon/safety.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
+#include <cmath>
 
 namespace station {
 
@@ -57,16 +59,42 @@ Protocol Safety::clamp_protocol(const Protocol& p, std::vector<std::string>& not
   return out;
 }
 
-std::optional<std::string> Safety::update(bool interlock_open, bool estop_pressed) {
+std::vector<std::string> Safety::judge(const std::optional<drivers::ChamberState>& chamber) const {
+  std::vector<std::string> out;
+  if (!chamber) return out;
+  const double lo = limits_.min_setpoint_c, hi = limits_.max_setpoint_c;
+  const double sp = chamber->setpoint_c, air = chamber->air_c;
+  // A NaN read-back fails both comparisons below: treat it as out of limits too.
+  if (!(sp >= lo && sp <= hi)) {
+    out.push_back(fmt::format("chamber setpoint read back {:.2f} C outside limits {:.1f}..{:.1f} C",
+                              sp, lo, hi));
+  }
+  // A NaN air temperature is a sensor break, reported by the chamber's alarms, not judged here.
+  const double m = limits_.air_margin_c;
+  if (std::isfinite(air) && (air < lo - m || air > hi + m)) {
+    out.push_back(
+        fmt::format("chamber air {:.2f} C beyond limits {:.1f}..{:.1f} C by more than "
+                    "{:.1f} C",
+                    air, lo, hi, m));
+  }
+  return out;
+}
+
+std::optional<std::string> Safety::update(bool interlock_open, bool estop_pressed,
+                                          const std::vector<std::string>& out_of_limits) {
   const bool was = holding_;
-  const bool changed = interlock_open != interlock_open_ || estop_pressed != estop_;
+  const bool fault = !out_of_limits.empty();
+  const bool changed =
+      interlock_open != interlock_open_ || estop_pressed != estop_ || fault != limits_fault_;
   interlock_open_ = interlock_open;
   estop_ = estop_pressed;
-  holding_ = interlock_open_ || estop_;
+  limits_fault_ = fault;
+  holding_ = interlock_open_ || estop_ || limits_fault_;
   if (!changed) return std::nullopt;
-  const std::string why =
-      fmt::format("interlock {}, e-stop {}", interlock_open_ ? "open" : "closed",
-                  estop_ ? "pressed" : "released");
+  std::string why = fmt::format("interlock {}, e-stop {}", interlock_open_ ? "open" : "closed",
+                                estop_ ? "pressed" : "released");
+  why += fault ? fmt::format(", out of limits: {}", fmt::join(out_of_limits, "; "))
+               : ", readings inside limits";
   if (holding_ && !was) return "enter: " + why;
   if (!holding_ && was) return "clear: " + why;
   return "still holding: " + why;

@@ -1,5 +1,6 @@
 // The safety layer no protocol can override: chamber commands clamped to the station's limits;
-// interlock or e-stop puts the chamber in a safe hold and stops the turntable.
+// interlock, e-stop or a device reading out of limits puts the chamber in a safe hold and stops the
+// turntable.
 #pragma once
 
 #include <optional>
@@ -23,9 +24,17 @@ class Safety {
   /// A copy of `p` with every setpoint and ramp inside the limits; a note per change.
   Protocol clamp_protocol(const Protocol& p, std::vector<std::string>& notes) const;
 
-  /// Feeds the interlock/e-stop inputs; returns a message when the safe-hold state changes
-  /// ("enter: ..." or "clear: ...").
-  std::optional<std::string> update(bool interlock_open, bool estop_pressed);
+  /// What the chamber reported this tick that lies outside the limits, one phrase each (read-back
+  /// setpoint outside the setpoint limits; air beyond them by more than the air margin). Empty
+  /// when all is inside or nothing was read.
+  std::vector<std::string> judge(const std::optional<drivers::ChamberState>& chamber) const;
+
+  /// Feeds the interlock/e-stop inputs and the readings judged out of limits; returns a message
+  /// when the safe-hold state changes ("enter: ..." or "clear: ...").
+  std::optional<std::string> update(bool interlock_open, bool estop_pressed,
+                                    const std::vector<std::string>& out_of_limits = {});
+  /// True while readings out of limits hold the rig (a fault: tower lamp red).
+  bool limits_fault() const { return limits_fault_; }
   /// True while the rig must stay in safe hold.
   bool holding() const { return holding_; }
   /// The command that holds the chamber where it is (setpoint = air, step), clamped.
@@ -34,7 +43,7 @@ class Safety {
  private:
   LimitsConfig limits_;
   bool holding_ = false;
-  bool interlock_open_ = false, estop_ = false;
+  bool interlock_open_ = false, estop_ = false, limits_fault_ = false;
 };
 
 }  // namespace station

@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <array>
 #include <chrono>
 #include <cmath>
 
@@ -186,7 +187,11 @@ void Sequencer::assemble_samples(double t_s, TickData& d) {
   const bool recording = runner_->progress().recording;
   d.obs.t_s = t_s;
   d.obs.has_turntable = rig_.turntable != nullptr;
-  if (d.table) d.obs.table_in_position = d.table->in_position;
+  if (d.table) {
+    d.obs.table_in_position = d.table->in_position;
+    d.obs.table_angle_deg = d.table->angle_deg;
+    d.obs.table_locked = d.table->locked;
+  }
   if (d.chamber && std::isfinite(d.chamber->air_c)) d.obs.air_c = d.chamber->air_c;
   if (d.obs.air_c) last_air_c_ = d.obs.air_c;
   for (const auto& slot : config_.slots) {
@@ -247,9 +252,12 @@ void Sequencer::apply_safety(double t_s, TickData& d) {
   interlock_open_ = interlock;
   estop_ = estop;
   const bool was_holding = safety_.holding();
-  const auto change = safety_.update(interlock, estop);
+  const auto change = safety_.update(interlock, estop, safety_.judge(d.chamber));
   if (change && safety_.holding() && !was_holding) enter_safe_hold(t_s, d, *change);
+  if (change && safety_.holding() && was_holding)
+    emit(t_s, "error", "safety", "safe_hold_changed", *change);
   if (safety_.holding()) keep_safe_hold(t_s, d);
+  drive_lamps(t_s);
   if (change && was_holding && !safety_.holding()) {
     emit(t_s, "info", "safety", "safe_hold_cleared", *change + ": resuming the protocol step");
     runner_->reenter(hold_air_c_);
@@ -291,6 +299,10 @@ void Sequencer::enter_safe_hold(double t_s, const TickData& d, const std::string
 void Sequencer::keep_safe_hold(double t_s, const TickData& d) {
   // Retried every tick until the devices accept: the hold setpoint needs one air reading.
   if (!hold_air_c_) hold_air_c_ = d.obs.air_c;
+  // Someone else wrote the setpoint during the hold: the hold is written again.
+  if (d.chamber && !(d.chamber->setpoint_c >= config_.limits.min_setpoint_c &&
+                     d.chamber->setpoint_c <= config_.limits.max_setpoint_c))
+    hold_commanded_ = false;
   if (!hold_commanded_ && hold_air_c_) {
     const auto r = rig_.chamber->command(safety_.hold_command(*hold_air_c_));
     hold_commanded_ = r.ok();
@@ -302,6 +314,26 @@ void Sequencer::keep_safe_hold(double t_s, const TickData& d) {
     table_stopped_ = r.ok();
     if (!r && command_failures_++ % 60 == 0)
       emit(t_s, "error", "table", "stop_failed", r.error().message);
+  }
+}
+
+void Sequencer::drive_lamps(double t_s) {
+  if (!rig_.gpio) return;
+  // Red: a fault (e-stop, readings out of limits); amber: safe hold; green: running.
+  const bool red = safety_.limits_fault() || estop_;
+  const bool amber = safety_.holding() && !red, green = !safety_.holding();
+  const std::array<std::pair<std::string_view, bool>, 3> lamps{
+      {{dr::gpio::roles::tower_red, red},
+       {dr::gpio::roles::tower_amber, amber},
+       {dr::gpio::roles::tower_green, green}}};
+  for (std::size_t i = 0; i < lamps.size(); ++i) {
+    const auto& [role, on] = lamps[i];
+    if (lamps_[i] == on || dr::gpio::find_role(rig_.gpio->config(), role) == nullptr) continue;
+    if (auto r = rig_.gpio->write(role, on); r) {
+      lamps_[i] = on;
+    } else if (command_failures_++ % 60 == 0) {
+      emit(t_s, "warn", "gpio", "lamp_failed", r.error().message);
+    }
   }
 }
 

@@ -4,6 +4,7 @@
 // never stops the loop: it is reported, retried, and the safety layer owns the safe state.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <functional>
@@ -84,6 +85,8 @@ class Sequencer {
   void enter_safe_hold(double t_s, const TickData& d, const std::string& why);
   void keep_safe_hold(double t_s, const TickData& d);
   void apply_actions(double t_s, const Actions& a);
+  /// Tower lamps from the safety state (red fault, amber hold, green running); writes changes.
+  void drive_lamps(double t_s);
   void assemble_samples(double t_s, TickData& d);
   /// Ends the run: closes open outages, bins and fits; returns the final state ('incomplete'
   /// instead of 'completed' when a slot lost more than max_lost_share of its record window).
@@ -121,6 +124,7 @@ class Sequencer {
   std::optional<double> hold_air_c_;  ///< where the chamber is held during a safe hold
   std::optional<double> last_air_c_;  ///< last chamber air reading
   bool hold_commanded_ = false, table_stopped_ = false;
+  std::array<std::optional<bool>, 3> lamps_;  ///< red, amber, green as last written
   /// Time spent per tick phase (wall seconds, summed), logged at the end of a run.
   struct PhaseTimes {
     double world = 0, can = 0, chamber = 0, table = 0, gpio = 0, store = 0;
