@@ -47,7 +47,9 @@ TEST(LockTurntable, ATableLockedAt90IsMovedTo0ThenLocked) {
     obs.table_angle_deg = st.value().angle_deg;
     obs.table_locked = st.value().locked;
     const auto a = runner.tick(obs);
-    if (a.table) ASSERT_TRUE(table.command(*a.table));
+    if (a.table) {
+      ASSERT_TRUE(table.command(*a.table));
+    }
     if (runner.done()) done_at_s = t;
   }
   // 90 deg at 20 deg/s max, 10 deg/s^2: 6.5 s of motion, so not before t = 7 s (a stale
