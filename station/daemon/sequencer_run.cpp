@@ -8,6 +8,7 @@
 #include "compensation/earth_rate.hpp"
 #include "drivers/common/tap.hpp"
 #include "station/store/calibration.hpp"
+#include "station/store/fit_json.hpp"
 #include "station/common/logging.hpp"
 #include "station/daemon/sequencer.hpp"
 
@@ -40,9 +41,9 @@ void Sequencer::finish(const std::string& state, double t_s) {
                      compensation::ModelSpec{{compensation::Term::dT, compensation::Term::gradT},
                                              config_.ref_temp_c});
       emit(t_s, "info", "seq", "fit",
-           fmt::format("{}: k1 {:.4e} deg/h/C, k0 {:.4e} deg/h/C, std ratio {:.3f} over {} bins",
-                       slot.serial, f.fit.coefficients[1], f.fit.coefficients[2], f.eval.std_ratio,
-                       f.fit.n_points));
+           fmt::format("{}: k1 {:.4e} deg/h/C, k0 {:.4e} deg/h/C, std ratio {} over {} bins",
+                       slot.serial, f.fit.coefficients[1], f.fit.coefficients[2],
+                       std_ratio_text(f.eval), f.fit.n_points));
     } catch (const InputError& e) {
       emit(t_s, "warn", "seq", "fit_skipped", e.what());
     }
