@@ -4,10 +4,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <stdexcept>
 #include <string>
 
 #include "compensation/chi_squared.hpp"
+#include "compensation/limits.hpp"
 
 namespace station::compensation {
 namespace {
@@ -94,6 +94,13 @@ double tangent_coefficient(const std::vector<CurvePoint>& pts, double slope) {
 
 }  // namespace
 
+std::optional<TauSpacing> tau_spacing_from_name(std::string_view name) {
+  if (name == "octave") return TauSpacing::octave;
+  if (name == "decade") return TauSpacing::decade;
+  if (name == "all") return TauSpacing::all;
+  return std::nullopt;
+}
+
 std::vector<std::size_t> tau_factors(std::size_t n, TauSpacing spacing) {
   std::vector<std::size_t> out;
   if (n < 3) return out;
@@ -118,9 +125,14 @@ std::vector<std::size_t> tau_factors(std::size_t n, TauSpacing spacing) {
 
 std::vector<AdevPoint> overlapping_adev(std::span<const double> rate, double rate_hz,
                                         std::span<const std::size_t> m_list, double confidence) {
-  if (!(rate_hz > 0.0) || !(confidence > 0.0 && confidence < 1.0)) {
-    throw std::invalid_argument("overlapping_adev: need rate_hz > 0 and 0 < confidence < 1, got " +
-                                std::to_string(rate_hz) + ", " + std::to_string(confidence));
+  if (!(rate_hz > 0.0) || !std::isfinite(rate_hz) || !(confidence > 0.0 && confidence < 1.0)) {
+    throw DataError("overlapping_adev: need rate_hz > 0 and 0 < confidence < 1, got " +
+                    std::to_string(rate_hz) + ", " + std::to_string(confidence));
+  }
+  for (std::size_t i = 0; i < rate.size(); ++i) {
+    if (!std::isfinite(rate[i]))
+      throw DataError("overlapping_adev: sample " + std::to_string(i) + ": " +
+                      finite_problem(rate[i]));
   }
   std::vector<AdevPoint> out;
   if (rate.empty()) return out;
@@ -152,6 +164,10 @@ std::vector<AdevPoint> overlapping_adev(std::span<const double> rate, double rat
     p.tau_s = md * tau0_s;
     p.n = n_terms;
     p.adev = std::sqrt(sum / (2.0 * md * md * static_cast<double>(n_terms)));
+    if (!std::isfinite(p.adev)) {
+      throw DataError("overlapping_adev: the Allan deviation at m = " + std::to_string(m) +
+                      " overflows: the values are too large");
+    }
     p.edf = white_fm_edf(static_cast<double>(n_angle), md);
     // Chi-squared interval, NIST SP 1065 §5.3: edf * s^2 / sigma^2 ~ chi^2(edf).
     p.ci_low = p.adev * std::sqrt(p.edf / chi_squared_quantile(1.0 - alpha / 2.0, p.edf));

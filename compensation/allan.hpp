@@ -5,12 +5,16 @@
 #include <cstddef>
 #include <optional>
 #include <span>
+#include <string_view>
 #include <vector>
 
 namespace station::compensation {
 
 /// How averaging factors m (tau = m * tau0) are chosen.
 enum class TauSpacing { octave, decade, all };
+
+/// Parses "octave", "decade" or "all"; empty for anything else.
+std::optional<TauSpacing> tau_spacing_from_name(std::string_view name);
 
 /// Averaging factors for a series of n rate samples: octave 1,2,4,...; decade 1,2,4 x 10^k;
 /// all 1..; each m kept while the overlapping estimator still has at least 2 terms (n - 2m + 1 >=
@@ -31,8 +35,9 @@ struct AdevPoint {
 /// Overlapping ADEV of `rate` (any rate unit, sampled at rate_hz) at each factor in `m_list`,
 /// computed from the integrated angle in O(N) per tau; interval at `confidence` (two-sided).
 /// Factors with fewer than 1 term are skipped. Interval from the white-FM (angle random walk)
-/// edf of NIST SP 1065 Table 5. Throws std::invalid_argument unless rate_hz > 0 and
-/// 0 < confidence < 1. Pure; no allocation beyond the result and one cumulative-sum buffer.
+/// edf of NIST SP 1065 Table 5. Throws DataError unless rate_hz > 0 is finite,
+/// 0 < confidence < 1 and every sample is finite, or when the result overflows. Pure; no allocation
+/// beyond the result and one cumulative-sum buffer.
 std::vector<AdevPoint> overlapping_adev(std::span<const double> rate, double rate_hz,
                                         std::span<const std::size_t> m_list,
                                         double confidence = 0.683);

@@ -3,8 +3,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
+#include <cstdint>
 #include <string>
+
+#include "compensation/limits.hpp"
 
 namespace station::compensation {
 namespace {
@@ -15,18 +17,50 @@ struct Sums {
   double t = 0, tt = 0, rate = 0, temp = 0, t_temp = 0, grad = 0, extra = 0;
 };
 
-void check_lengths(const BinInput& in) {
+// A bin index is an exact integer in a double only up to 2^53 (the binary64 significand).
+constexpr double kMaxBins = 9007199254740992.0;
+
+void check_finite(std::span<const double> v, const char* what) {
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    if (!std::isfinite(v[i])) {
+      throw DataError("make_bins: " + std::string(what) + " of sample " + std::to_string(i) + ": " +
+                      finite_problem(v[i]));
+    }
+  }
+}
+
+void check_input(const BinInput& in, const BinConfig& cfg) {
+  if (!(cfg.width_s > 0) || !std::isfinite(cfg.width_s))
+    throw DataError("make_bins: bin width must be a positive finite number");
+  if (!(cfg.sample_period_s >= 0) || !std::isfinite(cfg.sample_period_s))
+    throw DataError("make_bins: sample period must be a non-negative finite number");
   const std::size_t n = in.time_s.size();
   if (in.rate_dph.size() != n || in.temp_c.size() != n ||
       (!in.grad_c.empty() && in.grad_c.size() != n) ||
       (!in.extra.empty() && in.extra.size() != n)) {
-    throw std::invalid_argument("make_bins: series lengths differ");
+    throw DataError("make_bins: series lengths differ");
   }
+  check_finite(in.time_s, "time");
+  check_finite(in.rate_dph, "rate");
+  check_finite(in.temp_c, "temperature");
+  check_finite(in.grad_c, "gradient");
+  check_finite(in.extra, "extra channel");
   for (std::size_t i = 1; i < n; ++i) {
     if (!(in.time_s[i] > in.time_s[i - 1])) {
-      throw std::invalid_argument("make_bins: time not increasing at sample " + std::to_string(i));
+      throw DataError("make_bins: time not increasing at sample " + std::to_string(i));
     }
   }
+}
+
+void add(Sums& s, const BinInput& in, std::size_t i, double t_rel_s) {
+  ++s.n;
+  s.t += t_rel_s;
+  s.tt += t_rel_s * t_rel_s;
+  s.rate += in.rate_dph[i];
+  s.temp += in.temp_c[i];
+  s.t_temp += t_rel_s * in.temp_c[i];
+  if (!in.grad_c.empty()) s.grad += in.grad_c[i];
+  if (!in.extra.empty()) s.extra += in.extra[i];
 }
 
 Bin finish(const Sums& s, double t_start_s, double expected, double min_fill) {
@@ -61,38 +95,38 @@ double effective_sample_period_s(std::span<const double> time_s, const BinConfig
 }
 
 std::vector<Bin> make_bins(const BinInput& in, const BinConfig& cfg) {
-  if (!(cfg.width_s > 0)) throw std::invalid_argument("make_bins: bin width must be positive");
-  check_lengths(in);
+  check_input(in, cfg);
   std::vector<Bin> bins;
   if (in.time_s.empty()) return bins;
+  const double w = cfg.width_s;
   const double period = effective_sample_period_s(in.time_s, cfg);
-  const double expected = cfg.width_s / period;
+  const double expected = w / period;
   const double t0 = in.time_s.front();
-  const double record_end = in.time_s.back() + period;
-  const auto n_bins = static_cast<std::size_t>(std::floor((record_end - t0) / cfg.width_s + 1e-9));
-  bins.reserve(n_bins);
-  Sums s;
-  std::size_t k = 0;
-  for (std::size_t i = 0; i < in.time_s.size() && k < n_bins; ++i) {
-    const auto bin_of = static_cast<std::size_t>((in.time_s[i] - t0) / cfg.width_s);
-    while (k < bin_of && k < n_bins) {
-      bins.push_back(finish(s, t0 + static_cast<double>(k) * cfg.width_s, expected, cfg.min_fill));
-      s = Sums{};
-      ++k;
-    }
-    if (k >= n_bins) break;
-    const double t = in.time_s[i] - (t0 + static_cast<double>(k) * cfg.width_s);
-    ++s.n;
-    s.t += t;
-    s.tt += t * t;
-    s.rate += in.rate_dph[i];
-    s.temp += in.temp_c[i];
-    s.t_temp += t * in.temp_c[i];
-    if (!in.grad_c.empty()) s.grad += in.grad_c[i];
-    if (!in.extra.empty()) s.extra += in.extra[i];
+  const double span_bins = (in.time_s.back() + period - t0) / w;
+  if (!(span_bins < kMaxBins)) {
+    throw DataError("make_bins: the samples span " + number_text(in.time_s.back() - t0) +
+                    " s, more than 2^53 bins of " + number_text(w) + " s");
   }
-  if (k < n_bins)
-    bins.push_back(finish(s, t0 + static_cast<double>(k) * cfg.width_s, expected, cfg.min_fill));
+  // Bins 0 .. n_bins-1 end within the record; a later one is a trailing partial bin.
+  const auto n_bins = static_cast<std::int64_t>(std::floor(span_bins + 1e-9));
+  // Samples are in time order, so each bin's samples are consecutive: one pass, and a bin is
+  // made only where a sample falls.
+  Sums s;
+  std::int64_t k = -1;
+  auto close = [&] {
+    if (s.n > 0) bins.push_back(finish(s, t0 + static_cast<double>(k) * w, expected, cfg.min_fill));
+    s = Sums{};
+  };
+  for (std::size_t i = 0; i < in.time_s.size(); ++i) {
+    const auto bin_of = static_cast<std::int64_t>((in.time_s[i] - t0) / w);
+    if (bin_of >= n_bins) break;
+    if (bin_of != k) {
+      close();
+      k = bin_of;
+    }
+    add(s, in, i, in.time_s[i] - (t0 + static_cast<double>(k) * w));
+  }
+  close();
   return bins;
 }
 

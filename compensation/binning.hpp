@@ -37,10 +37,12 @@ struct Bin {
   bool complete = false;    ///< n >= min_fill * expected: usable in fits
 };
 
-/// Bin k covers [t0 + k*w, t0 + (k+1)*w), t0 the first sample's time. Trailing bins the record
-/// does not reach the end of (last time + period < bin end) are dropped. Empty bins inside gaps
-/// are kept with n = 0 and complete = false so the bin index stays the time index.
-/// Throws std::invalid_argument on mismatched lengths, non-increasing time or non-positive width.
+/// Bin k covers [t0 + k*w, t0 + (k+1)*w), t0 the first sample's time. Only bins that hold a
+/// sample are returned, in time order (a gap in the record is a jump in t_start_s, never a run
+/// of empty bins): the work and the memory are bounded by the samples, not by the time span.
+/// A trailing bin the record does not reach the end of (last time + period < bin end) is
+/// dropped. Throws DataError (a std::invalid_argument) on mismatched lengths, non-increasing or
+/// non-finite time, a non-finite value, a non-positive width, or a span of more than 2^53 bins.
 std::vector<Bin> make_bins(const BinInput& in, const BinConfig& cfg = {});
 
 /// The sample period used for `time_s` under `cfg` (cfg's value, or the median step).

@@ -4,9 +4,11 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
-#include <stdexcept>
 #include <string>
+
+#include "compensation/limits.hpp"
 
 namespace station::compensation {
 namespace {
@@ -17,16 +19,29 @@ constexpr double kCollinearCondition = 30.0;
 // Past this the standard errors are meaningless: the terms are linearly dependent.
 constexpr double kSingularCondition = 1e10;
 
+// The one table of the terms' names and units, in the order of enum Term.
 struct TermInfo {
   Term term;
   std::string_view option;
   std::string_view coefficient;
+  std::string_view unit;
 };
 constexpr TermInfo kTerms[] = {
-    {Term::dT, "dT", "k1"},           {Term::dT2, "dT2", "k2"},     {Term::dT3, "dT3", "k3"},
-    {Term::dT4, "dT4", "k4"},         {Term::gradT, "gradT", "k0"}, {Term::dTdt, "dTdt", "kr"},
-    {Term::channel, "channel", "kc"},
+    {Term::dT, "dT", "k1", "deg/h/C"},
+    {Term::dT2, "dT2", "k2", "deg/h/C^2"},
+    {Term::dT3, "dT3", "k3", "deg/h/C^3"},
+    {Term::dT4, "dT4", "k4", "deg/h/C^4"},
+    {Term::gradT, "gradT", "k0", "deg/h/C (gradient)"},
+    {Term::dTdt, "dTdt", "kr", "deg/h/(C/h)"},
+    {Term::channel, "channel", "kc", "deg/h per channel unit"},
 };
+constexpr bool table_in_enum_order() {
+  for (std::size_t i = 0; i < std::size(kTerms); ++i) {
+    if (static_cast<std::size_t>(kTerms[i].term) != i) return false;
+  }
+  return std::size(kTerms) == static_cast<std::size_t>(Term::channel) + 1;
+}
+static_assert(table_in_enum_order(), "kTerms must list every Term in enum order");
 
 const TermInfo& info(Term t) {
   return kTerms[static_cast<int>(t)];
@@ -34,15 +49,19 @@ const TermInfo& info(Term t) {
 
 std::span<const double> source_of(Term t, const ModelInput& in) {
   switch (t) {
+    case Term::dT:
+    case Term::dT2:
+    case Term::dT3:
+    case Term::dT4:
+      return in.temp_c;
     case Term::gradT:
       return in.grad_c;
     case Term::dTdt:
       return in.dtdt_c_per_h;
     case Term::channel:
       return in.channel;
-    default:
-      return in.temp_c;
   }
+  return in.temp_c;  // not reached: the switch covers every Term
 }
 
 double regressor(Term t, double x, double ref_temp_c) {
@@ -55,9 +74,61 @@ double regressor(Term t, double x, double ref_temp_c) {
       return std::pow(x - ref_temp_c, 3);
     case Term::dT4:
       return std::pow(x - ref_temp_c, 4);
-    default:
+    case Term::gradT:
+    case Term::dTdt:
+    case Term::channel:
       return x;
   }
+  return x;  // not reached: the switch covers every Term
+}
+
+// The physical bound a term's source values must keep (compensation/limits.hpp).
+std::string source_problem(Term t, double v) {
+  switch (t) {
+    case Term::dT:
+    case Term::dT2:
+    case Term::dT3:
+    case Term::dT4:
+      return temp_problem(v);
+    case Term::gradT:
+      return temp_diff_problem(v);
+    case Term::dTdt:
+    case Term::channel:
+      return finite_problem(v);
+  }
+  return {};  // not reached: the switch covers every Term
+}
+
+// Refuses data the model cannot use: every value finite and within its physical bound, so no
+// entry of the design matrix, and no sum of their squares, can overflow.
+void check_model_input(const ModelInput& in, const ModelSpec& spec) {
+  if (auto p = temp_problem(spec.ref_temp_c); !p.empty())
+    throw DataError("fit: reference temperature: " + p);
+  for (std::size_t i = 0; i < in.bias_dph.size(); ++i) {
+    if (auto p = rate_problem(in.bias_dph[i]); !p.empty())
+      throw DataError("fit: bin " + std::to_string(i) + " of those used: bias: " + p);
+  }
+  for (Term t : spec.terms) {
+    const auto src = source_of(t, in);
+    for (std::size_t i = 0; i < src.size(); ++i) {
+      if (auto p = source_problem(t, src[i]); !p.empty()) {
+        throw DataError("fit: bin " + std::to_string(i) + " of those used: term " +
+                        std::string(info(t).option) + ": " + p);
+      }
+    }
+  }
+}
+
+// A result that is not finite is refused rather than stored or printed.
+void check_result(const FitResult& r) {
+  for (std::size_t j = 0; j < r.coefficients.size(); ++j) {
+    if (!std::isfinite(r.coefficients[j]) || !std::isfinite(r.std_errors[j]) ||
+        !std::isfinite(r.std_errors_hac[j])) {
+      throw DataError("fit: coefficient " + r.names[j] + " or its standard error is not finite");
+    }
+  }
+  if (!std::isfinite(r.r2) || !std::isfinite(r.residual_rms_dph))
+    throw DataError("fit: R^2 or the residual RMS is not finite");
 }
 
 Eigen::MatrixXd design_matrix(const ModelInput& in, const ModelSpec& spec) {
@@ -68,8 +139,7 @@ Eigen::MatrixXd design_matrix(const ModelInput& in, const ModelSpec& spec) {
     const Term t = spec.terms[j];
     const auto src = source_of(t, in);
     if (src.size() != in.bias_dph.size()) {
-      throw std::invalid_argument("fit: term " + std::string(info(t).option) +
-                                  " has no data for every point");
+      throw DataError("fit: term " + std::string(info(t).option) + " has no data for every point");
     }
     for (Eigen::Index i = 0; i < n; ++i) x(i, j + 1) = regressor(t, src[i], spec.ref_temp_c);
   }
@@ -102,6 +172,14 @@ std::string_view term_option_name(Term t) {
 }
 std::string_view term_coefficient_name(Term t) {
   return info(t).coefficient;
+}
+
+std::string_view coefficient_unit(std::string_view coefficient_name) {
+  if (coefficient_name == "B0") return "deg/h";
+  for (const auto& ti : kTerms) {
+    if (ti.coefficient == coefficient_name) return ti.unit;
+  }
+  return {};
 }
 
 std::optional<Term> term_from_option_name(std::string_view name) {
@@ -148,10 +226,10 @@ FitResult fit_model(const ModelInput& in, const ModelSpec& spec) {
   const std::size_t p = spec.terms.size() + 1;
   const std::size_t n = in.bias_dph.size();
   if (n <= p) {
-    throw std::invalid_argument("too few bins: " + std::to_string(n) + " bins for " +
-                                std::to_string(p) + " coefficients (need at least " +
-                                std::to_string(p + 1) + ")");
+    throw DataError("too few bins: " + std::to_string(n) + " bins for " + std::to_string(p) +
+                    " coefficients (need at least " + std::to_string(p + 1) + ")");
   }
+  check_model_input(in, spec);
   Eigen::MatrixXd x = design_matrix(in, spec);
   const Eigen::Map<const Eigen::VectorXd> y(in.bias_dph.data(), static_cast<Eigen::Index>(n));
 
@@ -159,8 +237,8 @@ FitResult fit_model(const ModelInput& in, const ModelSpec& spec) {
   Eigen::VectorXd scale = x.colwise().norm().transpose();
   for (Eigen::Index j = 0; j < scale.size(); ++j) {
     if (!(scale(j) > 0)) {
-      throw std::invalid_argument("fit: term " + std::string(info(spec.terms[j - 1]).option) +
-                                  " is zero at every point");
+      throw DataError("fit: term " + std::string(info(spec.terms[j - 1]).option) +
+                      " is zero at every point");
     }
   }
   x = x * scale.cwiseInverse().asDiagonal();
@@ -174,8 +252,8 @@ FitResult fit_model(const ModelInput& in, const ModelSpec& spec) {
   res.spec = spec;
   res.condition_number = sv(sv.size() - 1) > 0 ? sv(0) / sv(sv.size() - 1) : INFINITY;
   if (!(res.condition_number < kSingularCondition)) {
-    throw std::invalid_argument("fit: the terms are linearly dependent (condition number " +
-                                std::to_string(res.condition_number) + ")");
+    throw DataError("fit: the terms are linearly dependent (condition number " +
+                    number_text(res.condition_number) + ")");
   }
   const Eigen::VectorXd beta_scaled = qr.solve(y);
   const Eigen::VectorXd resid = y - x * beta_scaled;
@@ -209,6 +287,7 @@ FitResult fit_model(const ModelInput& in, const ModelSpec& spec) {
                            std::to_string(static_cast<int>(kCollinearCondition)) +
                            " (Belsley); coefficients are poorly separated");
   }
+  check_result(res);
   return res;
 }
 
@@ -234,12 +313,36 @@ double sample_std(std::span<const double> v) {
   return std::sqrt(ss / static_cast<double>(v.size() - 1));
 }
 
-Evaluation evaluate(std::span<const double> before_dph, std::span<const double> after_dph) {
+Evaluation evaluate(std::span<const double> before_dph, std::span<const double> after_dph,
+                    double removed_dph) {
+  double magnitude_dph = std::abs(removed_dph);
+  double max_abs_before = 0;
+  for (auto v : {before_dph, after_dph}) {
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      if (!std::isfinite(v[i]))
+        throw DataError("evaluate: value " + std::to_string(i) + ": " + finite_problem(v[i]));
+    }
+  }
+  if (!std::isfinite(removed_dph)) throw DataError("evaluate: " + finite_problem(removed_dph));
+  for (double b : before_dph) max_abs_before = std::max(max_abs_before, std::abs(b));
+  magnitude_dph += max_abs_before;
   Evaluation e;
   e.std_before_dph = sample_std(before_dph);
   e.std_after_dph = sample_std(after_dph);
-  e.std_ratio = e.std_before_dph > 0 ? e.std_after_dph / e.std_before_dph : 0.0;
-  e.improvement_pct = 100.0 * (1.0 - e.std_ratio);
+  // Rounding level of the std. Each bias is a bin mean of m rates of magnitude M minus a
+  // constant; its rounding error grows like sqrt(m) u M for random rounding (u = eps/2; Higham,
+  // Accuracy and Stability of Numerical Algorithms, 2nd ed., sec. 4.2 and 3.1), about 12 eps M
+  // for the station's 600-sample bins. 64 eps M covers that with a margin of five, and is still
+  // 1.4e-14 M: the bin-to-bin scatter of any real gyro (bias instability of 1e-4 deg/h or more
+  // on rates up to the Earth rate, a relative 1e-6 at least) is eight orders above it. A std
+  // before at or below it is rounding noise, not a bias to compensate.
+  constexpr double kRoundingFactor = 64.0;
+  const double rounding_level_dph =
+      kRoundingFactor * std::numeric_limits<double>::epsilon() * magnitude_dph;
+  if (e.std_before_dph > rounding_level_dph) {
+    e.std_ratio = e.std_after_dph / e.std_before_dph;
+    e.improvement_pct = 100.0 * (1.0 - *e.std_ratio);
+  }
   return e;
 }
 

@@ -20,6 +20,8 @@ enum class Term { dT, dT2, dT3, dT4, gradT, dTdt, channel };
 std::string_view term_option_name(Term t);
 /// Coefficient name of a term as the paper writes it: k1..k4, k0 (gradient), kr (rate), kc.
 std::string_view term_coefficient_name(Term t);
+/// Unit of a coefficient by name ("B0" -> "deg/h", "k1" -> "deg/h/C", ...); empty when unknown.
+std::string_view coefficient_unit(std::string_view coefficient_name);
 /// Parses an option name; empty when unknown.
 std::optional<Term> term_from_option_name(std::string_view name);
 /// Parses a comma-separated list of option names; throws std::invalid_argument naming a bad one.
@@ -68,7 +70,10 @@ struct FitResult {
 };
 
 /// Least squares through Householder QR of the column-scaled design matrix (not normal
-/// equations). Throws std::invalid_argument on too few points, missing or constant series.
+/// equations). Throws DataError (compensation/limits.hpp) on too few points, missing or constant
+/// series, a value that is not finite or outside its physical bound (bias within
+/// +-kMaxAbsRateDph, temperatures and T_ref within kMinTempC..kMaxTempC, gradients within
+/// +-kMaxAbsTempDiffC), linearly dependent terms, or a result that is not finite.
 FitResult fit_model(const ModelInput& in, const ModelSpec& spec);
 
 /// Model value B(x) at each point.
@@ -81,15 +86,21 @@ std::vector<double> compensate(const FitResult& fit, const ModelInput& in);
 double sample_std(std::span<const double> v);
 
 /// Std of the bias before and after compensation, their ratio and 1 - ratio in percent
-/// (the paper's figure of merit: ratio 0.13, "87 %").
+/// (the paper's figure of merit: ratio 0.13, "87 %"). The ratio is undefined (empty) when the
+/// std before is at the rounding level of the data: a constant input has nothing to improve,
+/// and a ratio of two rounding errors would invent an improvement.
 struct Evaluation {
   double std_before_dph = 0;
   double std_after_dph = 0;
-  double std_ratio = 0;
-  double improvement_pct = 0;
+  std::optional<double> std_ratio;        ///< std_after / std_before; empty when undefined
+  std::optional<double> improvement_pct;  ///< 100 (1 - std_ratio); empty with it
 };
 
-/// Evaluates before/after series of equal meaning (bias and compensated bias).
-Evaluation evaluate(std::span<const double> before_dph, std::span<const double> after_dph);
+/// Evaluates before/after series of equal meaning (bias and compensated bias). `removed_dph` is
+/// a constant the caller subtracted from the measured rates to make `before` (the Earth rate):
+/// the rounding level is set by the magnitude of the values before that subtraction.
+/// Throws DataError when a value is not finite.
+Evaluation evaluate(std::span<const double> before_dph, std::span<const double> after_dph,
+                    double removed_dph = 0);
 
 }  // namespace station::compensation

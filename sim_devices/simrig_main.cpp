@@ -1,12 +1,17 @@
 // simrig: a whole simulated rig (SimWorld) on the wall clock, for running `station` against it.
 // stdout is a ready-to-use station TOML (endpoints in its leading comments); logs go to stderr.
 #include <fmt/format.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/un.h>
 
 #include <CLI/CLI.hpp>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <exception>
 #include <memory>
 #include <string>
@@ -44,6 +49,26 @@ struct Options {
 double earth_rate_up_dph(double latitude_deg) {
   const double omega_dph = 7.292115e-5 * 180.0 / M_PI * 3600.0;
   return omega_dph * std::sin(latitude_deg * M_PI / 180.0);
+}
+
+/// Why `path` cannot be the CAN socket (empty when it can). The simulator replaces a stale
+/// socket left by an earlier simrig, so anything else at the path (a regular file, a directory, a
+/// symlink) is refused, never unlinked; so is a path too long for sun_path, which would be
+/// truncated to another file's name.
+std::string can_socket_problem(const std::string& path) {
+  if (path.empty() || path.size() >= sizeof(sockaddr_un{}.sun_path)) {
+    return fmt::format("--can-socket '{}': a unix socket path must be 1..{} bytes", path,
+                       sizeof(sockaddr_un{}.sun_path) - 1);
+  }
+  struct stat st {};
+  if (lstat(path.c_str(), &st) != 0) {
+    if (errno == ENOENT) return {};
+    return fmt::format("--can-socket {}: {}", path, std::strerror(errno));
+  }
+  if (!S_ISSOCK(st.st_mode)) {
+    return fmt::format("--can-socket {}: exists and is not a socket; refusing to replace it", path);
+  }
+  return {};
 }
 
 void print_config(const sim::SimWorld& world, const Options& o) {
@@ -152,6 +177,10 @@ int main(int argc, char** argv) {
       fmt::print(stderr, "simrig: {}\n", e.what());
       return 2;
     }
+  }
+  if (const auto problem = can_socket_problem(o.can_socket); !problem.empty()) {
+    fmt::print(stderr, "simrig: {}\n", problem);
+    return 2;
   }
 
   struct sigaction sa {};

@@ -12,6 +12,10 @@
 int main(int argc, char** argv) {
   CLI::App app{"Gyro thermal-calibration test station"};
   app.require_subcommand(1);
+  // One line per error, like every other input error (CLI11's default adds a second line).
+  app.failure_message([](const CLI::App* /*app*/, const CLI::Error& e) {
+    return fmt::format("station: {} (see --help)\n", e.what());
+  });
   station::CommandStatus status;
   station::add_analyze_command(app, status);
   station::add_adev_command(app, status);

@@ -1,13 +1,16 @@
 // `station adev`: overlapping Allan deviation of one CSV column, with the IEEE 952 noise terms.
 #include <fmt/format.h>
 
+#include <charconv>
 #include <cmath>
 #include <iostream>
 #include <nlohmann/json.hpp>
 
 #include "compensation/allan.hpp"
+#include "compensation/limits.hpp"
 #include "station/cli/commands.hpp"
 #include "station/cli/csv_table.hpp"
+#include "station/cli/number_options.hpp"
 
 namespace station {
 namespace {
@@ -21,27 +24,31 @@ struct AdevOptions {
   bool json = false;
 };
 
-/// Averaging factors from "octave", "decade", "all" or a list of tau values in seconds.
+/// Averaging factors from "octave", "decade", "all" or a list of tau values in seconds, each a
+/// whole multiple of the sample period that the n samples can average over (n - 2m + 1 >= 2).
 std::vector<std::size_t> factors_from(const AdevOptions& o, std::size_t n) {
-  if (o.taus == "octave") return sc::tau_factors(n, sc::TauSpacing::octave);
-  if (o.taus == "decade") return sc::tau_factors(n, sc::TauSpacing::decade);
-  if (o.taus == "all") return sc::tau_factors(n, sc::TauSpacing::all);
+  if (auto spacing = sc::tau_spacing_from_name(o.taus)) return sc::tau_factors(n, *spacing);
   std::vector<std::size_t> ms;
+  const std::size_t m_max = n < 3 ? 0 : (n - 1) / 2;
   std::size_t start = 0;
   while (start <= o.taus.size()) {
     const auto comma = o.taus.find(',', start);
     const std::string word =
         o.taus.substr(start, comma == std::string::npos ? comma : comma - start);
     double tau_s = 0;
-    try {
-      tau_s = std::stod(word);
-    } catch (const std::exception&) {
+    const auto [ptr, ec] = std::from_chars(word.data(), word.data() + word.size(), tau_s);
+    if (word.empty() || ec != std::errc{} || ptr != word.data() + word.size() ||
+        !std::isfinite(tau_s)) {
       throw InputError(fmt::format("--taus: '{}' is not octave, decade, all or a number", word));
     }
     const double m = tau_s * o.rate_hz;
     if (!(m >= 1) || std::abs(m - std::round(m)) > 1e-9) {
       throw InputError(
           fmt::format("--taus: {} s is not a whole multiple of 1/{} s", word, o.rate_hz));
+    }
+    if (m > static_cast<double>(m_max)) {
+      throw InputError(
+          fmt::format("--taus: {} s is longer than {} samples can average over", word, n));
     }
     ms.push_back(static_cast<std::size_t>(std::llround(m)));
     if (comma == std::string::npos) break;
@@ -94,7 +101,7 @@ void add_adev_command(CLI::App& app, CommandStatus& status) {
   cmd->add_option("--col", o->col, "column holding the rate series")->required();
   cmd->add_option("--rate-hz", o->rate_hz, "sample rate, Hz")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(finite_positive(1e9, "Hz"));
   cmd->add_option("--taus", o->taus, "octave|decade|all|LIST of tau in s")->capture_default_str();
   cmd->add_flag("--json", o->json, "print one JSON object");
   cmd->callback([o, &status] {
@@ -104,7 +111,12 @@ void add_adev_command(CLI::App& app, CommandStatus& status) {
       throw InputError(fmt::format("{}: {} samples; ADEV needs at least 3", o->file, rate.size()));
     }
     const auto ms = factors_from(*o, rate.size());
-    const auto pts = sc::overlapping_adev(rate, o->rate_hz, ms);
+    std::vector<sc::AdevPoint> pts;
+    try {
+      pts = sc::overlapping_adev(rate, o->rate_hz, ms);
+    } catch (const sc::DataError& e) {
+      throw InputError(fmt::format("{}: column '{}': {}", o->file, o->col, e.what()));
+    }
     const auto nt = sc::noise_terms(pts);
     if (o->json) {
       nlohmann::json rows = nlohmann::json::array();

@@ -1,6 +1,7 @@
 // `station analyze`: the engineer's offline tool and batch calibration from another rig's CSV.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -8,14 +9,19 @@
 #include "compensation/binning.hpp"
 #include "compensation/earth_rate.hpp"
 #include "compensation/fit.hpp"
+#include "compensation/limits.hpp"
 #include "station/cli/commands.hpp"
 #include "station/cli/csv_table.hpp"
+#include "station/cli/number_options.hpp"
 #include "station/store/fit_json.hpp"
 
 namespace station {
 namespace {
 
 namespace sc = station::compensation;
+
+/// Widest bin accepted, s (116 days): wider than any record this station makes.
+constexpr double kMaxBinS = 1e7;
 
 struct AnalyzeOptions {
   std::string file;
@@ -37,12 +43,22 @@ double earth_rate_from(const AnalyzeOptions& o, std::vector<std::string>& warnin
         "no --earth-rate-dph or --latitude: Earth rate not removed (B0 holds it)");
     return 0.0;
   }
-  std::optional<sc::EnuAxis> axis = sc::axis_from_name(o.axis);
-  if (!axis && o.axis.rfind("heading:", 0) == 0) {
-    axis = sc::horizontal_axis(std::stod(o.axis.substr(8)));
+  sc::EnuAxis axis;
+  try {
+    axis = sc::parse_axis(o.axis);
+  } catch (const sc::DataError& e) {
+    throw InputError(fmt::format("--axis: {}", e.what()));
   }
-  if (!axis) throw InputError(fmt::format("--axis: unknown axis '{}'", o.axis));
-  return sc::earth_rate_along_axis_dph(*o.latitude_deg, *axis);
+  return sc::earth_rate_along_axis_dph(*o.latitude_deg, axis);
+}
+
+/// Every value within its physical bound (compensation/limits.hpp), named by file, line, column.
+void check_columns(const CsvColumns& csv, bool grad_is_difference) {
+  require_within(csv, 1, sc::rate_problem);
+  require_within(csv, 2, sc::temp_problem);
+  if (csv.columns.size() > 3) {
+    require_within(csv, 3, grad_is_difference ? sc::temp_diff_problem : sc::temp_problem);
+  }
 }
 
 struct Analysis {
@@ -54,7 +70,12 @@ struct Analysis {
 };
 
 Analysis analyze(const AnalyzeOptions& o) {
-  const std::vector<sc::Term> terms = sc::parse_terms(o.terms);
+  std::vector<sc::Term> terms;
+  try {
+    terms = sc::parse_terms(o.terms);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(fmt::format("--terms: {}", e.what()));
+  }
   std::vector<std::string> cols{o.time_col, o.rate_col, o.temp_col};
   const std::string grad_source = !o.grad_col.empty() ? o.grad_col : o.temp2_col;
   if (!grad_source.empty()) cols.push_back(grad_source);
@@ -64,6 +85,7 @@ Analysis analyze(const AnalyzeOptions& o) {
   }
   const CsvColumns csv = read_csv_columns(o.file, cols);
   require_increasing(csv, 0);
+  check_columns(csv, !o.grad_col.empty());
   std::vector<double> grad;
   if (!grad_source.empty()) {
     grad = csv[3];
@@ -77,16 +99,16 @@ Analysis analyze(const AnalyzeOptions& o) {
   a.earth_rate_dph = earth_rate_from(o, a.warnings);
   sc::BinConfig bin_cfg;
   bin_cfg.width_s = o.bin_s;
-  const auto bins = sc::make_bins({csv[0], csv[1], csv[2], grad, {}}, bin_cfg);
-  const sc::ModelData data = sc::model_data_from_bins(bins, a.earth_rate_dph);
-  a.bins_used = data.bias_dph.size();
-  a.bins_flagged = bins.size() - a.bins_used;
   try {
+    const auto bins = sc::make_bins({csv[0], csv[1], csv[2], grad, {}}, bin_cfg);
+    const sc::ModelData data = sc::model_data_from_bins(bins, a.earth_rate_dph);
+    a.bins_used = data.bias_dph.size();
+    a.bins_flagged = bins.size() - a.bins_used;
     a.fit = sc::fit_model(data.view(), sc::ModelSpec{terms, o.ref_temp_c});
-  } catch (const std::invalid_argument& e) {
+    a.eval = sc::evaluate(data.bias_dph, sc::compensate(a.fit, data.view()), a.earth_rate_dph);
+  } catch (const sc::DataError& e) {
     throw InputError(fmt::format("{}: {}", o.file, e.what()));
   }
-  a.eval = sc::evaluate(data.bias_dph, sc::compensate(a.fit, data.view()));
   a.warnings.insert(a.warnings.end(), a.fit.warnings.begin(), a.fit.warnings.end());
   return a;
 }
@@ -120,8 +142,7 @@ void print_table(const AnalyzeOptions& o, const Analysis& a) {
     fmt::print("  {:<4} {:>14.6e} {:>12.3e} {:>14.3e}\n", a.fit.names[i], a.fit.coefficients[i],
                a.fit.std_errors[i], a.fit.std_errors_hac[i]);
   }
-  fmt::print("\nstd before {:.5f} deg/h, after {:.5f} deg/h, ratio {:.3f} ({:.1f} % better)\n",
-             a.eval.std_before_dph, a.eval.std_after_dph, a.eval.std_ratio, a.eval.improvement_pct);
+  fmt::print("\n{}\n", evaluation_text(a.eval));
   fmt::print("R^2 {:.4f}, residual RMS {:.5f} deg/h, condition number {:.1f}\n", a.fit.r2,
              a.fit.residual_rms_dph, a.fit.condition_number);
   for (const auto& w : a.warnings) fmt::print("warning: {}\n", w);
@@ -142,13 +163,20 @@ void add_analyze_command(CLI::App& app, CommandStatus& status) {
       ->excludes(g);
   cmd->add_option("--bin-s", o->bin_s, "bin width, s")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(finite_positive(kMaxBinS, "s"));
   cmd->add_option("--ref-temp-c", o->ref_temp_c, "reference temperature T_ref, C")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(finite_within(sc::kMinTempC, sc::kMaxTempC, "C"));
   cmd->add_option("--terms", o->terms, "dT,dT2,dT3,dT4,gradT,dTdt (B0 always)")
       ->capture_default_str();
-  auto* er = cmd->add_option("--earth-rate-dph", o->earth_rate_dph, "Earth rate along the axis");
-  cmd->add_option("--latitude", o->latitude_deg, "site latitude, deg")->excludes(er);
+  // A component of the Earth rate cannot exceed the rate itself; 0.1 % slack for a user's
+  // rounding of 15.041 deg/h.
+  auto* er =
+      cmd->add_option("--earth-rate-dph", o->earth_rate_dph, "Earth rate along the axis")
+          ->check(finite_within(-1.001 * sc::kEarthRateDph, 1.001 * sc::kEarthRateDph, "deg/h"));
+  cmd->add_option("--latitude", o->latitude_deg, "site latitude, deg")
+      ->excludes(er)
+      ->check(finite_within(-90.0, 90.0, "deg"));
   cmd->add_option("--axis", o->axis, "up|down|north|south|east|west|heading:DEG")
       ->capture_default_str();
   cmd->add_flag("--json", o->json, "print one JSON object");

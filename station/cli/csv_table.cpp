@@ -6,10 +6,13 @@
 #include <charconv>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <string_view>
 
 namespace station {
 namespace {
+
+constexpr std::string_view kUtf8Bom = "\xEF\xBB\xBF";
 
 std::vector<std::string_view> split(std::string_view line) {
   std::vector<std::string_view> cells;
@@ -37,6 +40,9 @@ double parse_cell(std::string_view cell, const std::string& where) {
   const auto* end = cell.data() + cell.size();
   const auto [ptr, ec] = std::from_chars(cell.data(), end, v);
   if (cell.empty()) throw InputError(where + ": empty cell");
+  if (ec == std::errc::result_out_of_range && ptr == end) {
+    throw InputError(fmt::format("{}: number out of the range of a double: '{}'", where, cell));
+  }
   if (ec != std::errc{} || ptr != end) {
     throw InputError(fmt::format("{}: not a number: '{}'", where, cell));
   }
@@ -77,6 +83,8 @@ CsvColumns read_csv_columns(const std::string& path, const std::vector<std::stri
   std::size_t n_header = 0;
   while (std::getline(in, line)) {
     ++line_no;
+    // A UTF-8 byte-order mark (spreadsheets write one) is not part of the first column's name.
+    if (line_no == 1 && line.rfind(kUtf8Bom, 0) == 0) line.erase(0, kUtf8Bom.size());
     if (skippable(line)) continue;
     const auto cells = split(line);
     if (idx.empty()) {
@@ -104,6 +112,16 @@ void require_increasing(const CsvColumns& t, std::size_t c) {
     if (!(v[i] > v[i - 1])) {
       throw InputError(fmt::format("{}:{}: column '{}': {} does not increase (previous row {})",
                                    t.path, t.lines[i], t.names[c], v[i], v[i - 1]));
+    }
+  }
+}
+
+void require_within(const CsvColumns& t, std::size_t c,
+                    const std::function<std::string(double)>& problem) {
+  const auto& v = t.columns.at(c);
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    if (const std::string p = problem(v[i]); !p.empty()) {
+      throw InputError(fmt::format("{}:{}: column '{}': {}", t.path, t.lines[i], t.names[c], p));
     }
   }
 }

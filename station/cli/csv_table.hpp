@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -18,12 +19,18 @@ struct CsvColumns {
   const std::vector<double>& operator[](std::size_t c) const { return columns[c]; }
 };
 
-/// Reads `path` (comma-separated, header row, '#' comment lines and blank lines skipped) and
+/// Reads `path` (comma-separated, header row, '#' comment lines and blank lines skipped, a UTF-8
+/// byte-order mark at the start ignored) and
 /// returns the named columns. Throws InputError on a missing file or column, a ragged row, or a
 /// cell that is not a finite number ("FILE:LINE: column 'NAME': ...").
 CsvColumns read_csv_columns(const std::string& path, const std::vector<std::string>& names);
 
 /// Throws InputError naming the first row whose value in column c does not increase.
 void require_increasing(const CsvColumns& t, std::size_t c);
+
+/// Throws InputError ("FILE:LINE: column 'NAME': what") at the first row of column c for which
+/// `problem` returns a non-empty text (e.g. compensation::rate_problem).
+void require_within(const CsvColumns& t, std::size_t c,
+                    const std::function<std::string(double)>& problem);
 
 }  // namespace station

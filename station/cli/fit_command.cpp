@@ -25,14 +25,7 @@ struct FitOptions {
 
 /// Unit of each coefficient, for people and for the navigation computer.
 std::string unit_of(const std::string& name) {
-  if (name == "B0") return "deg/h";
-  if (name == "k1") return "deg/h/C";
-  if (name == "k2") return "deg/h/C^2";
-  if (name == "k3") return "deg/h/C^3";
-  if (name == "k4") return "deg/h/C^4";
-  if (name == "k0") return "deg/h/C (gradient)";
-  if (name == "kr") return "deg/h/(C/h)";
-  return "";
+  return std::string(sc::coefficient_unit(name));
 }
 
 nlohmann::json fit_json(const SerialFit& f) {
@@ -50,8 +43,7 @@ void print_fit(const SerialFit& f) {
     fmt::print("  {:<3} {:>13.5e} +- {:.2e} {}\n", f.fit.names[i], f.fit.coefficients[i],
                f.fit.std_errors[i], unit_of(f.fit.names[i]));
   }
-  fmt::print("  std before {:.5f} deg/h, after {:.5f} deg/h, ratio {:.3f} ({:.1f} % better)\n",
-             f.eval.std_before_dph, f.eval.std_after_dph, f.eval.std_ratio, f.eval.improvement_pct);
+  fmt::print("  {}\n", evaluation_text(f.eval));
   for (const auto& w : f.fit.warnings) fmt::print("  warning: {}\n", w);
 }
 
@@ -106,7 +98,7 @@ void run_export(const FitOptions& o) {
       {"model", "B = B0 + k1*dT + k2*dT^2 + ... + k0*gradT (dT = T - ref_temp_c, gradT = T2 - T1)"},
       {"coefficients", coef},
       {"units", units},
-      {"std_ratio", rec->eval.std_ratio}};
+      {"std_ratio", std_ratio_json(rec->eval)}};
   std::cout << j.dump(2) << '\n';
 }
 

@@ -7,6 +7,7 @@
 #include <set>
 #include <sstream>
 
+#include "compensation/limits.hpp"
 #include "drivers/can/can_transport.hpp"
 #include "drivers/chamber/chamber_map.hpp"
 #include "drivers/modbus/endpoint.hpp"
@@ -48,7 +49,7 @@ mb::PointOverride read_override(const TomlView& v) {
   if (auto s = v.opt_string("function")) {
     o.function = at_key(v, "function", [&] { return mb::parse_function_code(*s); });
   }
-  if (auto u = v.opt_integer("unit_id")) o.unit_id = static_cast<int>(*u);
+  if (auto u = v.opt_integer_in("unit_id", 0, 247)) o.unit_id = static_cast<int>(*u);
   o.one_based = v.opt_bool("one_based");
   if (auto s = v.opt_string("access"))
     o.access = at_key(v, "access", [&] { return mb::parse_access(*s); });
@@ -61,8 +62,7 @@ ModbusDeviceConfig read_modbus_device(const TomlView& v, bool is_chamber) {
   d.endpoint = v.get_string("endpoint");
   at_key(v, "endpoint", [&] { return mb::parse_endpoint(d.endpoint); });
   d.preset = v.opt_string("preset").value_or(is_chamber ? "watlow_f4" : "default");
-  d.unit_id = static_cast<int>(v.opt_integer("unit_id").value_or(1));
-  if (d.unit_id < 0 || d.unit_id > 247) throw v.error("unit_id", "must be 0..247");
+  d.unit_id = static_cast<int>(v.opt_integer_in("unit_id", 0, 247).value_or(1));
   d.timeout_s = v.opt_number("timeout_s").value_or(0.5);
   if (!(d.timeout_s > 0 && d.timeout_s <= 10)) throw v.error("timeout_s", "must be in (0, 10] s");
   for (const auto& p : v.table_array("point")) d.overrides.push_back(read_override(p));
@@ -79,8 +79,9 @@ ModbusDeviceConfig read_modbus_device(const TomlView& v, bool is_chamber) {
 SlotConfig read_slot(const TomlView& v) {
   v.allow_only({"node", "serial", "pulse_weight_arcsec", "axis", "relay"});
   SlotConfig s;
-  s.node = static_cast<int>(v.get_integer("node"));
-  if (s.node < 1 || s.node > 16) throw v.error("node", "CAN node must be 1..16");
+  const long long node = v.get_integer("node");
+  if (node < 1 || node > 16) throw v.error("node", "CAN node must be 1..16");
+  s.node = static_cast<int>(node);
   s.serial = v.get_string("serial");
   if (s.serial.empty()) throw v.error("serial", "must not be empty");
   s.pulse_weight_arcsec = v.opt_number("pulse_weight_arcsec").value_or(1.5);
@@ -88,14 +89,7 @@ SlotConfig read_slot(const TomlView& v) {
     throw v.error("pulse_weight_arcsec", "must be in (0, 100) arcsec");
   }
   s.axis = v.opt_string("axis").value_or("up");
-  if (auto named = compensation::axis_from_name(s.axis)) {
-    s.enu = *named;
-  } else if (s.axis.rfind("heading:", 0) == 0) {
-    s.enu = at_key(v, "axis",
-                   [&] { return compensation::horizontal_axis(std::stod(s.axis.substr(8))); });
-  } else {
-    throw v.error("axis", "expected up, down, north, south, east, west or heading:DEG");
-  }
+  s.enu = at_key(v, "axis", [&] { return compensation::parse_axis(s.axis); });
   s.relay = v.opt_string("relay").value_or("");
   return s;
 }
@@ -103,9 +97,12 @@ SlotConfig read_slot(const TomlView& v) {
 LimitsConfig read_limits(const TomlView& v) {
   v.allow_only({"min_setpoint_c", "max_setpoint_c", "max_ramp_c_per_min"});
   LimitsConfig l;
-  l.min_setpoint_c = v.opt_number("min_setpoint_c").value_or(l.min_setpoint_c);
-  l.max_setpoint_c = v.opt_number("max_setpoint_c").value_or(l.max_setpoint_c);
-  l.max_ramp_c_per_min = v.opt_number("max_ramp_c_per_min").value_or(l.max_ramp_c_per_min);
+  // Physical temperatures (compensation/limits.hpp); no chamber ramps faster than 100 C/min.
+  const double lo = compensation::kMinTempC, hi = compensation::kMaxTempC;
+  l.min_setpoint_c = v.opt_number_in("min_setpoint_c", lo, hi, "C").value_or(l.min_setpoint_c);
+  l.max_setpoint_c = v.opt_number_in("max_setpoint_c", lo, hi, "C").value_or(l.max_setpoint_c);
+  l.max_ramp_c_per_min =
+      v.opt_number_in("max_ramp_c_per_min", 0.0, 100.0, "C/min").value_or(l.max_ramp_c_per_min);
   if (!(l.min_setpoint_c < l.max_setpoint_c)) {
     throw v.error("max_setpoint_c", "must be above min_setpoint_c");
   }
@@ -149,9 +146,11 @@ StationConfig parse_station_config(const std::string& text, const std::string& p
     c.latitude_deg = st->get_number("latitude_deg");
     if (c.latitude_deg < -90 || c.latitude_deg > 90)
       throw st->error("latitude_deg", "must be -90..90");
-    c.ref_temp_c = st->opt_number("ref_temp_c").value_or(c.ref_temp_c);
-    c.bin_s = st->opt_number("bin_s").value_or(c.bin_s);
-    if (!(c.bin_s >= 1)) throw st->error("bin_s", "must be at least 1 s");
+    c.ref_temp_c =
+        st->opt_number_in("ref_temp_c", compensation::kMinTempC, compensation::kMaxTempC, "C")
+            .value_or(c.ref_temp_c);
+    // A bin of more than a day would average over a whole thermal cycle.
+    c.bin_s = st->opt_number_in("bin_s", 1.0, 86400.0, "s").value_or(c.bin_s);
     c.max_lost_share = st->opt_number("max_lost_share").value_or(c.max_lost_share);
     if (!(c.max_lost_share >= 0 && c.max_lost_share <= 1))
       throw st->error("max_lost_share", "must be 0..1 (a share of the record window's ticks)");
@@ -168,10 +167,11 @@ StationConfig parse_station_config(const std::string& text, const std::string& p
   can->allow_only({"transport", "tick_timeout_ms"});
   c.can_transport = can->get_string("transport");
   at_key(*can, "transport", [&] { return drivers::can::parse_can_spec(c.can_transport); });
-  c.can_tick_timeout_ms = static_cast<int>(can->opt_integer("tick_timeout_ms").value_or(200));
-  if (c.can_tick_timeout_ms < 10 || c.can_tick_timeout_ms > 900) {
+  const long long tick_ms = can->opt_integer("tick_timeout_ms").value_or(200);
+  if (tick_ms < 10 || tick_ms > 900) {
     throw can->error("tick_timeout_ms", "must be 10..900 ms (it must fit in the 1 s tick)");
   }
+  c.can_tick_timeout_ms = static_cast<int>(tick_ms);
   if (auto g = root.opt_table("gpio")) c.gpio = read_gpio(*g);
   for (const auto& s : root.table_array("slot")) c.slots.push_back(read_slot(s));
   if (c.slots.empty()) throw root.error("slot", "no [[slot]] entries: the rig has no gyros");

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "compensation/limits.hpp"
 #include "station/builtin_protocols.hpp"
 #include "station/config/toml_reader.hpp"
 
@@ -34,23 +35,31 @@ StepKind kind_of(const TomlView& v) {
                                     type));
 }
 
-double non_negative(const TomlView& v, const char* key, double fallback) {
-  const double x = v.opt_number(key).value_or(fallback);
-  if (!(x >= 0) || !std::isfinite(x)) throw v.error(key, "must be a non-negative number");
-  return x;
+// Bounds of step values. A step longer than a week is a typo (the paper's whole protocol takes
+// 12.8 h), and without a bound a hold of 1e300 s would never end. Temperatures are physical
+// (absolute zero to 1000 C, compensation/limits.hpp; the station's [limits] clamp them further
+// at run time); ramps and tolerances wider than any chamber's.
+constexpr double kMaxStepS = 7 * 86400.0;
+constexpr double kMaxRampCPerH = 6000.0;  // 100 C/min
+constexpr double kMaxToleranceC = 100.0;
+constexpr double kMaxPositionDeg = 360.0;
+
+double number_in(const TomlView& v, const char* key, double fallback, double hi, const char* unit) {
+  return v.opt_number_in(key, 0.0, hi, unit).value_or(fallback);
 }
 
 void read_set_temperature(const TomlView& v, Step& s) {
   v.allow_only({"type", "label", "setpoint_c", "to_start", "ramp_c_per_h", "wait", "tolerance_c",
                 "timeout_s"});
-  s.setpoint_c = v.opt_number("setpoint_c");
+  s.setpoint_c =
+      v.opt_number_in("setpoint_c", compensation::kMinTempC, compensation::kMaxTempC, "C");
   s.to_start = v.opt_bool("to_start").value_or(false);
   if (s.setpoint_c.has_value() == s.to_start) {
     throw v.error("setpoint_c", "give exactly one of setpoint_c or to_start = true");
   }
-  s.ramp_c_per_h = non_negative(v, "ramp_c_per_h", 0.0);
+  s.ramp_c_per_h = number_in(v, "ramp_c_per_h", 0.0, kMaxRampCPerH, "C/h");
   s.wait = v.opt_bool("wait").value_or(true);
-  s.tolerance_c = non_negative(v, "tolerance_c", 1.0);
+  s.tolerance_c = number_in(v, "tolerance_c", 1.0, kMaxToleranceC, "C");
 }
 
 Step read_step(const TomlView& v) {
@@ -64,23 +73,29 @@ Step read_step(const TomlView& v) {
       break;
     case StepKind::soak:
       v.allow_only({"type", "label", "tolerance_c", "duration_s", "timeout_s"});
-      s.tolerance_c = non_negative(v, "tolerance_c", 0.5);
-      s.duration_s = non_negative(v, "duration_s", 1800.0);
+      s.tolerance_c = number_in(v, "tolerance_c", 0.5, kMaxToleranceC, "C");
+      s.duration_s = number_in(v, "duration_s", 1800.0, kMaxStepS, "s");
       break;
     case StepKind::hold:
       v.allow_only({"type", "label", "duration_s"});
       s.duration_s = v.get_number("duration_s");
       if (!(s.duration_s > 0)) throw v.error("duration_s", "must be positive");
+      if (s.duration_s > kMaxStepS) {
+        throw v.error("duration_s", fmt::format("{:g} s is longer than {:g} s (7 days)",
+                                                s.duration_s, kMaxStepS));
+      }
       break;
     case StepKind::lock_turntable:
       v.allow_only({"type", "label", "position_deg"});
-      s.position_deg = v.opt_number("position_deg").value_or(0.0);
+      s.position_deg =
+          v.opt_number_in("position_deg", -kMaxPositionDeg, kMaxPositionDeg, "deg").value_or(0.0);
       break;
-    default:
+    case StepKind::record_start:
+    case StepKind::record_stop:
       v.allow_only({"type", "label"});
+      break;
   }
-  s.timeout_s = v.opt_number("timeout_s").value_or(0.0);
-  if (s.timeout_s < 0) throw v.error("timeout_s", "must not be negative");
+  s.timeout_s = number_in(v, "timeout_s", 0.0, kMaxStepS, "s");
   return s;
 }
 

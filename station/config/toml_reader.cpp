@@ -75,6 +75,23 @@ std::optional<long long> TomlView::opt_integer(std::string_view key) const {
   return n->value<long long>();
 }
 
+std::optional<double> TomlView::opt_number_in(std::string_view key, double lo, double hi,
+                                              std::string_view unit) const {
+  const auto v = opt_number(key);
+  if (v && (*v < lo || *v > hi)) {
+    throw error(key, fmt::format("{:g} is outside {:g}..{:g}{}{}", *v, lo, hi,
+                                 unit.empty() ? "" : " ", unit));
+  }
+  return v;
+}
+
+std::optional<long long> TomlView::opt_integer_in(std::string_view key, long long lo,
+                                                  long long hi) const {
+  const auto v = opt_integer(key);
+  if (v && (*v < lo || *v > hi)) throw error(key, fmt::format("{} is outside {}..{}", *v, lo, hi));
+  return v;
+}
+
 std::optional<bool> TomlView::opt_bool(std::string_view key) const {
   const toml::node* n = find(key);
   if (n == nullptr) return std::nullopt;

@@ -28,6 +28,12 @@ class TomlView {
   std::optional<double> opt_number(std::string_view key) const;
   std::optional<long long> opt_integer(std::string_view key) const;
   std::optional<bool> opt_bool(std::string_view key) const;
+  /// opt_number, and a value outside [lo, hi] throws "must be LO..HI UNIT" at the key.
+  std::optional<double> opt_number_in(std::string_view key, double lo, double hi,
+                                      std::string_view unit) const;
+  /// opt_integer, and a value outside [lo, hi] throws "must be LO..HI" at the key (checked
+  /// before any narrowing, so 2^32 + 1 is not read as 1).
+  std::optional<long long> opt_integer_in(std::string_view key, long long lo, long long hi) const;
   std::string get_string(std::string_view key) const;
   double get_number(std::string_view key) const;
   long long get_integer(std::string_view key) const;

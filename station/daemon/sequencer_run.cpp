@@ -8,6 +8,7 @@
 
 #include "compensation/earth_rate.hpp"
 #include "drivers/common/tap.hpp"
+#include "station/store/fit_json.hpp"
 #include "station/common/logging.hpp"
 #include "station/daemon/resume.hpp"
 #include "station/daemon/sequencer.hpp"
@@ -46,9 +47,9 @@ std::string Sequencer::finish(const std::string& end_state, double t_s) {
                                              config_.ref_temp_c},
                      it == lossy.end() ? std::vector<std::string>{} : std::vector{it->second});
       emit(t_s, "info", "seq", "fit",
-           fmt::format("{}: k1 {:.4e} deg/h/C, k0 {:.4e} deg/h/C, std ratio {:.3f} over {} bins",
-                       slot.serial, f.fit.coefficients[1], f.fit.coefficients[2], f.eval.std_ratio,
-                       f.fit.n_points));
+           fmt::format("{}: k1 {:.4e} deg/h/C, k0 {:.4e} deg/h/C, std ratio {} over {} bins",
+                       slot.serial, f.fit.coefficients[1], f.fit.coefficients[2],
+                       std_ratio_text(f.eval), f.fit.n_points));
     } catch (const InputError& e) {
       emit(t_s, "warn", "seq", "fit_skipped", e.what());
     }

@@ -58,7 +58,7 @@ nlohmann::json gyro_report(Store& store, std::int64_t run_id, const sim::SimGyro
   j["bins"] = fit->fit.n_points;
   j["std_before_dph"] = fit->eval.std_before_dph;
   j["std_after_dph"] = fit->eval.std_after_dph;
-  j["std_ratio"] = fit->eval.std_ratio;
+  j["std_ratio"] = std_ratio_json(fit->eval);  // null when undefined
   return j;
 }
 
@@ -150,10 +150,11 @@ void print_sim_report(const nlohmann::json& r) {
     }
     const auto& f = g["fitted"];
     const auto& se = g["std_errors"];
-    fmt::print("{:<10} {:>4} {:>11.4e} {:>11.4e} {:>9.4e} {:>9}  {:>9.5f} {:>9.5f} {:>6.3f}\n", "",
+    const auto& ratio = g["std_ratio"];
+    fmt::print("{:<10} {:>4} {:>11.4e} {:>11.4e} {:>9.4e} {:>9}  {:>9.5f} {:>9.5f} {:>6}\n", "",
                "fit", f["B0"].get<double>(), f["k1"].get<double>(), f["k0"].get<double>(), "",
                g["std_before_dph"].get<double>(), g["std_after_dph"].get<double>(),
-               g["std_ratio"].get<double>());
+               ratio.is_number() ? fmt::format("{:.3f}", ratio.get<double>()) : "undef");
     fmt::print("{:<10} {:>4} {:>11.1e} {:>11.1e} {:>9.1e}\n", "", "+-", se["B0"].get<double>(),
                se["k1"].get<double>(), se["k0"].get<double>());
   }

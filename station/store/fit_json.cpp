@@ -1,6 +1,8 @@
 // Fit coefficients as JSON objects.
 #include "station/store/fit_json.hpp"
 
+#include <fmt/format.h>
+
 namespace station {
 namespace {
 
@@ -36,9 +38,28 @@ nlohmann::json fit_summary_json(const compensation::FitResult& fit,
           {"condition_number", fit.condition_number},
           {"std_before_dph", eval.std_before_dph},
           {"std_after_dph", eval.std_after_dph},
-          {"std_ratio", eval.std_ratio},
-          {"improvement_pct", eval.improvement_pct},
+          {"std_ratio", std_ratio_json(eval)},
+          {"improvement_pct",
+           eval.improvement_pct ? nlohmann::json(*eval.improvement_pct) : nlohmann::json(nullptr)},
           {"warnings", fit.warnings}};
+}
+
+nlohmann::json std_ratio_json(const compensation::Evaluation& eval) {
+  return eval.std_ratio ? nlohmann::json(*eval.std_ratio) : nlohmann::json(nullptr);
+}
+
+std::string std_ratio_text(const compensation::Evaluation& eval) {
+  return eval.std_ratio ? fmt::format("{:.3f}", *eval.std_ratio) : "undefined";
+}
+
+std::string evaluation_text(const compensation::Evaluation& eval) {
+  const auto stds = fmt::format("std before {:.5f} deg/h, after {:.5f} deg/h", eval.std_before_dph,
+                                eval.std_after_dph);
+  if (!eval.std_ratio || !eval.improvement_pct) {
+    return stds + ", ratio undefined (the std before is at rounding level: nothing to compensate)";
+  }
+  return fmt::format("{}, ratio {:.3f} ({:.1f} % better)", stds, *eval.std_ratio,
+                     *eval.improvement_pct);
 }
 
 }  // namespace station

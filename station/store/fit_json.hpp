@@ -1,8 +1,10 @@
 // A fit's coefficients and standard errors as JSON objects keyed by coefficient name
-// (B0, k1, k2, k3, k4, k0, kr, kc): the one shape every command and the store use.
+// (B0, k1, k2, k3, k4, k0, kr, kc), and its evaluation for people: the one shape every command
+// and the store use.
 #pragma once
 
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "compensation/fit.hpp"
 
@@ -16,8 +18,16 @@ nlohmann::json std_errors_json(const compensation::FitResult& fit);
 nlohmann::json std_errors_hac_json(const compensation::FitResult& fit);
 /// The fit and its evaluation as every command reports them: coefficients, std_errors,
 /// std_errors_hac, hac_lag, bins, r2, residual_rms_dph, condition_number, std_before_dph,
-/// std_after_dph, std_ratio, improvement_pct, warnings (the fit's).
+/// std_after_dph, std_ratio, improvement_pct (both null when the ratio is undefined), warnings
+/// (the fit's).
 nlohmann::json fit_summary_json(const compensation::FitResult& fit,
                                 const compensation::Evaluation& eval);
+/// The std ratio as JSON: a number, or null when undefined.
+nlohmann::json std_ratio_json(const compensation::Evaluation& eval);
+/// The std ratio for people: "0.384", or "undefined".
+std::string std_ratio_text(const compensation::Evaluation& eval);
+/// "std before 0.01234 deg/h, after 0.00160 deg/h, ratio 0.130 (87.0 % better)"; an undefined
+/// ratio reads "ratio undefined (the std before is at rounding level: nothing to compensate)".
+std::string evaluation_text(const compensation::Evaluation& eval);
 
 }  // namespace station

@@ -315,8 +315,12 @@ std::optional<FitRecord> Store::latest_fit(const std::string& serial) {
   r.fit.r2 = st.column_double(8);
   r.fit.residual_rms_dph = st.column_double(9);
   r.fit.condition_number = st.column_double(10);
-  r.eval = {st.column_double(11), st.column_double(12), st.column_double(13),
-            100.0 * (1.0 - st.column_double(13))};
+  r.eval.std_before_dph = st.column_double(11);
+  r.eval.std_after_dph = st.column_double(12);
+  if (!st.column_is_null(13)) {  // NULL: the ratio is undefined (std before at rounding level)
+    r.eval.std_ratio = st.column_double(13);
+    r.eval.improvement_pct = 100.0 * (1.0 - *r.eval.std_ratio);
+  }
   r.fit.warnings = json::parse(st.column_text(14)).get<std::vector<std::string>>();
   return r;
 }

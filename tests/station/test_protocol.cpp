@@ -60,7 +60,7 @@ TEST(Protocol, BadFilesNameLineAndKey) {
   EXPECT_NE(
       error_of(
           "name = \"x\"\n[[step]]\ntype = \"set_temperature\"\nramp_c_per_h = -1\nsetpoint_c = 1\n")
-          .find("p.toml:4: key 'step[0].ramp_c_per_h': must be a non-negative number"),
+          .find("p.toml:4: key 'step[0].ramp_c_per_h': -1 is outside 0..6000 C/h"),
       std::string::npos);
   EXPECT_NE(error_of("name = \"x\"\n[[step]]\ntype = \"record_stop\"\n")
                 .find("record_stop while the record window is closed"),

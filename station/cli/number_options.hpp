@@ -1,0 +1,15 @@
+// CLI11 validators for numeric options: a number must be finite and within its bound, so `nan`,
+// `inf`, `1e308` and `--latitude 200` are refused at the edge with the option's name.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+namespace station {
+
+/// Accepts a finite number in [lo, hi]; the error reads "VALUE is not within LO..HI UNIT".
+CLI::Validator finite_within(double lo, double hi, const std::string& unit);
+/// Accepts a finite number in (0, hi].
+CLI::Validator finite_positive(double hi, const std::string& unit);
+
+}  // namespace station
