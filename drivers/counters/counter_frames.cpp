@@ -40,6 +40,7 @@ Result<std::uint8_t> check(const can_frame& f, canid_t function, std::uint8_t mi
                            std::uint8_t max_dlc) {
   if (f.can_id & (CAN_EFF_FLAG | CAN_RTR_FLAG | CAN_ERR_FLAG))
     return frame_error(f, "extended, remote or error frame where a data frame was expected");
+  if (f.can_id & ~CAN_SFF_MASK) return frame_error(f, "standard frame with ID bits above 11");
   if ((f.can_id & kFunctionMask) != function) return frame_error(f, "unexpected function code");
   const std::uint8_t node = node_bits(f.can_id);
   if (node < 1 || node > kMaxNode) return frame_error(f, "node out of range 1..16");
@@ -93,6 +94,7 @@ Result<FrameKind> classify(const can_frame& f, std::uint8_t* node) {
   *node = 0;
   if (f.can_id & (CAN_EFF_FLAG | CAN_RTR_FLAG | CAN_ERR_FLAG))
     return frame_error(f, "extended, remote or error frame on the counter bus");
+  if (f.can_id & ~CAN_SFF_MASK) return frame_error(f, "standard frame with ID bits above 11");
   if (f.can_id == kSyncId) return FrameKind::sync;
   FrameKind kind;
   switch (f.can_id & kFunctionMask) {

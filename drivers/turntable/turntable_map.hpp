@@ -10,6 +10,9 @@
 //                                                   105 mode actual (0/1/2)
 #pragma once
 
+#include <stdexcept>
+#include <string>
+
 #include "drivers/modbus/register_map.hpp"
 
 namespace station::drivers::turntable_map {
@@ -55,6 +58,14 @@ inline RegisterMap default_map(int unit_id = 1) {
                       p(kStop, 7, U, H, Access::rw), p(kAngle, 100, F, I, Access::ro),
                       p(kRate, 102, F, I, Access::ro), p(kStatus, 104, U, I, Access::ro),
                       p(kModeActual, 105, U, I, Access::ro)});
+}
+
+/// Preset by name (only "default" so far); throws std::invalid_argument naming the bad name, so a
+/// `preset` key in the config is never accepted and then ignored.
+inline RegisterMap preset(const std::string& name, int unit_id = 1) {
+  if (name == "default") return default_map(unit_id);
+  throw std::invalid_argument("unknown turntable register-map preset '" + name +
+                              "' (expected default)");
 }
 
 }  // namespace station::drivers::turntable_map

@@ -168,7 +168,9 @@ std::vector<DeviceReport> probe_counters(dc::CounterBoards& boards, const Statio
 
 /// Reads every input line once. Opening drives outputs to their safe levels (as the daemon does).
 std::vector<DeviceReport> probe_gpio(dr::gpio::GpioBank& bank, const StationConfig& c) {
-  if (auto ok = bank.open(); !ok) return {failed("gpio", c.gpio->chip, ok.error())};
+  if (auto ok = bank.open(); !ok)
+    return {failed("gpio", bank.config().lines.empty() ? "gpio" : bank.config().lines[0].chip,
+                   ok.error())};
   std::vector<DeviceReport> out;
   for (const auto& line : bank.config().lines) {
     if (line.direction != dr::gpio::GpioDirection::input) continue;

@@ -3,7 +3,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -67,9 +69,11 @@ ModbusDeviceConfig read_modbus_device(const TomlView& v, bool is_chamber) {
   if (!(d.timeout_s > 0 && d.timeout_s <= 10)) throw v.error("timeout_s", "must be in (0, 10] s");
   for (const auto& p : v.table_array("point")) d.overrides.push_back(read_override(p));
   // Build the map now so a bad preset or override fails before anything moves.
-  at_key(v, is_chamber ? "preset" : "point", [&] {
-    auto map = is_chamber ? drivers::chamber_map::preset(d.preset, d.unit_id)
-                          : drivers::turntable_map::default_map(d.unit_id);
+  auto map = at_key(v, "preset", [&] {
+    return is_chamber ? drivers::chamber_map::preset(d.preset, d.unit_id)
+                      : drivers::turntable_map::preset(d.preset, d.unit_id);
+  });
+  at_key(v, "point", [&] {
     mb::apply_overrides(map, d.overrides);
     return 0;
   });
@@ -95,7 +99,7 @@ SlotConfig read_slot(const TomlView& v) {
 }
 
 LimitsConfig read_limits(const TomlView& v) {
-  v.allow_only({"min_setpoint_c", "max_setpoint_c", "max_ramp_c_per_min"});
+  v.allow_only({"min_setpoint_c", "max_setpoint_c", "max_ramp_c_per_min", "air_margin_c"});
   LimitsConfig l;
   // Physical temperatures (compensation/limits.hpp); no chamber ramps faster than 100 C/min.
   const double lo = compensation::kMinTempC, hi = compensation::kMaxTempC;
@@ -103,6 +107,9 @@ LimitsConfig read_limits(const TomlView& v) {
   l.max_setpoint_c = v.opt_number_in("max_setpoint_c", lo, hi, "C").value_or(l.max_setpoint_c);
   l.max_ramp_c_per_min =
       v.opt_number_in("max_ramp_c_per_min", 0.0, 100.0, "C/min").value_or(l.max_ramp_c_per_min);
+  // How far the air may overshoot the setpoint limits before it is a fault (a controller's
+  // overshoot on a step is a few degrees; 0 makes any overshoot a safe hold).
+  l.air_margin_c = v.opt_number_in("air_margin_c", 0.0, 50.0, "C").value_or(l.air_margin_c);
   if (!(l.min_setpoint_c < l.max_setpoint_c)) {
     throw v.error("max_setpoint_c", "must be above min_setpoint_c");
   }
@@ -110,14 +117,29 @@ LimitsConfig read_limits(const TomlView& v) {
   return l;
 }
 
-GpioConfig read_gpio(const TomlView& v) {
-  v.allow_only({"chip", "interlock", "estop", "tower_green", "tower_amber", "tower_red"});
-  GpioConfig g;
-  g.chip = v.opt_string("chip").value_or(g.chip);
-  for (const char* role : {"interlock", "estop", "tower_green", "tower_amber", "tower_red"}) {
-    if (auto line = v.opt_string(role)) g.lines[role] = *line;
+// The [gpio] table plus every slot's `relay`, as the driver's line map: the TOML keys are the
+// roles (tower_green is role "tower.green"); slot N's relay is role "relay.N".
+drivers::gpio::GpioConfig read_gpio(const TomlView& root, const std::optional<TomlView>& v,
+                                    const std::vector<SlotConfig>& slots) {
+  std::map<std::string, std::string> roles;
+  std::string chip = "gpiochip0";
+  if (v) {
+    v->allow_only({"chip", "interlock", "estop", "tower_green", "tower_amber", "tower_red"});
+    chip = v->opt_string("chip").value_or(chip);
+    for (std::string role : {"interlock", "estop", "tower_green", "tower_amber", "tower_red"}) {
+      if (auto line = v->opt_string(role)) {
+        if (role.starts_with("tower_")) role = "tower." + role.substr(6);
+        roles[role] = *line;
+      }
+    }
   }
-  return g;
+  for (std::size_t i = 0; i < slots.size(); ++i) {
+    if (!slots[i].relay.empty())
+      roles[drivers::gpio::roles::relay(static_cast<int>(i + 1))] = slots[i].relay;
+  }
+  const TomlView& where = v ? *v : root;
+  return at_key(where, v ? "chip" : "slot",
+                [&] { return drivers::gpio::make_gpio_config(roles, chip); });
 }
 
 void check_slots_unique(const TomlView& root, const std::vector<SlotConfig>& slots) {
@@ -172,10 +194,13 @@ StationConfig parse_station_config(const std::string& text, const std::string& p
     throw can->error("tick_timeout_ms", "must be 10..900 ms (it must fit in the 1 s tick)");
   }
   c.can_tick_timeout_ms = static_cast<int>(tick_ms);
-  if (auto g = root.opt_table("gpio")) c.gpio = read_gpio(*g);
   for (const auto& s : root.table_array("slot")) c.slots.push_back(read_slot(s));
   if (c.slots.empty()) throw root.error("slot", "no [[slot]] entries: the rig has no gyros");
   check_slots_unique(root, c.slots);
+  const auto gpio = root.opt_table("gpio");
+  const bool relays = std::any_of(c.slots.begin(), c.slots.end(),
+                                  [](const SlotConfig& s) { return !s.relay.empty(); });
+  if (gpio || relays) c.gpio = read_gpio(root, gpio, c.slots);
   return c;
 }
 

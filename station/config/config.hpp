@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "compensation/earth_rate.hpp"
+#include "drivers/gpio/gpio_bank.hpp"
 #include "drivers/modbus/map_overrides.hpp"
 #include "station/common/input_error.hpp"
 
@@ -42,13 +43,6 @@ struct LimitsConfig {
   double air_margin_c = 5.0;
 };
 
-/// GPIO lines by role; empty when the rig has none.
-struct GpioConfig {
-  std::string chip = "gpiochip0";
-  std::map<std::string, std::string>
-      lines;  ///< role ("interlock", "estop", "tower_red", ...) -> line name
-};
-
 /// Everything in a station configuration file.
 struct StationConfig {
   std::string path;  ///< file it came from
@@ -64,7 +58,8 @@ struct StationConfig {
   std::optional<ModbusDeviceConfig> turntable;
   std::string can_transport;  ///< socketcan:can0 | unix:PATH | fd:N
   int can_tick_timeout_ms = 200;
-  std::optional<GpioConfig> gpio;
+  /// GPIO lines by role ([gpio] and the slots' relays); unset when the rig has none.
+  std::optional<drivers::gpio::GpioConfig> gpio;
   LimitsConfig limits;
   std::vector<SlotConfig> slots;
 };

@@ -16,20 +16,6 @@ namespace station {
 
 namespace dr = station::drivers;
 
-drivers::gpio::GpioConfig gpio_config_of(const StationConfig& config) {
-  std::map<std::string, std::string> roles;
-  for (const auto& [role, line] : config.gpio->lines) {
-    std::string r = role;
-    if (r.rfind("tower_", 0) == 0) r = "tower." + r.substr(6);
-    roles[r] = line;
-  }
-  for (std::size_t i = 0; i < config.slots.size(); ++i) {
-    if (!config.slots[i].relay.empty())
-      roles[dr::gpio::roles::relay(static_cast<int>(i + 1))] = config.slots[i].relay;
-  }
-  return dr::gpio::make_gpio_config(roles, config.gpio->chip);
-}
-
 namespace {
 
 std::unique_ptr<dr::counters::CounterBoards> open_counters(const StationConfig& c,
@@ -61,7 +47,7 @@ Rig build_rig(const StationConfig& c, const RigOptions& o) {
   chamber->client().set_clock(o.clock);
   rig.chamber = std::move(chamber);
   if (c.turntable) {
-    auto map = dr::turntable_map::default_map(c.turntable->unit_id);
+    auto map = dr::turntable_map::preset(c.turntable->preset, c.turntable->unit_id);
     dr::modbus::apply_overrides(map, c.turntable->overrides);
     auto table = std::make_unique<dr::ModbusTurntable>(
         "turntable", dr::modbus::parse_endpoint(c.turntable->endpoint), map, dr::TurntableLimits{},
@@ -71,9 +57,8 @@ Rig build_rig(const StationConfig& c, const RigOptions& o) {
   }
   rig.counters = open_counters(c, o);
   if (c.gpio) {
-    const auto gcfg = gpio_config_of(c);
-    rig.gpio =
-        o.gpio_factory ? o.gpio_factory(gcfg) : std::make_unique<dr::gpio::LibgpiodBank>(gcfg);
+    rig.gpio = o.gpio_factory ? o.gpio_factory(*c.gpio)
+                              : std::make_unique<dr::gpio::LibgpiodBank>(*c.gpio);
     rig.gpio->set_tap(o.tap);
   }
   return rig;

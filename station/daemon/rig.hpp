@@ -41,7 +41,4 @@ struct Rig {
 /// (unreachable_devices in station/cli/probe.hpp), not here. Throws only on config errors.
 Rig build_rig(const StationConfig& config, const RigOptions& options = {});
 
-/// The GPIO line map of a config: roles interlock, estop, tower.*, relay.N (slot N, 1-based).
-drivers::gpio::GpioConfig gpio_config_of(const StationConfig& config);
-
 }  // namespace station

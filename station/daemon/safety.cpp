@@ -100,6 +100,107 @@ std::optional<std::string> Safety::update(bool interlock_open, bool estop_presse
   return "still holding: " + why;
 }
 
+bool Safety::blind(const SafetyInputs& in) const {
+  return (sources_.table && !in.table_interlock_open) ||
+         (sources_.gpio_interlock && !in.gpio_interlock_closed) ||
+         (sources_.gpio_estop && !in.gpio_estop_pressed);
+}
+
+SafetyDecision Safety::decide(const SafetyInputs& in) {
+  SafetyDecision d;
+  blind_ticks_ = blind(in) ? blind_ticks_ + 1 : 0;
+  if (blind_ticks_ == kBlindTicks) {
+    d.events.push_back(
+        {"error", "inputs_unreadable",
+         fmt::format("interlock / e-stop unreadable for {} ticks: treated as open", kBlindTicks)});
+  }
+  // Each source keeps its last known value when its read fails.
+  bool interlock = in.table_interlock_open.value_or(sources_.table && interlock_open_);
+  if (in.gpio_interlock_closed)
+    interlock = interlock || !*in.gpio_interlock_closed;
+  else if (sources_.gpio_interlock)
+    interlock = interlock || interlock_open_;
+  // The chamber's own door switch counts as an interlock; its high-limit trip as an e-stop.
+  if (in.chamber) interlock = interlock || in.chamber->alarms.door_open;
+  bool estop = in.gpio_estop_pressed.value_or(estop_);
+  if (in.chamber) estop = estop || in.chamber->alarms.high_limit_trip;
+  if (blind_ticks_ >= kBlindTicks) interlock = true;
+  const bool was = holding_;
+  const auto change = update(interlock, estop, judge(in.chamber));
+  finish(d, was, change, in.chamber, in.air_c);
+  return d;
+}
+
+SafetyDecision Safety::decide_between_ticks(std::optional<bool> gpio_interlock_closed,
+                                            std::optional<bool> gpio_estop_pressed,
+                                            std::optional<double> air_c) {
+  SafetyDecision d;
+  const bool open = gpio_interlock_closed && !*gpio_interlock_closed;
+  const bool pressed = gpio_estop_pressed.value_or(false);
+  if (holding_ || !(open || pressed)) {
+    d.holding = holding_;
+    d.outputs = outputs();
+    return d;
+  }
+  // Readings out of limits are judged at the ticks; between them nothing was read.
+  const std::vector<std::string> faults =
+      limits_fault_ ? std::vector<std::string>{"as at the last tick"} : std::vector<std::string>{};
+  const bool was = holding_;
+  auto change = update(interlock_open_ || open, estop_ || pressed, faults);
+  if (change) *change += " (between ticks)";
+  finish(d, was, change, std::nullopt, air_c);
+  return d;
+}
+
+void Safety::finish(SafetyDecision& d, bool was, const std::optional<std::string>& change,
+                    const std::optional<drivers::ChamberState>& chamber,
+                    std::optional<double> air_c) {
+  d.holding = holding_;
+  if (change && holding_ && !was) {
+    d.entered = true;
+    d.events.push_back({"error", "safe_hold",
+                        *change + ": chamber held at its air temperature, turntable stopped"});
+    hold_air_c_ = air_c;
+    hold_acknowledged_ = false;
+    table_stopped_ = !sources_.table;
+  } else if (change && holding_) {
+    d.events.push_back({"error", "safe_hold_changed", *change});
+  } else if (change && was) {
+    d.cleared = true;
+    d.hold_air_c = hold_air_c_;
+    d.events.push_back({"info", "safe_hold_cleared", *change + ": resuming the protocol step"});
+  }
+  if (holding_) {
+    // The hold setpoint needs one air reading; it is retried every tick until accepted.
+    if (!hold_air_c_) hold_air_c_ = air_c;
+    d.hold_air_c = hold_air_c_;
+    // Someone else wrote the setpoint during the hold: the hold is written again.
+    if (chamber && !(chamber->setpoint_c >= limits_.min_setpoint_c &&
+                     chamber->setpoint_c <= limits_.max_setpoint_c))
+      hold_acknowledged_ = false;
+    if (!hold_acknowledged_ && hold_air_c_) d.chamber = hold_command(*hold_air_c_);
+    d.stop_table = !table_stopped_;
+  }
+  d.outputs = outputs();
+}
+
+void Safety::acknowledge(bool chamber_hold_ok, bool table_stop_ok) {
+  hold_acknowledged_ = hold_acknowledged_ || chamber_hold_ok;
+  table_stopped_ = table_stopped_ || table_stop_ok;
+}
+
+SafetyOutputs Safety::outputs() const {
+  SafetyOutputs o;
+  // Red: a fault (e-stop, readings out of limits); amber: safe hold; green: running. The gyros
+  // are powered while the run goes on and cut in every safe hold (the RLG's discharge supply is
+  // high voltage; a hold is when a person may reach into the chamber).
+  o.red = limits_fault_ || estop_;
+  o.amber = holding_ && !o.red;
+  o.green = !holding_;
+  o.gyro_power = !holding_;
+  return o;
+}
+
 drivers::ChamberCommand Safety::hold_command(double air_c) const {
   std::vector<std::string> ignored;
   return clamp(drivers::ChamberCommand{air_c, limits_.max_ramp_c_per_min, true}, ignored);

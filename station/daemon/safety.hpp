@@ -13,10 +13,56 @@
 
 namespace station {
 
-/// Limits enforcement and the safe-hold state. No I/O: the sequencer applies what it returns.
+/// Which safety sources the rig has (each configured source must be readable).
+struct SafetySources {
+  bool table = false;           ///< turntable (its interlock input)
+  bool gpio_interlock = false;  ///< GPIO interlock line
+  bool gpio_estop = false;      ///< GPIO e-stop line
+};
+
+/// What every source reported this tick; unset = configured but not readable this tick.
+struct SafetyInputs {
+  std::optional<drivers::ChamberState> chamber;  ///< also its door and high-limit alarms
+  std::optional<bool> table_interlock_open;
+  std::optional<bool> gpio_interlock_closed;
+  std::optional<bool> gpio_estop_pressed;
+  std::optional<double> air_c;  ///< last finite air reading (where a hold keeps the chamber)
+};
+
+/// The outputs the safety state asks for (tower lamps, gyro power relays).
+struct SafetyOutputs {
+  bool red = false, amber = false, green = false;
+  bool gyro_power = false;
+  bool operator==(const SafetyOutputs&) const = default;
+};
+
+/// One event to store (source "safety").
+struct SafetyEvent {
+  std::string severity, kind, message;
+};
+
+/// What to do this tick. The caller sends the commands, then reports with acknowledge().
+struct SafetyDecision {
+  bool holding = false;
+  bool entered = false;  ///< the hold began now: drop every pending protocol command
+  bool cleared = false;  ///< the hold ended now: re-enter the protocol step
+  std::vector<SafetyEvent> events;
+  std::optional<drivers::ChamberCommand> chamber;  ///< hold command to (re)send
+  bool stop_table = false;                         ///< turntable stop to (re)send
+  SafetyOutputs outputs;
+  std::optional<double> hold_air_c;  ///< where the chamber was held (for the step's re-entry)
+};
+
+/// The safety state of one run: limits enforcement, last-known inputs, blind ticks, the safe hold
+/// and its command retries, the outputs. No I/O: inputs in, a decision out (chrony's small
+/// modules), so every rule is a unit test without a rig.
 class Safety {
  public:
-  explicit Safety(const LimitsConfig& limits) : limits_(limits) {}
+  /// Ticks in a row with a configured interlock / e-stop unreadable before it counts as open.
+  static constexpr int kBlindTicks = 5;
+
+  explicit Safety(const LimitsConfig& limits, SafetySources sources = {})
+      : limits_(limits), sources_(sources) {}
 
   /// `cmd` with setpoint and ramp clamped to the limits; a note per clamp in `notes`.
   drivers::ChamberCommand clamp(drivers::ChamberCommand cmd, std::vector<std::string>& notes) const;
@@ -29,21 +75,43 @@ class Safety {
   /// when all is inside or nothing was read.
   std::vector<std::string> judge(const std::optional<drivers::ChamberState>& chamber) const;
 
-  /// Feeds the interlock/e-stop inputs and the readings judged out of limits; returns a message
-  /// when the safe-hold state changes ("enter: ..." or "clear: ...").
-  std::optional<std::string> update(bool interlock_open, bool estop_pressed,
-                                    const std::vector<std::string>& out_of_limits = {});
-  /// True while readings out of limits hold the rig (a fault: tower lamp red).
-  bool limits_fault() const { return limits_fault_; }
+  /// One tick: every source's report in, the hold state, commands, events and outputs out. A
+  /// source that could not be read keeps its last known value; unreadable for kBlindTicks in a
+  /// row it counts as open (fail safe); a hold clears only on positive readings.
+  SafetyDecision decide(const SafetyInputs& in);
+  /// Between ticks (a GPIO edge): may enter the hold, never clears it.
+  SafetyDecision decide_between_ticks(std::optional<bool> gpio_interlock_closed,
+                                      std::optional<bool> gpio_estop_pressed,
+                                      std::optional<double> air_c);
+  /// What the devices said to this tick's hold commands; a refused one is sent again next tick.
+  void acknowledge(bool chamber_hold_ok, bool table_stop_ok);
+
   /// True while the rig must stay in safe hold.
   bool holding() const { return holding_; }
+  /// True while readings out of limits hold the rig (a fault: tower lamp red).
+  bool limits_fault() const { return limits_fault_; }
   /// The command that holds the chamber where it is (setpoint = air, step), clamped.
   drivers::ChamberCommand hold_command(double air_c) const;
+  /// The outputs for the current state while a run is on (green running, amber hold, red
+  /// fault; gyro power on unless holding).
+  SafetyOutputs outputs() const;
 
  private:
+  /// Feeds the combined inputs; a message when the hold state changes.
+  std::optional<std::string> update(bool interlock_open, bool estop_pressed,
+                                    const std::vector<std::string>& out_of_limits);
+  bool blind(const SafetyInputs& in) const;
+  /// Applies a state change (or none) to `d`, and the hold's commands.
+  void finish(SafetyDecision& d, bool was_holding, const std::optional<std::string>& change,
+              const std::optional<drivers::ChamberState>& chamber, std::optional<double> air_c);
+
   LimitsConfig limits_;
+  SafetySources sources_;
   bool holding_ = false;
   bool interlock_open_ = false, estop_ = false, limits_fault_ = false;
+  int blind_ticks_ = 0;
+  std::optional<double> hold_air_c_;
+  bool hold_acknowledged_ = false, table_stopped_ = false;
 };
 
 }  // namespace station

@@ -31,6 +31,15 @@ class PhaseTimer {
   std::chrono::steady_clock::time_point start_;
 };
 
+// Which safety inputs the rig has: each one configured must be readable every tick.
+SafetySources sources_of(const Rig& rig) {
+  const auto has_line = [&rig](std::string_view role) {
+    return rig.gpio != nullptr && dr::gpio::find_role(rig.gpio->config(), role) != nullptr;
+  };
+  return {rig.turntable != nullptr, has_line(dr::gpio::roles::interlock),
+          has_line(dr::gpio::roles::estop)};
+}
+
 }  // namespace
 
 Sequencer::Sequencer(const StationConfig& config, const Protocol& protocol, Rig& rig, Store& store,
@@ -41,7 +50,7 @@ Sequencer::Sequencer(const StationConfig& config, const Protocol& protocol, Rig&
       store_(store),
       clock_(clock),
       options_(std::move(options)),
-      safety_(config.limits) {}
+      safety_(config.limits, sources_of(rig)) {}
 
 void Sequencer::emit(double t_s, const std::string& severity, const std::string& source,
                      const std::string& kind, const std::string& message,
@@ -55,11 +64,6 @@ void Sequencer::emit(double t_s, const std::string& severity, const std::string&
 }
 
 void Sequencer::connect_devices() {
-  const auto has_line = [this](std::string_view role) {
-    return rig_.gpio != nullptr && dr::gpio::find_role(rig_.gpio->config(), role) != nullptr;
-  };
-  has_gpio_interlock_ = has_line(dr::gpio::roles::interlock);
-  has_gpio_estop_ = has_line(dr::gpio::roles::estop);
   if (auto r = rig_.chamber->connect(); !r)
     emit(0, "warn", "chamber", "connect", r.error().message);
   if (rig_.turntable) {
@@ -226,42 +230,15 @@ void Sequencer::assemble_samples(double t_s, TickData& d) {
 }
 
 void Sequencer::apply_safety(double t_s, TickData& d) {
-  // Each source keeps its last known value when a read fails; the hold is cleared only on
-  // positive readings, and inputs unreadable for kSafetyBlindTicks count as open.
-  constexpr int kSafetyBlindTicks = 5;
-  const bool has_table = rig_.turntable != nullptr;
-  const bool has_gpio = has_gpio_interlock_, has_estop = has_gpio_estop_;
-  const bool blind = (has_table && !d.table_interlock_open) ||
-                     (has_gpio && !d.gpio_interlock_closed) || (has_estop && !d.gpio_estop_pressed);
-  safety_blind_ticks_ = blind ? safety_blind_ticks_ + 1 : 0;
-  if (safety_blind_ticks_ == kSafetyBlindTicks) {
-    emit(t_s, "error", "safety", "inputs_unreadable",
-         fmt::format("interlock / e-stop unreadable for {} ticks: treated as open",
-                     kSafetyBlindTicks));
-  }
-  bool interlock = d.table_interlock_open.value_or(has_table && interlock_open_);
-  if (d.gpio_interlock_closed)
-    interlock = interlock || !*d.gpio_interlock_closed;
-  else if (has_gpio)
-    interlock = interlock || interlock_open_;
-  // The chamber's own door switch counts as an interlock; its high-limit trip as an e-stop.
-  if (d.chamber) interlock = interlock || d.chamber->alarms.door_open;
-  bool estop = d.gpio_estop_pressed.value_or(estop_);
-  if (d.chamber) estop = estop || d.chamber->alarms.high_limit_trip;
-  if (safety_blind_ticks_ >= kSafetyBlindTicks) interlock = true;
-  interlock_open_ = interlock;
-  estop_ = estop;
-  const bool was_holding = safety_.holding();
-  const auto change = safety_.update(interlock, estop, safety_.judge(d.chamber));
-  if (change && safety_.holding() && !was_holding) enter_safe_hold(t_s, d, *change);
-  if (change && safety_.holding() && was_holding)
-    emit(t_s, "error", "safety", "safe_hold_changed", *change);
-  if (safety_.holding()) keep_safe_hold(t_s, d);
-  drive_lamps(t_s);
-  if (change && was_holding && !safety_.holding()) {
-    emit(t_s, "info", "safety", "safe_hold_cleared", *change + ": resuming the protocol step");
-    runner_->reenter(hold_air_c_);
-  }
+  SafetyInputs in;
+  in.chamber = d.chamber;
+  in.table_interlock_open = d.table_interlock_open;
+  in.gpio_interlock_closed = d.gpio_interlock_closed;
+  in.gpio_estop_pressed = d.gpio_estop_pressed;
+  in.air_c = d.obs.air_c;
+  const auto decision = safety_.decide(in);
+  act_on_safety(t_s, decision);
+  if (decision.cleared) runner_->reenter(decision.hold_air_c);
 }
 
 void Sequencer::watch_inputs_until(double deadline_s, double t_s) {
@@ -271,68 +248,52 @@ void Sequencer::watch_inputs_until(double deadline_s, double t_s) {
   while (fd >= 0 && clock_.wait_readable(fd, deadline_s)) {
     TickData d;
     read_gpio(t_s, d);
-    const bool open = d.gpio_interlock_closed && !*d.gpio_interlock_closed;
-    const bool pressed = d.gpio_estop_pressed.value_or(false);
-    if (safety_.holding() || !(open || pressed)) continue;
-    interlock_open_ = interlock_open_ || open;
-    estop_ = estop_ || pressed;
-    const auto change = safety_.update(interlock_open_, estop_);
-    d.obs.air_c = last_air_c_;
-    if (change && safety_.holding()) {
-      enter_safe_hold(t_s, d, *change + " (between ticks)");
-      keep_safe_hold(t_s, d);
-    }
+    act_on_safety(t_s, safety_.decide_between_ticks(d.gpio_interlock_closed, d.gpio_estop_pressed,
+                                                    last_air_c_));
   }
   clock_.sleep_until(deadline_s);
 }
 
-void Sequencer::enter_safe_hold(double t_s, const TickData& d, const std::string& why) {
-  emit(t_s, "error", "safety", "safe_hold",
-       why + ": chamber held at its air temperature, turntable stopped");
-  pending_chamber_.reset();  // nothing the protocol asked for goes out during the hold
-  pending_table_.reset();
-  hold_air_c_ = d.obs.air_c;
-  hold_commanded_ = false;
-  table_stopped_ = rig_.turntable == nullptr;
-}
-
-void Sequencer::keep_safe_hold(double t_s, const TickData& d) {
-  // Retried every tick until the devices accept: the hold setpoint needs one air reading.
-  if (!hold_air_c_) hold_air_c_ = d.obs.air_c;
-  // Someone else wrote the setpoint during the hold: the hold is written again.
-  if (d.chamber && !(d.chamber->setpoint_c >= config_.limits.min_setpoint_c &&
-                     d.chamber->setpoint_c <= config_.limits.max_setpoint_c))
-    hold_commanded_ = false;
-  if (!hold_commanded_ && hold_air_c_) {
-    const auto r = rig_.chamber->command(safety_.hold_command(*hold_air_c_));
-    hold_commanded_ = r.ok();
+void Sequencer::act_on_safety(double t_s, const SafetyDecision& d) {
+  for (const auto& e : d.events) emit(t_s, e.severity, "safety", e.kind, e.message);
+  if (d.entered) {
+    pending_chamber_.reset();  // nothing the protocol asked for goes out during the hold
+    pending_table_.reset();
+  }
+  bool chamber_ok = false, table_ok = false;
+  if (d.chamber) {
+    const auto r = rig_.chamber->command(*d.chamber);
+    chamber_ok = r.ok();
     if (!r && command_failures_++ % 60 == 0)
       emit(t_s, "error", "chamber", "hold_failed", r.error().message);
   }
-  if (!table_stopped_) {
+  if (d.stop_table && rig_.turntable) {
     const auto r = rig_.turntable->stop();
-    table_stopped_ = r.ok();
+    table_ok = r.ok();
     if (!r && command_failures_++ % 60 == 0)
       emit(t_s, "error", "table", "stop_failed", r.error().message);
   }
+  safety_.acknowledge(chamber_ok, table_ok);
+  drive_outputs(t_s, d.outputs);
 }
 
-void Sequencer::drive_lamps(double t_s) {
+void Sequencer::drive_outputs(double t_s, const SafetyOutputs& o) {
   if (!rig_.gpio) return;
-  // Red: a fault (e-stop, readings out of limits); amber: safe hold; green: running.
-  const bool red = safety_.limits_fault() || estop_;
-  const bool amber = safety_.holding() && !red, green = !safety_.holding();
-  const std::array<std::pair<std::string_view, bool>, 3> lamps{
-      {{dr::gpio::roles::tower_red, red},
-       {dr::gpio::roles::tower_amber, amber},
-       {dr::gpio::roles::tower_green, green}}};
-  for (std::size_t i = 0; i < lamps.size(); ++i) {
-    const auto& [role, on] = lamps[i];
-    if (lamps_[i] == on || dr::gpio::find_role(rig_.gpio->config(), role) == nullptr) continue;
+  std::vector<std::pair<std::string, bool>> lines{
+      {std::string(dr::gpio::roles::tower_red), o.red},
+      {std::string(dr::gpio::roles::tower_amber), o.amber},
+      {std::string(dr::gpio::roles::tower_green), o.green}};
+  for (std::size_t i = 0; i < config_.slots.size(); ++i)
+    lines.emplace_back(dr::gpio::roles::relay(static_cast<int>(i + 1)), o.gyro_power);
+  for (const auto& [role, on] : lines) {
+    const auto it = outputs_.find(role);
+    if ((it != outputs_.end() && it->second == on) ||
+        dr::gpio::find_role(rig_.gpio->config(), role) == nullptr)
+      continue;
     if (auto r = rig_.gpio->write(role, on); r) {
-      lamps_[i] = on;
+      outputs_[role] = on;
     } else if (command_failures_++ % 60 == 0) {
-      emit(t_s, "warn", "gpio", "lamp_failed", r.error().message);
+      emit(t_s, "warn", "gpio", "output_failed", r.error().message);
     }
   }
 }

@@ -82,11 +82,11 @@ class Sequencer {
   void apply_safety(double t_s, TickData& d);
   void read_gpio(double t_s, TickData& d);
   void watch_inputs_until(double deadline_s, double t_s);
-  void enter_safe_hold(double t_s, const TickData& d, const std::string& why);
-  void keep_safe_hold(double t_s, const TickData& d);
+  /// Carries out a safety decision: its events, hold commands (acknowledged back), outputs.
+  void act_on_safety(double t_s, const SafetyDecision& d);
   void apply_actions(double t_s, const Actions& a);
-  /// Tower lamps from the safety state (red fault, amber hold, green running); writes changes.
-  void drive_lamps(double t_s);
+  /// Tower lamps and gyro power relays (configured ones); writes the lines that change.
+  void drive_outputs(double t_s, const SafetyOutputs& o);
   void assemble_samples(double t_s, TickData& d);
   /// Ends the run: closes open outages, bins and fits; returns the final state ('incomplete'
   /// instead of 'completed' when a slot lost more than max_lost_share of its record window).
@@ -115,16 +115,9 @@ class Sequencer {
   std::uint8_t latch_seq_ = 0;
   bool replaying_ = false;
   int command_failures_ = 0;
-  OutageTracker outages_;  ///< link outages per device
-  /// Last known safety inputs: a failed read keeps the last value; unreadable for
-  /// kSafetyBlindTicks in a row counts as open (fail safe).
-  bool interlock_open_ = false, estop_ = false;
-  int safety_blind_ticks_ = 0;
-  bool has_gpio_interlock_ = false, has_gpio_estop_ = false;  ///< lines configured (set at connect)
-  std::optional<double> hold_air_c_;  ///< where the chamber is held during a safe hold
-  std::optional<double> last_air_c_;  ///< last chamber air reading
-  bool hold_commanded_ = false, table_stopped_ = false;
-  std::array<std::optional<bool>, 3> lamps_;  ///< red, amber, green as last written
+  OutageTracker outages_;                ///< link outages per device
+  std::optional<double> last_air_c_;     ///< last chamber air reading
+  std::map<std::string, bool> outputs_;  ///< output role -> level as last written
   /// Time spent per tick phase (wall seconds, summed), logged at the end of a run.
   struct PhaseTimes {
     double world = 0, can = 0, chamber = 0, table = 0, gpio = 0, store = 0;

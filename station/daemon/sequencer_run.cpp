@@ -8,11 +8,11 @@
 
 #include "compensation/earth_rate.hpp"
 #include "drivers/common/tap.hpp"
-#include "station/store/fit_json.hpp"
 #include "station/common/logging.hpp"
 #include "station/daemon/resume.hpp"
 #include "station/daemon/sequencer.hpp"
 #include "station/store/calibration.hpp"
+#include "station/store/fit_json.hpp"
 
 #ifndef STATION_VERSION
 #define STATION_VERSION "dev"
@@ -35,6 +35,7 @@ std::vector<RunSlot> run_slots_of(const StationConfig& c) {
 }  // namespace
 
 std::string Sequencer::finish(const std::string& end_state, double t_s) {
+  drive_outputs(t_s, SafetyOutputs{});    // the run is over: gyro power off, lamps dark
   const auto lossy = close_outages(t_s);  // serial -> why its record window is incomplete
   const std::string state = end_state == "completed" && !lossy.empty() ? "incomplete" : end_state;
   bin_run(store_, run_id_, config_.bin_s);

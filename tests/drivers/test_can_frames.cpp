@@ -96,6 +96,21 @@ TEST(CanFrames, UnknownIdAndNodeOutOfRange) {
   expect_protocol(c::classify(f, &node).error(), "extended");
 }
 
+// Found by fuzz_can_frames: 0x02000181 without CAN_EFF_FLAG was read as STATUS of node 1 (the
+// bits above 11 ignored), so a frame the codec accepted could not be re-encoded. A standard ID
+// has 11 bits; anything above them is a malformed frame, rejected by every decoder.
+TEST(CanFrames, StandardIdWithBitsAbove11IsRejected) {
+  std::uint8_t node = 0;
+  for (can_frame f : {c::encode(c::StatusFrame{1, 0, 0, 0, 0}), c::encode(c::CountsFrame{1, 0, 0}),
+                      c::encode(c::SyncFrame{0})}) {
+    f.can_id |= 0x02000000;
+    expect_protocol(c::classify(f, &node).error(), "ID bits above 11");
+    EXPECT_FALSE(c::decode_status(f).ok());
+    EXPECT_FALSE(c::decode_counts(f).ok());
+    EXPECT_FALSE(c::decode_sync(f).ok());
+  }
+}
+
 TEST(CanFrames, ClassifyNamesKindAndNode) {
   std::uint8_t node = 0;
   auto k = c::classify(c::encode(c::DischargeFrame{9, {}}), &node);

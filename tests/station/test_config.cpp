@@ -53,7 +53,12 @@ TEST(Config, ExamplesLoad) {
   EXPECT_EQ(*rtu.chamber.overrides[0].address, 2890);
   EXPECT_NEAR(rtu.slots[1].enu.east, 1.0, 1e-12);  // heading 90 = east
   ASSERT_TRUE(rtu.gpio.has_value());
-  EXPECT_EQ(rtu.gpio->lines.at("interlock"), "DOOR_SW");
+  ASSERT_NE(station::drivers::gpio::find_role(*rtu.gpio, "interlock"), nullptr);
+  EXPECT_EQ(station::drivers::gpio::find_role(*rtu.gpio, "interlock")->line_name, "DOOR_SW");
+  // One line map: the TOML's tower_red is the driver's role tower.red, slot 1's relay relay.1.
+  ASSERT_NE(station::drivers::gpio::find_role(*rtu.gpio, "tower.red"), nullptr);
+  ASSERT_NE(station::drivers::gpio::find_role(*rtu.gpio, "relay.1"), nullptr);
+  EXPECT_EQ(station::drivers::gpio::find_role(*rtu.gpio, "relay.1")->line_name, "GYRO_PWR1");
 }
 
 TEST(Config, ExamplesMatchTheJsonSchema) {
@@ -73,6 +78,7 @@ TEST(Config, MinimalFileGetsDefaults) {
   EXPECT_EQ(c.chamber.preset, "watlow_f4");
   EXPECT_DOUBLE_EQ(c.slots[0].pulse_weight_arcsec, 1.5);
   EXPECT_DOUBLE_EQ(c.limits.max_ramp_c_per_min, 3.0);
+  EXPECT_DOUBLE_EQ(c.limits.air_margin_c, 5.0);
   EXPECT_FALSE(c.turntable.has_value());
 }
 
@@ -100,6 +106,12 @@ TEST(Config, NonFiniteNumbersAreRejected) {
   EXPECT_NE(error_of(t).find("rig.toml:2: key 'station.latitude_deg': must be a finite number"),
             std::string::npos)
       << error_of(t);
+  const auto margin =
+      station::parse_station_config(kMinimal + "[limits]\nair_margin_c = 2.5\n", "rig.toml");
+  EXPECT_DOUBLE_EQ(margin.limits.air_margin_c, 2.5);
+  EXPECT_NE(error_of(kMinimal + "[limits]\nair_margin_c = -1\n").find("key 'limits.air_margin_c'"),
+            std::string::npos)
+      << error_of(kMinimal + "[limits]\nair_margin_c = -1\n");
   EXPECT_NE(error_of(kMinimal + "[limits]\nmax_setpoint_c = inf\n").find("must be a finite number"),
             std::string::npos);
 }
@@ -115,6 +127,13 @@ TEST(Config, BadEndpointPresetAndTransport) {
   EXPECT_NE(error_of(p).find("key 'chamber.preset': unknown chamber register-map preset 'acme'"),
             std::string::npos)
       << error_of(p);
+  // Issue 7, house: the turntable's preset was accepted and then ignored.
+  const std::string table = kMinimal + "[turntable]\nendpoint = \"tcp://127.0.0.1:503\"\n";
+  EXPECT_NO_THROW(station::parse_station_config(table + "preset = \"default\"\n", "rig.toml"));
+  EXPECT_NE(error_of(table + "preset = \"acme\"\n")
+                .find("key 'turntable.preset': unknown turntable register-map preset 'acme'"),
+            std::string::npos)
+      << error_of(table + "preset = \"acme\"\n");
   std::string c = kMinimal;
   c.replace(c.find("unix:/tmp/can.sock"), 18, "carrier-pigeon:1");
   EXPECT_NE(error_of(c).find("rig.toml:6: key 'can.transport'"), std::string::npos) << error_of(c);

@@ -61,35 +61,173 @@ TEST(Safety, AirBeyondTheLimitsByTheMarginIsAFault) {
   EXPECT_EQ(s.judge(chamber(150.0, 95.0)).size(), 2u);
 }
 
+// One tick's inputs: the chamber read (setpoint, air), the GPIO interlock closed, e-stop released.
+station::SafetyInputs inputs(double setpoint_c, double air_c) {
+  station::SafetyInputs in;
+  in.chamber = chamber(setpoint_c, air_c);
+  in.air_c = air_c;
+  in.gpio_interlock_closed = true;
+  in.gpio_estop_pressed = false;
+  return in;
+}
+
+const station::SafetySources kGpio{false, true, true};
+
+bool has_event(const station::SafetyDecision& d, const std::string& kind) {
+  for (const auto& e : d.events)
+    if (e.kind == kind) return true;
+  return false;
+}
+
 TEST(Safety, ReadingsOutOfLimitsHoldUntilTheyAreBackInside) {
-  station::Safety s(limits());
-  EXPECT_FALSE(s.update(false, false, {}));
-  const auto enter = s.update(false, false, s.judge(chamber(150.0, 25.0)));
-  ASSERT_TRUE(enter);
-  EXPECT_EQ(enter->rfind("enter: ", 0), 0u) << *enter;
-  EXPECT_NE(enter->find("out of limits: chamber setpoint read back 150.00 C"), std::string::npos);
-  EXPECT_TRUE(s.holding());
+  station::Safety s(limits(), kGpio);
+  auto d = s.decide(inputs(20.0, 25.0));
+  EXPECT_TRUE(d.events.empty());
+  EXPECT_FALSE(d.holding);
+  EXPECT_EQ(d.outputs, (station::SafetyOutputs{false, false, true, true}));  // green, power on
+  d = s.decide(inputs(150.0, 25.0));
+  ASSERT_TRUE(d.entered);
+  ASSERT_EQ(d.events.size(), 1u);
+  EXPECT_EQ(d.events[0].kind, "safe_hold");
+  EXPECT_EQ(d.events[0].message.rfind("enter: ", 0), 0u) << d.events[0].message;
+  EXPECT_NE(d.events[0].message.find("out of limits: chamber setpoint read back 150.00 C"),
+            std::string::npos);
   EXPECT_TRUE(s.limits_fault());
-  // The same fault on the next tick is no new message.
-  EXPECT_FALSE(s.update(false, false, s.judge(chamber(150.0, 25.0))));
-  // The hold is at the air temperature, inside the limits.
-  EXPECT_DOUBLE_EQ(*s.hold_command(25.0).setpoint_c, 25.0);
-  EXPECT_DOUBLE_EQ(*s.hold_command(96.0).setpoint_c, 85.0);
-  const auto clear = s.update(false, false, s.judge(chamber(25.0, 25.0)));
-  ASSERT_TRUE(clear);
-  EXPECT_EQ(clear->rfind("clear: ", 0), 0u) << *clear;
+  // Held at the air temperature; red lamp, gyro power cut.
+  ASSERT_TRUE(d.chamber && d.chamber->setpoint_c);
+  EXPECT_DOUBLE_EQ(*d.chamber->setpoint_c, 25.0);
+  EXPECT_EQ(d.outputs, (station::SafetyOutputs{true, false, false, false}));
+  s.acknowledge(true, true);
+  // The same fault next tick is no new event; the setpoint is still out: the hold is re-sent.
+  d = s.decide(inputs(150.0, 25.0));
+  EXPECT_TRUE(d.events.empty());
+  EXPECT_TRUE(d.chamber);
+  s.acknowledge(true, true);
+  d = s.decide(inputs(25.0, 25.0));
+  ASSERT_TRUE(d.cleared);
+  EXPECT_EQ(d.events[0].kind, "safe_hold_cleared");
+  EXPECT_EQ(d.events[0].message.rfind("clear: ", 0), 0u) << d.events[0].message;
+  ASSERT_TRUE(d.hold_air_c);
+  EXPECT_DOUBLE_EQ(*d.hold_air_c, 25.0);
   EXPECT_FALSE(s.holding());
-  EXPECT_FALSE(s.limits_fault());
+  EXPECT_EQ(d.outputs, (station::SafetyOutputs{false, false, true, true}));
+  // The hold setpoint is always inside the limits.
+  EXPECT_DOUBLE_EQ(*s.hold_command(96.0).setpoint_c, 85.0);
 }
 
 TEST(Safety, AFaultDuringAnInterlockHoldKeepsTheHoldAfterTheInterlockCloses) {
-  station::Safety s(limits());
-  ASSERT_TRUE(s.update(true, false, {}));
-  const auto both = s.update(true, false, s.judge(chamber(150.0, 25.0)));
-  ASSERT_TRUE(both);
-  EXPECT_EQ(both->rfind("still holding: ", 0), 0u) << *both;
-  s.update(false, false, s.judge(chamber(150.0, 25.0)));
-  EXPECT_TRUE(s.holding());
+  station::Safety s(limits(), kGpio);
+  auto open = inputs(20.0, 25.0);
+  open.gpio_interlock_closed = false;
+  auto d = s.decide(open);
+  ASSERT_TRUE(d.entered);
+  EXPECT_EQ(d.outputs, (station::SafetyOutputs{false, true, false, false}));  // amber
+  open.chamber->setpoint_c = 150.0;
+  d = s.decide(open);
+  ASSERT_EQ(d.events.size(), 1u);
+  EXPECT_EQ(d.events[0].kind, "safe_hold_changed");
+  EXPECT_EQ(d.events[0].message.rfind("still holding: ", 0), 0u) << d.events[0].message;
+  d = s.decide(inputs(150.0, 25.0));
+  EXPECT_TRUE(d.holding);
+}
+
+// Issue 7 item 12: a hold command refused by the device is sent again every tick until it is
+// acknowledged, and only then stops.
+TEST(Safety, HoldCommandsAreRetriedUntilAcknowledged) {
+  station::Safety s(limits(), {true, true, true});
+  auto in = inputs(20.0, 30.0);
+  in.table_interlock_open = true;
+  auto d = s.decide(in);
+  ASSERT_TRUE(d.entered);
+  EXPECT_TRUE(d.chamber);
+  EXPECT_TRUE(d.stop_table);
+  s.acknowledge(false, true);  // chamber refused, table stopped
+  d = s.decide(in);
+  EXPECT_TRUE(d.chamber);
+  EXPECT_FALSE(d.stop_table);
+  s.acknowledge(true, false);
+  d = s.decide(in);
+  EXPECT_FALSE(d.chamber);
+  EXPECT_FALSE(d.stop_table);
+}
+
+// A hold entered without an air reading waits for one to write its setpoint.
+TEST(Safety, AHoldWithoutAnAirReadingTakesTheFirstOne) {
+  station::Safety s(limits(), kGpio);
+  station::SafetyInputs in;
+  in.gpio_interlock_closed = false;
+  in.gpio_estop_pressed = false;
+  auto d = s.decide(in);
+  ASSERT_TRUE(d.entered);
+  EXPECT_FALSE(d.chamber);
+  in = inputs(20.0, -12.5);
+  in.gpio_interlock_closed = false;
+  d = s.decide(in);
+  ASSERT_TRUE(d.chamber);
+  EXPECT_DOUBLE_EQ(*d.chamber->setpoint_c, -12.5);
+}
+
+// A source that cannot be read keeps its last value; kBlindTicks unreadable ticks in a row
+// count as an open interlock (one event), and the hold clears only on positive readings.
+TEST(Safety, BlindInputsKeepTheirLastValueThenFailSafe) {
+  station::Safety s(limits(), kGpio);
+  s.decide(inputs(20.0, 25.0));
+  station::SafetyInputs blind;
+  blind.chamber = chamber(20.0, 25.0);
+  for (int i = 1; i < station::Safety::kBlindTicks; ++i) {
+    const auto d = s.decide(blind);
+    EXPECT_FALSE(d.holding) << "tick " << i;
+    EXPECT_TRUE(d.events.empty());
+  }
+  auto d = s.decide(blind);
+  EXPECT_TRUE(d.entered);
+  EXPECT_TRUE(has_event(d, "inputs_unreadable"));
+  EXPECT_TRUE(has_event(d, "safe_hold"));
+  d = s.decide(blind);
+  EXPECT_TRUE(d.holding);
+  EXPECT_TRUE(d.events.empty());
+  d = s.decide(inputs(20.0, 25.0));
+  EXPECT_TRUE(d.cleared);
+  // An e-stop pressed, then unreadable: still pressed.
+  auto pressed = inputs(20.0, 25.0);
+  pressed.gpio_estop_pressed = true;
+  EXPECT_TRUE(s.decide(pressed).entered);
+  auto unknown = inputs(20.0, 25.0);
+  unknown.gpio_estop_pressed.reset();
+  EXPECT_TRUE(s.decide(unknown).holding);
+  EXPECT_TRUE(s.decide(inputs(20.0, 25.0)).cleared);
+}
+
+// The chamber's own door switch is an interlock and its high-limit trip an e-stop (red).
+TEST(Safety, ChamberAlarmsHoldTheRig) {
+  station::Safety s(limits(), kGpio);
+  auto door = inputs(20.0, 25.0);
+  door.chamber->alarms.door_open = true;
+  auto d = s.decide(door);
+  EXPECT_TRUE(d.entered);
+  EXPECT_EQ(d.outputs, (station::SafetyOutputs{false, true, false, false}));
+  auto trip = inputs(20.0, 25.0);
+  trip.chamber->alarms.high_limit_trip = true;
+  d = s.decide(trip);
+  EXPECT_TRUE(d.holding);
+  EXPECT_TRUE(d.outputs.red);
+}
+
+// Between ticks an edge may enter the hold, never clear it.
+TEST(Safety, BetweenTicksAnEdgeEntersButNeverClears) {
+  station::Safety s(limits(), kGpio);
+  s.decide(inputs(20.0, 25.0));
+  auto d = s.decide_between_ticks(true, false, 25.0);
+  EXPECT_FALSE(d.holding);
+  EXPECT_TRUE(d.events.empty());
+  d = s.decide_between_ticks(true, true, 25.0);
+  ASSERT_TRUE(d.entered);
+  EXPECT_NE(d.events[0].message.find("(between ticks)"), std::string::npos);
+  ASSERT_TRUE(d.chamber);
+  EXPECT_DOUBLE_EQ(*d.chamber->setpoint_c, 25.0);
+  d = s.decide_between_ticks(true, false, 25.0);
+  EXPECT_TRUE(d.holding);
+  EXPECT_FALSE(d.cleared);
 }
 
 // Issue 7 item 9: 150 C written to the chamber's setpoint register by another master during
@@ -102,9 +240,12 @@ TEST(Safety, ASetpointWrittenBySomeoneElseIsCaughtOnTheSimulatedRig) {
   o.progress = false;
   o.fresh = true;
   o.gyros = 1;
-  std::optional<bool> red_after, green_after, red_before;
+  std::optional<bool> red_after, green_after, red_before, power_before, power_held, power_after;
   o.on_world_tick = [&](double t_s, station::sim::SimWorld& w) {
     if (t_s == 2999) red_before = w.gpio_chips()->pin_level("TOWER_R");
+    if (t_s == 2999) power_before = w.gpio_chips()->pin_level("GYRO_PWR1");
+    if (t_s == 3001) power_held = w.gpio_chips()->pin_level("GYRO_PWR1");
+    if (t_s == 3100) power_after = w.gpio_chips()->pin_level("GYRO_PWR1");
     if (t_s == 3000) {
       EXPECT_EQ(station::sim::run_fault_command(w, "chamber setpoint 150").rfind("ok", 0), 0u);
     }
@@ -126,6 +267,11 @@ TEST(Safety, ASetpointWrittenBySomeoneElseIsCaughtOnTheSimulatedRig) {
   EXPECT_EQ(red_before, std::optional<bool>(false));
   EXPECT_EQ(red_after, std::optional<bool>(true));
   EXPECT_EQ(green_after, std::optional<bool>(true));
+  // Issue 7 item 11: the gyro's power relay is on while the run goes on and cut in the hold.
+  // (Off at the end is not observable here: closing the bank drives its safe level anyway.)
+  EXPECT_EQ(power_before, std::optional<bool>(true));
+  EXPECT_EQ(power_held, std::optional<bool>(false));
+  EXPECT_EQ(power_after, std::optional<bool>(true));
   bool held = false;
   for (const auto& s : store.samples(run, "SIM-0001", false)) {
     if (s.t_s == 3001) held = (s.flags & 16) != 0;
