@@ -72,6 +72,11 @@ Result<void> ModbusClient::connect() {
   auto sec = static_cast<std::uint32_t>(whole);
   auto usec = static_cast<std::uint32_t>(std::lround((timeout_s_ - whole) * 1e6));
   modbus_set_response_timeout(ctx_.get(), sec, usec);
+  // libmodbus waits byte_timeout (default 0.5 s) for each later chunk of a reply: a device that
+  // sends part of a reply and stalls would hold the call that long whatever the response
+  // timeout. The same bound applies to both (found by fuzz_modbus_replies). Never 0: libmodbus
+  // reads a zero byte timeout as "wait forever".
+  modbus_set_byte_timeout(ctx_.get(), sec, usec);
   if (modbus_connect(ctx_.get()) == -1) {
     int err = errno;
     ctx_.reset();

@@ -167,7 +167,7 @@ std::vector<DeviceReport> probe_counters(dc::CounterBoards& boards, const Statio
 }
 
 /// Reads every input line once. Opening drives outputs to their safe levels (as the daemon does).
-std::vector<DeviceReport> probe_gpio(dr::gpio::GpioBank& bank, const StationConfig& c) {
+std::vector<DeviceReport> probe_gpio(dr::gpio::GpioBank& bank) {
   if (auto ok = bank.open(); !ok)
     return {failed("gpio", bank.config().lines.empty() ? "gpio" : bank.config().lines[0].chip,
                    ok.error())};
@@ -229,7 +229,7 @@ std::vector<DeviceReport> probe_all(const StationConfig& config, Rig& rig) {
   for (auto& r : probe_counters(*rig.counters, config)) reports.push_back(std::move(r));
   rig.counters->forget_latches();  // the probe's latch is no baseline for a run
   if (rig.gpio) {
-    for (auto& r : probe_gpio(*rig.gpio, config)) reports.push_back(std::move(r));
+    for (auto& r : probe_gpio(*rig.gpio)) reports.push_back(std::move(r));
   }
   return reports;
 }

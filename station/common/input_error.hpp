@@ -2,14 +2,41 @@
 // the file, the line and the key or column. main() turns it into one line and exit status 2.
 #pragma once
 
+#include <cstdio>
 #include <stdexcept>
+#include <string>
 
 namespace station {
 
-/// Bad user input; what() reads "FILE:LINE: key 'a.b': what is wrong".
+/// Bad user input; what() reads "FILE:LINE: key 'a.b': what is wrong". Always one line: control
+/// characters a message quotes from the input (a key with a newline, a parser's "saw '...'")
+/// are escaped as \n, \r, \t or \xNN.
 class InputError : public std::runtime_error {
  public:
-  using std::runtime_error::runtime_error;
+  explicit InputError(const std::string& what) : std::runtime_error(one_line(what)) {}
+
+  /// `s` with every control character escaped.
+  static std::string one_line(const std::string& s) {
+    std::string out;
+    out.reserve(s.size());
+    for (const char c : s) {
+      const auto u = static_cast<unsigned char>(c);
+      if (c == '\n') {
+        out += "\\n";
+      } else if (c == '\r') {
+        out += "\\r";
+      } else if (c == '\t') {
+        out += "\\t";
+      } else if (u < 0x20 || u == 0x7f) {
+        char buf[5];
+        std::snprintf(buf, sizeof buf, "\\x%02x", u);
+        out += buf;
+      } else {
+        out += c;
+      }
+    }
+    return out;
+  }
 };
 
 }  // namespace station

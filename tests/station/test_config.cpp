@@ -73,6 +73,17 @@ TEST(Config, ExamplesMatchTheJsonSchema) {
   EXPECT_EQ(run_validator(bad), 1);
 }
 
+// fuzz_station_config / fuzz_protocol: toml++ quotes what it saw ("expected 'inf', saw 'i\n2'"),
+// newline included, so a syntax error printed as two lines. Every InputError is one line.
+TEST(Config, ASyntaxErrorQuotingANewlineIsStillOneLine) {
+  const auto e = error_of(kMinimal + "pulse_weight_arcsec =i\n2x. 5as = \"up\"\n");
+  EXPECT_EQ(e.rfind("rig.toml:", 0), 0u) << e;
+  EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+  const auto k = error_of(kMinimal + "\"odd\\nkey\" = 1\n");
+  EXPECT_EQ(k.find('\n'), std::string::npos) << k;
+  EXPECT_NE(k.find("odd\\nkey"), std::string::npos) << k;
+}
+
 TEST(Config, MinimalFileGetsDefaults) {
   const auto c = station::parse_station_config(kMinimal, "rig.toml");
   EXPECT_EQ(c.chamber.preset, "watlow_f4");
