@@ -197,7 +197,10 @@ Result<const GpioSimBank::Slot*> GpioSimBank::find_slot(std::string_view role) c
 Result<bool> GpioSimBank::read(std::string_view role) {
   auto s = find_slot(role);
   if (!s) return s.error();
-  return chips_->level(s.value()->pin) != s.value()->cfg->active_low;
+  const bool active = chips_->level(s.value()->pin) != s.value()->cfg->active_low;
+  if (tap_ != nullptr)
+    tap_->on_exchange(drivers::gpio::gpio_read_record(device_, *s.value()->cfg, active));
+  return active;
 }
 
 void GpioSimBank::drive(const Slot& slot, bool active) {

@@ -154,15 +154,15 @@ std::vector<CandumpRecord> read_candump_log(const std::string& path) {
   return out;
 }
 
-CandumpTap::CandumpTap(std::ostream& out, std::string interface)
-    : out_(out), interface_(std::move(interface)) {}
+CandumpTap::CandumpTap(std::ostream& out, std::string interface, std::function<double()> now_s)
+    : out_(out), interface_(std::move(interface)), now_s_(std::move(now_s)) {}
 
 void CandumpTap::on_exchange(const TapRecord& record) noexcept {
   if (record.kind != "can" || record.bytes.size() != sizeof(can_frame)) return;
   try {
     CandumpRecord r;
     std::memcpy(&r.frame, record.bytes.data(), sizeof r.frame);
-    const double sec = record.wall_time_s;
+    const double sec = now_s_ ? now_s_() : record.wall_time_s;
     r.time_sec = static_cast<std::int64_t>(sec);
     r.time_usec = static_cast<std::uint32_t>((sec - static_cast<double>(r.time_sec)) * 1e6);
     if (r.time_usec > 999999) r.time_usec = 999999;

@@ -4,6 +4,7 @@
 #include <linux/can.h>
 
 #include <cstdint>
+#include <functional>
 #include <iosfwd>
 #include <mutex>
 #include <string>
@@ -38,14 +39,17 @@ std::vector<CandumpRecord> read_candump_log(const std::string& path);
 /// A Tap that appends every CAN frame (kind "can", 16 bytes) to a stream in candump -l format.
 class CandumpTap final : public Tap {
  public:
-  /// Writes to `out` (not owned, must outlive the tap), naming the bus `interface`.
-  CandumpTap(std::ostream& out, std::string interface);
+  /// Writes to `out` (not owned, must outlive the tap), naming the bus `interface`; stamps each
+  /// line with `now_s()` (seconds since the Unix epoch on the run's clock) or, without it, the
+  /// record's wall time.
+  CandumpTap(std::ostream& out, std::string interface, std::function<double()> now_s = {});
   void on_exchange(const TapRecord& record) noexcept override;
 
  private:
   std::mutex mutex_;
   std::ostream& out_;
   std::string interface_;
+  std::function<double()> now_s_;
 };
 
 }  // namespace station::drivers::can

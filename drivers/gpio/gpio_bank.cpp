@@ -122,6 +122,15 @@ TapRecord gpio_edge_record(const std::string& device, const GpioEdge& edge) {
                                edge.rising ? "rising" : "falling", edge.timestamp_s)};
 }
 
+TapRecord gpio_read_record(const std::string& device, const GpioLineConfig& line, bool active) {
+  return TapRecord{tap_wall_time_s(),
+                   device,
+                   TapDirection::rx,
+                   "gpio-read",
+                   {static_cast<std::uint8_t>(active ? 1 : 0)},
+                   fmt::format("role={} line={} active={}", line.role, line.where(), active)};
+}
+
 TapRecord gpio_write_record(const std::string& device, const GpioLineConfig& line, bool active) {
   return TapRecord{tap_wall_time_s(),
                    device,

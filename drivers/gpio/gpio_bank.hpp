@@ -98,6 +98,8 @@ const GpioLineConfig* find_role(const GpioConfig& config, std::string_view role)
 
 /// Tap record for an edge (direction event, kind "gpio-edge", bytes {level}).
 TapRecord gpio_edge_record(const std::string& device, const GpioEdge& edge);
+/// Tap record for a read (direction rx, kind "gpio-read", bytes {logical level}).
+TapRecord gpio_read_record(const std::string& device, const GpioLineConfig& line, bool active);
 /// Tap record for a write (direction tx, kind "gpio-write", bytes {level}).
 TapRecord gpio_write_record(const std::string& device, const GpioLineConfig& line, bool active);
 

@@ -133,6 +133,7 @@ Result<bool> LibgpiodBank::read(std::string_view role) {
     return make_error(ErrorKind::range, fmt::format("{}: no line with role '{}'", device_, role));
   const int v = gpiod_line_get_value(s->line.get());
   if (v < 0) return errno_error(errno, fmt::format("{}: read {}", device_, role));
+  tap(gpio_read_record(device_, *s->cfg, v != 0));
   return v != 0;
 }
 

@@ -12,19 +12,39 @@ namespace {
 
 // Request PDU bytes as the Modbus spec lays them out (function, address, count): libmodbus does
 // not expose the raw frame, so the tap records the reconstructed PDU.
-std::vector<std::uint8_t> request_pdu(int fc, std::uint16_t addr, int count) {
-  return {static_cast<std::uint8_t>(fc), static_cast<std::uint8_t>(addr >> 8),
-          static_cast<std::uint8_t>(addr & 0xFF), static_cast<std::uint8_t>(count >> 8),
-          static_cast<std::uint8_t>(count & 0xFF)};
+// Tap bytes are ADUs without the transport's framing (no MBAP header, no RTU CRC): the unit id,
+// then the PDU, as the Modbus spec writes them (big-endian words).
+void put_u16(std::vector<std::uint8_t>& out, std::uint16_t v) {
+  out.push_back(static_cast<std::uint8_t>(v >> 8));
+  out.push_back(static_cast<std::uint8_t>(v & 0xFF));
 }
 
-std::vector<std::uint8_t> words_pdu(int fc, std::span<const std::uint16_t> words) {
-  std::vector<std::uint8_t> out{static_cast<std::uint8_t>(fc),
+std::vector<std::uint8_t> request_adu(int unit, int fc, std::uint16_t addr, int count) {
+  std::vector<std::uint8_t> out{static_cast<std::uint8_t>(unit), static_cast<std::uint8_t>(fc)};
+  put_u16(out, addr);
+  put_u16(out, static_cast<std::uint16_t>(count));
+  return out;
+}
+
+std::vector<std::uint8_t> words_adu(int unit, int fc, std::span<const std::uint16_t> words) {
+  std::vector<std::uint8_t> out{static_cast<std::uint8_t>(unit), static_cast<std::uint8_t>(fc),
                                 static_cast<std::uint8_t>(2 * words.size())};
-  for (auto w : words) {
-    out.push_back(static_cast<std::uint8_t>(w >> 8));
-    out.push_back(static_cast<std::uint8_t>(w & 0xFF));
+  for (auto w : words) put_u16(out, w);
+  return out;
+}
+
+// fc 6: unit, 6, address, value; fc 16: unit, 16, address, count, byte count, values.
+std::vector<std::uint8_t> write_adu(int unit, std::uint16_t addr,
+                                    std::span<const std::uint16_t> words) {
+  const bool single = words.size() == 1;
+  std::vector<std::uint8_t> out{static_cast<std::uint8_t>(unit),
+                                static_cast<std::uint8_t>(single ? 6 : 16)};
+  put_u16(out, addr);
+  if (!single) {
+    put_u16(out, static_cast<std::uint16_t>(words.size()));
+    out.push_back(static_cast<std::uint8_t>(2 * words.size()));
   }
+  for (auto w : words) put_u16(out, w);
   return out;
 }
 
@@ -135,7 +155,7 @@ Result<std::vector<std::uint16_t>> ModbusClient::read_registers(FunctionCode fc,
   if (auto c = ensure_connected(); !c) return c.error();
   int code = static_cast<int>(fc);
   modbus_set_slave(ctx_.get(), unit);
-  tap(TapDirection::tx, "modbus-read", request_pdu(code, addr, count),
+  tap(TapDirection::tx, "modbus-read", request_adu(unit, code, addr, count),
       fmt::format("unit={} fc={} addr={} count={}", unit, code, addr, count));
   std::vector<std::uint16_t> words(static_cast<std::size_t>(count));
   int rc = fc == FunctionCode::holding
@@ -145,7 +165,8 @@ Result<std::vector<std::uint16_t>> ModbusClient::read_registers(FunctionCode fc,
   if (rc != count)
     return fail(EMBBADDATA, fmt::format("read addr={}: {} registers, wanted {}", addr, rc, count));
   consecutive_timeouts_ = 0;
-  tap(TapDirection::rx, "modbus-read", words_pdu(code, words), fmt::format("addr={}", addr));
+  tap(TapDirection::rx, "modbus-read", words_adu(unit, code, words),
+      fmt::format("unit={} addr={}", unit, addr));
   return words;
 }
 
@@ -155,14 +176,15 @@ Result<void> ModbusClient::write_registers(int unit, std::uint16_t addr,
   modbus_set_slave(ctx_.get(), unit);
   int n = static_cast<int>(words.size());
   int code = n == 1 ? 6 : 16;
-  auto pdu = request_pdu(code, addr, n == 1 ? words[0] : n);
-  tap(TapDirection::tx, "modbus-write", pdu,
+  tap(TapDirection::tx, "modbus-write", write_adu(unit, addr, words),
       fmt::format("unit={} fc={} addr={} count={}", unit, code, addr, n));
   int rc = n == 1 ? modbus_write_register(ctx_.get(), addr, words[0])
                   : modbus_write_registers(ctx_.get(), addr, n, words.data());
   if (rc == -1) return fail(errno, fmt::format("write fc={} addr={} count={}", code, addr, n));
   consecutive_timeouts_ = 0;
-  tap(TapDirection::rx, "modbus-write", pdu, fmt::format("addr={} ok", addr));
+  tap(TapDirection::rx, "modbus-write",
+      n == 1 ? write_adu(unit, addr, words) : request_adu(unit, code, addr, n),
+      fmt::format("unit={} addr={} ok", unit, addr));
   return {};
 }
 

@@ -7,6 +7,7 @@
 #include <atomic>
 #include <csignal>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <optional>
@@ -20,6 +21,7 @@
 #include "station/daemon/resume.hpp"
 #include "station/daemon/rig.hpp"
 #include "station/daemon/sequencer.hpp"
+#include "station/session/session_recording.hpp"
 #include "station/sim/sim_run.hpp"
 
 namespace station {
@@ -41,7 +43,7 @@ void install_signal_handlers() {
 
 struct RunOptions {
   bool sim = false, json = false, fresh = false;
-  std::string config, protocol = "paper", db, operator_name, log_file, record_can;
+  std::string config, protocol = "paper", db, operator_name, log_file, record_can, record;
   int gyros = 4;
   std::uint64_t seed = 1;
   double latitude_deg = 39.9;
@@ -68,6 +70,13 @@ struct DeferredTap final : drivers::Tap {
   }
 };
 
+// Whether `db` exists and holds a run to resume (read-only peek: nothing is created or written).
+bool has_unfinished_run(const std::string& db) {
+  if (!std::filesystem::exists(db)) return false;
+  Store peek(db, OpenMode::read_only);
+  return peek.find_unfinished_run().has_value();
+}
+
 int run_real(const RunOptions& o) {
   const StationConfig config = load_station_config(o.config);
   Protocol protocol = load_protocol(o.protocol);
@@ -77,8 +86,13 @@ int run_real(const RunOptions& o) {
   RigOptions ro;
   ro.tap = &tap;
   Rig rig = build_rig(config, ro);
-  if (const auto bad = unreachable_devices(config, rig); !bad.empty())
-    throw InputError(fmt::format("{}", fmt::join(bad, "\n")));
+  if (const auto bad = unreachable_devices(config, rig); !bad.empty()) {
+    // A new run starts only on a whole rig. A run a killed daemon left unfinished goes on: the
+    // device's outage (already open in the run's events, or starting now) is recorded and it
+    // rejoins when it answers; refusing would lose every other device's data as well.
+    if (o.fresh || !has_unfinished_run(o.db)) throw InputError::lines(bad);
+    for (const auto& line : bad) log("seq")->warn("resuming without: {}", line);
+  }
   Store store(o.db);
   const ResumeDecision resume_decision = decide_resume(store, config, o.fresh, false);
   const std::optional<RunRecord>& resume = resume_decision.run;
@@ -91,7 +105,13 @@ int run_real(const RunOptions& o) {
   }
   std::ofstream can_log;
   std::optional<drivers::can::CandumpTap> can_tap;
-  if (!o.record_can.empty()) {
+  std::optional<SessionRecording> session;
+  if (!o.record.empty()) {
+    // The probe above is not part of the session: the logs start with the run's first tick.
+    session.emplace(o.record);
+    tap.target = &session->tap();
+    session->start(config, protocol, false, std::nullopt);
+  } else if (!o.record_can.empty()) {
     can_log.open(o.record_can, std::ios::app);
     if (!can_log) throw InputError(fmt::format("{}: cannot write the CAN log", o.record_can));
     tap.target = &can_tap.emplace(can_log, "can0");
@@ -104,9 +124,11 @@ int run_real(const RunOptions& o) {
   if (sd_watchdog_enabled(0, &watchdog_usec) > 0) {
     so.watchdog = [] { sd_notify(0, "WATCHDOG=1"); };
   }
+  if (session) so.on_tick = [&session](const TickReport&) { session->after_tick(); };
   Sequencer seq(config, protocol, rig, store, clock, so);
   sd_notify(0, "READY=1");
   const RunOutcome out = seq.run(resume);
+  if (session) session->finish(store, out.run_id);
   sd_notify(0, "STOPPING=1");
   fmt::print("run {} {} at t = {:.0f} s after {} ticks\n", out.run_id, out.state, out.t_s,
              out.ticks);
@@ -125,6 +147,7 @@ int run_sim(const RunOptions& o) {
   so.fresh = o.fresh;
   so.stop = &g_stop;
   so.record_can_path = o.record_can;
+  so.record_dir = o.record;
   const auto report = run_simulated(so);
   if (o.json) {
     std::cout << report.dump(2) << '\n';
@@ -153,8 +176,13 @@ void add_run_command(CLI::App& app, CommandStatus& status) {
   cmd->add_option("--latitude", o->latitude_deg, "simulated site latitude, deg")
       ->capture_default_str();
   cmd->add_option("--log-file", o->log_file, "rotating log file");
+  auto* record =
+      cmd->add_option("--record", o->record,
+                      "record the session in this directory: session.toml, can.log, modbus.log, "
+                      "gpio.log, result.json (schemas/session.md)");
   cmd->add_option("--record-can", o->record_can,
-                  "write every CAN frame in can-utils' candump format to this file");
+                  "write only the CAN frames, in can-utils' candump format, to this file")
+      ->excludes(record);
   cmd->add_flag("--json", o->json, "print one JSON object at the end (--sim)");
   cmd->callback([o, &status] {
     LogOptions lo;

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace station {
 
@@ -14,6 +15,13 @@ namespace station {
 class InputError : public std::runtime_error {
  public:
   explicit InputError(const std::string& what) : std::runtime_error(one_line(what)) {}
+
+  /// Several problems found at once (e.g. every unreachable device): one line each.
+  static InputError lines(const std::vector<std::string>& problems) {
+    std::string joined;
+    for (const auto& p : problems) joined += (joined.empty() ? "" : "\n") + one_line(p);
+    return InputError(joined, Verbatim{});
+  }
 
   /// `s` with every control character escaped.
   static std::string one_line(const std::string& s) {
@@ -37,6 +45,10 @@ class InputError : public std::runtime_error {
     }
     return out;
   }
+
+ private:
+  struct Verbatim {};
+  InputError(const std::string& joined, Verbatim) : std::runtime_error(joined) {}
 };
 
 }  // namespace station

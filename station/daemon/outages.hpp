@@ -42,6 +42,9 @@ class OutageTracker {
                                     std::optional<bool> answered, std::string_view error = {});
   /// Ends every open outage at the run's last tick `t_s` (recovered = false), in device order.
   std::vector<Outage> close_all(double t_s);
+  /// Carries on an outage a killed daemon left open (resume): the next observation of its device
+  /// counts a lost tick or ends it, as if the process had never stopped.
+  void restore(Outage o) { open_[o.device] = std::move(o); }
   /// Whether `device` is in an outage now.
   bool down(const std::string& device) const { return open_.count(device) != 0; }
 

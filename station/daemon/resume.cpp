@@ -6,7 +6,19 @@
 
 #include <nlohmann/json.hpp>
 
+#include "compensation/earth_rate.hpp"
+
 namespace station {
+
+std::vector<RunSlot> run_slots_of(const StationConfig& c) {
+  std::vector<RunSlot> out;
+  for (std::size_t i = 0; i < c.slots.size(); ++i) {
+    const auto& s = c.slots[i];
+    out.push_back({static_cast<int>(i), s.node, s.serial, s.axis, s.pulse_weight_arcsec,
+                   compensation::earth_rate_along_axis_dph(c.latitude_deg, s.enu)});
+  }
+  return out;
+}
 namespace {
 
 using nlohmann::json;

@@ -19,6 +19,10 @@ struct ResumeDecision {
   std::optional<Protocol> protocol;  ///< its stored protocol (continue with this one)
 };
 
+/// The run's slots from the config: node, serial, axis, pulse weight and the Earth rate along
+/// the axis at the station's latitude (compensation/earth_rate.hpp, WGS-84).
+std::vector<RunSlot> run_slots_of(const StationConfig& config);
+
 /// What gives every sample of a run on `config` its meaning, as JSON text: latitude, reference
 /// temperature, bin length and per slot node, serial, pulse weight, axis and Earth rate. Stored
 /// with the run (runs.resolved_json) and compared on resume.

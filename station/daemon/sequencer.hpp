@@ -76,6 +76,8 @@ class Sequencer {
   };
   /// The first tick of a resumed run, strictly after its last committed one; logs the resume.
   double resume_first_tick(const RunRecord& resume);
+  /// Outages the killed daemon left open go on in this process (one event when they end).
+  void restore_outages(std::int64_t run_id, double last_s);
   void connect_devices();
   void tick(double t_s, TickData& d);
   void read_devices(double t_s, TickData& d);

@@ -20,20 +20,6 @@
 
 namespace station {
 
-namespace {
-
-std::vector<RunSlot> run_slots_of(const StationConfig& c) {
-  std::vector<RunSlot> out;
-  for (std::size_t i = 0; i < c.slots.size(); ++i) {
-    const auto& s = c.slots[i];
-    out.push_back({static_cast<int>(i), s.node, s.serial, s.axis, s.pulse_weight_arcsec,
-                   compensation::earth_rate_along_axis_dph(c.latitude_deg, s.enu)});
-  }
-  return out;
-}
-
-}  // namespace
-
 std::string Sequencer::finish(const std::string& end_state, double t_s) {
   drive_outputs(t_s, SafetyOutputs{});    // the run is over: gyro power off, lamps dark
   const auto lossy = close_outages(t_s);  // serial -> why its record window is incomplete
@@ -82,10 +68,25 @@ double Sequencer::resume_first_tick(const RunRecord& resume) {
            nlohmann::json{{"from_s", last_s}, {"to_s", t_first}}.dump());
     }
   }
+  if (!options_.replay_until_t_s) restore_outages(resume.id, last_s);
   emit(std::max(last_s, 0.0), "warn", "seq", "resume",
        fmt::format("resuming run {} at step {} after t = {:.0f} s (next tick t = {:.0f} s)",
                    run_id_, resume.progress.step_index, last_s, t_first));
   return t_first;
+}
+
+void Sequencer::restore_outages(std::int64_t run_id, double last_s) {
+  constexpr std::string_view kPrefix = "not answering: ";
+  for (const auto& e : store_.open_outages(run_id)) {
+    Outage o;
+    o.device = e.device;
+    o.start_s = e.start_s;
+    // Every stored tick from its start to the last one lost the device.
+    o.ticks_lost =
+        std::max<std::int64_t>(1, std::llround((last_s - e.start_s) / options_.period_s) + 1);
+    o.error = e.message.starts_with(kPrefix) ? e.message.substr(kPrefix.size()) : e.message;
+    outages_.restore(std::move(o));
+  }
 }
 
 RunOutcome Sequencer::run(const std::optional<RunRecord>& resume) {

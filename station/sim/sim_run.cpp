@@ -11,13 +11,14 @@
 #include "sim_devices/gpio_sim.hpp"
 #include "sim_devices/sim_clock.hpp"
 #include "sim_devices/sim_world.hpp"
-#include "station/store/calibration.hpp"
-#include "station/store/fit_json.hpp"
 #include "station/common/logging.hpp"
 #include "station/config/protocol.hpp"
 #include "station/daemon/resume.hpp"
 #include "station/daemon/rig.hpp"
 #include "station/daemon/sequencer.hpp"
+#include "station/session/session_recording.hpp"
+#include "station/store/calibration.hpp"
+#include "station/store/fit_json.hpp"
 
 namespace station {
 namespace {
@@ -74,12 +75,26 @@ nlohmann::json run_simulated(const SimRunOptions& o) {
   sim::SimWorld world(wc);
   const StationConfig config = parse_station_config(sim_config_text(world, o), "sim:station.toml");
   RigOptions ro;
+  sim::SimClock sim_clock;
+  drivers::MonotonicClock wall_clock;
+  drivers::Clock& clock = o.wall_clock ? static_cast<drivers::Clock&>(wall_clock) : sim_clock;
+  // Logs are stamped on the run's clock: the simulated one starts at the wall time the
+  // simulation started, so a simulated session reads like a recorded one (13 h of traffic
+  // spans 13 h of time stamps, not the seconds the simulation took).
+  const double t0_epoch_s = drivers::tap_wall_time_s();
+  const std::function<double()> run_now_s = [&, t0_epoch_s] {
+    return o.wall_clock ? drivers::tap_wall_time_s() : t0_epoch_s + sim_clock.now_s();
+  };
   std::ofstream can_log;
   std::optional<drivers::can::CandumpTap> can_tap;
-  if (!o.record_can_path.empty()) {
+  std::optional<SessionRecording> session;
+  if (!o.record_dir.empty()) {
+    session.emplace(o.record_dir, [run_now_s](const drivers::TapRecord&) { return run_now_s(); });
+    ro.tap = &session->tap();
+  } else if (!o.record_can_path.empty()) {
     can_log.open(o.record_can_path);
     if (!can_log) throw InputError(fmt::format("{}: cannot write the CAN log", o.record_can_path));
-    ro.tap = &can_tap.emplace(can_log, "can0");
+    ro.tap = &can_tap.emplace(can_log, "can0", run_now_s);
   }
   auto chips = world.gpio_chips();
   ro.gpio_factory = [chips](const drivers::gpio::GpioConfig& g) {
@@ -100,9 +115,6 @@ nlohmann::json run_simulated(const SimRunOptions& o) {
     store.finish_run(resume->id, "aborted");
     resume.reset();
   }
-  sim::SimClock sim_clock;
-  drivers::MonotonicClock wall_clock;
-  drivers::Clock& clock = o.wall_clock ? static_cast<drivers::Clock&>(wall_clock) : sim_clock;
   SequencerOptions so;
   so.sim_seed = static_cast<std::int64_t>(o.seed);
   so.stop = o.stop;
@@ -114,7 +126,9 @@ nlohmann::json run_simulated(const SimRunOptions& o) {
   };
   const double nominal_s = protocol.nominal_duration_s(wc.initial_c);
   double next_report_s = 0;
+  if (session) session->start(config, protocol, true, static_cast<std::int64_t>(o.seed));
   so.on_tick = [&](const TickReport& r) {
+    if (session) session->after_tick();
     if (!o.progress || r.t_s < next_report_s) return;
     next_report_s = r.t_s + 1800.0;
     fmt::print(stderr, "sim {:5.1f} h of ~{:.1f} h  step {}/{}  air {:6.1f} C{}{}\n",
@@ -123,6 +137,7 @@ nlohmann::json run_simulated(const SimRunOptions& o) {
   };
   Sequencer seq(config, protocol, rig, store, clock, so);
   const RunOutcome out = seq.run(resume);
+  if (session) session->finish(store, out.run_id);
   nlohmann::json report{
       {"run_id", out.run_id},
       {"state", out.state},

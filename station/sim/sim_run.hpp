@@ -26,6 +26,7 @@ struct SimRunOptions {
   bool progress = true;            ///< progress lines on stderr
   bool wall_clock = false;         ///< run at 1 Hz on CLOCK_MONOTONIC instead of simulated time
   std::string record_can_path;     ///< write every CAN frame in candump format here (empty: no)
+  std::string record_dir;          ///< record the session in this directory (empty: no)
   const std::atomic<bool>* stop = nullptr;
   /// Test hook: called with each tick's time and the world, after it advanced (fault injection).
   std::function<void(double t_s, sim::SimWorld& world)> on_world_tick;

@@ -6,7 +6,10 @@
 namespace station {
 namespace {
 
+// {name: value}; null for a value the fit does not have (a fit read back from the store has
+// no HAC errors: the fits table does not keep them).
 nlohmann::json keyed(const compensation::FitResult& fit, const std::vector<double>& values) {
+  if (values.size() != fit.names.size()) return nullptr;
   nlohmann::json j = nlohmann::json::object();
   for (std::size_t i = 0; i < fit.names.size(); ++i) j[fit.names[i]] = values[i];
   return j;

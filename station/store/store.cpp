@@ -352,4 +352,31 @@ std::vector<std::string> Store::events(std::int64_t run_id) {
   return out;
 }
 
+std::vector<EventRow> Store::event_rows(std::int64_t run_id) {
+  auto st = db_.prepare(
+      "SELECT t_s, severity, source, kind, message, data_json FROM events WHERE run_id = ? "
+      "ORDER BY id");
+  st.bind(1, run_id);
+  std::vector<EventRow> out;
+  while (st.step()) {
+    EventRow e{st.column_double(0), st.column_text(1), st.column_text(2),
+               st.column_text(3),   st.column_text(4), std::nullopt};
+    if (!st.column_is_null(5)) e.data_json = st.column_text(5);
+    out.push_back(std::move(e));
+  }
+  return out;
+}
+
+std::vector<OpenOutageEvent> Store::open_outages(std::int64_t run_id) {
+  auto st = db_.prepare(
+      "SELECT source, MAX(t_s), message FROM events AS s WHERE run_id = ?1 AND "
+      "kind = 'outage_start' AND NOT EXISTS (SELECT 1 FROM events AS e WHERE e.run_id = ?1 AND "
+      "e.source = s.source AND e.kind = 'outage' AND e.id > s.id) GROUP BY source "
+      "ORDER BY source");
+  st.bind(1, run_id);
+  std::vector<OpenOutageEvent> out;
+  while (st.step()) out.push_back({st.column_text(0), st.column_double(1), st.column_text(2)});
+  return out;
+}
+
 }  // namespace station

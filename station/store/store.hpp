@@ -14,6 +14,20 @@
 
 namespace station {
 
+/// One stored event.
+struct EventRow {
+  double t_s = 0;
+  std::string severity, source, kind, message;
+  std::optional<std::string> data_json;
+};
+
+/// An 'outage_start' event without its end (Store::open_outages).
+struct OpenOutageEvent {
+  std::string device;  ///< the event's source
+  double start_s = 0;  ///< the event's tick
+  std::string message;
+};
+
 /// What a new run records about itself.
 struct RunInfo {
   std::string protocol_name, protocol_text, config_text, software_version, station, operator_name;
@@ -128,6 +142,11 @@ class Store {
                  const std::optional<std::string>& data_json = std::nullopt);
   /// Events of a run as "kind: message" in order.
   std::vector<std::string> events(std::int64_t run_id);
+  /// Events of a run, in order, every column.
+  std::vector<EventRow> event_rows(std::int64_t run_id);
+  /// Outages a run's events opened (kind 'outage_start') and never ended (no later 'outage'
+  /// event of the same source): what a killed daemon left open, for the resumed one to carry on.
+  std::vector<OpenOutageEvent> open_outages(std::int64_t run_id);
 
   Database& db() { return db_; }
 

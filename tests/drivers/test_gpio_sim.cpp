@@ -149,8 +149,12 @@ TEST(GpioSim, InterlockOpeningIsAnEdgeOnThePollableFd) {
   EXPECT_EQ(wait_readable(bank.event_fd(), 0), 0);  // drained
   EXPECT_TRUE(bank.read_events().value().empty());
 
-  ASSERT_FALSE(tap.records.empty());
-  const TapRecord& r = tap.records.back();
+  // The edge, then the read after it.
+  ASSERT_GE(tap.records.size(), 2u);
+  EXPECT_EQ(tap.records.back().kind, "gpio-read");
+  EXPECT_EQ(tap.records.back().direction, TapDirection::rx);
+  EXPECT_EQ(tap.records.back().bytes, std::vector<std::uint8_t>{0});
+  const TapRecord& r = tap.records[tap.records.size() - 2];
   EXPECT_EQ(r.kind, "gpio-edge");
   EXPECT_EQ(r.direction, TapDirection::event);
   EXPECT_EQ(r.bytes, std::vector<std::uint8_t>{0});
@@ -192,7 +196,9 @@ TEST(GpioSim, WritesDriveTheirPinsAndPassTheTap) {
   EXPECT_EQ(chips->pin_level("GYRO_PWR1"), true);
   EXPECT_EQ(chips->pin_level("TOWER_R"), true);  // active-low: high = dark
   EXPECT_TRUE(bank.read(roles::relay(1)).value());
-  ASSERT_EQ(tap.records.size(), 7u);
+  ASSERT_EQ(tap.records.size(), 8u);  // two writes and the read
+  EXPECT_EQ(tap.records[7].kind, "gpio-read");
+  EXPECT_EQ(tap.records[7].bytes, std::vector<std::uint8_t>{1});
   EXPECT_EQ(tap.records[5].kind, "gpio-write");
   EXPECT_EQ(tap.records[5].direction, TapDirection::tx);
   EXPECT_EQ(tap.records[5].bytes, std::vector<std::uint8_t>{1});

@@ -139,3 +139,55 @@ TEST(DaemonProcesses, RunRefusesAnUnreachableRigBeforeWritingAnything) {
     EXPECT_NE(access(db.c_str(), F_OK), 0) << c.to << ": a database was created";
   }
 }
+
+// An outage open when the daemon is SIGKILLed goes on in the restarted daemon: one start event
+// and one end event for the chamber in all, the end covering the time the daemon was down.
+TEST(DaemonProcesses, AnOutageOpenAtSigkillEndsOnceInTheRestartedDaemon) {
+  ts::SimrigProcess rig;
+  const std::string control =
+      ::testing::TempDir() + "outage-kill-" + std::to_string(getpid()) + ".ctl";
+  rig.extra_args = {"--control", control};
+  ASSERT_TRUE(rig.start("outage-kill")) << ts::slurp(rig.err);
+  const auto send = [&](const std::string& cmd) {
+    const pid_t p = ts::spawn_process({ts::kSimrigBin, "--control", control, "--send", cmd},
+                                      control + ".send.out", control + ".send.err");
+    return ts::wait_bounded(p, std::chrono::seconds(5));
+  };
+  const auto db = ts::fresh_db("outage-kill");
+  const auto events_of = [&db] {
+    try {
+      station::Store s(db, station::OpenMode::read_only);
+      return s.events(1);
+    } catch (const std::exception&) {
+      return std::vector<std::string>{};
+    }
+  };
+  const auto count = [&](const std::string& prefix) {
+    int n = 0;
+    for (const auto& e : events_of()) n += e.rfind(prefix, 0) == 0 ? 1 : 0;
+    return n;
+  };
+  pid_t pid = start_daemon(rig, db, "a");
+  ASSERT_TRUE(ts::wait_until([&] { return ticks_of(db) >= 3; }, std::chrono::seconds(15)))
+      << ts::slurp(db + ".a.err");
+  ASSERT_EQ(send("chamber stall 600"), 0);
+  ASSERT_TRUE(
+      ts::wait_until([&] { return count("outage_start: ") == 1; }, std::chrono::seconds(15)))
+      << ::testing::PrintToString(events_of());
+  kill(pid, SIGKILL);
+  waitpid(pid, nullptr, 0);
+  pid = start_daemon(rig, db, "b");
+  const std::size_t at_restart = ticks_of(db);
+  ASSERT_TRUE(
+      ts::wait_until([&] { return ticks_of(db) >= at_restart + 2; }, std::chrono::seconds(15)))
+      << ts::slurp(db + ".b.err");
+  ASSERT_EQ(send("chamber clear"), 0);
+  ASSERT_TRUE(ts::wait_until([&] { return count("outage: ") == 1; }, std::chrono::seconds(15)))
+      << ::testing::PrintToString(events_of());
+  kill(pid, SIGTERM);
+  ASSERT_NE(ts::wait_bounded(pid, std::chrono::seconds(15)), -1);
+  EXPECT_EQ(count("outage_start: "), 1) << ::testing::PrintToString(events_of());
+  EXPECT_EQ(count("outage: "), 1) << ::testing::PrintToString(events_of());
+  station::Store s(db, station::OpenMode::read_only);
+  EXPECT_TRUE(s.open_outages(1).empty());
+}
