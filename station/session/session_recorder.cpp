@@ -57,6 +57,7 @@ SessionRecorder::SessionRecorder(const std::string& dir, Stamp stamp) : stamp_(s
 }
 
 void SessionRecorder::on_exchange(const dr::TapRecord& record) noexcept {
+  if (paused_) return;
   try {
     const double t_s = stamp_ ? stamp_(record) : record.wall_time_s;
     const std::lock_guard lock(mutex_);

@@ -2,6 +2,7 @@
 // clock, as line-oriented text in one directory: can.log (candump -l), modbus.log, gpio.log.
 #pragma once
 
+#include <atomic>
 #include <fstream>
 #include <functional>
 #include <mutex>
@@ -25,6 +26,9 @@ class SessionRecorder final : public drivers::Tap {
   void on_exchange(const drivers::TapRecord& record) noexcept override;
   /// Flushes the three logs (after each tick, so a kill loses at most one tick of log).
   void flush();
+  /// While paused nothing is written: a resumed simulation replays its stored ticks to rebuild
+  /// its state, and their exchanges are in the logs already.
+  void pause(bool paused) { paused_ = paused; }
 
  private:
   void write_can(const drivers::TapRecord& record, double t_s);
@@ -33,6 +37,7 @@ class SessionRecorder final : public drivers::Tap {
   std::mutex mutex_;
   std::ofstream can_, modbus_, gpio_;
   Stamp stamp_;
+  std::atomic<bool> paused_{false};
 };
 
 /// One line of modbus.log / gpio.log, without the newline:

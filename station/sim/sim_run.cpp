@@ -120,7 +120,8 @@ nlohmann::json run_simulated(const SimRunOptions& o) {
   so.stop = o.stop;
   // Resuming a simulation replays it deterministically from t = 0 up to the last stored tick.
   if (resume) so.replay_until_t_s = resume->last_tick_s.value_or(-1.0);
-  so.before_tick = [&world, &o](double t_s) {
+  so.before_tick = [&world, &o, &session, replay_until = so.replay_until_t_s](double t_s) {
+    if (session) session->tap().pause(replay_until && t_s <= *replay_until);
     world.advance_to(t_s);
     if (o.on_world_tick) o.on_world_tick(t_s, world);
   };
