@@ -33,6 +33,14 @@ std::vector<std::uint8_t> words_adu(int unit, int fc, std::span<const std::uint1
   return out;
 }
 
+// An error event's bytes: the errno (libmodbus's EMB* codes included) as 4 big-endian bytes, so
+// a recorded session says exactly which failure the client saw.
+std::vector<std::uint8_t> errno_bytes(int err) {
+  const auto u = static_cast<std::uint32_t>(err);
+  return {static_cast<std::uint8_t>(u >> 24), static_cast<std::uint8_t>(u >> 16),
+          static_cast<std::uint8_t>(u >> 8), static_cast<std::uint8_t>(u)};
+}
+
 // fc 6: unit, 6, address, value; fc 16: unit, 16, address, count, byte count, values.
 std::vector<std::uint8_t> write_adu(int unit, std::uint16_t addr,
                                     std::span<const std::uint16_t> words) {
@@ -77,33 +85,34 @@ Error translate_modbus_error(int err, const std::string& what) {
 }
 
 ModbusClient::ModbusClient(std::string device, Endpoint endpoint, double response_timeout_s)
-    : device_(std::move(device)), endpoint_(std::move(endpoint)), timeout_s_(response_timeout_s) {}
+    : ModbusClient(std::move(device), endpoint, std::make_unique<LibmodbusWire>(endpoint),
+                   response_timeout_s) {}
+
+ModbusClient::ModbusClient(std::string device, Endpoint endpoint, std::unique_ptr<ModbusWire> wire,
+                           double response_timeout_s)
+    : device_(std::move(device)),
+      endpoint_(std::move(endpoint)),
+      timeout_s_(response_timeout_s),
+      wire_(std::move(wire)) {}
+
+ModbusClient::~ModbusClient() = default;
 
 Result<void> ModbusClient::connect() {
   disconnect();
+  int rc = 0;
   try {
-    ctx_ = make_context(endpoint_);
+    rc = wire_->open(timeout_s_);
   } catch (const std::exception& e) {
     backoff_.failed();
     last_connect_error_ = device_ + ": " + e.what();
     return make_error(ErrorKind::io, last_connect_error_);
   }
-  double whole = std::floor(timeout_s_);
-  auto sec = static_cast<std::uint32_t>(whole);
-  auto usec = static_cast<std::uint32_t>(std::lround((timeout_s_ - whole) * 1e6));
-  modbus_set_response_timeout(ctx_.get(), sec, usec);
-  // libmodbus waits byte_timeout (default 0.5 s) for each later chunk of a reply: a device that
-  // sends part of a reply and stalls would hold the call that long whatever the response
-  // timeout. The same bound applies to both (found by fuzz_modbus_replies). Never 0: libmodbus
-  // reads a zero byte timeout as "wait forever".
-  modbus_set_byte_timeout(ctx_.get(), sec, usec);
-  if (modbus_connect(ctx_.get()) == -1) {
+  if (rc == -1) {
     int err = errno;
-    ctx_.reset();
     // A refused or failed connect is always "not connected", whatever errno says.
     auto e = translate_modbus_error(err, device_ + " connect " + to_string(endpoint_));
     if (e.kind != ErrorKind::timeout) e.kind = ErrorKind::disconnected;
-    tap(TapDirection::event, "error", {}, e.message);
+    tap(TapDirection::event, "error", errno_bytes(err), e.message);
     backoff_.failed();
     last_connect_error_ = e.message;
     return e;
@@ -115,8 +124,8 @@ Result<void> ModbusClient::connect() {
 }
 
 void ModbusClient::disconnect() {
-  if (ctx_ && connected_) tap(TapDirection::event, "disconnect", {}, to_string(endpoint_));
-  ctx_.reset();
+  if (connected_) tap(TapDirection::event, "disconnect", {}, to_string(endpoint_));
+  wire_->close();
   connected_ = false;
 }
 
@@ -139,13 +148,13 @@ Error ModbusClient::fail(int err, const std::string& what) {
                          std::holds_alternative<TcpEndpoint>(endpoint_);
   if (stale_tcp)
     e.message += fmt::format(" ({} timeouts in a row: reconnecting)", consecutive_timeouts_);
-  tap(TapDirection::event, "error", {}, e.message);
+  tap(TapDirection::event, "error", errno_bytes(err), e.message);
   if (e.kind == ErrorKind::disconnected || stale_tcp) {
     consecutive_timeouts_ = 0;
     disconnect();  // reconnect on the next call
   } else if (e.kind == ErrorKind::timeout || e.kind == ErrorKind::protocol) {
     // Discard late or partial bytes so the next reply is not misread as this one's.
-    if (ctx_) modbus_flush(ctx_.get());
+    if (connected_) wire_->flush();
   }
   return e;
 }
@@ -154,13 +163,10 @@ Result<std::vector<std::uint16_t>> ModbusClient::read_registers(FunctionCode fc,
                                                                 std::uint16_t addr, int count) {
   if (auto c = ensure_connected(); !c) return c.error();
   int code = static_cast<int>(fc);
-  modbus_set_slave(ctx_.get(), unit);
   tap(TapDirection::tx, "modbus-read", request_adu(unit, code, addr, count),
       fmt::format("unit={} fc={} addr={} count={}", unit, code, addr, count));
   std::vector<std::uint16_t> words(static_cast<std::size_t>(count));
-  int rc = fc == FunctionCode::holding
-               ? modbus_read_registers(ctx_.get(), addr, count, words.data())
-               : modbus_read_input_registers(ctx_.get(), addr, count, words.data());
+  int rc = wire_->read(fc, unit, addr, count, words.data());
   if (rc == -1) return fail(errno, fmt::format("read fc={} addr={} count={}", code, addr, count));
   if (rc != count)
     return fail(EMBBADDATA, fmt::format("read addr={}: {} registers, wanted {}", addr, rc, count));
@@ -173,13 +179,11 @@ Result<std::vector<std::uint16_t>> ModbusClient::read_registers(FunctionCode fc,
 Result<void> ModbusClient::write_registers(int unit, std::uint16_t addr,
                                            std::span<const std::uint16_t> words) {
   if (auto c = ensure_connected(); !c) return c.error();
-  modbus_set_slave(ctx_.get(), unit);
   int n = static_cast<int>(words.size());
   int code = n == 1 ? 6 : 16;
   tap(TapDirection::tx, "modbus-write", write_adu(unit, addr, words),
       fmt::format("unit={} fc={} addr={} count={}", unit, code, addr, n));
-  int rc = n == 1 ? modbus_write_register(ctx_.get(), addr, words[0])
-                  : modbus_write_registers(ctx_.get(), addr, n, words.data());
+  int rc = wire_->write(unit, addr, words);
   if (rc == -1) return fail(errno, fmt::format("write fc={} addr={} count={}", code, addr, n));
   consecutive_timeouts_ = 0;
   tap(TapDirection::rx, "modbus-write",

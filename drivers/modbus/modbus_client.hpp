@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -13,7 +14,7 @@
 #include "drivers/common/result.hpp"
 #include "drivers/common/tap.hpp"
 #include "drivers/modbus/endpoint.hpp"
-#include "drivers/modbus/modbus_handle.hpp"
+#include "drivers/modbus/modbus_wire.hpp"
 #include "drivers/modbus/read_plan.hpp"
 #include "drivers/modbus/register_map.hpp"
 
@@ -27,6 +28,13 @@ class ModbusClient {
  public:
   /// Stores the parameters; no I/O. `device` names the transport in errors and tap records.
   ModbusClient(std::string device, Endpoint endpoint, double response_timeout_s = 0.5);
+  /// The same over another link (a recorded session in replay); `endpoint` still says what the
+  /// link stands for (messages; TCP's reconnect after repeated timeouts).
+  ModbusClient(std::string device, Endpoint endpoint, std::unique_ptr<ModbusWire> wire,
+               double response_timeout_s = 0.5);
+  ~ModbusClient();
+  ModbusClient(ModbusClient&&) = default;
+  ModbusClient& operator=(ModbusClient&&) = default;
 
   /// Sets the tap every exchange passes (nullptr: none). Not owned.
   void set_tap(Tap* tap) { tap_ = tap; }
@@ -70,7 +78,7 @@ class ModbusClient {
   std::string device_;
   Endpoint endpoint_;
   double timeout_s_;
-  ModbusHandle ctx_;
+  std::unique_ptr<ModbusWire> wire_;
   bool connected_ = false;
   Tap* tap_ = nullptr;
   int consecutive_timeouts_ = 0;  ///< timeouts in a row since the last answer of any kind

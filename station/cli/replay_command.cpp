@@ -10,9 +10,10 @@
 
 #include "drivers/can/replay_transport.hpp"
 #include "drivers/counters/counter_boards.hpp"
-#include "station/store/calibration.hpp"
 #include "station/cli/commands.hpp"
 #include "station/config/config.hpp"
+#include "station/daemon/sample.hpp"
+#include "station/store/calibration.hpp"
 #include "station/store/fit_json.hpp"
 
 namespace station {
@@ -54,15 +55,16 @@ StoredSamples replay_samples(const ReplayOptions& o, const std::vector<RunSlot>&
     auto tick = boards.tick(syncs[k]);
     if (!tick) throw InputError(fmt::format("{}: tick {}: {}", o.log, k, tick.error().message));
     for (const auto& rd : tick.value().readings) {
-      SampleRow r = stored.at(rd.serial)[k];  // time, window, flags as recorded
-      r.rate_dph.reset();
-      r.temp_c.reset();
-      r.temp2_c.reset();
-      if (rd.answered && rd.has_delta) r.rate_dph = rd.rate_dph;
-      if (rd.temps_c.size() >= 2) {
-        r.temp_c = rd.temps_c[0];
-        r.temp2_c = rd.temps_c[1];
-      }
+      // The gyro part through the daemon's own path; time, window and flags as recorded.
+      const SampleRow& recorded = stored.at(rd.serial)[k];
+      SampleRow r;
+      apply_reading(&rd, r);
+      r.serial = recorded.serial;
+      r.t_s = recorded.t_s;
+      r.recording = recorded.recording;
+      r.air_c = recorded.air_c;
+      r.setpoint_c = recorded.setpoint_c;
+      r.flags = recorded.flags;
       out[rd.serial].push_back(std::move(r));
     }
   }

@@ -9,6 +9,7 @@
 
 #include "drivers/gpio/gpio_bank.hpp"
 #include "station/common/logging.hpp"
+#include "station/daemon/sample.hpp"
 
 namespace station {
 
@@ -210,21 +211,8 @@ void Sequencer::assemble_samples(double t_s, TickData& d) {
     if (d.counts) {
       for (const auto& x : d.counts->readings) rd = x.serial == slot.serial ? &x : rd;
     }
-    if (rd == nullptr || !rd->answered) r.flags |= kLatchLost;
-    if (rd != nullptr && rd->answered && rd->has_delta) {
-      r.net_pulses = rd->net_pulses;
-      r.interval_s = rd->interval_s;
-      r.rate_dph = rd->rate_dph;
-    }
-    if (rd != nullptr && rd->temps_c.size() >= 2 && std::isfinite(rd->temps_c[0]) &&
-        std::isfinite(rd->temps_c[1])) {
-      r.temp_c = rd->temps_c[0];
-      r.temp2_c = rd->temps_c[1];
-      d.obs.gyro_temps_c.push_back(rd->temps_c[0]);
-    } else {
-      r.flags |= kTempsMissing;
-    }
-    if (rd != nullptr && rd->status_flags != 0) r.flags |= kBoardFault;
+    apply_reading(rd, r);
+    if (r.temp_c) d.obs.gyro_temps_c.push_back(*r.temp_c);
     d.rows.push_back(std::move(r));
   }
 }

@@ -1,6 +1,7 @@
 // ModbusClient against a real libmodbus server on 127.0.0.1: errors are typed, faults recover.
 #include <gtest/gtest.h>
 
+#include <cerrno>
 #include <chrono>
 #include <vector>
 
@@ -132,6 +133,8 @@ TEST_F(ModbusClientTest, EveryExchangePassesTheTap) {
   server.inject_timeouts(1);
   ASSERT_FALSE(client->read(map.at(cm::kAir)));
   EXPECT_EQ(tap.records.back().kind, "error");
+  // The errno of the failure, big-endian: a timeout.
+  EXPECT_EQ(tap.records.back().bytes, (std::vector<std::uint8_t>{0, 0, 0, ETIMEDOUT}));
   // A write carries its values: fc 6, addr, value (a setpoint of 30.0 C = 300). (Copies: the
   // references above dangle once the tap's vector grows.)
   ASSERT_TRUE(client->write(map.at(cm::kSetpoint), 30.0));

@@ -1,0 +1,59 @@
+// A recorded session's modbus.log as a ModbusWire: the daemon's ModbusClient asks, the recording
+// answers, exchange by exchange. Asking for anything else (another register, another value
+// written) is a divergence: the code under replay no longer behaves as the recorded one.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "drivers/modbus/modbus_wire.hpp"
+#include "station/session/session_log.hpp"
+
+namespace station {
+
+/// The first request a replay could not answer from its recording.
+class ReplayDivergence : public std::runtime_error {
+ public:
+  ReplayDivergence(std::string device, std::string recorded, std::string asked, double t_s);
+  std::string device, recorded, asked;
+  double t_s;  ///< the recording's time at the point of divergence
+};
+
+/// One device's recorded exchanges (lines of modbus.log whose DEVICE is this device, in order).
+class RecordedModbusWire final : public drivers::modbus::ModbusWire {
+ public:
+  RecordedModbusWire(std::string device, std::vector<SessionLogLine> lines);
+  int open(double timeout_s) override;
+  void close() override;
+  int read(drivers::modbus::FunctionCode fc, int unit, std::uint16_t addr, int count,
+           std::uint16_t* dest) override;
+  int write(int unit, std::uint16_t addr, std::span<const std::uint16_t> words) override;
+  void flush() override {}
+  /// Exchanges not asked for yet (0 at the end of a faithful replay).
+  std::size_t remaining() const { return lines_.size() - next_; }
+
+ private:
+  /// The next line, which must be (direction, kind) and, when given, carry `bytes`; throws
+  /// ReplayDivergence otherwise.
+  const SessionLogLine& expect(const char* direction, const char* kind,
+                               const std::vector<std::uint8_t>* bytes, const std::string& asked);
+  /// After a request: its reply (rx → the reply's bytes, returns true) or its error (sets
+  /// errno, returns false).
+  bool reply(const char* kind, std::vector<std::uint8_t>& bytes, const std::string& asked);
+  const SessionLogLine* peek() const { return next_ < lines_.size() ? &lines_[next_] : nullptr; }
+
+  std::string device_;
+  std::vector<SessionLogLine> lines_;
+  std::size_t next_ = 0;
+};
+
+/// The request ADUs the client taps (drivers/modbus/modbus_client.cpp), rebuilt to compare.
+std::vector<std::uint8_t> read_request_adu(int unit, int fc, std::uint16_t addr, int count);
+std::vector<std::uint8_t> write_request_adu(int unit, std::uint16_t addr,
+                                            std::span<const std::uint16_t> words);
+
+}  // namespace station
