@@ -27,10 +27,12 @@ AlarmBits decode_alarms(unsigned bits) {
 }  // namespace
 
 ModbusChamber::ModbusChamber(std::string name, modbus::Endpoint endpoint, modbus::RegisterMap map,
-                             double response_timeout_s)
+                             double response_timeout_s, std::unique_ptr<modbus::ModbusWire> wire)
     : name_(std::move(name)),
       map_(std::move(map)),
-      client_(name_, std::move(endpoint), response_timeout_s) {
+      client_(name_, endpoint,
+              wire ? std::move(wire) : std::make_unique<modbus::LibmodbusWire>(endpoint),
+              response_timeout_s) {
   for (const char* p : {cm::kAir, cm::kProduct, cm::kStatus, cm::kAlarms, cm::kSetpoint, cm::kRamp,
                         cm::kSetpointLow, cm::kSetpointHigh, cm::kRun})
     (void)map_.at(p);  // throws naming the missing point

@@ -21,8 +21,11 @@ class ModbusChamber final : public Chamber {
 
   /// `name` for logs; `map` must define every chamber_map point (checked here, throws
   /// std::invalid_argument otherwise); `response_timeout_s` bounds each transaction.
+  /// `wire`: the link under the client (default: libmodbus to `endpoint`; replay passes a
+  /// recorded one).
   ModbusChamber(std::string name, modbus::Endpoint endpoint, modbus::RegisterMap map,
-                double response_timeout_s = 0.5);
+                double response_timeout_s = 0.5,
+                std::unique_ptr<modbus::ModbusWire> wire = nullptr);
 
   Result<void> connect() override;
   /// One block read per group of nearby points (same unit and function code, see

@@ -12,11 +12,14 @@ namespace tm = turntable_map;
 
 ModbusTurntable::ModbusTurntable(std::string name, modbus::Endpoint endpoint,
                                  modbus::RegisterMap map, TurntableLimits limits,
-                                 double response_timeout_s)
+                                 double response_timeout_s,
+                                 std::unique_ptr<modbus::ModbusWire> wire)
     : name_(std::move(name)),
       map_(std::move(map)),
       limits_(limits),
-      client_(name_, std::move(endpoint), response_timeout_s) {
+      client_(name_, endpoint,
+              wire ? std::move(wire) : std::make_unique<modbus::LibmodbusWire>(endpoint),
+              response_timeout_s) {
   for (const char* p : {tm::kModeDemand, tm::kPositionDemand, tm::kRateDemand, tm::kLock, tm::kStop,
                         tm::kAngle, tm::kRate, tm::kStatus, tm::kModeActual})
     (void)map_.at(p);

@@ -19,8 +19,10 @@ struct TurntableLimits {
 class ModbusTurntable final : public Turntable {
  public:
   /// `map` must define every turntable_map point (throws std::invalid_argument otherwise).
+  /// `wire`: the link under the client (default: libmodbus to `endpoint`).
   ModbusTurntable(std::string name, modbus::Endpoint endpoint, modbus::RegisterMap map,
-                  TurntableLimits limits = {}, double response_timeout_s = 0.5);
+                  TurntableLimits limits = {}, double response_timeout_s = 0.5,
+                  std::unique_ptr<modbus::ModbusWire> wire = nullptr);
 
   Result<void> connect() override;
   Result<TurntableState> read() override;
@@ -31,6 +33,8 @@ class ModbusTurntable final : public Turntable {
 
   /// Sets the tap every Modbus exchange passes (nullptr: none).
   void set_tap(Tap* tap) { client_.set_tap(tap); }
+  /// The underlying client (back-off clock, diagnostics).
+  modbus::ModbusClient& client() { return client_; }
 
  private:
   Result<void> check(const TurntableCommand& c) const;

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <filesystem>
 #include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -13,6 +14,7 @@
 #include "station/cli/commands.hpp"
 #include "station/config/config.hpp"
 #include "station/daemon/sample.hpp"
+#include "station/session/session_replay.hpp"
 #include "station/store/calibration.hpp"
 #include "station/store/fit_json.hpp"
 
@@ -22,18 +24,38 @@ namespace {
 namespace dr = station::drivers;
 namespace sc = station::compensation;
 
-struct ReplayOptions {
+struct ReplayCommandOptions {
   std::string log, db;
   std::int64_t run = 1;
   bool json = false;
+  double rtol = 0, atol = 0;
 };
+
+// `station replay DIR`: a whole session through the daemon (station/session/session_replay.*).
+int run_session_replay(const ReplayCommandOptions& o) {
+  station::ReplayOptions ro{o.log, o.db, o.rtol, o.atol};
+  const ReplayReport r = replay_session(ro);
+  if (o.json) {
+    std::cout << r.json().dump(2) << '\n';
+  } else if (r.same) {
+    fmt::print("{}: same ({} ticks, {} bins, {} events, {} fits)\n", o.log, r.ticks, r.bins,
+               r.events, r.fits);
+  } else {
+    fmt::print("{}: DIFFERS\n  first difference: {}\n", o.log, r.first_difference.dump());
+    for (const auto& [quantity, d] : r.max_abs_difference.items())
+      if (d.get<double>() > 0)
+        fmt::print("  max |difference| {}: {:.3e}\n", quantity, d.get<double>());
+    for (const auto& n : r.notes) fmt::print("  {}\n", n);
+  }
+  return r.same ? 0 : 1;
+}
 
 /// Per serial: the stored samples (tick times, record window, flags) of the run.
 using StoredSamples = std::map<std::string, std::vector<SampleRow>>;
 
 /// Re-derives every serial's samples from the log: rate and temperatures from the replayed
 /// driver, tick time / window / flags from the stored run.
-StoredSamples replay_samples(const ReplayOptions& o, const std::vector<RunSlot>& slots,
+StoredSamples replay_samples(const ReplayCommandOptions& o, const std::vector<RunSlot>& slots,
                              const StoredSamples& stored) {
   auto records = dr::can::read_candump_log(o.log);
   const auto syncs = dr::can::logged_syncs(records);
@@ -71,7 +93,7 @@ StoredSamples replay_samples(const ReplayOptions& o, const std::vector<RunSlot>&
   return out;
 }
 
-int run_replay(const ReplayOptions& o) {
+int run_replay(const ReplayCommandOptions& o) {
   Store store(o.db, OpenMode::read_only);
   const auto run = store.find_run(o.run);
   if (!run) throw InputError(fmt::format("{}: no run {}", o.db, o.run));
@@ -118,14 +140,29 @@ int run_replay(const ReplayOptions& o) {
 }  // namespace
 
 void add_replay_command(CLI::App& app, CommandStatus& status) {
-  auto o = std::make_shared<ReplayOptions>();
-  auto* cmd =
-      app.add_subcommand("replay", "Replay a run's recorded CAN log through the driver and refit");
-  cmd->add_option("log", o->log, "candump log written by run --record-can")->required();
-  cmd->add_option("--db", o->db, "the run's database")->required();
-  cmd->add_option("--run", o->run, "run id")->capture_default_str();
+  auto o = std::make_shared<ReplayCommandOptions>();
+  auto* cmd = app.add_subcommand(
+      "replay",
+      "Replay a recorded session directory through the daemon and compare with its result "
+      "(exit 0 same, 1 differs, 2 bad session); or a run's CAN log against its database");
+  cmd->add_option("source", o->log,
+                  "session directory (run --record DIR), or a candump log (run --record-can)")
+      ->required();
+  cmd->add_option("--db", o->db,
+                  "session: keep the replayed database in this new file; CAN log: the run's "
+                  "database");
+  cmd->add_option("--run", o->run, "CAN log: run id")->capture_default_str();
+  cmd->add_option("--rtol", o->rtol, "session: relative tolerance per value (default exact)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--atol", o->atol, "session: absolute tolerance per value (default exact)")
+      ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--json", o->json, "print one JSON object");
   cmd->callback([o, &status] {
+    if (std::filesystem::is_directory(o->log)) {
+      status.exit_code = run_session_replay(*o);
+      return;
+    }
+    if (o->db.empty()) throw InputError(o->log + ": a CAN log needs --db (the run's database)");
     try {
       status.exit_code = run_replay(*o);
     } catch (const std::runtime_error& e) {

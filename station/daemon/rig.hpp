@@ -5,11 +5,13 @@
 #include <functional>
 #include <memory>
 
+#include "drivers/can/can_transport.hpp"
 #include "drivers/chamber/chamber.hpp"
 #include "drivers/common/clock.hpp"
 #include "drivers/common/tap.hpp"
 #include "drivers/counters/counter_boards.hpp"
 #include "drivers/gpio/gpio_bank.hpp"
+#include "drivers/modbus/modbus_wire.hpp"
 #include "drivers/turntable/turntable.hpp"
 #include "station/config/config.hpp"
 
@@ -19,6 +21,12 @@ namespace station {
 using GpioFactory =
     std::function<std::unique_ptr<drivers::gpio::GpioBank>(const drivers::gpio::GpioConfig&)>;
 
+/// Makes the link under a Modbus device's client (default: libmodbus to the endpoint).
+using ModbusWireFactory = std::function<std::unique_ptr<drivers::modbus::ModbusWire>(
+    const std::string& device, const drivers::modbus::Endpoint& endpoint)>;
+/// Makes the counter boards' CAN transport (default: the configured one, reconnecting).
+using CanTransportFactory = std::function<std::unique_ptr<drivers::can::CanTransport>()>;
+
 /// How to build a rig.
 struct RigOptions {
   drivers::Tap* tap = nullptr;  ///< every exchange of every device passes here when set
@@ -26,6 +34,11 @@ struct RigOptions {
   /// Time of the links' reconnect back-off (nullptr: the steady clock; a simulation passes its
   /// clock so reconnects happen at the same simulated ticks every time). Not owned.
   const drivers::Clock* clock = nullptr;
+  ModbusWireFactory modbus_wire_factory;      ///< empty: libmodbus (replay: the recording)
+  CanTransportFactory can_transport_factory;  ///< empty: the config's transport
+  /// A replayed CAN log: a latch's answers end where the log's next SYNC begins, not at a
+  /// wall-clock deadline.
+  bool replayed_can = false;
 };
 
 /// The rig's devices. Turntable and GPIO are absent when the config has none.

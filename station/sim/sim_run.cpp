@@ -96,6 +96,8 @@ nlohmann::json run_simulated(const SimRunOptions& o) {
     if (!can_log) throw InputError(fmt::format("{}: cannot write the CAN log", o.record_can_path));
     ro.tap = &can_tap.emplace(can_log, "can0", run_now_s);
   }
+  // The links' reconnect back-off runs on the run's clock: a replay makes the same decisions.
+  ro.clock = &clock;
   auto chips = world.gpio_chips();
   ro.gpio_factory = [chips](const drivers::gpio::GpioConfig& g) {
     return std::make_unique<sim::GpioSimBank>(g, chips);

@@ -1,0 +1,112 @@
+// Answering the sequencer's GPIO calls from gpio.log (see replay_gpio.hpp).
+#include "station/session/replay_gpio.hpp"
+
+#include <fmt/format.h>
+#include <sys/eventfd.h>
+#include <unistd.h>
+
+#include "station/session/replay_modbus.hpp"
+
+namespace station {
+namespace {
+
+namespace dr = station::drivers;
+
+// The role a gpio.log line names ("role=interlock ..."), "" when none.
+std::string_view role_of(const SessionLogLine& l) {
+  std::string_view d = l.detail;
+  const auto at = d.find("role=");
+  if (at == std::string_view::npos) return {};
+  d.remove_prefix(at + 5);
+  return d.substr(0, d.find(' '));
+}
+
+std::string describe(const SessionLogLine& l) {
+  return fmt::format("line {}: {} {} {}", l.line_no, l.kind, role_of(l),
+                     l.bytes.empty() ? -1 : l.bytes[0]);
+}
+
+}  // namespace
+
+ReplayGpioBank::ReplayGpioBank(dr::gpio::GpioConfig config, std::vector<SessionLogLine> lines)
+    : config_(std::move(config)), lines_(std::move(lines)) {}
+
+const SessionLogLine& ReplayGpioBank::expect(const char* kind, std::string_view role,
+                                             const std::string& asked) {
+  if (next_ >= lines_.size()) throw ReplayDivergence("gpio", "no more exchanges", asked, 0);
+  const SessionLogLine& l = lines_[next_];
+  if (l.kind != kind || role_of(l) != role || l.bytes.size() != 1)
+    throw ReplayDivergence("gpio", describe(l), asked, l.t_s);
+  ++next_;
+  signal();
+  return l;
+}
+
+void ReplayGpioBank::signal() {
+  if (!efd_.valid()) return;
+  std::uint64_t v = 0;
+  (void)!::read(efd_.get(), &v, sizeof v);  // drain (non-blocking)
+  if (next_ < lines_.size() && lines_[next_].kind == "gpio-edge") {
+    const std::uint64_t one = 1;
+    (void)!::write(efd_.get(), &one, sizeof one);
+  }
+}
+
+dr::Result<void> ReplayGpioBank::open() {
+  efd_.reset(::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC));
+  open_ = true;
+  // Requesting the lines drove every output to its safe level, one write each.
+  for (const auto& line : config_.lines) {
+    if (line.direction != dr::gpio::GpioDirection::output) continue;
+    const auto& l = expect("gpio-write", line.role, "open: safe level of " + line.role);
+    if ((l.bytes[0] != 0) != line.safe_level)
+      throw ReplayDivergence("gpio", describe(l), "open: safe level of " + line.role, l.t_s);
+  }
+  signal();
+  return {};
+}
+
+dr::Result<bool> ReplayGpioBank::read(std::string_view role) {
+  return expect("gpio-read", role, fmt::format("read {}", role)).bytes[0] != 0;
+}
+
+dr::Result<void> ReplayGpioBank::write(std::string_view role, bool active) {
+  const std::string asked = fmt::format("write {} {}", role, active ? 1 : 0);
+  const auto& l = expect("gpio-write", role, asked);
+  if ((l.bytes[0] != 0) != active) throw ReplayDivergence("gpio", describe(l), asked, l.t_s);
+  return {};
+}
+
+dr::Result<void> ReplayGpioBank::apply_safe_state() {
+  for (const auto& line : config_.lines) {
+    if (line.direction == dr::gpio::GpioDirection::output) (void)write(line.role, line.safe_level);
+  }
+  return {};
+}
+
+void ReplayGpioBank::close() {
+  // Releasing the lines drove the outputs to their safe levels (the recording's last writes);
+  // taken when they are next, never thrown from here (a replay may have stopped early).
+  for (const auto& line : config_.lines) {
+    if (line.direction != dr::gpio::GpioDirection::output || next_ >= lines_.size()) continue;
+    const SessionLogLine& l = lines_[next_];
+    if (l.kind == "gpio-write" && role_of(l) == line.role) ++next_;
+  }
+  open_ = false;
+  efd_.reset();
+}
+
+dr::Result<std::vector<dr::gpio::GpioEdge>> ReplayGpioBank::read_events() {
+  std::vector<dr::gpio::GpioEdge> out;
+  while (next_ < lines_.size() && lines_[next_].kind == "gpio-edge") {
+    const SessionLogLine& l = lines_[next_++];
+    const auto* cfg = dr::gpio::find_role(config_, role_of(l));
+    if (cfg == nullptr || l.bytes.size() != 1)
+      throw ReplayDivergence("gpio", describe(l), "an edge of a configured line", l.t_s);
+    out.push_back({cfg->role, cfg->where(), l.bytes[0] != 0, l.t_s});
+  }
+  signal();
+  return out;
+}
+
+}  // namespace station

@@ -1,0 +1,42 @@
+// A recorded session's gpio.log as a GpioBank: reads answer what the lines read then, writes and
+// the drained edges must be the recorded ones (else a ReplayDivergence). Its event fd is readable
+// while the recording's next exchange is an edge, so a between-ticks wait (ReplayClock) sees it
+// where the live daemon did.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "drivers/can/unique_fd.hpp"
+#include "drivers/gpio/gpio_bank.hpp"
+#include "station/session/session_log.hpp"
+
+namespace station {
+
+class ReplayGpioBank final : public drivers::gpio::GpioBank {
+ public:
+  ReplayGpioBank(drivers::gpio::GpioConfig config, std::vector<SessionLogLine> lines);
+  drivers::Result<void> open() override;
+  drivers::Result<bool> read(std::string_view role) override;
+  drivers::Result<void> write(std::string_view role, bool active) override;
+  drivers::Result<void> apply_safe_state() override;
+  void close() override;
+  int event_fd() const override { return efd_.get(); }
+  drivers::Result<std::vector<drivers::gpio::GpioEdge>> read_events() override;
+  void set_tap(drivers::Tap*) override {}
+  const drivers::gpio::GpioConfig& config() const override { return config_; }
+  /// Exchanges not replayed yet.
+  std::size_t remaining() const { return lines_.size() - next_; }
+
+ private:
+  const SessionLogLine& expect(const char* kind, std::string_view role, const std::string& asked);
+  void signal();  ///< the event fd readable iff the next exchange is an edge
+
+  drivers::gpio::GpioConfig config_;
+  std::vector<SessionLogLine> lines_;
+  std::size_t next_ = 0;
+  drivers::can::UniqueFd efd_;
+  bool open_ = false;
+};
+
+}  // namespace station

@@ -1,0 +1,42 @@
+// `station replay DIR`: a recorded session (schemas/session.md) through the unchanged daemon —
+// sequencer, safety, protocol runner, store, binning, fit — with replay transports for every
+// device on a virtual clock (no sockets, no wall-clock waits, no original database), then
+// compared with the session's result.json sample by sample, bin by bin, event by event, fit by
+// fit.
+#pragma once
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <string>
+
+namespace station {
+
+struct ReplayOptions {
+  std::string dir;  ///< the session directory
+  std::string db;   ///< keep the replayed database here (must not exist); empty: a temp file
+  double rtol = 0;  ///< relative tolerance per value (0: exact)
+  double atol = 0;  ///< absolute tolerance per value (0: exact)
+};
+
+/// What a replay found.
+struct ReplayReport {
+  bool same = true;
+  std::int64_t ticks = 0, bins = 0, events = 0, fits = 0;  ///< in the replay
+  nlohmann::json first_difference;                         ///< null when same
+  nlohmann::json max_abs_difference;  ///< quantity -> largest |replayed - recorded|
+  std::vector<std::string> notes;     ///< the short report, one line each
+
+  /// {"verdict": "same"|"differs", "ticks", "bins", "first_difference", "max_abs_difference"}.
+  nlohmann::json json() const;
+};
+
+/// Replays `o.dir`. A bad session (unreadable, malformed, unknown format version) throws
+/// InputError naming the file and line; a divergence (the daemon asked what the recording does
+/// not hold) is a difference, reported with the tick, the device and both requests.
+ReplayReport replay_session(const ReplayOptions& o);
+
+/// Compares a replayed result with the recorded one (both as session_result_json writes them).
+ReplayReport compare_results(const nlohmann::json& recorded, const nlohmann::json& replayed,
+                             double rtol, double atol);
+
+}  // namespace station

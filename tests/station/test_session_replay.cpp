@@ -1,0 +1,189 @@
+// Issue 8, replay: a recorded session replays through the unchanged daemon to the same samples,
+// bins, events and fits; a changed recorded byte that changes a sample makes it differ (bytes
+// flipped at many positions, mid-bin included); a changed setpoint is a divergence naming both
+// requests; a bad session is one line naming the file.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "station/common/input_error.hpp"
+#include "station/session/session_replay.hpp"
+#include "station/sim/sim_run.hpp"
+#include "tests/station/temp_db.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::vector<std::string> read_lines(const fs::path& p) {
+  std::ifstream in(p);
+  std::vector<std::string> out;
+  for (std::string l; std::getline(in, l);) out.push_back(l);
+  return out;
+}
+
+void write_lines(const fs::path& p, const std::vector<std::string>& lines) {
+  std::ofstream out(p);
+  for (const auto& l : lines) out << l << '\n';
+}
+
+// A copy of the recorded session to tamper with.
+fs::path copy_of(const fs::path& session, const std::string& name) {
+  const fs::path d = session.string() + "." + name;
+  fs::remove_all(d);
+  fs::copy(session, d, fs::copy_options::recursive);
+  return d;
+}
+
+int run_station(const std::string& args, std::string& out) {
+  const std::string cmd = std::string(STATION_BINARY_DIR) + "/station/station " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::array<char, 4096> buf{};
+  std::size_t n = 0;
+  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) out.append(buf.data(), n);
+  const int raw = pclose(p);
+  return WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+}
+
+class SessionReplay : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    const auto db = station::testing_support::fresh_db("session_replay");
+    dir_ = new fs::path(db + ".session");
+    fs::remove_all(*dir_);
+    station::SimRunOptions o;
+    o.db_path = db;
+    o.protocol = std::string(STATION_TEST_DATA_DIR) + "/short_cycle.toml";
+    o.progress = false;
+    o.fresh = true;
+    o.gyros = 2;
+    o.record_dir = dir_->string();
+    station::run_simulated(o);
+  }
+  static void TearDownTestSuite() { delete dir_; }
+  static station::ReplayReport replay(const fs::path& d) {
+    return station::replay_session({d.string(), "", 0, 0});
+  }
+  static fs::path* dir_;
+};
+fs::path* SessionReplay::dir_ = nullptr;
+
+}  // namespace
+
+TEST_F(SessionReplay, AnUntouchedSessionReplaysTheSameEveryTime) {
+  for (int i = 0; i < 3; ++i) {
+    const auto r = replay(*dir_);
+    EXPECT_TRUE(r.same) << r.json().dump(1);
+    EXPECT_EQ(r.ticks, 8101);
+    EXPECT_GT(r.bins, 0);
+    EXPECT_EQ(r.fits, 2);
+    EXPECT_EQ(r.json()["verdict"], "same");
+  }
+}
+
+// Every COUNTS frame (ID 0x281/0x282) is a sample's rate: flipping one count byte anywhere —
+// mid-bin included, where the cumulative counts cancel in the bin mean — must be seen.
+TEST_F(SessionReplay, AFlippedCountByteAnywhereMakesTheReplayDiffer) {
+  const auto lines = read_lines(*dir_ / "can.log");
+  std::vector<std::size_t> counts;
+  for (std::size_t i = 0; i < lines.size(); ++i)
+    if (lines[i].find(" can0 281#") != std::string::npos) counts.push_back(i);
+  ASSERT_GT(counts.size(), 8000u);
+  std::mt19937 rng(7);
+  for (int trial = 0; trial < 6; ++trial) {
+    const std::size_t at = counts[rng() % counts.size()];
+    auto tampered = lines;
+    std::string& l = tampered[at];
+    const std::size_t data = l.find('#') + 1;
+    l[data] = l[data] == '0' ? '1' : '0';  // the low count byte's high nibble
+    const auto d = copy_of(*dir_, "flip");
+    write_lines(d / "can.log", tampered);
+    const auto r = replay(d);
+    EXPECT_FALSE(r.same) << "line " << at + 1 << ": " << l;
+    EXPECT_TRUE(r.first_difference.dump().find("tick") != std::string::npos)
+        << r.first_difference.dump();
+    EXPECT_GT(r.max_abs_difference.value("rate_dph", 0.0), 0.0) << r.json().dump(1);
+  }
+}
+
+// Another setpoint written than the recorded one: the daemon's behaviour changed.
+TEST_F(SessionReplay, ADifferentSetpointWrittenIsADivergenceNamingBothRequests) {
+  auto lines = read_lines(*dir_ / "modbus.log");
+  bool changed = false;
+  for (auto& l : lines) {
+    // The second setpoint write (40 C = 400 = 0x0190) becomes 41 C (0x019a) in the recording.
+    const auto at = l.find(" tx modbus-write 0106012c0190 ");
+    if (at == std::string::npos) continue;
+    l.replace(at, 30, " tx modbus-write 0106012c019a ");
+    changed = true;
+    break;
+  }
+  ASSERT_TRUE(changed);
+  const auto d = copy_of(*dir_, "setpoint");
+  write_lines(d / "modbus.log", lines);
+  const auto r = replay(d);
+  ASSERT_FALSE(r.same);
+  const auto& f = r.first_difference;
+  EXPECT_EQ(f["at"]["device"], "chamber") << f.dump();
+  EXPECT_NE(f["recorded"].get<std::string>().find("0106012c019a"), std::string::npos) << f.dump();
+  EXPECT_EQ(f["replayed"], "tx modbus-write 0106012c0190") << f.dump();
+}
+
+TEST_F(SessionReplay, ABadSessionIsOneLineNamingTheFile) {
+  const auto d = copy_of(*dir_, "bad");
+  auto header = read_lines(d / "session.toml");
+  for (auto& l : header)
+    if (l.rfind("format_version", 0) == 0) l = "format_version = 99";
+  write_lines(d / "session.toml", header);
+  try {
+    replay(d);
+    FAIL() << "accepted format_version 99";
+  } catch (const station::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("session.toml: key 'format_version': 99"),
+              std::string::npos)
+        << e.what();
+  }
+  const auto m = copy_of(*dir_, "badlog");
+  auto log = read_lines(m / "modbus.log");
+  log[2] = "not a line";
+  write_lines(m / "modbus.log", log);
+  try {
+    replay(m);
+    FAIL() << "accepted a malformed modbus.log";
+  } catch (const station::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("modbus.log:3: bad time 'not'"), std::string::npos)
+        << e.what();
+  }
+}
+
+TEST_F(SessionReplay, TheCommandExits0Same1Differs2BadSession) {
+  std::string out;
+  EXPECT_EQ(run_station("replay " + dir_->string() + " --json", out), 0) << out;
+  EXPECT_NE(out.find("\"verdict\": \"same\""), std::string::npos) << out;
+  const auto d = copy_of(*dir_, "cli");
+  auto lines = read_lines(d / "can.log");
+  for (std::size_t i = lines.size() / 2; i < lines.size(); ++i) {
+    const auto at = lines[i].find(" can0 282#");
+    if (at == std::string::npos) continue;
+    char& c = lines[i][at + 10];
+    c = c == '0' ? '1' : '0';
+    break;
+  }
+  write_lines(d / "can.log", lines);
+  out.clear();
+  EXPECT_EQ(run_station("replay " + d.string(), out), 1) << out;
+  EXPECT_NE(out.find("DIFFERS"), std::string::npos) << out;
+  EXPECT_NE(out.find("rate_dph"), std::string::npos) << out;
+  fs::remove(d / "result.json");
+  out.clear();
+  EXPECT_EQ(run_station("replay " + d.string(), out), 2) << out;
+  EXPECT_NE(out.find("result.json: cannot open"), std::string::npos) << out;
+}
