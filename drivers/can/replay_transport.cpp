@@ -22,6 +22,7 @@ Result<void> ReplayCanTransport::send(const can_frame& frame) {
   for (std::size_t i = cursor_; i < records_.size(); ++i) {
     if (is_sync(records_[i].frame) && records_[i].frame.data[0] == frame.data[0]) {
       cursor_ = i + 1;
+      ++syncs_sent_;
       return {};
     }
   }

@@ -22,10 +22,13 @@ class ReplayCanTransport final : public CanTransport {
   Result<can_frame> receive(std::chrono::milliseconds timeout) override;
   int fd() const override { return -1; }
   double last_rx_time_s() const override { return last_rx_time_s_; }
+  /// SYNC frames sent so far (ticks the replay has started).
+  std::size_t syncs_sent() const { return syncs_sent_; }
 
  private:
   std::vector<CandumpRecord> records_;
   std::size_t cursor_ = 0;
+  std::size_t syncs_sent_ = 0;
   double last_rx_time_s_ = 0;
 };
 

@@ -12,6 +12,7 @@
 #include "drivers/can/replay_transport.hpp"
 #include "drivers/counters/counter_boards.hpp"
 #include "station/cli/commands.hpp"
+#include "station/common/logging.hpp"
 #include "station/config/config.hpp"
 #include "station/daemon/sample.hpp"
 #include "station/session/session_replay.hpp"
@@ -159,6 +160,9 @@ void add_replay_command(CLI::App& app, CommandStatus& status) {
   cmd->add_flag("--json", o->json, "print one JSON object");
   cmd->callback([o, &status] {
     if (std::filesystem::is_directory(o->log)) {
+      LogOptions lo;  // the replayed daemon's info lines are the recording's, not news
+      lo.console_level = spdlog::level::warn;
+      setup_logging(lo);
       status.exit_code = run_session_replay(*o);
       return;
     }

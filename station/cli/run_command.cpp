@@ -5,6 +5,7 @@
 #include <systemd/sd-daemon.h>
 
 #include <atomic>
+#include <cmath>
 #include <csignal>
 #include <cstdlib>
 #include <filesystem>
@@ -44,6 +45,7 @@ void install_signal_handlers() {
 struct RunOptions {
   bool sim = false, json = false, fresh = false;
   std::string config, protocol = "paper", db, operator_name, log_file, record_can, record;
+  std::vector<std::string> faults;  ///< --sim: "T:COMMAND"
   int gyros = 4;
   std::uint64_t seed = 1;
   double latitude_deg = 39.9;
@@ -148,6 +150,17 @@ int run_sim(const RunOptions& o) {
   so.stop = &g_stop;
   so.record_can_path = o.record_can;
   so.record_dir = o.record;
+  for (const auto& f : o.faults) {
+    const auto colon = f.find(':');
+    double at_s = -1;
+    try {
+      at_s = colon == std::string::npos ? -1 : std::stod(f.substr(0, colon));
+    } catch (const std::exception&) {
+    }
+    if (!(at_s >= 0) || std::floor(at_s) != at_s || colon + 1 >= f.size())
+      throw InputError(fmt::format("--fault '{}': expected TICK:COMMAND, e.g. 3000:door open", f));
+    so.faults.emplace_back(at_s, f.substr(colon + 1));
+  }
   const auto report = run_simulated(so);
   if (o.json) {
     std::cout << report.dump(2) << '\n';
@@ -183,6 +196,9 @@ void add_run_command(CLI::App& app, CommandStatus& status) {
   cmd->add_option("--record-can", o->record_can,
                   "write only the CAN frames, in can-utils' candump format, to this file")
       ->excludes(record);
+  cmd->add_option("--fault", o->faults,
+                  "--sim: at tick T (s) inject a simrig fault command, T:COMMAND "
+                  "(docs/SIMRIG.md), e.g. '3000:door open'; repeatable");
   cmd->add_flag("--json", o->json, "print one JSON object at the end (--sim)");
   cmd->callback([o, &status] {
     LogOptions lo;

@@ -5,6 +5,8 @@
 #include <sys/eventfd.h>
 #include <unistd.h>
 
+#include <algorithm>
+
 #include "station/session/replay_modbus.hpp"
 
 namespace station {
@@ -28,8 +30,13 @@ std::string describe(const SessionLogLine& l) {
 
 }  // namespace
 
-ReplayGpioBank::ReplayGpioBank(dr::gpio::GpioConfig config, std::vector<SessionLogLine> lines)
-    : config_(std::move(config)), lines_(std::move(lines)) {}
+ReplayGpioBank::ReplayGpioBank(dr::gpio::GpioConfig config, std::vector<SessionLogLine> lines,
+                               std::vector<double> sync_times_s,
+                               std::function<std::size_t()> syncs_sent)
+    : config_(std::move(config)),
+      lines_(std::move(lines)),
+      sync_times_s_(std::move(sync_times_s)),
+      syncs_sent_(std::move(syncs_sent)) {}
 
 const SessionLogLine& ReplayGpioBank::expect(const char* kind, std::string_view role,
                                              const std::string& asked) {
@@ -46,7 +53,15 @@ void ReplayGpioBank::signal() {
   if (!efd_.valid()) return;
   std::uint64_t v = 0;
   (void)!::read(efd_.get(), &v, sizeof v);  // drain (non-blocking)
-  if (next_ < lines_.size() && lines_[next_].kind == "gpio-edge") {
+  // The next exchange is an edge drained between ticks when no more SYNCs preceded it than the
+  // replay has sent: a tick's own drain comes after that tick's SYNC. (Stamps: SYNCs truncated
+  // to the microsecond, session lines rounded, so one instant never orders an edge first.)
+  const auto before_edge = [this](double t_s) {
+    return static_cast<std::size_t>(
+        std::upper_bound(sync_times_s_.begin(), sync_times_s_.end(), t_s) - sync_times_s_.begin());
+  };
+  if (next_ < lines_.size() && lines_[next_].kind == "gpio-edge" &&
+      before_edge(lines_[next_].t_s) <= (syncs_sent_ ? syncs_sent_() : 0)) {
     const std::uint64_t one = 1;
     (void)!::write(efd_.get(), &one, sizeof one);
   }

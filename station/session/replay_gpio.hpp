@@ -4,6 +4,7 @@
 // where the live daemon did.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -15,7 +16,11 @@ namespace station {
 
 class ReplayGpioBank final : public drivers::gpio::GpioBank {
  public:
-  ReplayGpioBank(drivers::gpio::GpioConfig config, std::vector<SessionLogLine> lines);
+  /// `sync_times_s`: the stamps of the recording's SYNC frames (ticks), and `syncs_sent` how
+  /// many the replay has sent: an edge is offered between ticks only when the recording drained
+  /// it before the next tick's SYNC.
+  ReplayGpioBank(drivers::gpio::GpioConfig config, std::vector<SessionLogLine> lines,
+                 std::vector<double> sync_times_s, std::function<std::size_t()> syncs_sent);
   drivers::Result<void> open() override;
   drivers::Result<bool> read(std::string_view role) override;
   drivers::Result<void> write(std::string_view role, bool active) override;
@@ -37,6 +42,8 @@ class ReplayGpioBank final : public drivers::gpio::GpioBank {
   std::size_t next_ = 0;
   drivers::can::UniqueFd efd_;
   bool open_ = false;
+  std::vector<double> sync_times_s_;
+  std::function<std::size_t()> syncs_sent_;
 };
 
 }  // namespace station

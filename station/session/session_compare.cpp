@@ -44,9 +44,11 @@ struct Comparer {
 
 // "run 7 completed" and "run 1 completed" say the same: the replay's database numbers its run
 // afresh.
+// Likewise the database a message names ("f.db: serial ...") is the replay's own.
 std::string without_run_ids(const std::string& message) {
   static const std::regex run_id(R"(\brun \d+\b)");
-  return std::regex_replace(message, run_id, "run #");
+  static const std::regex db_path(R"(\S+\.db\b)");
+  return std::regex_replace(std::regex_replace(message, run_id, "run #"), db_path, "DB");
 }
 
 void compare_ticks(Comparer& c, const json& rec, const json& rep) {

@@ -73,24 +73,20 @@ dr::Result<SessionLogLine> parse_session_line(std::string_view line) {
   return out;
 }
 
-std::vector<SessionLogLine> read_session_log(const std::string& path) {
+std::string for_each_line(const std::string& path,
+                          const std::function<void(const std::string&, int)>& each) {
   std::string file = path;
   if (!std::filesystem::exists(file) && std::filesystem::exists(path + ".gz")) file = path + ".gz";
   // zlib reads a file that is not gzip-compressed as it is.
   GzHandle in(gzopen(file.c_str(), "rb"));
   if (!in) throw InputError(fmt::format("{}: cannot open the session log", file));
-  std::vector<SessionLogLine> out;
   std::string line;
   char buf[4096];
   int line_no = 0;
   const auto take = [&] {
     ++line_no;
     if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.empty()) return;
-    auto parsed = parse_session_line(line);
-    if (!parsed) throw InputError(fmt::format("{}:{}: {}", file, line_no, parsed.error().message));
-    parsed.value().line_no = line_no;
-    out.push_back(std::move(parsed).value());
+    if (!line.empty()) each(line, line_no);
   };
   while (gzgets(in.get(), buf, sizeof buf) != nullptr) {
     line += buf;
@@ -104,6 +100,37 @@ std::vector<SessionLogLine> read_session_log(const std::string& path) {
   if (err != Z_OK && err != Z_STREAM_END)
     throw InputError(fmt::format("{}:{}: corrupt compressed data", file, line_no + 1));
   if (!line.empty()) take();
+  return file;
+}
+
+std::vector<SessionLogLine> read_session_log(const std::string& path) {
+  std::vector<SessionLogLine> out;
+  std::string file = path;
+  file = for_each_line(path, [&](const std::string& line, int line_no) {
+    auto parsed = parse_session_line(line);
+    if (!parsed) {
+      const bool gz = !std::filesystem::exists(path);
+      throw InputError(
+          fmt::format("{}{}:{}: {}", path, gz ? ".gz" : "", line_no, parsed.error().message));
+    }
+    parsed.value().line_no = line_no;
+    out.push_back(std::move(parsed).value());
+  });
+  return out;
+}
+
+std::vector<drivers::can::CandumpRecord> read_session_can_log(const std::string& path) {
+  std::vector<drivers::can::CandumpRecord> out;
+  for_each_line(path, [&](const std::string& line, int line_no) {
+    if (line.find_first_not_of(" \t") == std::string::npos) return;
+    auto r = drivers::can::parse_candump_line(line);
+    if (!r) {
+      const bool gz = !std::filesystem::exists(path);
+      throw InputError(
+          fmt::format("{}{}:{}: {}", path, gz ? ".gz" : "", line_no, r.error().message));
+    }
+    out.push_back(std::move(r).value());
+  });
   return out;
 }
 

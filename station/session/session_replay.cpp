@@ -81,16 +81,17 @@ struct ReplayRig {
   std::map<std::string, std::vector<SessionLogLine>> modbus;  ///< by device
   std::vector<SessionLogLine> gpio;
   std::vector<dr::can::CandumpRecord> can;
+  std::vector<double> sync_times_s;
+  const dr::can::ReplayCanTransport* can_transport = nullptr;
 
   explicit ReplayRig(const std::string& dir) {
     for (auto& l : read_session_log((fs::path(dir) / "modbus.log").string()))
       modbus[l.device].push_back(std::move(l));
     gpio = read_session_log((fs::path(dir) / "gpio.log").string());
-    try {
-      can = dr::can::read_candump_log((fs::path(dir) / "can.log").string());
-    } catch (const std::runtime_error& e) {
-      throw InputError(e.what());  // "path:line: what"
-    }
+    can = read_session_can_log((fs::path(dir) / "can.log").string());
+    for (const auto& r : can)
+      if ((r.frame.can_id & CAN_EFF_MASK) == 0x080)  // SYNC (schemas/can_frames.md)
+        sync_times_s.push_back(static_cast<double>(r.time_sec) + 1e-6 * r.time_usec);
   }
   RigOptions options(const dr::Clock& clock) {
     RigOptions o;
@@ -98,10 +99,16 @@ struct ReplayRig {
     o.modbus_wire_factory = [this](const std::string& device, const dr::modbus::Endpoint&) {
       return std::make_unique<RecordedModbusWire>(device, modbus[device]);
     };
-    o.can_transport_factory = [this] { return std::make_unique<dr::can::ReplayCanTransport>(can); };
+    o.can_transport_factory = [this] {
+      auto t = std::make_unique<dr::can::ReplayCanTransport>(can);
+      can_transport = t.get();
+      return t;
+    };
     o.replayed_can = true;
     o.gpio_factory = [this](const dr::gpio::GpioConfig& g) {
-      return std::make_unique<ReplayGpioBank>(g, gpio);
+      return std::make_unique<ReplayGpioBank>(g, gpio, sync_times_s, [this] {
+        return can_transport != nullptr ? can_transport->syncs_sent() : std::size_t{0};
+      });
     };
     return o;
   }
@@ -112,15 +119,16 @@ struct ReplayRig {
 ReplayReport replay_session(const ReplayOptions& o) {
   const Session session = read_header(o.dir);
   const std::string result_path = (fs::path(o.dir) / "result.json").string();
+  if (!fs::exists(result_path) && !fs::exists(result_path + ".gz"))
+    throw InputError(fmt::format("{}: cannot open (the run did not end?)", result_path));
+  std::string text;
+  const std::string read_from =
+      for_each_line(result_path, [&text](const std::string& line, int) { text += line + '\n'; });
   nlohmann::json recorded;
-  {
-    std::ifstream in(result_path);
-    if (!in) throw InputError(fmt::format("{}: cannot open (the run did not end?)", result_path));
-    try {
-      recorded = nlohmann::json::parse(in);
-    } catch (const nlohmann::json::parse_error& e) {
-      throw InputError(fmt::format("{}: byte {}: not JSON", result_path, e.byte));
-    }
+  try {
+    recorded = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InputError(fmt::format("{}: byte {}: not JSON", read_from, e.byte));
   }
   ReplayRig devices(o.dir);
   ReplayClock clock;

@@ -8,6 +8,7 @@
 
 #include "compensation/earth_rate.hpp"
 #include "drivers/can/candump_log.hpp"
+#include "sim_devices/fault_commands.hpp"
 #include "sim_devices/gpio_sim.hpp"
 #include "sim_devices/sim_clock.hpp"
 #include "sim_devices/sim_world.hpp"
@@ -125,6 +126,12 @@ nlohmann::json run_simulated(const SimRunOptions& o) {
   so.before_tick = [&world, &o, &session, replay_until = so.replay_until_t_s](double t_s) {
     if (session) session->tap().pause(replay_until && t_s <= *replay_until);
     world.advance_to(t_s);
+    for (const auto& [at_s, command] : o.faults) {
+      if (at_s != t_s) continue;
+      const std::string reply = sim::run_fault_command(world, command);
+      if (reply.rfind("ok", 0) != 0)
+        throw InputError(fmt::format("--fault {:.0f}:{}: {}", at_s, command, reply));
+    }
     if (o.on_world_tick) o.on_world_tick(t_s, world);
   };
   const double nominal_s = protocol.nominal_duration_s(wc.initial_c);

@@ -8,6 +8,8 @@
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace station::sim {
 class SimWorld;
@@ -27,6 +29,9 @@ struct SimRunOptions {
   bool wall_clock = false;         ///< run at 1 Hz on CLOCK_MONOTONIC instead of simulated time
   std::string record_can_path;     ///< write every CAN frame in candump format here (empty: no)
   std::string record_dir;          ///< record the session in this directory (empty: no)
+  /// Faults injected into the simulated rig: at tick t_s (after the world advanced to it), the
+  /// simrig control command (docs/SIMRIG.md), e.g. {3000, "door open"}. In time order.
+  std::vector<std::pair<double, std::string>> faults;
   const std::atomic<bool>* stop = nullptr;
   /// Test hook: called with each tick's time and the world, after it advanced (fault injection).
   std::function<void(double t_s, sim::SimWorld& world)> on_world_tick;

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Re-records the shipped sessions (tests/sessions/*/) with the simulated rig, for when the
+# station's behaviour changed on purpose: `tests/sessions/record.sh build/station/station`.
+# Each session is the protocol session_cycle.toml on one simulated gyro (seed 1), with faults
+# injected at fixed ticks; logs and result are gzip-compressed (read as .gz transparently).
+set -euo pipefail
+station=${1:?usage: record.sh PATH/TO/station}
+here=$(cd "$(dirname "$0")" && pwd)
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+record() {
+  local name=$1
+  shift
+  rm -rf "${here:?}/$name"
+  "$station" run --sim --new --gyros 1 --seed 1 --db "$tmp/$name.db" \
+    --protocol "$here/session_cycle.toml" --record "$here/$name" "$@" >/dev/null
+  gzip -9 -n "$here/$name"/*.log "$here/$name/result.json"
+  "$station" replay "$here/$name"
+}
+record happy_cycle
+# The door opens mid-record: safe hold (gyro power off, amber), closes a minute later.
+record door_mid_record --fault "1800:door open" --fault "1860:door close"
+# A chamber that stops answering for 2 s of wall time, CAN frames lost and sent twice, the
+# turntable dropping its connections once.
+record link_faults --fault "1500:chamber stall 2" --fault "2000:can drop 3" \
+  --fault "2300:can duplicate 5" --fault "2600:table disconnect"
