@@ -97,16 +97,17 @@ struct ReplayRig {
     RigOptions o;
     o.clock = &clock;
     o.modbus_wire_factory = [this](const std::string& device, const dr::modbus::Endpoint&) {
-      return std::make_unique<RecordedModbusWire>(device, modbus[device]);
+      // Each factory runs once per device: the recording moves into its transport.
+      return std::make_unique<RecordedModbusWire>(device, std::move(modbus[device]));
     };
     o.can_transport_factory = [this] {
-      auto t = std::make_unique<dr::can::ReplayCanTransport>(can);
+      auto t = std::make_unique<dr::can::ReplayCanTransport>(std::move(can));
       can_transport = t.get();
       return t;
     };
     o.replayed_can = true;
     o.gpio_factory = [this](const dr::gpio::GpioConfig& g) {
-      return std::make_unique<ReplayGpioBank>(g, gpio, sync_times_s, [this] {
+      return std::make_unique<ReplayGpioBank>(g, std::move(gpio), sync_times_s, [this] {
         return can_transport != nullptr ? can_transport->syncs_sent() : std::size_t{0};
       });
     };
