@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -21,32 +22,55 @@ json or_null(const std::optional<T>& v) {
   return v ? json(*v) : json(nullptr);
 }
 
-json sample_json(const SampleRow& r) {
-  return {{"serial", r.serial},
-          {"net_pulses", or_null(r.net_pulses)},
-          {"interval_s", or_null(r.interval_s)},
-          {"rate_dph", or_null(r.rate_dph)},
-          {"temp_c", or_null(r.temp_c)},
-          {"temp2_c", or_null(r.temp2_c)},
-          {"air_c", or_null(r.air_c)},
-          {"setpoint_c", or_null(r.setpoint_c)},
-          {"flags", r.flags},
-          {"recording", r.recording}};
+}  // namespace
+
+const std::vector<std::string>& sample_columns() {
+  static const std::vector<std::string> columns{"serial", "net_pulses", "interval_s", "rate_dph",
+                                                "temp_c", "temp2_c",    "air_c",      "setpoint_c",
+                                                "flags",  "recording"};
+  return columns;
 }
 
-json ticks_json(Store& store, std::int64_t run_id, const std::vector<RunSlot>& slots) {
-  std::map<double, json> by_tick;
-  for (const auto& slot : slots) {
-    for (const auto& r : store.samples(run_id, slot.serial, false)) {
-      auto& t = by_tick[r.t_s];
-      if (t.is_null()) t = {{"t_s", r.t_s}, {"samples", json::array()}};
-      t["samples"].push_back(sample_json(r));
-    }
-  }
-  json out = json::array();
-  for (auto& [t_s, tick] : by_tick) out.push_back(std::move(tick));
-  return out;
+json sample_row_json(const SampleRow& r) {
+  return json::array({r.serial, or_null(r.net_pulses), or_null(r.interval_s), or_null(r.rate_dph),
+                      or_null(r.temp_c), or_null(r.temp2_c), or_null(r.air_c),
+                      or_null(r.setpoint_c), r.flags, r.recording});
 }
+
+TickCursor::TickCursor(Store& store, std::int64_t run_id) {
+  for (const auto& slot : store.run_slots(run_id))
+    by_slot_.push_back(store.samples(run_id, slot.serial, false));
+  next_.assign(by_slot_.size(), 0);
+}
+
+bool TickCursor::next(double& t_s, std::vector<const SampleRow*>& rows) {
+  // A merge of the slots' series (each sorted by t_s); slot order within a tick.
+  t_s = INFINITY;
+  for (std::size_t k = 0; k < by_slot_.size(); ++k)
+    if (next_[k] < by_slot_[k].size()) t_s = std::min(t_s, by_slot_[k][next_[k]].t_s);
+  if (!std::isfinite(t_s)) return false;
+  rows.clear();
+  for (std::size_t k = 0; k < by_slot_.size(); ++k)
+    if (next_[k] < by_slot_[k].size() && by_slot_[k][next_[k]].t_s == t_s)
+      rows.push_back(&by_slot_[k][next_[k]++]);
+  return true;
+}
+
+void for_each_tick(Store& store, std::int64_t run_id,
+                   const std::function<void(double, const std::vector<const SampleRow*>&)>& each) {
+  TickCursor cursor(store, run_id);
+  double t_s = 0;
+  std::vector<const SampleRow*> rows;
+  while (cursor.next(t_s, rows)) each(t_s, rows);
+}
+
+json tick_json(double t_s, const std::vector<const SampleRow*>& rows) {
+  json tick = json::array({t_s});
+  for (const auto* r : rows) tick.push_back(sample_row_json(*r));
+  return tick;
+}
+
+namespace {
 
 json bins_json(Store& store, std::int64_t run_id, const std::vector<RunSlot>& slots) {
   json out = json::array();
@@ -120,13 +144,23 @@ void write_session_header(const std::string& dir, const SessionHeader& h) {
   if (!out) throw InputError(fmt::format("{}: cannot write the session header", path.string()));
 }
 
-json session_result_json(Store& store, std::int64_t run_id) {
+json session_result_head_json(Store& store, std::int64_t run_id) {
   const auto run = store.find_run(run_id);
   const auto slots = store.run_slots(run_id);
   return {{"format_version", kSessionFormatVersion},   {"run_id", run_id},
-          {"state", run ? run->state : std::string()}, {"ticks", ticks_json(store, run_id, slots)},
+          {"state", run ? run->state : std::string()}, {"sample_columns", sample_columns()},
           {"bins", bins_json(store, run_id, slots)},   {"events", events_json(store, run_id)},
           {"fits", fits_json(store, run_id, slots)}};
+}
+
+json session_result_json(Store& store, std::int64_t run_id) {
+  json out = session_result_head_json(store, run_id);
+  json ticks = json::array();
+  for_each_tick(store, run_id, [&ticks](double t_s, const std::vector<const SampleRow*>& rows) {
+    ticks.push_back(tick_json(t_s, rows));
+  });
+  out["ticks"] = std::move(ticks);
+  return out;
 }
 
 void write_session_result(Store& store, std::int64_t run_id, const std::string& dir) {
@@ -134,7 +168,19 @@ void write_session_result(Store& store, std::int64_t run_id, const std::string& 
   const auto tmp = std::filesystem::path(dir) / "result.json.tmp";
   {
     std::ofstream out(tmp);
-    out << session_result_json(store, run_id).dump(1) << '\n';
+    // The head (state, bins, events, fits) first, then one line per tick: greppable, diffable,
+    // and read tick by tick by the replay.
+    const json head = session_result_head_json(store, run_id);
+    out << "{\n";
+    for (const auto& [key, value] : head.items())
+      out << fmt::format(" \"{}\": {},\n", key, value.dump(1));
+    out << " \"ticks\": [";
+    const char* sep = "\n  ";
+    for_each_tick(store, run_id, [&](double t_s, const std::vector<const SampleRow*>& rows) {
+      out << sep << tick_json(t_s, rows).dump();
+      sep = ",\n  ";
+    });
+    out << "\n ]\n}\n";
     if (!out) throw InputError(fmt::format("{}: cannot write the session result", tmp.string()));
   }
   std::filesystem::rename(tmp, path);  // whole or not at all

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -13,7 +14,7 @@
 namespace station {
 
 /// The session format's version (schemas/session.md, "Versions").
-inline constexpr int kSessionFormatVersion = 1;
+inline constexpr int kSessionFormatVersion = 2;
 
 /// What session.toml holds.
 struct SessionHeader {
@@ -34,6 +35,36 @@ void write_session_header(const std::string& dir, const SessionHeader& header);
 /// What run `run_id` stored, as result.json holds it: every tick's samples, every bin, every
 /// event and every fit of the run.
 nlohmann::json session_result_json(Store& store, std::int64_t run_id);
+
+/// result.json without its ticks: format_version, run_id, state, sample_columns, bins, events,
+/// fits.
+nlohmann::json session_result_head_json(Store& store, std::int64_t run_id);
+
+/// The names of a tick's sample rows' columns, in order (result.json "sample_columns").
+const std::vector<std::string>& sample_columns();
+
+/// One stored sample as result.json keeps it: an array in sample_columns() order.
+nlohmann::json sample_row_json(const SampleRow& r);
+
+/// The run's stored ticks one at a time, in time order, with the samples of a tick in slot order.
+class TickCursor {
+ public:
+  TickCursor(Store& store, std::int64_t run_id);
+  /// The next tick's time and samples (pointers valid while the cursor lives); false at the end.
+  bool next(double& t_s, std::vector<const SampleRow*>& rows);
+
+ private:
+  std::vector<std::vector<SampleRow>> by_slot_;
+  std::vector<std::size_t> next_;
+};
+
+/// Calls `each(t_s, rows)` for every tick of the run in time order, with the stored samples of
+/// that tick in slot order.
+void for_each_tick(Store& store, std::int64_t run_id,
+                   const std::function<void(double, const std::vector<const SampleRow*>&)>& each);
+
+/// One tick as result.json keeps it: [t_s, row, row, ...].
+nlohmann::json tick_json(double t_s, const std::vector<const SampleRow*>& rows);
 
 /// Writes session_result_json to `dir`/result.json (replacing it). Throws InputError.
 void write_session_result(Store& store, std::int64_t run_id, const std::string& dir);

@@ -74,39 +74,44 @@ dr::Result<SessionLogLine> parse_session_line(std::string_view line) {
 }
 
 std::string for_each_line(const std::string& path,
-                          const std::function<void(const std::string&, int)>& each) {
+                          const std::function<void(std::string_view, int)>& each) {
   std::string file = path;
   if (!std::filesystem::exists(file) && std::filesystem::exists(path + ".gz")) file = path + ".gz";
   // zlib reads a file that is not gzip-compressed as it is.
   GzHandle in(gzopen(file.c_str(), "rb"));
   if (!in) throw InputError(fmt::format("{}: cannot open the session log", file));
-  std::string line;
-  char buf[4096];
+  gzbuffer(in.get(), 1 << 20);
+  // Large reads, lines split in place: a session log has millions of lines.
+  std::string buf;
+  std::size_t begin = 0;  // first byte of buf not yet handed out
   int line_no = 0;
-  const auto take = [&] {
+  const auto take = [&](std::string_view line) {
     ++line_no;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
     if (!line.empty()) each(line, line_no);
   };
-  while (gzgets(in.get(), buf, sizeof buf) != nullptr) {
-    line += buf;
-    if (line.back() != '\n') continue;  // a line longer than the buffer: read on
-    line.pop_back();
-    take();
-    line.clear();
+  constexpr std::size_t kChunk = 1 << 20;
+  for (;;) {
+    buf.erase(0, begin);
+    begin = 0;
+    const std::size_t had = buf.size();
+    buf.resize(had + kChunk);
+    const int n = gzread(in.get(), buf.data() + had, static_cast<unsigned>(kChunk));
+    buf.resize(had + static_cast<std::size_t>(std::max(n, 0)));
+    if (n <= 0) break;
+    for (std::size_t nl; (nl = buf.find('\n', begin)) != std::string::npos; begin = nl + 1)
+      take(std::string_view(buf).substr(begin, nl - begin));
   }
   int err = Z_OK;
   gzerror(in.get(), &err);
   if (err != Z_OK && err != Z_STREAM_END)
     throw InputError(fmt::format("{}:{}: corrupt compressed data", file, line_no + 1));
-  if (!line.empty()) take();
+  if (begin < buf.size()) take(std::string_view(buf).substr(begin));
   return file;
 }
 
-std::vector<SessionLogLine> read_session_log(const std::string& path) {
-  std::vector<SessionLogLine> out;
-  std::string file = path;
-  file = for_each_line(path, [&](const std::string& line, int line_no) {
+void read_session_log(const std::string& path, const std::function<void(SessionLogLine&&)>& each) {
+  const std::string file = for_each_line(path, [&](std::string_view line, int line_no) {
     auto parsed = parse_session_line(line);
     if (!parsed) {
       const bool gz = !std::filesystem::exists(path);
@@ -114,14 +119,19 @@ std::vector<SessionLogLine> read_session_log(const std::string& path) {
           fmt::format("{}{}:{}: {}", path, gz ? ".gz" : "", line_no, parsed.error().message));
     }
     parsed.value().line_no = line_no;
-    out.push_back(std::move(parsed).value());
+    each(std::move(parsed).value());
   });
+}
+
+std::vector<SessionLogLine> read_session_log(const std::string& path) {
+  std::vector<SessionLogLine> out;
+  read_session_log(path, [&out](SessionLogLine&& l) { out.push_back(std::move(l)); });
   return out;
 }
 
 std::vector<drivers::can::CandumpRecord> read_session_can_log(const std::string& path) {
   std::vector<drivers::can::CandumpRecord> out;
-  for_each_line(path, [&](const std::string& line, int line_no) {
+  for_each_line(path, [&](std::string_view line, int line_no) {
     if (line.find_first_not_of(" \t") == std::string::npos) return;
     auto r = drivers::can::parse_candump_line(line);
     if (!r) {

@@ -30,7 +30,7 @@ drivers::Result<SessionLogLine> parse_session_line(std::string_view line);
 /// read through zlib (a plain file reads as it is); returns the file actually read. Throws
 /// InputError naming the file when it cannot be read or its compressed data is corrupt.
 std::string for_each_line(const std::string& path,
-                          const std::function<void(const std::string&, int)>& line);
+                          const std::function<void(std::string_view, int)>& line);
 
 /// Every CAN frame of a session's can.log (or can.log.gz); throws InputError "path:line: what".
 std::vector<drivers::can::CandumpRecord> read_session_can_log(const std::string& path);
@@ -38,5 +38,8 @@ std::vector<drivers::can::CandumpRecord> read_session_can_log(const std::string&
 /// Every line of a log file (`path`, or `path`.gz read through zlib when only that exists);
 /// throws InputError "path:line: what" on a malformed line or an unreadable file.
 std::vector<SessionLogLine> read_session_log(const std::string& path);
+
+/// The same, one line at a time (nothing held).
+void read_session_log(const std::string& path, const std::function<void(SessionLogLine&&)>& each);
 
 }  // namespace station

@@ -8,6 +8,7 @@
 #include <atomic>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <map>
 
 #include "drivers/can/candump_log.hpp"
@@ -85,10 +86,18 @@ struct ReplayRig {
   const dr::can::ReplayCanTransport* can_transport = nullptr;
 
   explicit ReplayRig(const std::string& dir) {
-    for (auto& l : read_session_log((fs::path(dir) / "modbus.log").string()))
-      modbus[l.device].push_back(std::move(l));
+    // The CAN log is read on a second thread while the Modbus and GPIO logs are read here: the
+    // files are independent, and reading them is most of a long replay's set-up.
+    auto can_log = std::async(std::launch::async, [path = (fs::path(dir) / "can.log").string()] {
+      return read_session_can_log(path);
+    });
+    std::vector<SessionLogLine>* to = nullptr;  // the last line's device's (lines come in runs)
+    read_session_log((fs::path(dir) / "modbus.log").string(), [&](SessionLogLine&& l) {
+      if (to == nullptr || to->back().device != l.device) to = &modbus[l.device];
+      to->push_back(std::move(l));
+    });
     gpio = read_session_log((fs::path(dir) / "gpio.log").string());
-    can = read_session_can_log((fs::path(dir) / "can.log").string());
+    can = can_log.get();  // rethrows the reader's InputError
     for (const auto& r : can)
       if ((r.frame.can_id & CAN_EFF_MASK) == 0x080)  // SYNC (schemas/can_frames.md)
         sync_times_s.push_back(static_cast<double>(r.time_sec) + 1e-6 * r.time_usec);
@@ -122,15 +131,6 @@ ReplayReport replay_session(const ReplayOptions& o) {
   const std::string result_path = (fs::path(o.dir) / "result.json").string();
   if (!fs::exists(result_path) && !fs::exists(result_path + ".gz"))
     throw InputError(fmt::format("{}: cannot open (the run did not end?)", result_path));
-  std::string text;
-  const std::string read_from =
-      for_each_line(result_path, [&text](const std::string& line, int) { text += line + '\n'; });
-  nlohmann::json recorded;
-  try {
-    recorded = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(fmt::format("{}: byte {}: not JSON", read_from, e.byte));
-  }
   ReplayRig devices(o.dir);
   ReplayClock clock;
   Rig rig = build_rig(session.config, devices.options(clock));
@@ -159,7 +159,7 @@ ReplayReport replay_session(const ReplayOptions& o) {
     }
     if (run_id != 0) {
       store.flush();
-      report = compare_results(recorded, session_result_json(store, run_id), o.rtol, o.atol);
+      report = compare_with_store(result_path, store, run_id, o.rtol, o.atol);
     }
   }
   if (o.db.empty()) {

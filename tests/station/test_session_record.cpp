@@ -135,7 +135,7 @@ TEST_F(SessionRecord, TheResultIsWhatTheStoreHolds) {
   EXPECT_EQ(r, station::session_result_json(store, r["run_id"].get<std::int64_t>()));
   const double sim_s = (*report_)["sim_s"].get<double>();
   EXPECT_EQ(r["ticks"].size(), static_cast<std::size_t>(sim_s) + 1);
-  EXPECT_EQ(r["ticks"][10]["samples"].size(), 2u);
+  EXPECT_EQ(r["ticks"][10].size(), 3u);  // [t_s, row, row]
   EXPECT_FALSE(r["bins"].empty());
   ASSERT_EQ(r["fits"].size(), 2u);
   EXPECT_TRUE(r["fits"][0]["coefficients"].contains("k1"));

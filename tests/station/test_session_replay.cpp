@@ -162,6 +162,20 @@ TEST_F(SessionReplay, ABadSessionIsOneLineNamingTheFile) {
     EXPECT_NE(std::string(e.what()).find("modbus.log:3: bad time 'not'"), std::string::npos)
         << e.what();
   }
+  // A result.json cut short (the disk filled while it was written by hand, say): its byte named.
+  const auto r = copy_of(*dir_, "badresult");
+  auto result = read_lines(r / "result.json");
+  result.resize(result.size() - 3);
+  write_lines(r / "result.json", result);
+  try {
+    replay(r);
+    FAIL() << "accepted a truncated result.json";
+  } catch (const station::InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("result.json: byte "), std::string::npos) << what;
+    EXPECT_NE(what.find("not JSON"), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+  }
 }
 
 TEST_F(SessionReplay, TheCommandExits0Same1Differs2BadSession) {

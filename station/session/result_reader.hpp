@@ -1,0 +1,17 @@
+// Reading a session's result.json without holding its ticks: a SAX parse (nlohmann) builds the
+// head (state, bins, events, fits) as a tree and hands each tick to a callback as it completes.
+#pragma once
+
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <string>
+
+namespace station {
+
+/// Parses `path` (or `path`.gz); calls `on_tick` with every element of the top-level "ticks"
+/// array in order and returns the rest of the document ("ticks" left empty). Throws InputError
+/// "FILE: byte N: what" when the text is not JSON or its top level is not an object.
+nlohmann::json read_result_file(const std::string& path,
+                                const std::function<void(nlohmann::json&&)>& on_tick);
+
+}  // namespace station
