@@ -24,6 +24,10 @@ class ReplayCanTransport final : public CanTransport {
   double last_rx_time_s() const override { return last_rx_time_s_; }
   /// SYNC frames sent so far (ticks the replay has started).
   std::size_t syncs_sent() const { return syncs_sent_; }
+  /// The records played back or skipped so far.
+  std::vector<CandumpRecord> consumed() const {
+    return {records_.begin(), records_.begin() + static_cast<std::ptrdiff_t>(cursor_)};
+  }
 
  private:
   std::vector<CandumpRecord> records_;

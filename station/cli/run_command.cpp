@@ -112,7 +112,9 @@ int run_real(const RunOptions& o) {
     // The probe above is not part of the session: the logs start with the run's first tick.
     session.emplace(o.record);
     tap.target = &session->tap();
-    session->start(config, protocol, false, std::nullopt);
+    session->start(
+        config, protocol, false, std::nullopt,
+        resume ? std::optional<double>(resume->last_tick_s.value_or(-1.0)) : std::nullopt);
   } else if (!o.record_can.empty()) {
     can_log.open(o.record_can, std::ios::app);
     if (!can_log) throw InputError(fmt::format("{}: cannot write the CAN log", o.record_can));
@@ -198,7 +200,8 @@ void add_run_command(CLI::App& app, CommandStatus& status) {
       ->excludes(record);
   cmd->add_option("--fault", o->faults,
                   "--sim: at tick T (s) inject a simrig fault command, T:COMMAND "
-                  "(docs/SIMRIG.md), e.g. '3000:door open'; repeatable");
+                  "(docs/SIMRIG.md), e.g. '3000:door open', or T:kill (the daemon SIGKILLs "
+                  "itself before tick T, to record a killed and resumed run); repeatable");
   cmd->add_flag("--json", o->json, "print one JSON object at the end (--sim)");
   cmd->callback([o, &status] {
     LogOptions lo;

@@ -32,6 +32,10 @@ class ReplayGpioBank final : public drivers::gpio::GpioBank {
   const drivers::gpio::GpioConfig& config() const override { return config_; }
   /// Exchanges not replayed yet.
   std::size_t remaining() const { return lines_.size() - next_; }
+  /// The exchanges replayed so far (a resumed simulation asks them again).
+  std::vector<SessionLogLine> consumed() const {
+    return {lines_.begin(), lines_.begin() + static_cast<std::ptrdiff_t>(next_)};
+  }
 
  private:
   const SessionLogLine& expect(const char* kind, std::string_view role, const std::string& asked);

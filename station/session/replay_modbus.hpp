@@ -35,6 +35,10 @@ class RecordedModbusWire final : public drivers::modbus::ModbusWire {
   void flush() override {}
   /// Exchanges not asked for yet (0 at the end of a faithful replay).
   std::size_t remaining() const { return lines_.size() - next_; }
+  /// The exchanges replayed so far (a resumed simulation asks them again).
+  std::vector<SessionLogLine> consumed() const {
+    return {lines_.begin(), lines_.begin() + static_cast<std::ptrdiff_t>(next_)};
+  }
 
  private:
   /// The next line, which must be (direction, kind) and, when given, carry `bytes`; throws

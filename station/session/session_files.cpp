@@ -144,6 +144,64 @@ void write_session_header(const std::string& dir, const SessionHeader& h) {
   if (!out) throw InputError(fmt::format("{}: cannot write the session header", path.string()));
 }
 
+namespace {
+
+// Cuts `path` after its last newline (a kill can stop a write mid-line) and counts its lines.
+std::int64_t complete_lines(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return 0;
+  std::int64_t lines = 0;
+  std::uintmax_t size = 0, last_newline_end = 0;
+  char buf[1 << 16];
+  while (in.read(buf, sizeof buf) || in.gcount() > 0) {
+    const auto n = static_cast<std::size_t>(in.gcount());
+    for (std::size_t i = 0; i < n; ++i)
+      if (buf[i] == '\n') {
+        ++lines;
+        last_newline_end = size + i + 1;
+      }
+    size += n;
+  }
+  in.close();
+  if (last_newline_end != size) std::filesystem::resize_file(path, last_newline_end);
+  return lines;
+}
+
+}  // namespace
+
+void append_session_resume(const std::string& dir, double after_tick_s) {
+  const std::filesystem::path d(dir);
+  toml::table r{{"after_tick_s", after_tick_s},
+                {"can_lines", complete_lines(d / "can.log")},
+                {"modbus_lines", complete_lines(d / "modbus.log")},
+                {"gpio_lines", complete_lines(d / "gpio.log")}};
+  std::ofstream out(d / "session.toml", std::ios::app);
+  out << "\n[[resume]]  # a killed run resumed here (schemas/session.md)\n" << r << '\n';
+  if (!out)
+    throw InputError(fmt::format("{}: cannot append the resume", (d / "session.toml").string()));
+}
+
+std::vector<SessionResume> read_session_resumes(const std::string& path) {
+  std::vector<SessionResume> out;
+  const toml::table t = toml::parse_file(path);
+  const auto* list = t["resume"].as_array();
+  if (list == nullptr) return out;
+  for (std::size_t i = 0; i < list->size(); ++i) {
+    const auto* r = list->get(i)->as_table();
+    const auto number = [&](const char* key) {
+      const auto v = r != nullptr ? (*r)[key].value<double>() : std::nullopt;
+      if (!v || *v < 0)
+        throw InputError(
+            fmt::format("{}: resume {}: key '{}': missing or negative", path, i + 1, key));
+      return *v;
+    };
+    out.push_back({number("after_tick_s"), static_cast<std::int64_t>(number("can_lines")),
+                   static_cast<std::int64_t>(number("modbus_lines")),
+                   static_cast<std::int64_t>(number("gpio_lines"))});
+  }
+  return out;
+}
+
 json session_result_head_json(Store& store, std::int64_t run_id) {
   const auto run = store.find_run(run_id);
   const auto slots = store.run_slots(run_id);

@@ -32,6 +32,20 @@ struct SessionHeader {
 /// Throws InputError naming the path when it cannot be written.
 void write_session_header(const std::string& dir, const SessionHeader& header);
 
+/// Where a killed run was resumed: the last tick its store had committed, and how many lines
+/// each log held when the resumed daemon began (what the killed daemon wrote).
+struct SessionResume {
+  double after_tick_s = 0;
+  std::int64_t can_lines = 0, modbus_lines = 0, gpio_lines = 0;
+};
+
+/// Marks a resume in `dir`: cuts a line the killed daemon left half-written from each log, counts
+/// the logs' lines and appends a [[resume]] table to session.toml. Throws InputError.
+void append_session_resume(const std::string& dir, double after_tick_s);
+
+/// The [[resume]] tables of a session.toml (empty for a run recorded without a restart).
+std::vector<SessionResume> read_session_resumes(const std::string& session_toml_path);
+
 /// What run `run_id` stored, as result.json holds it: every tick's samples, every bin, every
 /// event and every fit of the run.
 nlohmann::json session_result_json(Store& store, std::int64_t run_id);

@@ -21,9 +21,12 @@ class SessionRecording {
 
   /// The tap every transport of the rig writes to.
   SessionRecorder& tap() { return recorder_; }
-  /// Writes session.toml (kept if it exists: a resumed run keeps its start's header).
+  /// Writes session.toml (kept if it exists: a resumed run keeps its start's header). A run
+  /// resumed after its last committed tick `resumed_after_tick_s` marks the restart in the
+  /// session (append_session_resume) before anything more is logged.
   void start(const StationConfig& config, const Protocol& protocol, bool simulated,
-             std::optional<std::int64_t> sim_seed);
+             std::optional<std::int64_t> sim_seed,
+             std::optional<double> resumed_after_tick_s = std::nullopt);
   /// After every tick: the logs reach the disk, so a kill loses at most one tick of log.
   void after_tick() { recorder_.flush(); }
   /// Writes result.json from what the run stored.

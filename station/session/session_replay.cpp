@@ -5,10 +5,12 @@
 #include <toml++/toml.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <filesystem>
 #include <fstream>
 #include <future>
+#include <limits>
 #include <map>
 
 #include "drivers/can/candump_log.hpp"
@@ -16,6 +18,7 @@
 #include "station/common/input_error.hpp"
 #include "station/config/config.hpp"
 #include "station/config/protocol.hpp"
+#include "station/daemon/resume.hpp"
 #include "station/daemon/rig.hpp"
 #include "station/daemon/sequencer.hpp"
 #include "station/session/replay_clock.hpp"
@@ -77,27 +80,50 @@ std::string fresh_db_path(const ReplayOptions& o) {
       .string();
 }
 
-/// The replay transports of every device, from the session's logs.
-struct ReplayRig {
-  std::map<std::string, std::vector<SessionLogLine>> modbus;  ///< by device
-  std::vector<SessionLogLine> gpio;
+/// Everything the session's three logs hold, in order.
+struct SessionLogs {
+  std::vector<SessionLogLine> modbus, gpio;
   std::vector<dr::can::CandumpRecord> can;
-  std::vector<double> sync_times_s;
-  const dr::can::ReplayCanTransport* can_transport = nullptr;
 
-  explicit ReplayRig(const std::string& dir) {
+  explicit SessionLogs(const std::string& dir) {
     // The CAN log is read on a second thread while the Modbus and GPIO logs are read here: the
     // files are independent, and reading them is most of a long replay's set-up.
     auto can_log = std::async(std::launch::async, [path = (fs::path(dir) / "can.log").string()] {
       return read_session_can_log(path);
     });
-    std::vector<SessionLogLine>* to = nullptr;  // the last line's device's (lines come in runs)
-    read_session_log((fs::path(dir) / "modbus.log").string(), [&](SessionLogLine&& l) {
-      if (to == nullptr || to->back().device != l.device) to = &modbus[l.device];
-      to->push_back(std::move(l));
-    });
+    modbus = read_session_log((fs::path(dir) / "modbus.log").string());
     gpio = read_session_log((fs::path(dir) / "gpio.log").string());
     can = can_log.get();  // rethrows the reader's InputError
+  }
+};
+
+/// The lines [from, to) of a log (1-based line numbers as the file counts them) appended to
+/// `out`, moved out of `lines`.
+void take_lines(std::vector<SessionLogLine>& lines, std::int64_t from, std::int64_t to,
+                std::vector<SessionLogLine>& out) {
+  for (auto& l : lines)
+    if (l.line_no >= from && l.line_no < to) out.push_back(std::move(l));
+}
+
+/// The replay transports of every device for one daemon's life (one segment of a session: the
+/// whole run, or the part before a kill, or after a resume).
+struct ReplayRig {
+  std::map<std::string, std::vector<SessionLogLine>> modbus;  ///< by device
+  std::vector<SessionLogLine> gpio;
+  std::vector<dr::can::CandumpRecord> can;
+  std::vector<double> sync_times_s;
+  std::map<std::string, const RecordedModbusWire*> wires;
+  const dr::can::ReplayCanTransport* can_transport = nullptr;
+  const ReplayGpioBank* gpio_bank = nullptr;
+
+  ReplayRig(std::vector<SessionLogLine> modbus_lines, std::vector<SessionLogLine> gpio_lines,
+            std::vector<dr::can::CandumpRecord> can_records)
+      : gpio(std::move(gpio_lines)), can(std::move(can_records)) {
+    std::vector<SessionLogLine>* to = nullptr;  // the last line's device's (lines come in runs)
+    for (auto& l : modbus_lines) {
+      if (to == nullptr || to->back().device != l.device) to = &modbus[l.device];
+      to->push_back(std::move(l));
+    }
     for (const auto& r : can)
       if ((r.frame.can_id & CAN_EFF_MASK) == 0x080)  // SYNC (schemas/can_frames.md)
         sync_times_s.push_back(static_cast<double>(r.time_sec) + 1e-6 * r.time_usec);
@@ -107,7 +133,9 @@ struct ReplayRig {
     o.clock = &clock;
     o.modbus_wire_factory = [this](const std::string& device, const dr::modbus::Endpoint&) {
       // Each factory runs once per device: the recording moves into its transport.
-      return std::make_unique<RecordedModbusWire>(device, std::move(modbus[device]));
+      auto w = std::make_unique<RecordedModbusWire>(device, std::move(modbus[device]));
+      wires[device] = w.get();
+      return w;
     };
     o.can_transport_factory = [this] {
       auto t = std::make_unique<dr::can::ReplayCanTransport>(std::move(can));
@@ -116,37 +144,105 @@ struct ReplayRig {
     };
     o.replayed_can = true;
     o.gpio_factory = [this](const dr::gpio::GpioConfig& g) {
-      return std::make_unique<ReplayGpioBank>(g, std::move(gpio), sync_times_s, [this] {
+      auto b = std::make_unique<ReplayGpioBank>(g, std::move(gpio), sync_times_s, [this] {
         return can_transport != nullptr ? can_transport->syncs_sent() : std::size_t{0};
       });
+      gpio_bank = b.get();
+      return b;
     };
     return o;
   }
+  /// What this daemon's life replayed so far, in log order: a resumed simulation asks it again.
+  void consumed(std::vector<SessionLogLine>& modbus_out, std::vector<SessionLogLine>& gpio_out,
+                std::vector<dr::can::CandumpRecord>& can_out) const {
+    for (const auto& [device, wire] : wires)
+      for (auto& l : wire->consumed()) modbus_out.push_back(std::move(l));
+    std::sort(modbus_out.begin(), modbus_out.end(),
+              [](const auto& a, const auto& b) { return a.line_no < b.line_no; });
+    if (gpio_bank != nullptr) gpio_out = gpio_bank->consumed();
+    if (can_transport != nullptr) can_out = can_transport->consumed();
+  }
 };
 
-}  // namespace
+/// Thrown from the tick callback where the recorded daemon was killed.
+struct KilledHere {};
 
-ReplayReport replay_session(const ReplayOptions& o) {
-  const Session session = read_header(o.dir);
-  const std::string result_path = (fs::path(o.dir) / "result.json").string();
-  if (!fs::exists(result_path) && !fs::exists(result_path + ".gz"))
-    throw InputError(fmt::format("{}: cannot open (the run did not end?)", result_path));
-  ReplayRig devices(o.dir);
-  ReplayClock clock;
-  Rig rig = build_rig(session.config, devices.options(clock));
-  const std::string db = fresh_db_path(o);
-  ReplayReport report;
-  {
-    Store store(db);
-    store.set_ticks_per_commit(600);  // nothing to lose: the recording is the record
+/// The session's restarts (session.toml [[resume]]), checked for what replay can reproduce.
+std::vector<SessionResume> replayable_resumes(const std::string& dir, const Session& session) {
+  const std::string path = (fs::path(dir) / "session.toml").string();
+  auto resumes = read_session_resumes(path);
+  if (resumes.empty()) return resumes;
+  if (!session.sim_seed)
+    throw InputError(fmt::format(
+        "{}: a rig run killed and resumed (resume after t = {:.0f} s) is not replayable yet: "
+        "its restart tick came from the wall clock; simulated sessions are",
+        path, resumes.front().after_tick_s));
+  const auto& first = resumes.front();
+  if (first.can_lines + first.modbus_lines + first.gpio_lines == 0)
+    throw InputError(
+        fmt::format("{}: the recording starts with a resumed run (after t = {:.0f} "
+                    "s); its first part was not recorded",
+                    path, first.after_tick_s));
+  return resumes;
+}
+
+/// Replays the session's daemons one after the other into `store` (one, or one per restart);
+/// returns the run's id, 0 when a divergence ended it (reported in `report`).
+std::int64_t replay_daemons(const ReplayOptions& o, const Session& session, Store& store,
+                            ReplayReport& report) {
+  const auto resumes = replayable_resumes(o.dir, session);
+  SessionLogs logs(o.dir);
+  // The part of the recording a segment's daemon asks first: a resumed simulation recomputes
+  // its stored ticks through the devices, with the recorder paused.
+  std::vector<SessionLogLine> modbus_prefix, gpio_prefix;
+  std::vector<dr::can::CandumpRecord> can_prefix;
+  std::int64_t modbus_from = 1, gpio_from = 1, can_from = 0;
+  double last_tick_s = -1;
+  for (std::size_t k = 0; k <= resumes.size(); ++k) {
+    const bool killed = k < resumes.size();
+    const auto end = [killed](std::int64_t lines) {
+      return killed ? lines + 1 : std::numeric_limits<std::int64_t>::max();
+    };
+    std::vector<SessionLogLine> modbus = std::move(modbus_prefix), gpio = std::move(gpio_prefix);
+    take_lines(logs.modbus, modbus_from, end(killed ? resumes[k].modbus_lines : 0), modbus);
+    take_lines(logs.gpio, gpio_from, end(killed ? resumes[k].gpio_lines : 0), gpio);
+    std::vector<dr::can::CandumpRecord> can = std::move(can_prefix);
+    const auto can_to =
+        killed
+            ? std::min<std::size_t>(static_cast<std::size_t>(resumes[k].can_lines), logs.can.size())
+            : logs.can.size();
+    for (auto i = static_cast<std::size_t>(can_from); i < can_to; ++i) can.push_back(logs.can[i]);
+    if (killed) {
+      modbus_from = resumes[k].modbus_lines + 1;
+      gpio_from = resumes[k].gpio_lines + 1;
+      can_from = static_cast<std::int64_t>(can_to);
+    }
+    ReplayRig devices(std::move(modbus), std::move(gpio), std::move(can));
+    ReplayClock clock;
+    Rig rig = build_rig(session.config, devices.options(clock));
     SequencerOptions so;
     so.sim_seed = session.sim_seed;
-    double last_tick_s = -1;
-    so.on_tick = [&last_tick_s](const TickReport& r) { last_tick_s = r.t_s; };
-    std::int64_t run_id = 0;
+    std::optional<RunRecord> resume;
+    if (k > 0) {
+      resume = decide_resume(store, session.config, false, true).run;
+      if (!resume) throw InputError(fmt::format("{}: resume {}: no run to resume", o.dir, k));
+      so.replay_until_t_s = resume->last_tick_s.value_or(-1.0);
+    }
+    so.on_tick = [&](const TickReport& r) {
+      last_tick_s = r.t_s;
+      if (!killed || r.t_s < resumes[k].after_tick_s) return;
+      store.flush();  // what the killed daemon had committed
+      devices.consumed(modbus_prefix, gpio_prefix, can_prefix);
+      throw KilledHere{};
+    };
     try {
       Sequencer seq(session.config, session.protocol, rig, store, clock, so);
-      run_id = seq.run().run_id;
+      const auto out = seq.run(resume);
+      if (!killed) return out.run_id;
+      throw InputError(fmt::format("{}: the run ended before its recorded kill at t = {:.0f} s",
+                                   o.dir, resumes[k].after_tick_s));
+    } catch (const KilledHere&) {
+      continue;
     } catch (const ReplayDivergence& d) {
       report.same = false;
       report.first_difference = {{"at", {{"tick", last_tick_s + 1}, {"device", d.device}}},
@@ -156,7 +252,25 @@ ReplayReport replay_session(const ReplayOptions& o) {
       report.notes.push_back(
           fmt::format("diverged at tick t = {:.0f} s: {}", last_tick_s + 1, d.what()));
       report.ticks = static_cast<std::int64_t>(last_tick_s + 1);
+      return 0;
     }
+  }
+  return 0;
+}
+
+}  // namespace
+
+ReplayReport replay_session(const ReplayOptions& o) {
+  const Session session = read_header(o.dir);
+  const std::string result_path = (fs::path(o.dir) / "result.json").string();
+  if (!fs::exists(result_path) && !fs::exists(result_path + ".gz"))
+    throw InputError(fmt::format("{}: cannot open (the run did not end?)", result_path));
+  const std::string db = fresh_db_path(o);
+  ReplayReport report;
+  {
+    Store store(db);
+    store.set_ticks_per_commit(600);  // nothing to lose: the recording is the record
+    const std::int64_t run_id = replay_daemons(o, session, store, report);
     if (run_id != 0) {
       store.flush();
       report = compare_with_store(result_path, store, run_id, o.rtol, o.atol);

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <chrono>
+#include <csignal>
 #include <fstream>
 
 #include "compensation/earth_rate.hpp"
@@ -128,6 +129,9 @@ nlohmann::json run_simulated(const SimRunOptions& o) {
     world.advance_to(t_s);
     for (const auto& [at_s, command] : o.faults) {
       if (at_s != t_s) continue;
+      // The daemon itself killed before the tick (what a power cut does): committed ticks stay,
+      // the rest is lost, a later `run` resumes. For recording resumed sessions.
+      if (command == "kill") ::raise(SIGKILL);
       const std::string reply = sim::run_fault_command(world, command);
       if (reply.rfind("ok", 0) != 0)
         throw InputError(fmt::format("--fault {:.0f}:{}: {}", at_s, command, reply));
@@ -136,7 +140,14 @@ nlohmann::json run_simulated(const SimRunOptions& o) {
   };
   const double nominal_s = protocol.nominal_duration_s(wc.initial_c);
   double next_report_s = 0;
-  if (session) session->start(config, protocol, true, static_cast<std::int64_t>(o.seed));
+  if (session) {
+    session->start(
+        config, protocol, true, static_cast<std::int64_t>(o.seed),
+        resume ? std::optional<double>(resume->last_tick_s.value_or(-1.0)) : std::nullopt);
+    // A resumed simulation connects and recomputes its stored ticks first: all of that is in
+    // the logs already (before_tick lifts the pause after the last stored tick).
+    if (resume) session->tap().pause(true);
+  }
   so.on_tick = [&](const TickReport& r) {
     if (session) session->after_tick();
     if (!o.progress || r.t_s < next_report_s) return;

@@ -8,14 +8,22 @@ station=${1:?usage: record.sh PATH/TO/station}
 here=$(cd "$(dirname "$0")" && pwd)
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
+run_sim() {
+  local name=$1
+  shift
+  "$station" run --sim --gyros 1 --seed 1 --db "$tmp/$name.db" \
+    --protocol "$here/session_cycle.toml" --record "$here/$name" "$@" >/dev/null
+}
+finish() {
+  gzip -9 -n "$here/$1"/*.log "$here/$1/result.json"
+  "$station" replay "$here/$1"
+}
 record() {
   local name=$1
   shift
   rm -rf "${here:?}/$name"
-  "$station" run --sim --new --gyros 1 --seed 1 --db "$tmp/$name.db" \
-    --protocol "$here/session_cycle.toml" --record "$here/$name" "$@" >/dev/null
-  gzip -9 -n "$here/$name"/*.log "$here/$name/result.json"
-  "$station" replay "$here/$name"
+  run_sim "$name" --new "$@"
+  finish "$name"
 }
 record happy_cycle
 # The door opens mid-record: safe hold (gyro power off, amber), closes a minute later.
@@ -24,3 +32,9 @@ record door_mid_record --fault "1800:door open" --fault "1860:door close"
 # turntable dropping its connections once.
 record link_faults --fault "1500:chamber stall 2" --fault "2000:can drop 3" \
   --fault "2300:can duplicate 5" --fault "2600:table disconnect"
+# The daemon killed (SIGKILL) before tick 1230, mid-record and mid-bin, and run again: it
+# resumes after its last committed tick (1199: the simulation commits once a minute).
+rm -rf "${here:?}/killed_resumed"
+run_sim killed_resumed --new --fault "1230:kill" 2>/dev/null || [ $? -eq 137 ]
+run_sim killed_resumed 2>/dev/null
+finish killed_resumed

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -15,6 +16,7 @@
 #include <vector>
 
 #include "station/common/input_error.hpp"
+#include "station/session/session_files.hpp"
 #include "station/session/session_replay.hpp"
 #include "station/sim/sim_run.hpp"
 #include "tests/station/temp_db.hpp"
@@ -200,4 +202,56 @@ TEST_F(SessionReplay, TheCommandExits0Same1Differs2BadSession) {
   out.clear();
   EXPECT_EQ(run_station("replay " + d.string(), out), 2) << out;
   EXPECT_NE(out.find("result.json: cannot open"), std::string::npos) << out;
+}
+
+// The shipped killed_resumed session (tests/sessions/record.sh): SIGKILL before tick 1230, resumed
+// after the last committed tick 1199. Each daemon's part of the logs is replayed by its own
+// daemon; the killed daemon's ticks 1200..1229 (logged, never committed) are not used.
+TEST(SessionReplayResumed, EachDaemonsPartCountsAndTheLostTicksDoNot) {
+  const auto d = fs::path(station::testing_support::fresh_db("resumed") + ".session");
+  fs::remove_all(d);
+  fs::copy(fs::path(STATION_SOURCE_DIR) / "tests/sessions/killed_resumed", d);
+  ASSERT_EQ(std::system(("gzip -d " + d.string() + "/*.gz").c_str()), 0);
+  const auto resumes = station::read_session_resumes((d / "session.toml").string());
+  ASSERT_EQ(resumes.size(), 1u);
+  EXPECT_EQ(resumes[0].after_tick_s, 1199.0);
+  const auto lines = read_lines(d / "can.log");
+  const auto killed_lines = static_cast<std::size_t>(resumes[0].can_lines);
+  ASSERT_LT(killed_lines, lines.size());
+  std::vector<std::size_t> counts;  // the COUNTS frames of node 1
+  for (std::size_t i = 0; i < lines.size(); ++i)
+    if (lines[i].find(" can0 281#") != std::string::npos) counts.push_back(i);
+  const auto flipped_replay = [&](std::size_t at) {
+    auto tampered = lines;
+    std::string& l = tampered[at];
+    const std::size_t data = l.find('#') + 1;
+    l[data] = l[data] == '0' ? '1' : '0';
+    const auto t = copy_of(d, "flip");
+    write_lines(t / "can.log", tampered);
+    return station::replay_session({t.string(), "", 0, 0});
+  };
+  EXPECT_TRUE(station::replay_session({d.string(), "", 0, 0}).same);
+  std::size_t first_daemon = 0, lost = 0, second_daemon = 0;
+  for (const auto i : counts) {
+    if (i < killed_lines / 2 && first_daemon == 0) first_daemon = i;
+    if (i < killed_lines) lost = i;  // the last one the killed daemon logged: tick 1229
+    if (i > killed_lines + 100 && second_daemon == 0) second_daemon = i;
+  }
+  EXPECT_FALSE(flipped_replay(first_daemon).same) << lines[first_daemon];
+  EXPECT_FALSE(flipped_replay(second_daemon).same) << lines[second_daemon];
+  const auto r = flipped_replay(lost);
+  EXPECT_TRUE(r.same) << lines[lost] << "\n" << r.json().dump(1);
+  // The same restart on a rig: its restart tick came from the wall clock. Refused, one line.
+  const auto rig = copy_of(d, "rig");
+  auto header = read_lines(rig / "session.toml");
+  std::erase_if(header, [](const std::string& l) { return l.rfind("sim_seed", 0) == 0; });
+  write_lines(rig / "session.toml", header);
+  try {
+    station::replay_session({rig.string(), "", 0, 0});
+    FAIL() << "replayed a resumed rig session";
+  } catch (const station::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("session.toml: a rig run killed and resumed"),
+              std::string::npos)
+        << e.what();
+  }
 }
