@@ -208,6 +208,7 @@ bool ModbusServer::tcp_link_up(std::vector<int>& clients) {
   if (kick) {
     for (int c : clients) close(c);
     clients.clear();
+    pending_.clear();
     if (listen_fd_ != -1) close(listen_fd_);
     listen_fd_ = -1;
   }
@@ -236,6 +237,7 @@ void ModbusServer::run_tcp() {
     }
   }
   for (int c : clients) close(c);
+  pending_.clear();
 }
 
 // RTU frames are read here, not by modbus_receive(): libmodbus 3.1.6 stops reading a frame for
@@ -252,13 +254,35 @@ void ModbusServer::run_rtu() {
   }
 }
 
+// One recv per request instead of libmodbus's select/recv/select/recv: the Modbus TCP frame is
+// cut from the client's byte stream by its MBAP header (Modbus Messaging on TCP/IP
+// Implementation Guide v1.0b, 3.1.3: transaction id, protocol id 0, length of the unit id and
+// PDU). A frame split across segments waits for the rest; a bad header closes the connection,
+// as libmodbus does.
 bool ModbusServer::serve_one(int fd) {
-  modbus_set_socket(ctx_.get(), fd);
-  std::uint8_t query[MODBUS_MAX_ADU_LENGTH];
-  int len = modbus_receive(ctx_.get(), query);
-  if (len == -1) return false;  // peer closed, or a malformed/timed-out frame
-  if (len == 0) return true;    // addressed to another unit
-  return handle(query, len);
+  auto& buf = pending_[fd];
+  std::uint8_t chunk[MODBUS_TCP_MAX_ADU_LENGTH];
+  const ssize_t n = recv(fd, chunk, sizeof chunk, MSG_DONTWAIT);
+  if (n == 0 || (n < 0 && errno != EAGAIN && errno != EINTR)) return forget(fd);
+  if (n > 0) buf.insert(buf.end(), chunk, chunk + n);
+  constexpr std::size_t kMbap = 7;  // transaction 2, protocol 2, length 2, unit 1
+  while (buf.size() >= kMbap) {
+    const std::size_t length = (std::size_t{buf[4]} << 8) | buf[5];  // unit id + PDU
+    if (buf[2] != 0 || buf[3] != 0 || length < 2 || 6 + length > MODBUS_TCP_MAX_ADU_LENGTH)
+      return forget(fd);
+    if (buf.size() < 6 + length) break;
+    std::uint8_t query[MODBUS_TCP_MAX_ADU_LENGTH];
+    std::copy_n(buf.begin(), 6 + length, query);
+    buf.erase(buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(6 + length));
+    modbus_set_socket(ctx_.get(), fd);
+    if (!handle(query, static_cast<int>(6 + length))) return forget(fd);
+  }
+  return true;
+}
+
+bool ModbusServer::forget(int fd) {
+  pending_.erase(fd);
+  return false;
 }
 
 bool ModbusServer::handle(const std::uint8_t* query, int len) {

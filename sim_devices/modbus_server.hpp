@@ -7,6 +7,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <span>
@@ -104,6 +105,7 @@ class ModbusServer {
   bool tcp_link_up(std::vector<int>& clients);
   void accept_client(std::vector<int>& clients);
   bool serve_one(int fd);
+  bool forget(int fd);  ///< drops a client's partial frame; false (close it)
   bool handle(const std::uint8_t* query, int len);
   std::uint8_t strict_exception(std::span<const std::uint8_t> pdu) const;
   void apply_writes(std::span<const std::uint8_t> pdu);
@@ -126,6 +128,7 @@ class ModbusServer {
   int timeouts_ = 0, exceptions_ = 0, exception_code_ = 0, drops_ = 0;
   SteadyTime stall_until_{}, down_until_{};
   bool kick_clients_ = false;
+  std::map<int, std::vector<std::uint8_t>> pending_;  // per TCP client: bytes of a partial frame
 };
 
 }  // namespace station::sim

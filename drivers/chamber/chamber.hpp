@@ -22,7 +22,9 @@ struct AlarmBits {
   bool any() const { return deviation || sensor_break || door_open || high_limit_trip; }
 };
 
-/// One reading of the chamber.
+/// One reading of the chamber. A driver may read the command registers and the informational points
+/// (setpoint ramp, run, mode, product) less often than every read (ModbusChamber's readback_every),
+/// returning their last read-back values in between; air, alarms and setpoint are always fresh.
 struct ChamberState {
   double air_c = 0;           ///< air temperature, °C (NaN on sensor break)
   double product_c = 0;       ///< product (second sensor) temperature, °C

@@ -15,9 +15,15 @@ namespace cm = chamber_map;
 namespace {
 
 // The points read() fetches; values come back in this order.
-constexpr std::array kReadPoints{cm::kAlarms,   cm::kStatus, cm::kAir, cm::kProduct,
-                                 cm::kSetpoint, cm::kRamp,   cm::kRun};
-enum ReadField : std::size_t { kAlarmsF, kStatusF, kAirF, kProductF, kSetpointF, kRampF, kRunF };
+// Live points first, read on every read: what the safety layer judges every tick — alarms (door,
+// high-limit trip, sensor break), air, and the setpoint (one written at the panel out of limits
+// must be caught before the station's next write would hide it). Then the points read with the
+// command registers (modbus/readback.hpp): ramp and run, and two informational ones no record or
+// safety rule uses (probe shows them): the controller's status and the product temperature.
+constexpr std::array kReadPoints{cm::kAlarms,  cm::kAir,  cm::kSetpoint, cm::kStatus,
+                                 cm::kProduct, cm::kRamp, cm::kRun};
+constexpr std::size_t kLivePoints = 3;
+enum ReadField : std::size_t { kAlarmsF, kAirF, kSetpointF, kStatusF, kProductF, kRampF, kRunF };
 
 AlarmBits decode_alarms(unsigned bits) {
   return AlarmBits{(bits & cm::kDeviation) != 0, (bits & cm::kSensorBreak) != 0,
@@ -42,6 +48,7 @@ ModbusChamber::ModbusChamber(std::string name, modbus::Endpoint endpoint, modbus
 
 void ModbusChamber::set_max_read_gap(int registers) {
   read_plan_ = modbus::plan_reads(read_points_, registers);
+  live_plan_ = modbus::plan_reads(std::span(read_points_).first(kLivePoints), registers);
 }
 
 Result<void> ModbusChamber::connect() {
@@ -53,7 +60,29 @@ Result<double> ModbusChamber::get(const char* point) {
 }
 
 Result<std::vector<double>> ModbusChamber::read_values() {
-  return client_.read_points(read_points_, read_plan_);
+  if (client_.connects() != connects_seen_) {  // a restarted controller may hold anything
+    connects_seen_ = client_.connects();
+    readback_.invalidate();
+  }
+  const bool full = readback_.due();
+  auto values = full ? client_.read_points(read_points_, read_plan_)
+                     : client_.read_points(std::span(read_points_).first(kLivePoints), live_plan_);
+  if (values && full) {
+    const auto& v = values.value();
+    const int st = static_cast<int>(v[kStatusF]);
+    if (st < 0 || st > 3) {
+      readback_.read_done(false, full);
+      return make_error(ErrorKind::protocol,
+                        fmt::format("{}: status register {} not 0..3", name_, st));
+    }
+    connects_seen_ = client_.connects();  // read after any (re)connect inside this read
+    mode_ = static_cast<ChamberMode>(st);
+    product_c_ = v[kProductF];
+    ramp_c_per_min_ = v[kRampF];
+    run_enabled_ = v[kRunF] != 0;
+  }
+  readback_.read_done(values.ok(), full);
+  return values;
 }
 
 Result<ChamberState> ModbusChamber::read() {
@@ -62,16 +91,12 @@ Result<ChamberState> ModbusChamber::read() {
   const auto& v = values.value();
   ChamberState s;
   s.alarms = decode_alarms(static_cast<unsigned>(v[kAlarmsF]));
-  const int st = static_cast<int>(v[kStatusF]);
-  if (st < 0 || st > 3)
-    return make_error(ErrorKind::protocol,
-                      fmt::format("{}: status register {} not 0..3", name_, st));
-  s.mode = static_cast<ChamberMode>(st);
+  s.mode = mode_;
   s.air_c = v[kAirF];
-  s.product_c = v[kProductF];
+  s.product_c = product_c_;
   s.setpoint_c = v[kSetpointF];
-  s.ramp_c_per_min = v[kRampF];
-  s.run_enabled = v[kRunF] != 0;
+  s.ramp_c_per_min = ramp_c_per_min_;
+  s.run_enabled = run_enabled_;
   // On sensor break the controller's air value is meaningless; never let it reach a record.
   if (s.alarms.sensor_break) s.air_c = std::numeric_limits<double>::quiet_NaN();
   return s;
@@ -90,6 +115,7 @@ Result<void> ModbusChamber::check_setpoint(double setpoint_c) {
 }
 
 Result<void> ModbusChamber::command(const ChamberCommand& c) {
+  readback_.invalidate();  // the next read confirms what the controller took
   if (c.ramp_c_per_min && !(*c.ramp_c_per_min >= 0 && std::isfinite(*c.ramp_c_per_min)))
     return make_error(ErrorKind::range,
                       fmt::format("{}: ramp {} C/min must be >= 0", name_, *c.ramp_c_per_min));

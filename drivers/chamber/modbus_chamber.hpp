@@ -7,6 +7,7 @@
 #include "drivers/chamber/chamber.hpp"
 #include "drivers/modbus/modbus_client.hpp"
 #include "drivers/modbus/read_plan.hpp"
+#include "drivers/modbus/readback.hpp"
 #include "drivers/modbus/register_map.hpp"
 
 namespace station::drivers {
@@ -42,8 +43,13 @@ class ModbusChamber final : public Chamber {
   /// adjacent points; -1 = one transaction per point; > 0 only for a controller known to serve
   /// reads of unimplemented registers).
   void set_max_read_gap(int registers);
-  /// Block reads one read() performs (for diagnostics and tests).
+  /// Block reads a read() with the command registers performs (for diagnostics and tests).
   const std::vector<modbus::ReadBlock>& read_plan() const { return read_plan_; }
+  /// Reads back ramp and run (and the informational status and product temperature) every
+  /// `reads` reads, and on the read after a write or a reconnect (modbus/readback.hpp); the
+  /// reads between return the values read back last. Alarms, air and the setpoint (judged by
+  /// the safety layer every tick) are read every time. 1: everything on every read.
+  void set_readback_every(int reads) { readback_.set_every(reads); }
   /// The underlying client (for diagnostics).
   modbus::ModbusClient& client() { return client_; }
 
@@ -57,6 +63,12 @@ class ModbusChamber final : public Chamber {
   modbus::ModbusClient client_;
   std::vector<modbus::Point> read_points_;  // in the order of the state fields (see .cpp)
   std::vector<modbus::ReadBlock> read_plan_;
+  std::vector<modbus::ReadBlock> live_plan_;  // alarms, air, setpoint
+  modbus::ReadbackSchedule readback_;
+  std::uint64_t connects_seen_ = 0;
+  ChamberMode mode_ = ChamberMode::off;        // read back last
+  double product_c_ = 0, ramp_c_per_min_ = 0;  // read back last
+  bool run_enabled_ = false;
 };
 
 }  // namespace station::drivers

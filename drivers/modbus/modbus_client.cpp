@@ -119,6 +119,7 @@ Result<void> ModbusClient::connect() {
   }
   backoff_.succeeded();
   connected_ = true;
+  ++connects_;
   tap(TapDirection::event, "connect", {}, to_string(endpoint_));
   return {};
 }

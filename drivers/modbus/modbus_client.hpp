@@ -47,6 +47,8 @@ class ModbusClient {
   void disconnect();
   /// True while the transport is open.
   bool connected() const { return connected_; }
+  /// Successful connects so far (a change tells a driver the device may have restarted).
+  std::uint64_t connects() const { return connects_; }
 
   /// Every read and write below first reopens a lost transport: at once after the loss, then
   /// after 0.5, 1, 2, 4, 8, 8 ... s of failed attempts (Backoff); while no attempt is due they
@@ -80,6 +82,7 @@ class ModbusClient {
   double timeout_s_;
   std::unique_ptr<ModbusWire> wire_;
   bool connected_ = false;
+  std::uint64_t connects_ = 0;
   Tap* tap_ = nullptr;
   int consecutive_timeouts_ = 0;  ///< timeouts in a row since the last answer of any kind
   Backoff backoff_;               ///< when the next connect attempt is due

@@ -37,7 +37,10 @@ Result<void> ModbusTurntable::connect() {
 Result<TurntableState> ModbusTurntable::read() {
   // One block read of the input registers 100..105 (see turntable_map.hpp) instead of four.
   auto values = client_.read_points(read_points_, read_plan_);
-  if (!values) return values.error();
+  if (!values) {
+    readback_.invalidate();
+    return values.error();
+  }
   const auto& v = values.value();  // mode, angle, rate, status: the order of kReadPoints
   const int m = static_cast<int>(v[0]);
   if (m < 0 || m > 2)
@@ -51,9 +54,20 @@ Result<TurntableState> ModbusTurntable::read() {
   s.at_rate = (bits & tm::kAtRate) != 0;
   s.fault = (bits & tm::kFault) != 0;
   s.interlock_open = (bits & tm::kInterlockOpen) != 0;
-  auto lock = client_.read(map_.at(tm::kLock));
-  if (!lock) return lock.error();
-  s.locked = lock.value() != 0;
+  if (client_.connects() != connects_seen_) {  // a restarted drive may hold anything
+    connects_seen_ = client_.connects();
+    readback_.invalidate();
+  }
+  if (readback_.due()) {
+    auto lock = client_.read(map_.at(tm::kLock));
+    readback_.read_done(lock.ok(), true);
+    if (!lock) return lock.error();
+    locked_ = lock.value() != 0;
+    connects_seen_ = client_.connects();  // read after any (re)connect inside this read
+  } else {
+    readback_.read_done(true, false);
+  }
+  s.locked = locked_;
   return s;
 }
 
@@ -68,6 +82,7 @@ Result<void> ModbusTurntable::check(const TurntableCommand& c) const {
 
 Result<void> ModbusTurntable::command(const TurntableCommand& c) {
   if (auto ok = check(c); !ok) return ok;
+  readback_.invalidate();  // the next read confirms what the drive took
   // A release goes out before the demands; an engage after them (a locked axis does not move, and
   // the drive engages the lock only at rest: the caller waits for in-position before locking).
   if (c.lock && !*c.lock) {

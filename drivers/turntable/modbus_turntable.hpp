@@ -5,6 +5,7 @@
 
 #include "drivers/modbus/modbus_client.hpp"
 #include "drivers/modbus/read_plan.hpp"
+#include "drivers/modbus/readback.hpp"
 #include "drivers/modbus/register_map.hpp"
 #include "drivers/turntable/turntable.hpp"
 
@@ -26,6 +27,9 @@ class ModbusTurntable final : public Turntable {
 
   Result<void> connect() override;
   Result<TurntableState> read() override;
+  /// Reads the lock register back every `reads` reads (and on the read after a write or a
+  /// reconnect; modbus/readback.hpp); mode, angle, rate and status are read every time.
+  void set_readback_every(int reads) { readback_.set_every(reads); }
   /// Writes lock, demands, then mode; out-of-range demands give ErrorKind::range, nothing written.
   Result<void> command(const TurntableCommand& c) override;
   Result<void> stop() override;
@@ -45,6 +49,9 @@ class ModbusTurntable final : public Turntable {
   modbus::ModbusClient client_;
   std::vector<modbus::Point> read_points_;  // mode, angle, rate, status
   std::vector<modbus::ReadBlock> read_plan_;
+  modbus::ReadbackSchedule readback_;
+  std::uint64_t connects_seen_ = 0;
+  bool locked_ = false;  // the lock register read back last
 };
 
 }  // namespace station::drivers

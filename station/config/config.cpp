@@ -59,7 +59,7 @@ mb::PointOverride read_override(const TomlView& v) {
 }
 
 ModbusDeviceConfig read_modbus_device(const TomlView& v, bool is_chamber) {
-  v.allow_only({"endpoint", "preset", "unit_id", "timeout_s", "point"});
+  v.allow_only({"endpoint", "preset", "unit_id", "timeout_s", "readback_every", "point"});
   ModbusDeviceConfig d;
   d.endpoint = v.get_string("endpoint");
   at_key(v, "endpoint", [&] { return mb::parse_endpoint(d.endpoint); });
@@ -67,6 +67,8 @@ ModbusDeviceConfig read_modbus_device(const TomlView& v, bool is_chamber) {
   d.unit_id = static_cast<int>(v.opt_integer_in("unit_id", 0, 247).value_or(1));
   d.timeout_s = v.opt_number("timeout_s").value_or(0.5);
   if (!(d.timeout_s > 0 && d.timeout_s <= 10)) throw v.error("timeout_s", "must be in (0, 10] s");
+  d.readback_every =
+      static_cast<int>(v.opt_integer_in("readback_every", 1, 600).value_or(d.readback_every));
   for (const auto& p : v.table_array("point")) d.overrides.push_back(read_override(p));
   // Build the map now so a bad preset or override fails before anything moves.
   auto map = at_key(v, "preset", [&] {

@@ -11,6 +11,7 @@
 #include "compensation/earth_rate.hpp"
 #include "drivers/gpio/gpio_bank.hpp"
 #include "drivers/modbus/map_overrides.hpp"
+#include "drivers/modbus/readback.hpp"
 #include "station/common/input_error.hpp"
 
 namespace station {
@@ -21,6 +22,9 @@ struct ModbusDeviceConfig {
   std::string preset;      ///< register-map preset name
   int unit_id = 1;         ///< Modbus unit id 0..247
   double timeout_s = 0.5;  ///< response timeout of one transaction, s
+  /// Command registers (setpoint, ramp, run; a table's lock) read back every this many reads,
+  /// and on the read after a write or reconnect (drivers/modbus/readback.hpp), 1..600.
+  int readback_every = drivers::modbus::ReadbackSchedule::kDefaultEvery;
   std::vector<drivers::modbus::PointOverride> overrides;
 };
 

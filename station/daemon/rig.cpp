@@ -50,6 +50,7 @@ Rig build_rig(const StationConfig& c, const RigOptions& o) {
   const auto chamber_ep = dr::modbus::parse_endpoint(c.chamber.endpoint);
   auto chamber = std::make_unique<dr::ModbusChamber>(
       "chamber", chamber_ep, chamber_map, c.chamber.timeout_s, wire("chamber", chamber_ep));
+  chamber->set_readback_every(c.chamber.readback_every);
   chamber->set_tap(o.tap);
   chamber->client().set_clock(o.clock);
   rig.chamber = std::move(chamber);
@@ -60,6 +61,7 @@ Rig build_rig(const StationConfig& c, const RigOptions& o) {
     auto table =
         std::make_unique<dr::ModbusTurntable>("turntable", table_ep, map, dr::TurntableLimits{},
                                               c.turntable->timeout_s, wire("turntable", table_ep));
+    table->set_readback_every(c.turntable->readback_every);
     table->set_tap(o.tap);
     table->client().set_clock(o.clock);  // reconnect back-off on the run's clock too
     rig.turntable = std::move(table);

@@ -54,6 +54,7 @@ TEST(ModbusChamber, ReadsInitialStateFromWatlowF4Map) {
 // Tolerance: register resolution 0.05 C plus the discretisation error r*dt/2 < 0.001 C.
 TEST(ModbusChamber, RampFollowsFirstOrderModelOverSimulatedTime) {
   Rig rig(cm::watlow_f4());
+  rig.chamber->set_readback_every(1);  // mode and ramp on every read (they are what is checked)
   ASSERT_TRUE(rig.chamber->command({.setpoint_c = -40.0, .ramp_c_per_min = 1.0}));
   rig.sim.step_to(1800.0);
   auto s = rig.chamber->read();
@@ -153,6 +154,7 @@ TEST(ModbusChamber, OverriddenMapIsSharedByDriverAndSimulator) {
 
 TEST(ModbusChamber, SensorBreakDoorAndHighLimitAlarms) {
   Rig rig(cm::watlow_f4());
+  rig.chamber->set_readback_every(1);  // the mode (read back periodically) is checked too
   rig.sim.set_air_sensor_failed(true);
   rig.sim.set_door_open(true);
   auto s = rig.chamber->read();

@@ -134,3 +134,45 @@ TEST(ModbusChamber, FailedBlockReadIsOneTypedErrorAndTheNextReadRecovers) {
   ASSERT_TRUE(ok) << ok.error().message;
   EXPECT_DOUBLE_EQ(ok.value().air_c, 25.0);
 }
+
+// Ramp, run, status and product are read back every N reads (drivers/modbus/readback.hpp), and
+// on the read after a write or a reconnect; alarms, air and the setpoint on every read.
+TEST(ModbusChamber, CommandRegistersAreReadBackEveryNReadsAndAfterAWriteOrReconnect) {
+  const auto map = cm::watlow_f4();
+  ChamberSim sim(map);
+  ModbusServer server(sim);
+  server.start_tcp();
+  ModbusChamber chamber("chamber", mb::parse_endpoint(server.endpoint()), map, 0.5);
+  chamber.set_readback_every(5);
+  const auto requests_of_read = [&] {
+    const std::uint64_t before = server.requests();
+    auto s = chamber.read();
+    EXPECT_TRUE(s) << s.error().message;
+    return server.requests() - before;
+  };
+  std::vector<std::uint64_t> seen;
+  for (int i = 0; i < 11; ++i) seen.push_back(requests_of_read());
+  // Full reads are 7 blocks (no two points adjacent), live reads 3 (110, 100, 300).
+  EXPECT_EQ(seen, (std::vector<std::uint64_t>{7, 3, 3, 3, 3, 7, 3, 3, 3, 3, 7}));
+  // The panel's setpoint shows on the very next read; its ramp only at the next read-back.
+  sim.set_setpoint_c(-12.5);
+  auto s = chamber.read();
+  ASSERT_TRUE(s);
+  EXPECT_DOUBLE_EQ(s.value().setpoint_c, -12.5);
+  // A write: the next read confirms what the controller took.
+  ASSERT_TRUE(chamber.command({.ramp_c_per_min = 1.5}));
+  EXPECT_EQ(requests_of_read(), 7u);
+  s = chamber.read();
+  ASSERT_TRUE(s);
+  EXPECT_DOUBLE_EQ(s.value().ramp_c_per_min, 1.5);
+  // A reconnect (the controller may have restarted): full again.
+  EXPECT_EQ(requests_of_read(), 3u);
+  server.disconnect_for(0.0);
+  std::uint64_t first_after_reconnect = 0;
+  for (int i = 0; i < 50 && first_after_reconnect == 0; ++i) {
+    const std::uint64_t before = server.requests();
+    if (chamber.read()) first_after_reconnect = server.requests() - before;
+  }
+  EXPECT_EQ(first_after_reconnect, 7u);
+  EXPECT_EQ(requests_of_read(), 3u);
+}

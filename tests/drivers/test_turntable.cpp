@@ -157,3 +157,25 @@ TEST(ModbusTurntable, InjectedFaultsGiveTypedErrorsThenRecover) {
   EXPECT_EQ(rig.table->read().error().kind, ErrorKind::disconnected);
   EXPECT_TRUE(rig.table->read());
 }
+
+// The lock register is read back every N reads and after a write (drivers/modbus/readback.hpp);
+// mode, angle, rate and status (one block) on every read.
+TEST(ModbusTurntable, LockIsReadBackEveryNReadsAndAfterAWrite) {
+  Rig rig;
+  rig.table->set_readback_every(3);
+  ASSERT_TRUE(rig.table->connect());
+  const auto requests_of_read = [&] {
+    const std::uint64_t before = rig.server.requests();
+    EXPECT_TRUE(rig.table->read());
+    return rig.server.requests() - before;
+  };
+  std::vector<std::uint64_t> seen;
+  for (int i = 0; i < 7; ++i) seen.push_back(requests_of_read());
+  EXPECT_EQ(seen, (std::vector<std::uint64_t>{2, 1, 1, 2, 1, 1, 2}));
+  ASSERT_TRUE(rig.table->command({.lock = true}));
+  const std::uint64_t before = rig.server.requests();
+  auto s = rig.table->read();
+  ASSERT_TRUE(s);
+  EXPECT_EQ(rig.server.requests() - before, 2u);
+  EXPECT_TRUE(s.value().locked);
+}
