@@ -91,4 +91,10 @@ json read_result_file(const std::string& path, const std::function<void(json&&)>
   return root;
 }
 
+RecordedResult read_recorded_result(const std::string& path) {
+  RecordedResult r;
+  r.head = read_result_file(path, [&r](json&& tick) { r.ticks.push_back(std::move(tick)); });
+  return r;
+}
+
 }  // namespace station

@@ -5,6 +5,7 @@
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 namespace station {
 
@@ -13,5 +14,14 @@ namespace station {
 /// "FILE: byte N: what" when the text is not JSON or its top level is not an object.
 nlohmann::json read_result_file(const std::string& path,
                                 const std::function<void(nlohmann::json&&)>& on_tick);
+
+/// A whole result.json as read: its head and its ticks in order.
+struct RecordedResult {
+  nlohmann::json head;
+  std::vector<nlohmann::json> ticks;
+};
+
+/// Reads `path` (or `path`.gz) whole with read_result_file. Throws InputError as it does.
+RecordedResult read_recorded_result(const std::string& path);
 
 }  // namespace station

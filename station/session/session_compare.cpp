@@ -79,7 +79,7 @@ class TickComparer {
                  {"recorded", tick.size() - 1},
                  {"replayed", rows_.size()}});
     for (std::size_t k = 0; k < std::min(tick.size() - 1, rows_.size()); ++k)
-      row(tick[k + 1], sample_row_json(*rows_[k]), at);
+      row(tick[k + 1], *rows_[k], at);
   }
   /// Counts the replayed ticks left over, reports a count mismatch and the maxima; returns the
   /// number of replayed ticks.
@@ -95,26 +95,55 @@ class TickComparer {
   }
 
  private:
-  void row(const json& a, const json& b, const json& t_s) {
+  // A replayed sample's numeric column as sample_row_json writes it (no JSON built per row).
+  static std::optional<double> number_of(const SampleRow& r, std::size_t column) {
+    switch (column) {
+      case 1:
+        return r.net_pulses ? std::optional<double>(static_cast<double>(*r.net_pulses))
+                            : std::nullopt;
+      case 2:
+        return r.interval_s;
+      case 3:
+        return r.rate_dph;
+      case 4:
+        return r.temp_c;
+      case 5:
+        return r.temp2_c;
+      case 6:
+        return r.air_c;
+      case 7:
+        return r.setpoint_c;
+      default:
+        return static_cast<double>(r.flags);  // 8
+    }
+  }
+  // One column: numbers within the tolerances (the largest difference kept), null against
+  // null, serial and recording equal.
+  bool same_cell(const json& a, const SampleRow& r, std::size_t i) {
+    if (i == 0) return a.is_string() && a.get_ref<const std::string&>() == r.serial;
+    if (i == 9) return a.is_boolean() && a.get<bool>() == r.recording;
+    const auto y = number_of(r, i);
+    if (!y || !a.is_number()) return !y && a.is_null();
+    const double x = a.get<double>(), d = std::abs(x - *y);
+    max_[i] = std::max(max_[i], d);
+    seen_[i] = true;
+    return d <= c_.atol + c_.rtol * std::abs(x);
+  }
+  void row(const json& a, const SampleRow& r, const json& t_s) {
     const auto& columns = sample_columns();
     if (!a.is_array() || a.size() != columns.size()) {
-      c_.differ(
-          {{"at", {{"tick", t_s}}}, {"quantity", "sample row"}, {"recorded", a}, {"replayed", b}});
+      c_.differ({{"at", {{"tick", t_s}}},
+                 {"quantity", "sample row"},
+                 {"recorded", a},
+                 {"replayed", sample_row_json(r)}});
       return;
     }
     for (std::size_t i = 0; i < columns.size(); ++i) {
-      if (a[i].is_number() && b[i].is_number()) {
-        const double x = a[i].get<double>(), y = b[i].get<double>(), d = std::abs(x - y);
-        max_[i] = std::max(max_[i], d);
-        seen_[i] = true;
-        if (d <= c_.atol + c_.rtol * std::abs(x)) continue;
-      } else if (a[i] == b[i]) {
-        continue;
-      }
+      if (same_cell(a[i], r, i)) continue;
       c_.differ({{"at", {{"tick", t_s}, {"serial", a[0]}}},
                  {"quantity", columns[i]},
                  {"recorded", a[i]},
-                 {"replayed", b[i]}});
+                 {"replayed", sample_row_json(r)[i]}});
     }
   }
 
@@ -168,13 +197,14 @@ nlohmann::json ReplayReport::json() const {
            max_abs_difference.is_null() ? nlohmann::json::object() : max_abs_difference}};
 }
 
-ReplayReport compare_with_store(const std::string& result_path, Store& store, std::int64_t run_id,
+ReplayReport compare_with_store(const RecordedResult& recorded_result,
+                                const std::string& result_path, Store& store, std::int64_t run_id,
                                 double rtol, double atol) {
   ReplayReport r;
   Comparer c{rtol, atol, r};
   TickComparer ticks(c, store, run_id);
-  const json recorded =
-      read_result_file(result_path, [&ticks](json&& tick) { ticks.recorded(tick); });
+  for (const auto& tick : recorded_result.ticks) ticks.recorded(tick);
+  const json& recorded = recorded_result.head;
   r.ticks = ticks.finish();
   const auto version = recorded.value("format_version", json());
   if (version != kSessionFormatVersion)

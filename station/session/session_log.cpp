@@ -123,14 +123,28 @@ void read_session_log(const std::string& path, const std::function<void(SessionL
   });
 }
 
+namespace {
+
+// A guess at a log's line count from its size (plain files only; a .gz is not sized), so the
+// record vectors of a long session do not grow by copying millions of records.
+std::size_t expected_lines(const std::string& path, std::size_t bytes_per_line) {
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  return ec ? 0 : static_cast<std::size_t>(size / bytes_per_line) + 16;
+}
+
+}  // namespace
+
 std::vector<SessionLogLine> read_session_log(const std::string& path) {
   std::vector<SessionLogLine> out;
+  out.reserve(expected_lines(path, 60));
   read_session_log(path, [&out](SessionLogLine&& l) { out.push_back(std::move(l)); });
   return out;
 }
 
 std::vector<drivers::can::CandumpRecord> read_session_can_log(const std::string& path) {
   std::vector<drivers::can::CandumpRecord> out;
+  out.reserve(expected_lines(path, 40));
   for_each_line(path, [&](std::string_view line, int line_no) {
     if (line.find_first_not_of(" \t") == std::string::npos) return;
     auto r = drivers::can::parse_candump_line(line);

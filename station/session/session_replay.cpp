@@ -101,6 +101,12 @@ struct SessionLogs {
 /// `out`, moved out of `lines`.
 void take_lines(std::vector<SessionLogLine>& lines, std::int64_t from, std::int64_t to,
                 std::vector<SessionLogLine>& out) {
+  const bool all = lines.empty() || (lines.front().line_no >= from && lines.back().line_no < to);
+  if (all && out.empty()) {  // a session without restarts: no copy at all
+    out = std::move(lines);
+    lines.clear();
+    return;
+  }
   for (auto& l : lines)
     if (l.line_no >= from && l.line_no < to) out.push_back(std::move(l));
 }
@@ -211,7 +217,14 @@ std::int64_t replay_daemons(const ReplayOptions& o, const Session& session, Stor
         killed
             ? std::min<std::size_t>(static_cast<std::size_t>(resumes[k].can_lines), logs.can.size())
             : logs.can.size();
-    for (auto i = static_cast<std::size_t>(can_from); i < can_to; ++i) can.push_back(logs.can[i]);
+    if (can.empty() && can_from == 0 && can_to == logs.can.size()) {
+      can = std::move(logs.can);
+      logs.can.clear();
+    } else {
+      can.reserve(can.size() + (can_to - static_cast<std::size_t>(can_from)));
+      for (auto i = static_cast<std::size_t>(can_from); i < can_to; ++i)
+        can.push_back(std::move(logs.can[i]));
+    }
     if (killed) {
       modbus_from = resumes[k].modbus_lines + 1;
       gpio_from = resumes[k].gpio_lines + 1;
@@ -266,6 +279,9 @@ ReplayReport replay_session(const ReplayOptions& o) {
   if (!fs::exists(result_path) && !fs::exists(result_path + ".gz"))
     throw InputError(fmt::format("{}: cannot open (the run did not end?)", result_path));
   const std::string db = fresh_db_path(o);
+  // result.json is parsed on another thread while the daemon replays.
+  auto recorded =
+      std::async(std::launch::async, [result_path] { return read_recorded_result(result_path); });
   ReplayReport report;
   {
     Store store(db);
@@ -273,7 +289,7 @@ ReplayReport replay_session(const ReplayOptions& o) {
     const std::int64_t run_id = replay_daemons(o, session, store, report);
     if (run_id != 0) {
       store.flush();
-      report = compare_with_store(result_path, store, run_id, o.rtol, o.atol);
+      report = compare_with_store(recorded.get(), result_path, store, run_id, o.rtol, o.atol);
     }
   }
   if (o.db.empty()) {
