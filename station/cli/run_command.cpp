@@ -112,9 +112,7 @@ int run_real(const RunOptions& o) {
     // The probe above is not part of the session: the logs start with the run's first tick.
     session.emplace(o.record);
     tap.target = &session->tap();
-    session->start(
-        config, protocol, false, std::nullopt,
-        resume ? std::optional<double>(resume->last_tick_s.value_or(-1.0)) : std::nullopt);
+    session->start(config, protocol, false, std::nullopt);
   } else if (!o.record_can.empty()) {
     can_log.open(o.record_can, std::ios::app);
     if (!can_log) throw InputError(fmt::format("{}: cannot write the CAN log", o.record_can));
@@ -128,7 +126,10 @@ int run_real(const RunOptions& o) {
   if (sd_watchdog_enabled(0, &watchdog_usec) > 0) {
     so.watchdog = [] { sd_notify(0, "WATCHDOG=1"); };
   }
-  if (session) so.on_tick = [&session](const TickReport&) { session->after_tick(); };
+  if (session) {
+    so.on_tick = [&session](const TickReport&) { session->after_tick(); };
+    so.on_resume = [&session](double last_s, double next_s) { session->resumed(last_s, next_s); };
+  }
   Sequencer seq(config, protocol, rig, store, clock, so);
   sd_notify(0, "READY=1");
   const RunOutcome out = seq.run(resume);

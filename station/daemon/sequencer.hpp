@@ -44,6 +44,11 @@ struct SequencerOptions {
   const std::atomic<bool>* stop = nullptr;         ///< set by SIGTERM/SIGINT
   /// Deterministic simulation resume: replay ticks up to this time without storing them.
   std::optional<double> replay_until_t_s;
+  /// A resumed run's first tick as a recorded daemon chose it (from the wall clock): a session
+  /// replay of a rig resume (station/session). Never before the tick after the last committed.
+  std::optional<double> resume_at_t_s;
+  /// Told, before any device I/O, that a run resumes: last committed tick, first tick now.
+  std::function<void(double last_s, double next_s)> on_resume;
 };
 
 /// How a run ended.

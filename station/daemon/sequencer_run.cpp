@@ -60,7 +60,9 @@ double Sequencer::resume_first_tick(const RunRecord& resume) {
     // committed tick, whatever the wall clock did while the daemon was down (a step backwards
     // must not land on stored ticks).
     const double elapsed_s = drivers::tap_wall_time_s() - resume.t0_wall_s;
-    if (std::isfinite(elapsed_s))
+    if (options_.resume_at_t_s)
+      t_first = std::max(t_first, *options_.resume_at_t_s);
+    else if (std::isfinite(elapsed_s))
       t_first = std::max(t_first, std::floor(elapsed_s / period) * period);
     if (t_first > last_s + period) {
       emit(last_s, "warn", "seq", "resume_gap",
@@ -72,6 +74,7 @@ double Sequencer::resume_first_tick(const RunRecord& resume) {
   emit(std::max(last_s, 0.0), "warn", "seq", "resume",
        fmt::format("resuming run {} at step {} after t = {:.0f} s (next tick t = {:.0f} s)",
                    run_id_, resume.progress.step_index, last_s, t_first));
+  if (options_.on_resume) options_.on_resume(last_s, t_first);
   return t_first;
 }
 

@@ -169,9 +169,10 @@ std::int64_t complete_lines(const std::filesystem::path& path) {
 
 }  // namespace
 
-void append_session_resume(const std::string& dir, double after_tick_s) {
+void append_session_resume(const std::string& dir, double after_tick_s, double next_tick_s) {
   const std::filesystem::path d(dir);
   toml::table r{{"after_tick_s", after_tick_s},
+                {"next_tick_s", next_tick_s},
                 {"can_lines", complete_lines(d / "can.log")},
                 {"modbus_lines", complete_lines(d / "modbus.log")},
                 {"gpio_lines", complete_lines(d / "gpio.log")}};
@@ -195,7 +196,8 @@ std::vector<SessionResume> read_session_resumes(const std::string& path) {
             fmt::format("{}: resume {}: key '{}': missing or negative", path, i + 1, key));
       return *v;
     };
-    out.push_back({number("after_tick_s"), static_cast<std::int64_t>(number("can_lines")),
+    const auto next = r != nullptr ? (*r)["next_tick_s"].value<double>() : std::nullopt;
+    out.push_back({number("after_tick_s"), next, static_cast<std::int64_t>(number("can_lines")),
                    static_cast<std::int64_t>(number("modbus_lines")),
                    static_cast<std::int64_t>(number("gpio_lines"))});
   }

@@ -36,12 +36,13 @@ void write_session_header(const std::string& dir, const SessionHeader& header);
 /// each log held when the resumed daemon began (what the killed daemon wrote).
 struct SessionResume {
   double after_tick_s = 0;
+  std::optional<double> next_tick_s;  ///< the resumed daemon's first tick (rig: wall clock)
   std::int64_t can_lines = 0, modbus_lines = 0, gpio_lines = 0;
 };
 
 /// Marks a resume in `dir`: cuts a line the killed daemon left half-written from each log, counts
 /// the logs' lines and appends a [[resume]] table to session.toml. Throws InputError.
-void append_session_resume(const std::string& dir, double after_tick_s);
+void append_session_resume(const std::string& dir, double after_tick_s, double next_tick_s);
 
 /// The [[resume]] tables of a session.toml (empty for a run recorded without a restart).
 std::vector<SessionResume> read_session_resumes(const std::string& session_toml_path);

@@ -16,8 +16,7 @@
 namespace station {
 
 void SessionRecording::start(const StationConfig& config, const Protocol& protocol, bool simulated,
-                             std::optional<std::int64_t> sim_seed,
-                             std::optional<double> resumed_after_tick_s) {
+                             std::optional<std::int64_t> sim_seed) {
   SessionHeader h;
   h.station = config.name;
   h.software_version = STATION_VERSION;
@@ -33,10 +32,6 @@ void SessionRecording::start(const StationConfig& config, const Protocol& protoc
   h.protocol_text = protocol.text;
   h.slots = run_slots_of(config);
   write_session_header(dir_, h);
-  if (resumed_after_tick_s) {
-    recorder_.flush();
-    append_session_resume(dir_, *resumed_after_tick_s);
-  }
 }
 
 void SessionRecording::finish(Store& store, std::int64_t run_id) {

@@ -8,6 +8,7 @@
 
 #include "station/config/config.hpp"
 #include "station/config/protocol.hpp"
+#include "station/session/session_files.hpp"
 #include "station/session/session_recorder.hpp"
 #include "station/store/store.hpp"
 
@@ -21,12 +22,16 @@ class SessionRecording {
 
   /// The tap every transport of the rig writes to.
   SessionRecorder& tap() { return recorder_; }
-  /// Writes session.toml (kept if it exists: a resumed run keeps its start's header). A run
-  /// resumed after its last committed tick `resumed_after_tick_s` marks the restart in the
-  /// session (append_session_resume) before anything more is logged.
+  /// Writes session.toml (kept if it exists: a resumed run keeps its start's header).
   void start(const StationConfig& config, const Protocol& protocol, bool simulated,
-             std::optional<std::int64_t> sim_seed,
-             std::optional<double> resumed_after_tick_s = std::nullopt);
+             std::optional<std::int64_t> sim_seed);
+  /// A resumed run marks its restart in the session (append_session_resume) before it logs
+  /// anything: the last committed tick and the first tick of the resumed daemon
+  /// (SequencerOptions::on_resume).
+  void resumed(double after_tick_s, double next_tick_s) {
+    recorder_.flush();
+    append_session_resume(dir_, after_tick_s, next_tick_s);
+  }
   /// After every tick: the logs reach the disk, so a kill loses at most one tick of log.
   void after_tick() { recorder_.flush(); }
   /// Writes result.json from what the run stored.

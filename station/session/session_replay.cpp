@@ -178,11 +178,12 @@ std::vector<SessionResume> replayable_resumes(const std::string& dir, const Sess
   const std::string path = (fs::path(dir) / "session.toml").string();
   auto resumes = read_session_resumes(path);
   if (resumes.empty()) return resumes;
-  if (!session.sim_seed)
-    throw InputError(fmt::format(
-        "{}: a rig run killed and resumed (resume after t = {:.0f} s) is not replayable yet: "
-        "its restart tick came from the wall clock; simulated sessions are",
-        path, resumes.front().after_tick_s));
+  for (std::size_t i = 0; i < resumes.size(); ++i)
+    if (!session.sim_seed && !resumes[i].next_tick_s)
+      throw InputError(
+          fmt::format("{}: resume {}: key 'next_tick_s' missing: a rig's resumed "
+                      "daemon chose its first tick from the wall clock",
+                      path, i + 1));
   const auto& first = resumes.front();
   if (first.can_lines + first.modbus_lines + first.gpio_lines == 0)
     throw InputError(
@@ -239,13 +240,16 @@ std::int64_t replay_daemons(const ReplayOptions& o, const Session& session, Stor
     if (k > 0) {
       resume = decide_resume(store, session.config, false, true).run;
       if (!resume) throw InputError(fmt::format("{}: resume {}: no run to resume", o.dir, k));
-      so.replay_until_t_s = resume->last_tick_s.value_or(-1.0);
+      if (session.sim_seed)  // a simulation recomputes its stored ticks from t = 0
+        so.replay_until_t_s = resume->last_tick_s.value_or(-1.0);
+      else  // a rig continued where the wall clock was when it came back
+        so.resume_at_t_s = resumes[k - 1].next_tick_s;
     }
     so.on_tick = [&](const TickReport& r) {
       last_tick_s = r.t_s;
       if (!killed || r.t_s < resumes[k].after_tick_s) return;
       store.flush();  // what the killed daemon had committed
-      devices.consumed(modbus_prefix, gpio_prefix, can_prefix);
+      if (session.sim_seed) devices.consumed(modbus_prefix, gpio_prefix, can_prefix);
       throw KilledHere{};
     };
     try {

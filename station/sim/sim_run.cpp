@@ -141,9 +141,8 @@ nlohmann::json run_simulated(const SimRunOptions& o) {
   const double nominal_s = protocol.nominal_duration_s(wc.initial_c);
   double next_report_s = 0;
   if (session) {
-    session->start(
-        config, protocol, true, static_cast<std::int64_t>(o.seed),
-        resume ? std::optional<double>(resume->last_tick_s.value_or(-1.0)) : std::nullopt);
+    session->start(config, protocol, true, static_cast<std::int64_t>(o.seed));
+    so.on_resume = [&session](double last_s, double next_s) { session->resumed(last_s, next_s); };
     // A resumed simulation connects and recomputes its stored ticks first: all of that is in
     // the logs already (before_tick lifts the pause after the last stored tick).
     if (resume) session->tap().pause(true);

@@ -6,7 +6,9 @@
 
 #include <map>
 #include <optional>
+#include <thread>
 
+#include "station/session/session_files.hpp"
 #include "station/store/store.hpp"
 #include "tests/station/rig_process.hpp"
 #include "tests/station/temp_db.hpp"
@@ -190,4 +192,40 @@ TEST(DaemonProcesses, AnOutageOpenAtSigkillEndsOnceInTheRestartedDaemon) {
   EXPECT_EQ(count("outage: "), 1) << ::testing::PrintToString(events_of());
   station::Store s(db, station::OpenMode::read_only);
   EXPECT_TRUE(s.open_outages(1).empty());
+}
+
+// Issue 8: a session recorded on a real-transport rig (simrig, the wall clock), the daemon
+// SIGKILLed mid-record and started again two seconds later (the resumed daemon picks its first
+// tick from the wall clock: a gap), replays daemon by daemon to the same result.
+TEST(DaemonProcesses, ARigSessionKilledAndResumedReplaysTheSame) {
+  ts::SimrigProcess rig;
+  ASSERT_TRUE(rig.start("rigresume")) << ts::slurp(rig.err);
+  const auto db = ts::fresh_db("rigresume");
+  const std::string dir = db + ".session";
+  const std::string hold20 = std::string(STATION_TEST_DATA_DIR) + "/hold_20.toml";
+  const auto start = [&](const std::string& tag) {
+    return ts::spawn_process({ts::kStationBin, "run", "--config", rig.config_path, "--protocol",
+                              hold20, "--db", db, "--record", dir},
+                             db + "." + tag + ".out", db + "." + tag + ".err");
+  };
+  pid_t pid = start("a");
+  ASSERT_TRUE(ts::wait_until([&] { return ticks_of(db) >= 6; }, std::chrono::seconds(15)))
+      << ts::slurp(db + ".a.err");
+  kill(pid, SIGKILL);
+  waitpid(pid, nullptr, 0);
+  std::this_thread::sleep_for(std::chrono::seconds(2));
+  pid = start("b");
+  const int status = ts::wait_bounded(pid, std::chrono::seconds(40));
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << ts::slurp(db + ".b.err");
+  const auto resumes = station::read_session_resumes(dir + "/session.toml");
+  ASSERT_EQ(resumes.size(), 1u);
+  ASSERT_TRUE(resumes[0].next_tick_s);
+  EXPECT_GE(*resumes[0].next_tick_s, resumes[0].after_tick_s + 2) << "no gap: not a rig resume";
+  const pid_t replay =
+      ts::spawn_process({ts::kStationBin, "replay", dir}, db + ".replay.out", db + ".replay.err");
+  const int replayed = ts::wait_bounded(replay, std::chrono::seconds(30));
+  EXPECT_TRUE(WIFEXITED(replayed) && WEXITSTATUS(replayed) == 0)
+      << ts::slurp(db + ".replay.out") << ts::slurp(db + ".replay.err");
+  EXPECT_NE(ts::slurp(db + ".replay.out").find(": same"), std::string::npos)
+      << ts::slurp(db + ".replay.out");
 }

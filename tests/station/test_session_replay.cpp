@@ -241,16 +241,18 @@ TEST(SessionReplayResumed, EachDaemonsPartCountsAndTheLostTicksDoNot) {
   EXPECT_FALSE(flipped_replay(second_daemon).same) << lines[second_daemon];
   const auto r = flipped_replay(lost);
   EXPECT_TRUE(r.same) << lines[lost] << "\n" << r.json().dump(1);
-  // The same restart on a rig: its restart tick came from the wall clock. Refused, one line.
+  // A rig's restart tick came from the wall clock: a resume that does not say it is refused.
   const auto rig = copy_of(d, "rig");
   auto header = read_lines(rig / "session.toml");
-  std::erase_if(header, [](const std::string& l) { return l.rfind("sim_seed", 0) == 0; });
+  std::erase_if(header, [](const std::string& l) {
+    return l.rfind("sim_seed", 0) == 0 || l.rfind("next_tick_s", 0) == 0;
+  });
   write_lines(rig / "session.toml", header);
   try {
     station::replay_session({rig.string(), "", 0, 0});
-    FAIL() << "replayed a resumed rig session";
+    FAIL() << "replayed a rig resume without its next tick";
   } catch (const station::InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("session.toml: a rig run killed and resumed"),
+    EXPECT_NE(std::string(e.what()).find("session.toml: resume 1: key 'next_tick_s' missing"),
               std::string::npos)
         << e.what();
   }
