@@ -51,8 +51,15 @@ const SessionLogLine& ReplayGpioBank::expect(const char* kind, std::string_view 
 
 void ReplayGpioBank::signal() {
   if (!efd_.valid()) return;
-  std::uint64_t v = 0;
-  (void)!::read(efd_.get(), &v, sizeof v);  // drain (non-blocking)
+  const auto set = [this](bool readable) {  // a syscall only when the fd's state changes
+    if (readable == readable_) return;
+    std::uint64_t v = 1;
+    if (readable)
+      (void)!::write(efd_.get(), &v, sizeof v);
+    else
+      (void)!::read(efd_.get(), &v, sizeof v);  // drain (non-blocking)
+    readable_ = readable;
+  };
   // The next exchange is an edge drained between ticks when no more SYNCs preceded it than the
   // replay has sent: a tick's own drain comes after that tick's SYNC. (Stamps: SYNCs truncated
   // to the microsecond, session lines rounded, so one instant never orders an edge first.)
@@ -60,15 +67,13 @@ void ReplayGpioBank::signal() {
     return static_cast<std::size_t>(
         std::upper_bound(sync_times_s_.begin(), sync_times_s_.end(), t_s) - sync_times_s_.begin());
   };
-  if (next_ < lines_.size() && lines_[next_].kind == "gpio-edge" &&
-      before_edge(lines_[next_].t_s) <= (syncs_sent_ ? syncs_sent_() : 0)) {
-    const std::uint64_t one = 1;
-    (void)!::write(efd_.get(), &one, sizeof one);
-  }
+  set(next_ < lines_.size() && lines_[next_].kind == "gpio-edge" &&
+      before_edge(lines_[next_].t_s) <= (syncs_sent_ ? syncs_sent_() : 0));
 }
 
 dr::Result<void> ReplayGpioBank::open() {
   efd_.reset(::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC));
+  readable_ = false;
   open_ = true;
   // Requesting the lines drove every output to its safe level, one write each.
   for (const auto& line : config_.lines) {

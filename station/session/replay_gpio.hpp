@@ -45,6 +45,7 @@ class ReplayGpioBank final : public drivers::gpio::GpioBank {
   std::vector<SessionLogLine> lines_;
   std::size_t next_ = 0;
   drivers::can::UniqueFd efd_;
+  bool readable_ = false;  ///< what the event fd holds (only this bank reads or writes it)
   bool open_ = false;
   std::vector<double> sync_times_s_;
   std::function<std::size_t()> syncs_sent_;

@@ -60,37 +60,35 @@ RecordedModbusWire::RecordedModbusWire(std::string device, std::vector<SessionLo
 
 const SessionLogLine& RecordedModbusWire::expect(const char* direction, const char* kind,
                                                  const std::vector<std::uint8_t>* bytes,
-                                                 const std::string& asked) {
+                                                 const Asked& asked) {
   const SessionLogLine* l = peek();
-  if (l == nullptr) throw ReplayDivergence(device_, "no more exchanges", asked, 0);
+  if (l == nullptr) throw ReplayDivergence(device_, "no more exchanges", asked(), 0);
   if (l->direction != direction || l->kind != kind || (bytes != nullptr && l->bytes != *bytes))
-    throw ReplayDivergence(device_, describe(*l), asked, l->t_s);
+    throw ReplayDivergence(device_, describe(*l), asked(), l->t_s);
   ++next_;
   return *l;
 }
 
-bool RecordedModbusWire::reply(const char* kind, std::vector<std::uint8_t>& bytes,
-                               const std::string& asked) {
+const std::vector<std::uint8_t>* RecordedModbusWire::reply(const char* kind, const Asked& asked) {
   const SessionLogLine* l = peek();
   if (l != nullptr && l->direction == "event" && l->kind == "error" && l->bytes.size() == 4) {
     ++next_;
     errno = static_cast<int>(static_cast<std::uint32_t>(l->bytes[0]) << 24 |
                              static_cast<std::uint32_t>(l->bytes[1]) << 16 |
                              static_cast<std::uint32_t>(l->bytes[2]) << 8 | l->bytes[3]);
-    return false;
+    return nullptr;
   }
-  bytes = expect("rx", kind, nullptr, "the reply to " + asked).bytes;
-  return true;
+  return &expect("rx", kind, nullptr, [&asked] { return "the reply to " + asked(); }).bytes;
 }
 
 int RecordedModbusWire::open(double) {
+  const Asked asked = [] { return std::string("connect"); };
   const SessionLogLine* l = peek();
   if (l != nullptr && l->direction == "event" && l->kind == "error" && l->bytes.size() == 4) {
-    std::vector<std::uint8_t> unused;
-    (void)reply("connect", unused, "connect");
+    (void)reply("connect", asked);
     return -1;
   }
-  expect("event", "connect", nullptr, "connect");
+  expect("event", "connect", nullptr, asked);
   return 0;
 }
 
@@ -99,28 +97,29 @@ void RecordedModbusWire::close() {
   if (l != nullptr && l->direction == "event" && l->kind == "disconnect") ++next_;
 }
 
+// The request's description is built only for a divergence: a long replay asks ~10^6 times.
 int RecordedModbusWire::read(mb::FunctionCode fc, int unit, std::uint16_t addr, int count,
                              std::uint16_t* dest) {
   const auto req = read_request_adu(unit, static_cast<int>(fc), addr, count);
-  const std::string asked = "tx modbus-read " + hex(req);
+  const Asked asked = [&req] { return "tx modbus-read " + hex(req); };
   expect("tx", "modbus-read", &req, asked);
-  std::vector<std::uint8_t> rx;
-  if (!reply("modbus-read", rx, asked)) return -1;
+  const auto* rx = reply("modbus-read", asked);
+  if (rx == nullptr) return -1;
   // unit, fc, byte count, registers (big-endian).
-  if (rx.size() < 3 || rx.size() != 3u + rx[2] || rx[2] % 2 != 0)
-    throw ReplayDivergence(device_, "a malformed reply " + hex(rx), asked, 0);
-  const int n = rx[2] / 2;
+  const auto& r = *rx;
+  if (r.size() < 3 || r.size() != 3u + r[2] || r[2] % 2 != 0)
+    throw ReplayDivergence(device_, "a malformed reply " + hex(r), asked(), 0);
+  const int n = r[2] / 2;
   for (int i = 0; i < n && i < count; ++i)
-    dest[i] = static_cast<std::uint16_t>(rx[3 + 2 * i] << 8 | rx[4 + 2 * i]);
+    dest[i] = static_cast<std::uint16_t>(r[3 + 2 * i] << 8 | r[4 + 2 * i]);
   return n;
 }
 
 int RecordedModbusWire::write(int unit, std::uint16_t addr, std::span<const std::uint16_t> words) {
   const auto req = write_request_adu(unit, addr, words);
-  const std::string asked = "tx modbus-write " + hex(req);
+  const Asked asked = [&req] { return "tx modbus-write " + hex(req); };
   expect("tx", "modbus-write", &req, asked);
-  std::vector<std::uint8_t> rx;
-  if (!reply("modbus-write", rx, asked)) return -1;
+  if (reply("modbus-write", asked) == nullptr) return -1;
   return static_cast<int>(words.size());
 }
 

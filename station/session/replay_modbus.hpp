@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <span>
 #include <stdexcept>
@@ -41,13 +42,14 @@ class RecordedModbusWire final : public drivers::modbus::ModbusWire {
   }
 
  private:
+  /// Describes the daemon's request, for a divergence only.
+  using Asked = std::function<std::string()>;
   /// The next line, which must be (direction, kind) and, when given, carry `bytes`; throws
   /// ReplayDivergence otherwise.
   const SessionLogLine& expect(const char* direction, const char* kind,
-                               const std::vector<std::uint8_t>* bytes, const std::string& asked);
-  /// After a request: its reply (rx → the reply's bytes, returns true) or its error (sets
-  /// errno, returns false).
-  bool reply(const char* kind, std::vector<std::uint8_t>& bytes, const std::string& asked);
+                               const std::vector<std::uint8_t>* bytes, const Asked& asked);
+  /// After a request: its reply's bytes, or nullptr for its recorded error (errno set).
+  const std::vector<std::uint8_t>* reply(const char* kind, const Asked& asked);
   const SessionLogLine* peek() const { return next_ < lines_.size() ? &lines_[next_] : nullptr; }
 
   std::string device_;

@@ -76,8 +76,12 @@ std::string fresh_db_path(const ReplayOptions& o) {
     return o.db;
   }
   static std::atomic<int> n{0};
-  return (fs::temp_directory_path() / fmt::format("station-replay-{}-{}.db", getpid(), n++))
-      .string();
+  // The replayed database is thrown away: on tmpfs when there is one (no disk writes at all).
+  std::error_code ec;
+  const fs::path dir = fs::is_directory("/dev/shm", ec) && access("/dev/shm", W_OK) == 0
+                           ? fs::path("/dev/shm")
+                           : fs::temp_directory_path();
+  return (dir / fmt::format("station-replay-{}-{}.db", getpid(), n++)).string();
 }
 
 /// Everything the session's three logs hold, in order.
