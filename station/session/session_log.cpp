@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <zlib.h>
 
+#include <algorithm>
 #include <charconv>
 #include <filesystem>
 #include <memory>
@@ -80,8 +81,13 @@ std::string for_each_line(const std::string& path,
   // zlib reads a file that is not gzip-compressed as it is.
   GzHandle in(gzopen(file.c_str(), "rb"));
   if (!in) throw InputError(fmt::format("{}: cannot open the session log", file));
-  gzbuffer(in.get(), 1 << 20);
-  // Large reads, lines split in place: a session log has millions of lines.
+  // Large reads, lines split in place: a session log has millions of lines (a small file gets a
+  // small buffer).
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(file, ec);
+  const std::size_t kChunk =
+      ec ? std::size_t{1} << 20 : std::clamp<std::size_t>(size + 1, 4096, std::size_t{1} << 20);
+  gzbuffer(in.get(), static_cast<unsigned>(kChunk));
   std::string buf;
   std::size_t begin = 0;  // first byte of buf not yet handed out
   int line_no = 0;
@@ -90,7 +96,6 @@ std::string for_each_line(const std::string& path,
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
     if (!line.empty()) each(line, line_no);
   };
-  constexpr std::size_t kChunk = 1 << 20;
   for (;;) {
     buf.erase(0, begin);
     begin = 0;
