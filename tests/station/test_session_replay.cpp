@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "station/common/input_error.hpp"
+#include "station/session/result_reader.hpp"
 #include "station/session/session_files.hpp"
 #include "station/session/session_replay.hpp"
 #include "station/sim/sim_run.hpp"
@@ -256,4 +257,24 @@ TEST(SessionReplayResumed, EachDaemonsPartCountsAndTheLostTicksDoNot) {
               std::string::npos)
         << e.what();
   }
+}
+
+// Fuzz finding (fuzz_result_json): a "ticks" that is not an array stayed in the head, where the
+// comparison would have seen no ticks at all. Now one line naming the key.
+TEST(ResultReader, TicksThatAreNotAnArrayAreABadFile) {
+  const auto path = station::testing_support::fresh_db("ticks_object") + ".json";
+  std::ofstream(path) << "{\"ticks\": {\"ticks\": [3]}}\n";
+  int handed = 0;
+  try {
+    station::read_result_file(path, [&handed](nlohmann::json&&) { ++handed; });
+    FAIL() << "accepted a ticks object";
+  } catch (const station::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(".json: key 'ticks': not an array"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(handed, 0);
+  std::ofstream(path) << "{\"ticks\": [[1.0], [2.0]], \"state\": \"completed\"}\n";
+  const auto head = station::read_result_file(path, [&handed](nlohmann::json&&) { ++handed; });
+  EXPECT_EQ(handed, 2);
+  EXPECT_EQ(head["state"], "completed");
 }
