@@ -60,28 +60,23 @@ Result<double> ModbusChamber::get(const char* point) {
 }
 
 Result<std::vector<double>> ModbusChamber::read_values() {
-  if (client_.connects() != connects_seen_) {  // a restarted controller may hold anything
-    connects_seen_ = client_.connects();
-    readback_.invalidate();
-  }
-  const bool full = readback_.due();
+  const bool full = readback_.due(client_.connects());
   auto values = full ? client_.read_points(read_points_, read_plan_)
                      : client_.read_points(std::span(read_points_).first(kLivePoints), live_plan_);
   if (values && full) {
     const auto& v = values.value();
     const int st = static_cast<int>(v[kStatusF]);
     if (st < 0 || st > 3) {
-      readback_.read_done(false, full);
+      readback_.read_done(false, full, client_.connects());
       return make_error(ErrorKind::protocol,
                         fmt::format("{}: status register {} not 0..3", name_, st));
     }
-    connects_seen_ = client_.connects();  // read after any (re)connect inside this read
     mode_ = static_cast<ChamberMode>(st);
     product_c_ = v[kProductF];
     ramp_c_per_min_ = v[kRampF];
     run_enabled_ = v[kRunF] != 0;
   }
-  readback_.read_done(values.ok(), full);
+  readback_.read_done(values.ok(), full, client_.connects());
   return values;
 }
 

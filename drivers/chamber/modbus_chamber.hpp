@@ -65,7 +65,6 @@ class ModbusChamber final : public Chamber {
   std::vector<modbus::ReadBlock> read_plan_;
   std::vector<modbus::ReadBlock> live_plan_;  // alarms, air, setpoint
   modbus::ReadbackSchedule readback_;
-  std::uint64_t connects_seen_ = 0;
   ChamberMode mode_ = ChamberMode::off;        // read back last
   double product_c_ = 0, ramp_c_per_min_ = 0;  // read back last
   bool run_enabled_ = false;

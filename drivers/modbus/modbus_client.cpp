@@ -7,56 +7,9 @@
 #include <cmath>
 #include <variant>
 
+#include "drivers/modbus/modbus_adu.hpp"
+
 namespace station::drivers::modbus {
-namespace {
-
-// Request PDU bytes as the Modbus spec lays them out (function, address, count): libmodbus does
-// not expose the raw frame, so the tap records the reconstructed PDU.
-// Tap bytes are ADUs without the transport's framing (no MBAP header, no RTU CRC): the unit id,
-// then the PDU, as the Modbus spec writes them (big-endian words).
-void put_u16(std::vector<std::uint8_t>& out, std::uint16_t v) {
-  out.push_back(static_cast<std::uint8_t>(v >> 8));
-  out.push_back(static_cast<std::uint8_t>(v & 0xFF));
-}
-
-std::vector<std::uint8_t> request_adu(int unit, int fc, std::uint16_t addr, int count) {
-  std::vector<std::uint8_t> out{static_cast<std::uint8_t>(unit), static_cast<std::uint8_t>(fc)};
-  put_u16(out, addr);
-  put_u16(out, static_cast<std::uint16_t>(count));
-  return out;
-}
-
-std::vector<std::uint8_t> words_adu(int unit, int fc, std::span<const std::uint16_t> words) {
-  std::vector<std::uint8_t> out{static_cast<std::uint8_t>(unit), static_cast<std::uint8_t>(fc),
-                                static_cast<std::uint8_t>(2 * words.size())};
-  for (auto w : words) put_u16(out, w);
-  return out;
-}
-
-// An error event's bytes: the errno (libmodbus's EMB* codes included) as 4 big-endian bytes, so
-// a recorded session says exactly which failure the client saw.
-std::vector<std::uint8_t> errno_bytes(int err) {
-  const auto u = static_cast<std::uint32_t>(err);
-  return {static_cast<std::uint8_t>(u >> 24), static_cast<std::uint8_t>(u >> 16),
-          static_cast<std::uint8_t>(u >> 8), static_cast<std::uint8_t>(u)};
-}
-
-// fc 6: unit, 6, address, value; fc 16: unit, 16, address, count, byte count, values.
-std::vector<std::uint8_t> write_adu(int unit, std::uint16_t addr,
-                                    std::span<const std::uint16_t> words) {
-  const bool single = words.size() == 1;
-  std::vector<std::uint8_t> out{static_cast<std::uint8_t>(unit),
-                                static_cast<std::uint8_t>(single ? 6 : 16)};
-  put_u16(out, addr);
-  if (!single) {
-    put_u16(out, static_cast<std::uint16_t>(words.size()));
-    out.push_back(static_cast<std::uint8_t>(2 * words.size()));
-  }
-  for (auto w : words) put_u16(out, w);
-  return out;
-}
-
-}  // namespace
 
 Error translate_modbus_error(int err, const std::string& what) {
   std::string msg = what + ": " + modbus_strerror(err);
@@ -164,7 +117,7 @@ Result<std::vector<std::uint16_t>> ModbusClient::read_registers(FunctionCode fc,
                                                                 std::uint16_t addr, int count) {
   if (auto c = ensure_connected(); !c) return c.error();
   int code = static_cast<int>(fc);
-  tap(TapDirection::tx, "modbus-read", request_adu(unit, code, addr, count),
+  tap(TapDirection::tx, "modbus-read", read_request_adu(unit, code, addr, count),
       fmt::format("unit={} fc={} addr={} count={}", unit, code, addr, count));
   std::vector<std::uint16_t> words(static_cast<std::size_t>(count));
   int rc = wire_->read(fc, unit, addr, count, words.data());
@@ -172,7 +125,7 @@ Result<std::vector<std::uint16_t>> ModbusClient::read_registers(FunctionCode fc,
   if (rc != count)
     return fail(EMBBADDATA, fmt::format("read addr={}: {} registers, wanted {}", addr, rc, count));
   consecutive_timeouts_ = 0;
-  tap(TapDirection::rx, "modbus-read", words_adu(unit, code, words),
+  tap(TapDirection::rx, "modbus-read", read_reply_adu(unit, code, words),
       fmt::format("unit={} addr={}", unit, addr));
   return words;
 }
@@ -182,13 +135,13 @@ Result<void> ModbusClient::write_registers(int unit, std::uint16_t addr,
   if (auto c = ensure_connected(); !c) return c.error();
   int n = static_cast<int>(words.size());
   int code = n == 1 ? 6 : 16;
-  tap(TapDirection::tx, "modbus-write", write_adu(unit, addr, words),
+  tap(TapDirection::tx, "modbus-write", write_request_adu(unit, addr, words),
       fmt::format("unit={} fc={} addr={} count={}", unit, code, addr, n));
   int rc = wire_->write(unit, addr, words);
   if (rc == -1) return fail(errno, fmt::format("write fc={} addr={} count={}", code, addr, n));
   consecutive_timeouts_ = 0;
   tap(TapDirection::rx, "modbus-write",
-      n == 1 ? write_adu(unit, addr, words) : request_adu(unit, code, addr, n),
+      n == 1 ? write_request_adu(unit, addr, words) : read_request_adu(unit, code, addr, n),
       fmt::format("unit={} addr={} ok", unit, addr));
   return {};
 }

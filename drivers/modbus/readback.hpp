@@ -6,6 +6,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cstdint>
 
 namespace station::drivers::modbus {
 
@@ -16,28 +17,33 @@ class ReadbackSchedule {
 
   void set_every(int reads) { every_ = std::max(1, reads); }
   int every() const { return every_; }
-  /// Whether this read must include the command registers.
-  bool due() const { return stale_ || since_ + 1 >= every_; }
-  /// After a read: `with_commands` whether it read them; a failed read makes the next one full.
-  void read_done(bool ok, bool with_commands) {
+  /// Whether this read must include the command registers. `connects`: the client's count of
+  /// successful connects (ModbusClient::connects) — a new connection since the last read-back
+  /// may be a restarted device holding anything.
+  bool due(std::uint64_t connects) const {
+    return stale_ || connects != connects_ || since_ + 1 >= every_;
+  }
+  /// After a read: `with_commands` whether it read them, `connects` the client's count after
+  /// it; a failed read makes the next one full.
+  void read_done(bool ok, bool with_commands, std::uint64_t connects) {
     if (!ok) {
       stale_ = true;
-      return;
-    }
-    if (with_commands) {
+    } else if (with_commands) {
       stale_ = false;
       since_ = 0;
+      connects_ = connects;
     } else {
       ++since_;
     }
   }
-  /// After a write or a (re)connect: the next read confirms what the device now holds.
+  /// After a write: the next read confirms what the device now holds.
   void invalidate() { stale_ = true; }
 
  private:
   int every_ = kDefaultEvery;
   int since_ = 0;
-  bool stale_ = true;  // nothing read back yet
+  std::uint64_t connects_ = 0;  // the client's connect count at the last read-back
+  bool stale_ = true;           // nothing read back yet
 };
 
 }  // namespace station::drivers::modbus

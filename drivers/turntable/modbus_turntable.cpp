@@ -54,18 +54,13 @@ Result<TurntableState> ModbusTurntable::read() {
   s.at_rate = (bits & tm::kAtRate) != 0;
   s.fault = (bits & tm::kFault) != 0;
   s.interlock_open = (bits & tm::kInterlockOpen) != 0;
-  if (client_.connects() != connects_seen_) {  // a restarted drive may hold anything
-    connects_seen_ = client_.connects();
-    readback_.invalidate();
-  }
-  if (readback_.due()) {
+  if (readback_.due(client_.connects())) {
     auto lock = client_.read(map_.at(tm::kLock));
-    readback_.read_done(lock.ok(), true);
+    readback_.read_done(lock.ok(), true, client_.connects());
     if (!lock) return lock.error();
     locked_ = lock.value() != 0;
-    connects_seen_ = client_.connects();  // read after any (re)connect inside this read
   } else {
-    readback_.read_done(true, false);
+    readback_.read_done(true, false, client_.connects());
   }
   s.locked = locked_;
   return s;

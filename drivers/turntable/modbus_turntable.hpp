@@ -50,7 +50,6 @@ class ModbusTurntable final : public Turntable {
   std::vector<modbus::Point> read_points_;  // mode, angle, rate, status
   std::vector<modbus::ReadBlock> read_plan_;
   modbus::ReadbackSchedule readback_;
-  std::uint64_t connects_seen_ = 0;
   bool locked_ = false;  // the lock register read back last
 };
 

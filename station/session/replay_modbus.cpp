@@ -5,24 +5,16 @@
 
 #include <cerrno>
 
+#include "drivers/modbus/modbus_adu.hpp"
+#include "station/session/session_recorder.hpp"
+
 namespace station {
 namespace {
 
 namespace mb = station::drivers::modbus;
 
-std::string hex(const std::vector<std::uint8_t>& bytes) {
-  std::string out;
-  for (auto b : bytes) out += fmt::format("{:02x}", b);
-  return out.empty() ? "-" : out;
-}
-
 std::string describe(const SessionLogLine& l) {
-  return fmt::format("line {}: {} {} {}", l.line_no, l.direction, l.kind, hex(l.bytes));
-}
-
-void put_u16(std::vector<std::uint8_t>& out, std::uint16_t v) {
-  out.push_back(static_cast<std::uint8_t>(v >> 8));
-  out.push_back(static_cast<std::uint8_t>(v & 0xFF));
+  return fmt::format("line {}: {} {} {}", l.line_no, l.direction, l.kind, hex_field(l.bytes));
 }
 
 }  // namespace
@@ -33,27 +25,6 @@ ReplayDivergence::ReplayDivergence(std::string d, std::string rec, std::string a
       recorded(std::move(rec)),
       asked(std::move(ask)),
       t_s(t) {}
-
-std::vector<std::uint8_t> read_request_adu(int unit, int fc, std::uint16_t addr, int count) {
-  std::vector<std::uint8_t> out{static_cast<std::uint8_t>(unit), static_cast<std::uint8_t>(fc)};
-  put_u16(out, addr);
-  put_u16(out, static_cast<std::uint16_t>(count));
-  return out;
-}
-
-std::vector<std::uint8_t> write_request_adu(int unit, std::uint16_t addr,
-                                            std::span<const std::uint16_t> words) {
-  const bool single = words.size() == 1;
-  std::vector<std::uint8_t> out{static_cast<std::uint8_t>(unit),
-                                static_cast<std::uint8_t>(single ? 6 : 16)};
-  put_u16(out, addr);
-  if (!single) {
-    put_u16(out, static_cast<std::uint16_t>(words.size()));
-    out.push_back(static_cast<std::uint8_t>(2 * words.size()));
-  }
-  for (auto w : words) put_u16(out, w);
-  return out;
-}
 
 RecordedModbusWire::RecordedModbusWire(std::string device, std::vector<SessionLogLine> lines)
     : device_(std::move(device)), lines_(std::move(lines)) {}
@@ -73,9 +44,7 @@ const std::vector<std::uint8_t>* RecordedModbusWire::reply(const char* kind, con
   const SessionLogLine* l = peek();
   if (l != nullptr && l->direction == "event" && l->kind == "error" && l->bytes.size() == 4) {
     ++next_;
-    errno = static_cast<int>(static_cast<std::uint32_t>(l->bytes[0]) << 24 |
-                             static_cast<std::uint32_t>(l->bytes[1]) << 16 |
-                             static_cast<std::uint32_t>(l->bytes[2]) << 8 | l->bytes[3]);
+    errno = mb::errno_of_bytes(std::span<const std::uint8_t, 4>(l->bytes.data(), 4));
     return nullptr;
   }
   return &expect("rx", kind, nullptr, [&asked] { return "the reply to " + asked(); }).bytes;
@@ -100,15 +69,15 @@ void RecordedModbusWire::close() {
 // The request's description is built only for a divergence: a long replay asks ~10^6 times.
 int RecordedModbusWire::read(mb::FunctionCode fc, int unit, std::uint16_t addr, int count,
                              std::uint16_t* dest) {
-  const auto req = read_request_adu(unit, static_cast<int>(fc), addr, count);
-  const Asked asked = [&req] { return "tx modbus-read " + hex(req); };
+  const auto req = mb::read_request_adu(unit, static_cast<int>(fc), addr, count);
+  const Asked asked = [&req] { return "tx modbus-read " + hex_field(req); };
   expect("tx", "modbus-read", &req, asked);
   const auto* rx = reply("modbus-read", asked);
   if (rx == nullptr) return -1;
   // unit, fc, byte count, registers (big-endian).
   const auto& r = *rx;
   if (r.size() < 3 || r.size() != 3u + r[2] || r[2] % 2 != 0)
-    throw ReplayDivergence(device_, "a malformed reply " + hex(r), asked(), 0);
+    throw ReplayDivergence(device_, "a malformed reply " + hex_field(r), asked(), 0);
   const int n = r[2] / 2;
   for (int i = 0; i < n && i < count; ++i)
     dest[i] = static_cast<std::uint16_t>(r[3 + 2 * i] << 8 | r[4 + 2 * i]);
@@ -116,8 +85,8 @@ int RecordedModbusWire::read(mb::FunctionCode fc, int unit, std::uint16_t addr, 
 }
 
 int RecordedModbusWire::write(int unit, std::uint16_t addr, std::span<const std::uint16_t> words) {
-  const auto req = write_request_adu(unit, addr, words);
-  const Asked asked = [&req] { return "tx modbus-write " + hex(req); };
+  const auto req = mb::write_request_adu(unit, addr, words);
+  const Asked asked = [&req] { return "tx modbus-write " + hex_field(req); };
   expect("tx", "modbus-write", &req, asked);
   if (reply("modbus-write", asked) == nullptr) return -1;
   return static_cast<int>(words.size());

@@ -57,9 +57,4 @@ class RecordedModbusWire final : public drivers::modbus::ModbusWire {
   std::size_t next_ = 0;
 };
 
-/// The request ADUs the client taps (drivers/modbus/modbus_client.cpp), rebuilt to compare.
-std::vector<std::uint8_t> read_request_adu(int unit, int fc, std::uint16_t addr, int count);
-std::vector<std::uint8_t> write_request_adu(int unit, std::uint16_t addr,
-                                            std::span<const std::uint16_t> words);
-
 }  // namespace station

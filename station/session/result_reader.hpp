@@ -1,5 +1,6 @@
-// Reading a session's result.json without holding its ticks: a SAX parse (nlohmann) builds the
-// head (state, bins, events, fits) as a tree and hands each tick to a callback as it completes.
+// Reading a session's result.json: a SAX parse (nlohmann) builds the head (state, bins, events,
+// fits) as a tree and hands each tick to a callback as it completes, so no document tree of the
+// whole file (four times its text) is ever built.
 #pragma once
 
 #include <functional>

@@ -54,9 +54,9 @@ std::string without_run_ids(const std::string& message) {
   return std::regex_replace(std::regex_replace(message, run_id, "run #"), db_path, "DB");
 }
 
-// The recorded ticks arrive one by one (result_reader); each is compared with the replayed
-// store's next tick, row by row, column by column. The largest difference per column is kept in
-// an array (3.7 M values in a 13 h, 8-gyro session) and merged into the report at the end.
+// The recorded ticks (read by result_reader while the daemon replayed) are compared in order with
+// the replayed store's ticks, row by row, column by column. The largest difference per column is
+// kept in an array (3.7 M values in a 13 h, 8-gyro session) and merged into the report at the end.
 class TickComparer {
  public:
   TickComparer(Comparer& c, Store& store, std::int64_t run_id)
@@ -95,34 +95,12 @@ class TickComparer {
   }
 
  private:
-  // A replayed sample's numeric column as sample_row_json writes it (no JSON built per row).
-  static std::optional<double> number_of(const SampleRow& r, std::size_t column) {
-    switch (column) {
-      case 1:
-        return r.net_pulses ? std::optional<double>(static_cast<double>(*r.net_pulses))
-                            : std::nullopt;
-      case 2:
-        return r.interval_s;
-      case 3:
-        return r.rate_dph;
-      case 4:
-        return r.temp_c;
-      case 5:
-        return r.temp2_c;
-      case 6:
-        return r.air_c;
-      case 7:
-        return r.setpoint_c;
-      default:
-        return static_cast<double>(r.flags);  // 8
-    }
-  }
   // One column: numbers within the tolerances (the largest difference kept), null against
   // null, serial and recording equal.
   bool same_cell(const json& a, const SampleRow& r, std::size_t i) {
     if (i == 0) return a.is_string() && a.get_ref<const std::string&>() == r.serial;
     if (i == 9) return a.is_boolean() && a.get<bool>() == r.recording;
-    const auto y = number_of(r, i);
+    const auto y = sample_number(r, i);
     if (!y || !a.is_number()) return !y && a.is_null();
     const double x = a.get<double>(), d = std::abs(x - *y);
     max_[i] = std::max(max_[i], d);

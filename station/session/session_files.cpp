@@ -37,6 +37,30 @@ json sample_row_json(const SampleRow& r) {
                       or_null(r.setpoint_c), r.flags, r.recording});
 }
 
+std::optional<double> sample_number(const SampleRow& r, std::size_t column) {
+  switch (column) {  // sample_columns() order, as sample_row_json writes them
+    case 1:
+      return r.net_pulses ? std::optional<double>(static_cast<double>(*r.net_pulses))
+                          : std::nullopt;
+    case 2:
+      return r.interval_s;
+    case 3:
+      return r.rate_dph;
+    case 4:
+      return r.temp_c;
+    case 5:
+      return r.temp2_c;
+    case 6:
+      return r.air_c;
+    case 7:
+      return r.setpoint_c;
+    case 8:
+      return static_cast<double>(r.flags);
+    default:
+      return std::nullopt;  // serial (0), recording (9): not numbers
+  }
+}
+
 TickCursor::TickCursor(Store& store, std::int64_t run_id) {
   for (const auto& slot : store.run_slots(run_id))
     by_slot_.push_back(store.samples(run_id, slot.serial, false));

@@ -61,6 +61,10 @@ const std::vector<std::string>& sample_columns();
 /// One stored sample as result.json keeps it: an array in sample_columns() order.
 nlohmann::json sample_row_json(const SampleRow& r);
 
+/// Column `column` of sample_row_json(r) when it is a number (columns 1..8; null: empty), without
+/// building the JSON — for comparing millions of rows.
+std::optional<double> sample_number(const SampleRow& r, std::size_t column);
+
 /// The run's stored ticks one at a time, in time order, with the samples of a tick in slot order.
 class TickCursor {
  public:

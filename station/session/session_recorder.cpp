@@ -34,10 +34,14 @@ const char* direction_name(dr::TapDirection d) {
 
 }  // namespace
 
-std::string format_session_line(const dr::TapRecord& record, double t_s) {
+std::string hex_field(const std::vector<std::uint8_t>& bytes) {
   std::string hex;
-  for (const auto b : record.bytes) hex += fmt::format("{:02x}", b);
-  if (hex.empty()) hex = "-";
+  for (const auto b : bytes) hex += fmt::format("{:02x}", b);
+  return hex.empty() ? "-" : hex;
+}
+
+std::string format_session_line(const dr::TapRecord& record, double t_s) {
+  const std::string hex = hex_field(record.bytes);
   std::string detail = record.detail;
   for (auto& c : detail)
     if (c == '\n' || c == '\r') c = ' ';  // one exchange, one line

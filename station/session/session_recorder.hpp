@@ -40,6 +40,9 @@ class SessionRecorder final : public drivers::Tap {
   std::atomic<bool> paused_{false};
 };
 
+/// The HEX field of a session log line: two lower-case digits per byte, "-" for none.
+std::string hex_field(const std::vector<std::uint8_t>& bytes);
+
 /// One line of modbus.log / gpio.log, without the newline:
 /// "TIME DEVICE DIRECTION KIND HEX DETAIL" (HEX "-" when there are no bytes).
 std::string format_session_line(const drivers::TapRecord& record, double t_s);

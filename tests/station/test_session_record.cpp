@@ -17,17 +17,13 @@
 #include "station/sim/sim_run.hpp"
 #include "station/store/store.hpp"
 #include "tests/station/temp_db.hpp"
+#include "tests/station/text_file.hpp"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-std::vector<std::string> lines_of(const fs::path& p) {
-  std::ifstream in(p);
-  std::vector<std::string> out;
-  for (std::string l; std::getline(in, l);) out.push_back(l);
-  return out;
-}
+using station::testing_support::read_lines;
 
 std::vector<std::string> fields(const std::string& line) {
   std::istringstream in(line);
@@ -97,7 +93,7 @@ TEST_F(SessionRecord, TheCanLogIsOnTheSimulatedClock) {
 
 TEST_F(SessionRecord, ModbusAndGpioLogsHoldEveryExchangeOneLineEach) {
   int reads = 0, writes = 0, setpoint_writes = 0;
-  for (const auto& line : lines_of(*dir_ / "modbus.log")) {
+  for (const auto& line : read_lines(*dir_ / "modbus.log")) {
     const auto f = fields(line);
     ASSERT_GE(f.size(), 5u) << line;
     EXPECT_TRUE(f[1] == "chamber" || f[1] == "turntable") << line;
@@ -115,7 +111,7 @@ TEST_F(SessionRecord, ModbusAndGpioLogsHoldEveryExchangeOneLineEach) {
   EXPECT_GT(writes, 0);
   EXPECT_GE(setpoint_writes, 2) << "0 C, then 40 C";
   int gpio_reads = 0, gpio_writes = 0;
-  for (const auto& line : lines_of(*dir_ / "gpio.log")) {
+  for (const auto& line : read_lines(*dir_ / "gpio.log")) {
     const auto f = fields(line);
     ASSERT_GE(f.size(), 6u) << line;
     gpio_reads += f[3] == "gpio-read" ? 1 : 0;

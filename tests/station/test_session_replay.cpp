@@ -21,22 +21,14 @@
 #include "station/session/session_replay.hpp"
 #include "station/sim/sim_run.hpp"
 #include "tests/station/temp_db.hpp"
+#include "tests/station/text_file.hpp"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-std::vector<std::string> read_lines(const fs::path& p) {
-  std::ifstream in(p);
-  std::vector<std::string> out;
-  for (std::string l; std::getline(in, l);) out.push_back(l);
-  return out;
-}
-
-void write_lines(const fs::path& p, const std::vector<std::string>& lines) {
-  std::ofstream out(p);
-  for (const auto& l : lines) out << l << '\n';
-}
+using station::testing_support::read_lines;
+using station::testing_support::write_lines;
 
 // A copy of the recorded session to tamper with.
 fs::path copy_of(const fs::path& session, const std::string& name) {
