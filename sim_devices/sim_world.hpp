@@ -6,8 +6,10 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "sim_devices/chamber_sim.hpp"
@@ -18,17 +20,27 @@
 
 namespace station::sim {
 
+/// Which kind of gyro the simulated slots hold.
+///  - station: distinct coefficients over a wide range (|k1| 0.5..2e-3, |k0| 0.01..0.04), a strong
+///    thermal effect against the noise (std ratio 0.014..0.07 on the paper's cycle);
+///  - paper: the thermal effect and noise in the proportions of the paper's gyros: on the paper's
+///    cycle the std of the bias after compensation is ~0.13 of the std before (docs/SIMRIG.md).
+enum class GyroPreset { station, paper };
+/// "station" / "paper"; empty when unknown.
+std::optional<GyroPreset> gyro_preset_from_name(std::string_view name);
+
 /// What to simulate.
 struct SimWorldConfig {
-  int gyros = 4;                     ///< simulated RLGs, nodes 1..gyros (at most 16)
-  std::uint64_t seed = 1;            ///< drives coefficients and every noise source
-  double earth_rate_dph = 0;         ///< Earth rate along each gyro's input axis, deg/h
-  double initial_c = 25.0;           ///< chamber and gyros at t = 0, deg C
-  double pulse_weight_arcsec = 1.5;  ///< every gyro's pulse weight
-  std::string can_unix_path;         ///< empty: socketpair (in-process); else listen on this path
-  int chamber_port = 0;              ///< chamber Modbus TCP port on 127.0.0.1, 0 = ephemeral
-  int turntable_port = 0;            ///< turntable Modbus TCP port on 127.0.0.1, 0 = ephemeral
-  ChamberSimConfig chamber;          ///< chamber model
+  int gyros = 4;                            ///< simulated RLGs, nodes 1..gyros (at most 16)
+  std::uint64_t seed = 1;                   ///< drives coefficients and every noise source
+  GyroPreset preset = GyroPreset::station;  ///< coefficients of the simulated gyros
+  double earth_rate_dph = 0;                ///< Earth rate along each gyro's input axis, deg/h
+  double initial_c = 25.0;                  ///< chamber and gyros at t = 0, deg C
+  double pulse_weight_arcsec = 1.5;         ///< every gyro's pulse weight
+  std::string can_unix_path;  ///< empty: socketpair (in-process); else listen on this path
+  int chamber_port = 0;       ///< chamber Modbus TCP port on 127.0.0.1, 0 = ephemeral
+  int turntable_port = 0;     ///< turntable Modbus TCP port on 127.0.0.1, 0 = ephemeral
+  ChamberSimConfig chamber;   ///< chamber model
 };
 
 /// One simulated gyro as the station will see it.
@@ -114,6 +126,9 @@ class SimWorld {
 
 /// Distinct, realistic true coefficients for gyro `index` of a world seeded with `seed`
 /// (k2 = 0 so the paper's model B0 + k1 dT + k0 gradT is exact).
-TrueCoefficients sim_coefficients(std::uint64_t seed, int index);
+TrueCoefficients sim_coefficients(std::uint64_t seed, int index,
+                                  GyroPreset preset = GyroPreset::station);
+/// Serial number of simulated gyro `index`: SIM-0001... (station), PAP-0001... (paper).
+std::string sim_serial(GyroPreset preset, int index);
 
 }  // namespace station::sim

@@ -48,6 +48,7 @@ struct RunOptions {
   std::vector<std::string> faults;  ///< --sim: "T:COMMAND"
   int gyros = 4;
   std::uint64_t seed = 1;
+  std::string gyro_preset = "station";
   double latitude_deg = 39.9;
 };
 
@@ -146,6 +147,7 @@ int run_sim(const RunOptions& o) {
   SimRunOptions so;
   so.gyros = o.gyros;
   so.seed = o.seed;
+  so.gyro_preset = o.gyro_preset;
   so.latitude_deg = o.latitude_deg;
   so.protocol = o.protocol;
   so.db_path = db;
@@ -189,6 +191,11 @@ void add_run_command(CLI::App& app, CommandStatus& status) {
       ->capture_default_str()
       ->check(CLI::Range(1, 16));
   cmd->add_option("--seed", o->seed, "simulation seed")->capture_default_str();
+  cmd->add_option("--gyro-preset", o->gyro_preset,
+                  "simulated gyros: station (strong thermal effect) or paper (the paper's "
+                  "proportions: std ratio ~0.13)")
+      ->check(CLI::IsMember({"station", "paper"}))
+      ->capture_default_str();
   cmd->add_option("--latitude", o->latitude_deg, "simulated site latitude, deg")
       ->capture_default_str();
   cmd->add_option("--log-file", o->log_file, "rotating log file");

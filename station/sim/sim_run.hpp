@@ -21,6 +21,7 @@ namespace station {
 struct SimRunOptions {
   int gyros = 4;
   std::uint64_t seed = 1;
+  std::string gyro_preset = "station";  ///< sim::GyroPreset by name: "station" or "paper"
   double latitude_deg = 39.9;
   std::string protocol = "paper";  ///< shipped name or file
   std::string db_path;             ///< empty: station-sim.db in the current directory
