@@ -3,6 +3,7 @@
 #include "compensation/correlated_errors.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -11,6 +12,13 @@ namespace station::compensation {
 namespace {
 
 constexpr double kMaxShare = 0.99;  // q = 1 with tau -> infinity makes the filter degenerate
+constexpr int kCoarseSteps = 15;    // 15 x 15 grid over log tau and q, then
+constexpr int kRefinements = 4;     // 4 rounds of 5 x 5 around the best point
+// The filter's columns: y and up to 8 regressors (B0 and the seven terms of fit.hpp).
+constexpr int kMaxColumns = 9;
+using SmallMatrix =
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxColumns, kMaxColumns>;
+using SmallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxColumns, 1>;
 
 bool same_run(std::span<const int> segment, Eigen::Index i, Eigen::Index j) {
   return segment.empty() ||
@@ -21,11 +29,15 @@ double time_of(std::span<const double> t_s, Eigen::Index i) {
   return t_s.empty() ? static_cast<double>(i) : t_s[static_cast<std::size_t>(i)];
 }
 
-/// Correlation of the Gauss-Markov part from bin i-1 to bin i (0 across runs).
-double step_corr(std::span<const double> t_s, std::span<const int> segment, Eigen::Index i,
-                 double tau_s) {
-  if (i == 0 || !same_run(segment, i, i - 1)) return 0.0;
-  return std::exp(-std::abs(time_of(t_s, i) - time_of(t_s, i - 1)) / tau_s);
+/// Correlation of the Gauss-Markov part from bin i-1 to bin i, for each bin (0 across runs).
+void step_corrs(std::vector<double>& phi, std::span<const double> t_s, std::span<const int> segment,
+                Eigen::Index n, double tau_s) {
+  phi.assign(static_cast<std::size_t>(n), 0.0);
+  for (Eigen::Index i = 1; i < n; ++i) {
+    if (!same_run(segment, i, i - 1)) continue;
+    phi[static_cast<std::size_t>(i)] =
+        std::exp(-std::abs(time_of(t_s, i) - time_of(t_s, i - 1)) / tau_s);
+  }
 }
 
 struct Profile {
@@ -36,31 +48,43 @@ struct Profile {
 /// -2 x restricted log-likelihood (constants dropped) of (tau, q) with b and s^2 concentrated
 /// out. The filter runs on y and on every column of X with the same gains (Harvey 1989, 3.4.2):
 /// innovations v, their variances f (in units of s^2); GLS normal equations from v/sqrt(f).
-Profile reml_profile(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
-                     std::span<const double> t_s, std::span<const int> segment, double tau_s,
-                     double q) {
-  const Eigen::Index n = x.rows(), p = x.cols();
-  Eigen::MatrixXd m = Eigen::MatrixXd::Zero(p, p);
-  Eigen::VectorXd c = Eigen::VectorXd::Zero(p), state = Eigen::VectorXd::Zero(p + 1);
-  Eigen::VectorXd v(p + 1), z(p + 1);
-  double d = 0, sum_log_f = 0, var_state = 0;
+/// `z` holds the rows [y_i, x_i] (n x (p+1), row-major); plain loops: it runs ~250 times a fit.
+Profile reml_profile(
+    const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>& z,
+    const std::vector<double>& phi, double q) {
+  const Eigen::Index n = z.rows(), k = z.cols(), p = k - 1;
+  // [y X]' F^-1 [y X] of the innovations; sizes bounded by kMaxColumns, so nothing is allocated.
+  SmallMatrix m = SmallMatrix::Zero(k, k);
+  std::array<double, kMaxColumns> state{}, v{};
+  // f >= 1 - q >= 0.01, so the product of up to ~100 bins' f stays far from underflow; one log
+  // per 64 bins instead of one per bin (the log was most of the cost).
+  double sum_log_f = 0, prod_f = 1, var_state = 0;
   for (Eigen::Index i = 0; i < n; ++i) {
-    const double phi = step_corr(t_s, segment, i, tau_s);
-    const double var_pred = phi * phi * var_state + q * (1.0 - phi * phi);
+    const double ph = phi[static_cast<std::size_t>(i)];
+    const double var_pred = ph * ph * var_state + q * (1.0 - ph * ph);
     const double f = var_pred + (1.0 - q);
     const double gain = var_pred / f;
-    z << y(i), x.row(i).transpose();
-    v = z - phi * state;
-    state = phi * state + gain * v;
+    for (Eigen::Index c = 0; c < k; ++c) {
+      const auto cu = static_cast<std::size_t>(c);
+      v[cu] = z(i, c) - ph * state[cu];
+      state[cu] = ph * state[cu] + gain * v[cu];
+    }
     var_state = var_pred * (1.0 - gain);
-    sum_log_f += std::log(f);
-    const auto vx = v.tail(p);
-    m.noalias() += vx * vx.transpose() / f;
-    c += vx * (v(0) / f);
-    d += v(0) * v(0) / f;
+    prod_f *= f;
+    if ((i & 63) == 63) {
+      sum_log_f += std::log(prod_f);
+      prod_f = 1;
+    }
+    for (Eigen::Index a = 0; a < k; ++a) {
+      const double va = v[static_cast<std::size_t>(a)] / f;
+      for (Eigen::Index b = a; b < k; ++b) m(a, b) += va * v[static_cast<std::size_t>(b)];
+    }
   }
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(m);
-  const double rss = d - c.dot(ldlt.solve(c));
+  sum_log_f += std::log(prod_f);
+  const SmallMatrix mxx = m.bottomRightCorner(p, p).selfadjointView<Eigen::Upper>();
+  const SmallVector mxy = m.row(0).tail(p).transpose();
+  const Eigen::LDLT<SmallMatrix> ldlt(mxx);
+  const double rss = m(0, 0) - mxy.dot(ldlt.solve(mxy));
   Profile out;
   const auto dof = static_cast<double>(n - p);
   if (!(rss > 0) || ldlt.info() != Eigen::Success) return out;
@@ -85,15 +109,22 @@ struct Best {
   Profile profile;
 };
 
+/// What the search needs: the rows [y X], the bin times and runs.
+struct Problem {
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> z;
+  std::span<const double> t_s;
+  std::span<const int> segment;
+  std::vector<double> phi;  // scratch
+};
+
 /// Grid search over log tau in [lo, hi] and q in [q_lo, q_hi], `steps` points each way.
-void search(Best& best, const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
-            std::span<const double> t_s, std::span<const int> segment, double lo, double hi,
-            double q_lo, double q_hi, int steps) {
+void search(Best& best, Problem& pb, double lo, double hi, double q_lo, double q_hi, int steps) {
   for (int a = 0; a < steps; ++a) {
     const double log_tau = lo + (hi - lo) * a / (steps - 1);
+    step_corrs(pb.phi, pb.t_s, pb.segment, pb.z.rows(), std::exp(log_tau));
     for (int b = 0; b < steps; ++b) {
       const double q = std::clamp(q_lo + (q_hi - q_lo) * b / (steps - 1), 0.0, kMaxShare);
-      const Profile pr = reml_profile(x, y, t_s, segment, std::exp(log_tau), q);
+      const Profile pr = reml_profile(pb.z, pb.phi, q);
       if (pr.minus2_loglik < best.profile.minus2_loglik) best = {log_tau, q, pr};
     }
   }
@@ -105,7 +136,7 @@ ErrorModel estimate_error_model(const Eigen::MatrixXd& x, const Eigen::VectorXd&
                                 std::span<const double> t_s, std::span<const int> segment) {
   const Eigen::Index n = x.rows(), p = x.cols();
   ErrorModel model;
-  if (n < p + 4) {  // too few bins to estimate two more parameters
+  if (n < p + 4 || p + 1 > kMaxColumns) {  // too few bins to estimate two more parameters
     const Eigen::VectorXd b = x.colPivHouseholderQr().solve(y);
     model.sigma_dph = std::sqrt((y - x * b).squaredNorm() / static_cast<double>(n - p));
     return model;
@@ -115,17 +146,22 @@ ErrorModel estimate_error_model(const Eigen::MatrixXd& x, const Eigen::VectorXd&
   // tau from a third of a bin (the Gauss-Markov part is then white) to ten record lengths
   // (then it is a drift the constant and the regressors mostly absorb).
   const double lo = std::log(spacing_s / 3.0), hi = std::log(10.0 * span_s);
+  Problem pb{{}, t_s, segment, {}};
+  pb.z.resize(n, p + 1);
+  pb.z.col(0) = y;
+  pb.z.rightCols(p) = x;
   Best best;
-  best.profile = reml_profile(x, y, t_s, segment, std::exp(lo), 0.0);  // iid: q = 0
-  search(best, x, y, t_s, segment, lo, hi, 0.0, kMaxShare, 21);
-  // Two finer searches around the best point of the grid.
-  double step_tau = (hi - lo) / 20, step_q = kMaxShare / 20;
-  for (int round = 0; round < 2; ++round) {
+  step_corrs(pb.phi, t_s, segment, n, std::exp(lo));
+  best.profile = reml_profile(pb.z, pb.phi, 0.0);  // iid: q = 0
+  search(best, pb, lo, hi, 0.0, kMaxShare, kCoarseSteps);
+  // Finer searches around the best point so far, each on a grid a third as wide.
+  double half_tau = (hi - lo) / (kCoarseSteps - 1), half_q = kMaxShare / (kCoarseSteps - 1);
+  for (int round = 0; round < kRefinements; ++round) {
     const Best centre = best;
-    search(best, x, y, t_s, segment, centre.log_tau - step_tau, centre.log_tau + step_tau,
-           std::max(centre.q - step_q, 0.0), std::min(centre.q + step_q, kMaxShare), 9);
-    step_tau /= 4;
-    step_q /= 4;
+    search(best, pb, centre.log_tau - half_tau, centre.log_tau + half_tau,
+           std::max(centre.q - half_q, 0.0), std::min(centre.q + half_q, kMaxShare), 5);
+    half_tau /= 2;
+    half_q /= 2;
   }
   model.method = "ar1+white (REML)";
   model.corr_time_s = std::exp(best.log_tau);
@@ -142,10 +178,15 @@ Eigen::VectorXd ols_variances_under(const ErrorModel& model, const Eigen::Matrix
   const double q = model.correlated_share, tau_s = model.corr_time_s;
   Eigen::MatrixXd r = Eigen::MatrixXd::Identity(n, n);
   if (q > 0 && tau_s > 0) {
-    for (Eigen::Index i = 0; i < n; ++i) {
-      for (Eigen::Index j = 0; j < i; ++j) {
-        if (!same_run(segment, i, j)) continue;
-        r(i, j) = r(j, i) = q * std::exp(-std::abs(time_of(t_s, i) - time_of(t_s, j)) / tau_s);
+    // exp(-|t_i - t_j| / tau) is the product of the step correlations between them (0 across
+    // runs): one multiplication per pair instead of an exp.
+    std::vector<double> phi;
+    step_corrs(phi, t_s, segment, n, tau_s);
+    for (Eigen::Index i = 1; i < n; ++i) {
+      double corr = 1.0;
+      for (Eigen::Index j = i - 1; j >= 0 && corr > 0; --j) {
+        corr *= phi[static_cast<std::size_t>(j + 1)];
+        r(i, j) = r(j, i) = q * corr;
       }
     }
   }
