@@ -27,6 +27,12 @@ Store::Store(const std::string& path, OpenMode mode) : db_(path, mode) {
   db_.migrate();
 }
 
+StatementLease Store::cached(const std::string& sql) {
+  auto it = cache_.find(sql);
+  if (it == cache_.end()) it = cache_.emplace(sql, db_.prepare(sql)).first;
+  return StatementLease(it->second);
+}
+
 std::int64_t Store::create_run(const RunInfo& info, const std::vector<RunSlot>& slots) {
   flush();
   Transaction tx(db_);
