@@ -17,7 +17,8 @@ std::optional<double> lookup(const std::vector<std::pair<std::string, double>>& 
 
 std::vector<std::pair<std::string, double>> keyed(const std::string& text) {
   std::vector<std::pair<std::string, double>> out;
-  for (const auto& [k, v] : json::parse(text).items())
+  const json j = json::parse(text);  // items() of a temporary would dangle
+  for (const auto& [k, v] : j.items())
     if (v.is_number()) out.emplace_back(k, v.get<double>());
   return out;
 }
