@@ -95,10 +95,10 @@ RunRecord read_run(const Statement& st) {
 }  // namespace
 
 std::optional<RunRecord> Store::find_run(std::int64_t id) {
-  auto st = db_.prepare(std::string(kRunColumns) + "WHERE id = ?");
-  st.bind(1, id);
-  if (!st.step()) return std::nullopt;
-  return read_run(st);
+  auto st = cached(std::string(kRunColumns) + "WHERE id = ?");
+  st->bind(1, id);
+  if (!st->step()) return std::nullopt;
+  return read_run(*st);
 }
 
 std::optional<RunRecord> Store::find_unfinished_run() {
@@ -249,9 +249,10 @@ void Store::replace_bins(std::int64_t run_id, const std::string& serial,
 
 sc::ModelData Store::model_data(const std::string& serial, const std::vector<std::int64_t>& runs) {
   sc::ModelData d;
-  auto st = db_.prepare(
+  auto lease = cached(
       "SELECT bias_dph, temp_c, grad_c, dtdt_c_per_h, t_start_s FROM bins WHERE run_id = ? "
       "AND serial = ? AND complete = 1 ORDER BY t_start_s");
+  Statement& st = *lease;
   for (const auto run : runs) {
     st.bind(1, run).bind(2, serial);
     while (st.step()) {
@@ -268,10 +269,10 @@ sc::ModelData Store::model_data(const std::string& serial, const std::vector<std
 }
 
 std::vector<std::int64_t> Store::runs_of_serial(const std::string& serial) {
-  auto st = db_.prepare("SELECT DISTINCT run_id FROM run_slots WHERE serial = ? ORDER BY run_id");
-  st.bind(1, serial);
+  auto st = cached("SELECT DISTINCT run_id FROM run_slots WHERE serial = ? ORDER BY run_id");
+  st->bind(1, serial);
   std::vector<std::int64_t> out;
-  while (st.step()) out.push_back(st.column_int(0));
+  while (st->step()) out.push_back(st->column_int(0));
   return out;
 }
 

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "station/parts/judged_fit.hpp"
+#include "station/store/serial_history.hpp"
 #include "tests/station/synthetic_bins.hpp"
 
 namespace {
@@ -16,12 +17,23 @@ namespace {
 namespace fs = std::filesystem;
 using station::testing_support::SyntheticGyro;
 
+// Removes the benchmark's database files when the program ends.
+struct TempFiles {
+  std::string base;
+  ~TempFiles() {
+    for (const char* f : {"", ".work.db", ".each.db"})
+      for (const char* ext : {"", "-wal", "-shm"}) fs::remove(base + f + ext);
+  }
+};
+
 // A database of `serials` gyros, 16 per run, built once per process.
 const std::string& template_db(int serials) {
   static std::string path;
+  static TempFiles cleanup;
   if (!path.empty()) return path;
   path = (fs::temp_directory_path() / ("bench_fit_all-" + std::to_string(getpid()) + ".db"));
   fs::remove(path);
+  cleanup.base = path;
   station::Store store(path);
   for (int first = 0; first < serials; first += 16) {
     std::vector<std::string> names;
@@ -56,5 +68,23 @@ void BM_FitAll1000Serials(benchmark::State& state) {
                                                     benchmark::Counter::kIsIterationInvariantRate);
 }
 BENCHMARK(BM_FitAll1000Serials)->Arg(1000)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The same fits as before fit_all: one serial at a time, each fit its own autocommit
+// transaction (what `fit --serial` per serial costs), for comparison.
+void BM_FitEachSerialOnItsOwn(benchmark::State& state) {
+  const int serials = static_cast<int>(state.range(0));
+  const std::string& tmpl = template_db(serials);
+  const std::string work = tmpl + ".each.db";
+  for (auto _ : state) {
+    state.PauseTiming();
+    for (const char* ext : {"", "-wal", "-shm"}) fs::remove(work + ext);
+    fs::copy_file(tmpl, work);
+    state.ResumeTiming();
+    station::Store store(work, station::OpenMode::existing);
+    for (const auto& serial : station::all_serials(store))
+      benchmark::DoNotOptimize(station::fit_serial(store, serial, {}, {}).fit_id);
+  }
+}
+BENCHMARK(BM_FitEachSerialOnItsOwn)->Arg(1000)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
