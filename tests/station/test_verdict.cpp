@@ -60,7 +60,9 @@ void expect_one_failure(const Verdict& v, const std::string& limit, std::optiona
   ASSERT_EQ(v.failed.size(), 1u) << limit;
   EXPECT_EQ(v.failed[0].limit, limit);
   EXPECT_EQ(v.failed[0].value.has_value(), value.has_value()) << limit;
-  if (value) EXPECT_DOUBLE_EQ(*v.failed[0].value, *value) << limit;
+  if (value) {
+    EXPECT_DOUBLE_EQ(*v.failed[0].value, *value) << limit;
+  }
   EXPECT_DOUBLE_EQ(v.failed[0].bound, bound) << limit;
 }
 
