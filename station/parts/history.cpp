@@ -8,10 +8,11 @@
 namespace station {
 namespace {
 
-// The calibrations: per distinct run set the newest fit, ordered by the newest run they used.
+// The calibrations: per distinct run set and terms the newest fit, ordered by the newest run
+// they used.
 std::vector<Calibration> calibrations_of(const std::vector<SerialFitRow>& fits) {
-  std::map<std::vector<std::int64_t>, const SerialFitRow*> by_runs;
-  for (const auto& f : fits) by_runs[f.runs] = &f;  // fits are oldest first: the newest wins
+  std::map<std::pair<std::vector<std::int64_t>, std::string>, const SerialFitRow*> by_runs;
+  for (const auto& f : fits) by_runs[{f.runs, f.terms}] = &f;  // oldest first: the newest wins
   std::vector<Calibration> out;
   for (const auto& [runs, f] : by_runs) out.push_back({f});
   const auto newest_run = [](const Calibration& c) {
@@ -63,6 +64,22 @@ CoefficientScatter scatter_of(const std::vector<Calibration>& cals, const std::s
   return s;
 }
 
+// The terms most calibrations used (ties: the newest's): a refit with other terms must not
+// decide which coefficients the scatter compares.
+std::string most_common_terms(const std::vector<Calibration>& cals) {
+  std::map<std::string, int> count;
+  for (const auto& c : cals) ++count[c.fit->terms];
+  std::string best;
+  int best_n = 0;
+  for (const auto& c : cals) {  // oldest first, so >= lets the newest win a tie
+    if (count[c.fit->terms] >= best_n) {
+      best = c.fit->terms;
+      best_n = count[c.fit->terms];
+    }
+  }
+  return best;
+}
+
 void flag_drift(const SerialFitRow& now, const SerialFitRow& prev, std::vector<DriftFlag>& out) {
   for (const std::string name : {"k1", "k0"}) {
     const auto a = now.coefficient(name), ua = now.std_error(name);
@@ -86,7 +103,7 @@ SerialHistoryStats serial_history_stats(const std::vector<SerialFitRow>& fits) {
   SerialHistoryStats h;
   h.calibrations = calibrations_of(fits);
   if (h.calibrations.empty()) return h;
-  h.terms = h.calibrations.back().fit->terms;
+  h.terms = most_common_terms(h.calibrations);
   for (const char* name : {"k1", "k0"})
     h.scatter.push_back(scatter_of(h.calibrations, h.terms, name));
   // Each calibration against the last earlier one with the same terms (k1 of a dT-only fit

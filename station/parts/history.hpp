@@ -19,8 +19,8 @@ namespace station {
 /// Annex B, which uses expanded (k = 2) uncertainties and a limit of 1.
 inline constexpr double kDriftZetaLimit = 3.0;
 
-/// A calibration: the newest fit over one set of runs (a refit of the same runs is the same
-/// calibration, not a new one).
+/// A calibration: the newest fit over one set of runs with one set of terms (a refit of the same
+/// runs is the same calibration, not a new one).
 struct Calibration {
   const SerialFitRow* fit = nullptr;
 };
@@ -47,7 +47,7 @@ struct CoefficientScatter {
 /// Everything `station history` computes.
 struct SerialHistoryStats {
   std::vector<Calibration> calibrations;  ///< in measurement order (newest run of each)
-  std::string terms;                      ///< the newest calibration's terms: scatter uses those
+  std::string terms;  ///< the terms most calibrations used: the scatter is over those
   std::vector<CoefficientScatter> scatter;
   std::vector<DriftFlag> flags;
 };

@@ -113,3 +113,17 @@ TEST(History, SeededSyntheticFitsJumpingTwoSigmaAreNotFlaggedFiveSigmaAre) {
   EXPECT_NEAR(h5.flags[0].zeta, 5.0, 1e-6);
   EXPECT_NEAR(h5.flags[0].delta, 5.0 * combined, 1e-6 * combined);
 }
+
+TEST(History, ARefitWithOtherTermsIsComparedOnlyWithItsKind) {
+  // Run 2 refitted with dT only: its k1 means something else (no gradient term) and is neither
+  // compared with the dT+gradT calibrations nor does it choose the scatter's terms.
+  auto dt_only = row(4, {2}, 9e-3, 1e-4);
+  dt_only.terms = "dT";
+  const std::vector<SerialFitRow> fits{row(1, {1}, 1e-3, 1e-4), row(2, {2}, 1.1e-3, 1e-4),
+                                       row(3, {3}, 1.05e-3, 1e-4), dt_only};
+  const auto h = station::serial_history_stats(fits);
+  EXPECT_EQ(h.calibrations.size(), 4u);
+  EXPECT_EQ(h.terms, "dT,gradT");
+  EXPECT_EQ(h.scatter[0].n, 3);
+  EXPECT_TRUE(h.flags.empty());
+}
