@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   station::add_probe_command(app, status);
   station::add_run_command(app, status);
   station::add_fit_commands(app, status);
+  station::add_history_command(app, status);
   station::add_replay_command(app, status);
   try {
     app.parse(argc, argv);

@@ -21,6 +21,8 @@ void add_probe_command(CLI::App& app, CommandStatus& status);
 void add_run_command(CLI::App& app, CommandStatus& status);
 /// `station fit` and `station export`: per-serial fits from the database and their export.
 void add_fit_commands(CLI::App& app, CommandStatus& status);
+/// `station history --db DB --serial SN [--json]`: one gyro's runs, fits, scatter and drift.
+void add_history_command(CLI::App& app, CommandStatus& status);
 /// `station replay LOG --db PATH --run ID`: a recorded session through the driver again.
 void add_replay_command(CLI::App& app, CommandStatus& status);
 

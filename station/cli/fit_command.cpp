@@ -7,6 +7,7 @@
 
 #include "station/cli/commands.hpp"
 #include "station/common/input_error.hpp"
+#include "station/parts/judged_fit.hpp"
 #include "station/store/calibration.hpp"
 #include "station/store/fit_json.hpp"
 
@@ -16,9 +17,9 @@ namespace {
 namespace sc = station::compensation;
 
 struct FitOptions {
-  std::string db, serial, terms = "dT,gradT", format = "json";
+  std::string db, serial, terms = "dT,gradT", format = "json", parts, part;
   std::vector<std::int64_t> runs;
-  std::int64_t run = 0;
+  std::optional<std::int64_t> run;
   double ref_temp_c = 25.0;
   bool all = false, json = false;
 };
@@ -28,15 +29,20 @@ std::string unit_of(const std::string& name) {
   return std::string(sc::coefficient_unit(name));
 }
 
-nlohmann::json fit_json(const SerialFit& f) {
+nlohmann::json fit_json(const JudgedFit& jf) {
+  const SerialFit& f = jf.fit;
   nlohmann::json j = fit_summary_json(f.fit, f.eval);
   j["serial"] = f.serial;
   j["fit_id"] = f.fit_id;
   j["runs"] = f.runs;
+  j["part_number"] = jf.verdict ? nlohmann::json(jf.verdict->part_number) : nlohmann::json();
+  j["verdict"] = jf.verdict ? verdict_json(*jf.verdict) : nlohmann::json();
+  j["adev_floor_dph"] = jf.adev_floor_dph ? nlohmann::json(*jf.adev_floor_dph) : nlohmann::json();
   return j;
 }
 
-void print_fit(const SerialFit& f) {
+void print_fit(const JudgedFit& jf) {
+  const SerialFit& f = jf.fit;
   fmt::print("{}: fit {} over runs {} ({} bins)\n", f.serial, f.fit_id, fmt::join(f.runs, ","),
              f.fit.n_points);
   for (std::size_t i = 0; i < f.fit.names.size(); ++i) {
@@ -47,27 +53,43 @@ void print_fit(const SerialFit& f) {
   fmt::print("  {}\n", error_model_text(f.fit.error_model));
   fmt::print("  {}\n", evaluation_text(f.eval));
   for (const auto& w : f.fit.warnings) fmt::print("  warning: {}\n", w);
+  if (jf.adev_floor_dph) fmt::print("  ADEV floor {:.5f} deg/h\n", *jf.adev_floor_dph);
+  fmt::print("  verdict: {}\n", verdict_text(jf.verdict));
 }
 
-void run_fit(const FitOptions& o) {
+int run_fit(const FitOptions& o) {
+  // A bad part file stops before the database is opened.
+  std::optional<PartFile> parts;
+  if (!o.parts.empty()) parts = load_part_file(o.parts);
+  if (!o.part.empty() && !parts) throw InputError("fit: --part needs the part file (--parts)");
+  if (parts && !o.part.empty() && !parts->parts.contains(o.part))
+    throw InputError(fmt::format("{}: no part '{}' (--part)", o.parts, o.part));
+  const PartChoice choice{parts ? &*parts : nullptr, o.part};
+  if (!o.all && o.serial.empty()) throw InputError("fit: give --serial SN, or --all [--run ID]");
   Store store(o.db, OpenMode::existing);  // stores the fit; never creates a database
   const sc::ModelSpec spec{sc::parse_terms(o.terms), o.ref_temp_c};
-  std::vector<SerialFit> fits;
+  FitAllResult result;
   if (o.all) {
-    if (!store.find_run(o.run)) throw InputError(fmt::format("{}: no run {}", o.db, o.run));
-    for (const auto& slot : store.run_slots(o.run))
-      fits.push_back(fit_serial(store, slot.serial, {o.run}, spec));
+    if (o.run && !store.find_run(*o.run))
+      throw InputError(fmt::format("{}: no run {}", o.db, *o.run));
+    result = fit_all(store, o.run, spec, choice);
   } else {
-    if (o.serial.empty()) throw InputError("fit: give --serial SN, or --all --run ID");
-    fits.push_back(fit_serial(store, o.serial, o.runs, spec));
+    const auto runs = o.runs.empty() ? store.runs_of_serial(o.serial) : o.runs;
+    const auto limits = runs.empty() ? std::nullopt : limits_for(store, o.serial, runs, choice);
+    result.fits.push_back(judge_and_store(store, fit_serial(store, o.serial, runs, spec), limits));
   }
+  // Serials with nothing to fit: one line each on stderr, and exit status 1 (the others stored).
+  for (const auto& s : result.skipped) fmt::print(stderr, "station: fit skipped: {}\n", s);
+  const auto& fits = result.fits;
+  const int status = result.skipped.empty() ? 0 : 1;
   if (o.json) {
     nlohmann::json arr = nlohmann::json::array();
     for (const auto& f : fits) arr.push_back(fit_json(f));
     std::cout << (o.all ? arr : arr[0]).dump(2) << '\n';
-    return;
+    return status;
   }
   for (const auto& f : fits) print_fit(f);
+  return status;
 }
 
 void run_export(const FitOptions& o) {
@@ -77,12 +99,22 @@ void run_export(const FitOptions& o) {
     throw InputError(
         fmt::format("{}: no fit stored for serial '{}' (run `station fit` first)", o.db, o.serial));
   const auto& f = rec->fit;
+  const auto verdict = stored_verdict(store, rec->id);
   if (o.format == "csv") {
-    fmt::print("serial,fit_id,term,value,std_error,std_error_ols,unit,ref_temp_c\n");
+    // The verdict on every row (a CSV has no header block): pass, fail, or empty for no part;
+    // failed limits joined by ';'.
+    std::string failed;
+    if (verdict)
+      for (const auto& x : verdict->failed) failed += (failed.empty() ? "" : ";") + x.limit;
+    const std::string v = !verdict ? "" : verdict->pass ? "pass" : "fail";
+    fmt::print(
+        "serial,fit_id,term,value,std_error,std_error_ols,unit,ref_temp_c,part_number,verdict,"
+        "failed_limits\n");
     for (std::size_t i = 0; i < f.names.size(); ++i) {
       const double ols = i < f.std_errors_ols.size() ? f.std_errors_ols[i] : NAN;
-      fmt::print("{},{},{},{:.9e},{:.3e},{:.3e},{},{}\n", o.serial, rec->id, f.names[i],
-                 f.coefficients[i], f.std_errors[i], ols, unit_of(f.names[i]), f.spec.ref_temp_c);
+      fmt::print("{},{},{},{:.9e},{:.3e},{:.3e},{},{},{},{},{}\n", o.serial, rec->id, f.names[i],
+                 f.coefficients[i], f.std_errors[i], ols, unit_of(f.names[i]), f.spec.ref_temp_c,
+                 verdict ? verdict->part_number : "", v, failed);
     }
     return;
   }
@@ -104,7 +136,9 @@ void run_export(const FitOptions& o) {
       {"std_errors_ols", std_errors_ols_json(f)},
       {"error_model", error_model_json(f.error_model)},
       {"units", units},
-      {"std_ratio", std_ratio_json(rec->eval)}};
+      {"std_ratio", std_ratio_json(rec->eval)},
+      {"part_number", verdict ? nlohmann::json(verdict->part_number) : nlohmann::json()},
+      {"verdict", verdict ? verdict_json(*verdict) : nlohmann::json()}};
   std::cout << j.dump(2) << '\n';
 }
 
@@ -116,16 +150,19 @@ void add_fit_commands(CLI::App& app, CommandStatus& status) {
   fit->add_option("--db", o->db, "SQLite database")->required();
   auto* serial = fit->add_option("--serial", o->serial, "gyro serial number");
   fit->add_option("--runs", o->runs, "run ids (default: every run of the serial)")->delimiter(',');
-  auto* all = fit->add_flag("--all", o->all, "fit every serial of --run")->excludes(serial);
+  auto* all = fit->add_flag("--all", o->all,
+                            "fit every serial of --run, or of the database over all its runs "
+                            "(one transaction)")
+                  ->excludes(serial);
   fit->add_option("--run", o->run, "run id for --all")->needs(all);
+  fit->add_option("--parts", o->parts,
+                  "part file: judge against it (default: the limits stored with the run)");
+  fit->add_option("--part", o->part, "part number (default: the one the run's slot named)");
   fit->add_option("--terms", o->terms, "dT,dT2,dT3,dT4,gradT,dTdt (B0 always)")
       ->capture_default_str();
   fit->add_option("--ref-temp-c", o->ref_temp_c, "T_ref, C")->capture_default_str();
   fit->add_flag("--json", o->json, "print JSON");
-  fit->callback([o, &status] {
-    run_fit(*o);
-    status.exit_code = 0;
-  });
+  fit->callback([o, &status] { status.exit_code = run_fit(*o); });
   auto e = std::make_shared<FitOptions>();
   auto* exp = app.add_subcommand(
       "export", "Write a serial's latest coefficients for the navigation computer");

@@ -22,6 +22,7 @@
 #include "station/daemon/resume.hpp"
 #include "station/daemon/rig.hpp"
 #include "station/daemon/sequencer.hpp"
+#include "station/parts/judged_fit.hpp"
 #include "station/session/session_recording.hpp"
 #include "station/sim/sim_run.hpp"
 
@@ -45,6 +46,7 @@ void install_signal_handlers() {
 struct RunOptions {
   bool sim = false, json = false, fresh = false;
   std::string config, protocol = "paper", db, operator_name, log_file, record_can, record;
+  std::string parts, part;          ///< --parts FILE, --part PN (--sim)
   std::vector<std::string> faults;  ///< --sim: "T:COMMAND"
   int gyros = 4;
   std::uint64_t seed = 1;
@@ -80,8 +82,23 @@ bool has_unfinished_run(const std::string& db) {
   return peek.find_unfinished_run().has_value();
 }
 
+/// Each slot's fit and verdict of run `run_id`, one line per slot.
+void print_verdicts(Store& store, std::int64_t run_id) {
+  for (const auto& slot : store.run_slots(run_id)) {
+    const auto fit = store.latest_fit(slot.serial);
+    if (!fit || fit->runs != std::vector<std::int64_t>{run_id}) {
+      fmt::print("  {}: no fit\n", slot.serial);
+      continue;
+    }
+    fmt::print("  {}: fit {}: {}\n", slot.serial, fit->id,
+               verdict_text(stored_verdict(store, fit->id)));
+  }
+}
+
 int run_real(const RunOptions& o) {
   const StationConfig config = load_station_config(o.config);
+  if (!o.part.empty()) throw InputError("--part is for --sim; a rig's slots name their part");
+  auto part_limits = slot_part_limits(config, o.parts);  // a bad part file stops here
   Protocol protocol = load_protocol(o.protocol);
   const auto locks = lock_db_and_devices(o.db, &config);
   // Every device must answer before anything moves or the database is touched.
@@ -123,6 +140,7 @@ int run_real(const RunOptions& o) {
   SequencerOptions so;
   so.operator_name = o.operator_name;
   so.stop = &g_stop;
+  so.part_limits = std::move(part_limits);
   std::uint64_t watchdog_usec = 0;
   if (sd_watchdog_enabled(0, &watchdog_usec) > 0) {
     so.watchdog = [] { sd_notify(0, "WATCHDOG=1"); };
@@ -138,13 +156,17 @@ int run_real(const RunOptions& o) {
   sd_notify(0, "STOPPING=1");
   fmt::print("run {} {} at t = {:.0f} s after {} ticks\n", out.run_id, out.state, out.t_s,
              out.ticks);
+  print_verdicts(store, out.run_id);
   return 0;
 }
 
 int run_sim(const RunOptions& o) {
   const std::string db = o.db.empty() ? "station-sim.db" : o.db;
-  const auto locks = lock_db_and_devices(db, nullptr);
   SimRunOptions so;
+  so.parts_path = o.parts;
+  so.part_number = o.part;
+  sim_part_number(so);  // a bad part file stops here, before the database is locked
+  const auto locks = lock_db_and_devices(db, nullptr);
   so.gyros = o.gyros;
   so.seed = o.seed;
   so.gyro_preset = o.gyro_preset;
@@ -210,6 +232,13 @@ void add_run_command(CLI::App& app, CommandStatus& status) {
                   "--sim: at tick T (s) inject a simrig fault command, T:COMMAND "
                   "(docs/SIMRIG.md), e.g. '3000:door open', or T:kill (the daemon SIGKILLs "
                   "itself before tick T, to record a killed and resumed run); repeatable");
+  cmd->add_option("--parts", o->parts,
+                  "part file (TOML, schemas/parts.schema.json): each fit gets a verdict against "
+                  "its slot's part (overrides [station] parts; with --sim: applied to every "
+                  "simulated gyro)");
+  cmd->add_option("--part", o->part,
+                  "--sim: the simulated gyros' part number (default: the part file's first, in "
+                  "sort order)");
   cmd->add_flag("--json", o->json, "print one JSON object at the end (--sim)");
   cmd->callback([o, &status] {
     LogOptions lo;

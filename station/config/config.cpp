@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <set>
@@ -83,7 +84,7 @@ ModbusDeviceConfig read_modbus_device(const TomlView& v, bool is_chamber) {
 }
 
 SlotConfig read_slot(const TomlView& v) {
-  v.allow_only({"node", "serial", "pulse_weight_arcsec", "axis", "relay"});
+  v.allow_only({"node", "serial", "pulse_weight_arcsec", "axis", "relay", "part"});
   SlotConfig s;
   const long long node = v.get_integer("node");
   if (node < 1 || node > 16) throw v.error("node", "CAN node must be 1..16");
@@ -97,6 +98,11 @@ SlotConfig read_slot(const TomlView& v) {
   s.axis = v.opt_string("axis").value_or("up");
   s.enu = at_key(v, "axis", [&] { return compensation::parse_axis(s.axis); });
   s.relay = v.opt_string("relay").value_or("");
+  if (auto part = v.opt_string("part")) {
+    if (part->empty()) throw v.error("part", "must not be empty");
+    s.part = *part;
+    s.part_line = v.line_of("part");
+  }
   return s;
 }
 
@@ -165,7 +171,7 @@ StationConfig parse_station_config(const std::string& text, const std::string& p
   c.path = path;
   c.text = text;
   if (auto st = root.opt_table("station")) {
-    st->allow_only({"name", "latitude_deg", "ref_temp_c", "bin_s", "max_lost_share"});
+    st->allow_only({"name", "latitude_deg", "ref_temp_c", "bin_s", "max_lost_share", "parts"});
     c.name = st->opt_string("name").value_or(c.name);
     c.latitude_deg = st->get_number("latitude_deg");
     if (c.latitude_deg < -90 || c.latitude_deg > 90)
@@ -178,6 +184,11 @@ StationConfig parse_station_config(const std::string& text, const std::string& p
     c.max_lost_share = st->opt_number("max_lost_share").value_or(c.max_lost_share);
     if (!(c.max_lost_share >= 0 && c.max_lost_share <= 1))
       throw st->error("max_lost_share", "must be 0..1 (a share of the record window's ticks)");
+    if (auto parts = st->opt_string("parts")) {
+      if (parts->empty()) throw st->error("parts", "must not be empty");
+      // Relative to the configuration file, so a station's files travel together.
+      c.parts_path = (std::filesystem::path(path).parent_path() / *parts).string();
+    }
   } else {
     throw root.error("station", "missing [station] table (latitude_deg is required)");
   }

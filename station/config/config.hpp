@@ -36,6 +36,8 @@ struct SlotConfig {
   std::string axis = "up";    ///< input axis: up, down, north, south, east, west, heading:DEG
   compensation::EnuAxis enu;  ///< the axis as a unit vector
   std::string relay;          ///< GPIO line powering this gyro (optional)
+  std::string part;           ///< part number, a key of the part file (empty: no verdict)
+  std::size_t part_line = 0;  ///< line of the `part` key, for messages naming it
 };
 
 /// The station's hard limits, enforced by the safety layer whatever a protocol asks.
@@ -58,6 +60,9 @@ struct StationConfig {
   /// Largest share of a slot's record-window ticks that may lack a rate (link outages) before
   /// the run ends 'incomplete', 0..1.
   double max_lost_share = 0.05;
+  /// Part file ([station] parts, station/parts/part_file.hpp) resolved against the folder of
+  /// this file; empty when the key is absent.
+  std::string parts_path;
   ModbusDeviceConfig chamber;
   std::optional<ModbusDeviceConfig> turntable;
   std::string can_transport;  ///< socketcan:can0 | unix:PATH | fd:N

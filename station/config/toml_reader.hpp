@@ -52,10 +52,11 @@ class TomlView {
   std::string full_key(std::string_view key) const;
   const std::string& file() const { return file_; }
   const toml::table& table() const { return *table_; }
+  /// Line of `key` (or of the table when absent).
+  std::size_t line_of(std::string_view key) const;
 
  private:
   const toml::node* find(std::string_view key) const;
-  std::size_t line_of(std::string_view key) const;
 
   const toml::table* table_;
   std::string file_;

@@ -19,6 +19,8 @@
 #include "station/daemon/protocol_runner.hpp"
 #include "station/daemon/rig.hpp"
 #include "station/daemon/safety.hpp"
+#include "station/parts/part_file.hpp"
+#include "station/store/calibration.hpp"
 #include "station/store/store.hpp"
 
 namespace station {
@@ -49,6 +51,9 @@ struct SequencerOptions {
   std::optional<double> resume_at_t_s;
   /// Told, before any device I/O, that a run resumes: last committed tick, first tick now.
   std::function<void(double last_s, double next_s)> on_resume;
+  /// Part limits by serial (slot_part_limits): each such gyro's fit is judged and its verdict
+  /// stored and logged. Empty: no verdicts (and no verdict events).
+  std::map<std::string, PartLimits> part_limits;
 };
 
 /// How a run ended.
@@ -98,6 +103,10 @@ class Sequencer {
   /// Ends the run: closes open outages, bins and fits; returns the final state ('incomplete'
   /// instead of 'completed' when a slot lost more than max_lost_share of its record window).
   std::string finish(const std::string& state, double t_s);
+  /// Judges a slot's fit against its part (options_.part_limits): verdict stored and an event.
+  void judge(double t_s, const SerialFit& f);
+  /// Stores each slot's part and a snapshot of its limits with a new run.
+  void save_parts();
   void emit(double t_s, const std::string& severity, const std::string& source,
             const std::string& kind, const std::string& message,
             const std::optional<std::string>& data_json = std::nullopt);

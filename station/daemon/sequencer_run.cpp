@@ -11,8 +11,10 @@
 #include "station/common/logging.hpp"
 #include "station/daemon/resume.hpp"
 #include "station/daemon/sequencer.hpp"
+#include "station/parts/judged_fit.hpp"
 #include "station/store/calibration.hpp"
 #include "station/store/fit_json.hpp"
+#include "station/store/fit_verdicts.hpp"
 
 #ifndef STATION_VERSION
 #define STATION_VERSION "dev"
@@ -37,6 +39,7 @@ std::string Sequencer::finish(const std::string& end_state, double t_s) {
            fmt::format("{}: k1 {:.4e} deg/h/C, k0 {:.4e} deg/h/C, std ratio {} over {} bins",
                        slot.serial, f.fit.coefficients[1], f.fit.coefficients[2],
                        std_ratio_text(f.eval), f.fit.n_points));
+      judge(t_s, f);
     } catch (const InputError& e) {
       emit(t_s, "warn", "seq", "fit_skipped", e.what());
     }
@@ -44,6 +47,21 @@ std::string Sequencer::finish(const std::string& end_state, double t_s) {
   store_.finish_run(run_id_, state);
   emit(t_s, "info", "seq", "run_end", fmt::format("run {} {}", run_id_, state));
   return state;
+}
+
+void Sequencer::judge(double t_s, const SerialFit& f) {
+  const auto it = options_.part_limits.find(f.serial);
+  if (it == options_.part_limits.end()) return;
+  const auto j = judge_and_store(store_, f, it->second);
+  emit(t_s, j.verdict->pass ? "info" : "warn", "seq", "verdict",
+       fmt::format("{}: {}", f.serial, verdict_text(j.verdict)), verdict_json(*j.verdict).dump());
+}
+
+void Sequencer::save_parts() {
+  std::vector<SlotPart> parts;
+  for (const auto& [serial, limits] : options_.part_limits)
+    parts.push_back({serial, limits.number, part_limits_json(limits).dump()});
+  if (!parts.empty()) save_run_parts(store_, run_id_, parts);
 }
 
 double Sequencer::resume_first_tick(const RunRecord& resume) {
@@ -111,6 +129,7 @@ RunOutcome Sequencer::run(const std::optional<RunRecord>& resume) {
                  drivers::tap_wall_time_s(),
                  resolved_meaning_json(config_)};
     run_id_ = store_.create_run(info, run_slots_of(config_));
+    save_parts();
     emit(0, "info", "seq", "run_start",
          fmt::format("run {} protocol '{}' with {} gyros", run_id_, protocol_.name,
                      config_.slots.size()));

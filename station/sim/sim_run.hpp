@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <functional>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -30,6 +31,8 @@ struct SimRunOptions {
   bool wall_clock = false;         ///< run at 1 Hz on CLOCK_MONOTONIC instead of simulated time
   std::string record_can_path;     ///< write every CAN frame in candump format here (empty: no)
   std::string record_dir;          ///< record the session in this directory (empty: no)
+  std::string parts_path;          ///< part file: every simulated gyro is judged (empty: no)
+  std::string part_number;         ///< their part (empty: the file's first in sort order)
   /// Faults injected into the simulated rig: at tick t_s (after the world advanced to it), the
   /// simrig control command (docs/SIMRIG.md), e.g. {3000, "door open"}. In time order.
   std::vector<std::pair<double, std::string>> faults;
@@ -37,6 +40,10 @@ struct SimRunOptions {
   /// Test hook: called with each tick's time and the world, after it advanced (fault injection).
   std::function<void(double t_s, sim::SimWorld& world)> on_world_tick;
 };
+
+/// The part the simulated gyros are given: empty without a part file; throws InputError for a
+/// bad part file, a part it lacks, or --part without a file. Called before anything moves.
+std::optional<std::string> sim_part_number(const SimRunOptions& options);
 
 /// Runs the simulated rig to the end of the protocol (or a resumed one to its end) and returns
 /// the report: {"run_id","sim_s","wall_s","gyros":[{serial,true,fitted,std_errors,std_*}]}.

@@ -53,6 +53,21 @@ class Statement {
   std::string db_path_;
 };
 
+/// A statement borrowed from a cache (Store::cached): reset, bindings cleared, when the lease ends,
+/// so a half-read result never holds the database's read snapshot.
+class StatementLease {
+ public:
+  explicit StatementLease(Statement& s) : s_(&s) {}
+  ~StatementLease() { s_->reset(); }
+  StatementLease(const StatementLease&) = delete;
+  StatementLease& operator=(const StatementLease&) = delete;
+  Statement* operator->() const { return s_; }
+  Statement& operator*() const { return *s_; }
+
+ private:
+  Statement* s_;
+};
+
 /// How a command may touch its database file.
 enum class OpenMode {
   create,     ///< the daemon: create the file when missing, migrate it

@@ -27,6 +27,12 @@ Store::Store(const std::string& path, OpenMode mode) : db_(path, mode) {
   db_.migrate();
 }
 
+StatementLease Store::cached(const std::string& sql) {
+  auto it = cache_.find(sql);
+  if (it == cache_.end()) it = cache_.emplace(sql, db_.prepare(sql)).first;
+  return StatementLease(it->second);
+}
+
 std::int64_t Store::create_run(const RunInfo& info, const std::vector<RunSlot>& slots) {
   flush();
   Transaction tx(db_);
@@ -89,10 +95,10 @@ RunRecord read_run(const Statement& st) {
 }  // namespace
 
 std::optional<RunRecord> Store::find_run(std::int64_t id) {
-  auto st = db_.prepare(std::string(kRunColumns) + "WHERE id = ?");
-  st.bind(1, id);
-  if (!st.step()) return std::nullopt;
-  return read_run(st);
+  auto st = cached(std::string(kRunColumns) + "WHERE id = ?");
+  st->bind(1, id);
+  if (!st->step()) return std::nullopt;
+  return read_run(*st);
 }
 
 std::optional<RunRecord> Store::find_unfinished_run() {
@@ -243,9 +249,10 @@ void Store::replace_bins(std::int64_t run_id, const std::string& serial,
 
 sc::ModelData Store::model_data(const std::string& serial, const std::vector<std::int64_t>& runs) {
   sc::ModelData d;
-  auto st = db_.prepare(
+  auto lease = cached(
       "SELECT bias_dph, temp_c, grad_c, dtdt_c_per_h, t_start_s FROM bins WHERE run_id = ? "
       "AND serial = ? AND complete = 1 ORDER BY t_start_s");
+  Statement& st = *lease;
   for (std::size_t k = 0; k < runs.size(); ++k) {
     st.bind(1, runs[k]).bind(2, serial);
     while (st.step()) {
@@ -263,10 +270,10 @@ sc::ModelData Store::model_data(const std::string& serial, const std::vector<std
 }
 
 std::vector<std::int64_t> Store::runs_of_serial(const std::string& serial) {
-  auto st = db_.prepare("SELECT DISTINCT run_id FROM run_slots WHERE serial = ? ORDER BY run_id");
-  st.bind(1, serial);
+  auto st = cached("SELECT DISTINCT run_id FROM run_slots WHERE serial = ? ORDER BY run_id");
+  st->bind(1, serial);
   std::vector<std::int64_t> out;
-  while (st.step()) out.push_back(st.column_int(0));
+  while (st->step()) out.push_back(st->column_int(0));
   return out;
 }
 

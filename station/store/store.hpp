@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "compensation/binning.hpp"
@@ -149,6 +150,9 @@ class Store {
   std::vector<OpenOutageEvent> open_outages(std::int64_t run_id);
 
   Database& db() { return db_; }
+  /// Statement `sql` prepared once per Store and reused: for statements run once per serial
+  /// (`fit --all` over a thousand serials), where preparing would cost more than running.
+  StatementLease cached(const std::string& sql);
 
  private:
   void write_tick(std::int64_t run_id, double t_s, const std::vector<SampleRow>& rows,
@@ -158,6 +162,7 @@ class Store {
   // The 1 Hz path's statements, prepared once (preparing costs more than the inserts).
   std::optional<Statement> insert_sample_, update_progress_;
   std::optional<Transaction> batch_;
+  std::unordered_map<std::string, Statement> cache_;  // by SQL text; nodes never move
   int ticks_per_commit_ = 1, batch_ticks_ = 0;
 };
 

@@ -1,6 +1,7 @@
 // The `station` executable end to end: analyze/adev output and exit status 2 on bad input.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
 #include <cstdio>
@@ -108,7 +109,7 @@ TEST(Cli, AdevMissingColumnExitsTwo) {
 }
 
 TEST(Cli, SimRunThenFitAllAndExport) {
-  const std::string db = testing::TempDir() + "cli_sim.db";
+  const std::string db = testing::TempDir() + "cli_sim-" + std::to_string(getpid()) + ".db";
   for (const char* ext : {"", "-wal", "-shm"}) std::remove((db + ext).c_str());
   const auto run = run_station("run --sim --gyros 2 --seed 9 --new --json --db " + db +
                                    " --protocol " + STATION_TEST_DATA_DIR "/short_cycle.toml",
@@ -138,7 +139,10 @@ TEST(Cli, SimRunThenFitAllAndExport) {
 
   const auto csv = run_station("export --db " + db + " --serial SIM-0002 --format csv", false);
   ASSERT_EQ(csv.status, 0) << csv.out;
-  EXPECT_EQ(csv.out.rfind("serial,fit_id,term,value,std_error,std_error_ols,unit,ref_temp_c\n", 0), 0u)
+  EXPECT_EQ(csv.out.rfind("serial,fit_id,term,value,std_error,std_error_ols,unit,ref_temp_c,"
+                          "part_number,verdict,failed_limits\n",
+                          0),
+            0u)
       << csv.out;
   EXPECT_NE(csv.out.find("SIM-0002,"), std::string::npos);
   EXPECT_NE(csv.out.find(",k0,"), std::string::npos);  // the latest fit is the dT+gradT one
@@ -149,8 +153,8 @@ TEST(Cli, SimRunThenFitAllAndExport) {
 }
 
 TEST(Cli, SimRunRecordsEveryCanFrameInCandumpFormat) {
-  const std::string db = testing::TempDir() + "cli_rec.db";
-  const std::string log = testing::TempDir() + "cli_rec.log";
+  const std::string db = testing::TempDir() + "cli_rec-" + std::to_string(getpid()) + ".db";
+  const std::string log = testing::TempDir() + "cli_rec-" + std::to_string(getpid()) + ".log";
   for (const char* ext : {"", "-wal", "-shm"}) std::remove((db + ext).c_str());
   std::remove(log.c_str());
   const auto run = run_station("run --sim --gyros 2 --new --json --db " + db + " --record-can " +
@@ -173,8 +177,8 @@ TEST(Cli, SimRunRecordsEveryCanFrameInCandumpFormat) {
 // gpsd-style regression: a recorded session replayed through the same driver gives the stored
 // fit exactly; a log missing one COUNTS frame inside the record window does not.
 TEST(Cli, ReplayOfARecordedRunReproducesItsFitAndCatchesATamperedLog) {
-  const std::string db = testing::TempDir() + "cli_replay.db";
-  const std::string log = testing::TempDir() + "cli_replay.log";
+  const std::string db = testing::TempDir() + "cli_replay-" + std::to_string(getpid()) + ".db";
+  const std::string log = testing::TempDir() + "cli_replay-" + std::to_string(getpid()) + ".log";
   for (const char* ext : {"", "-wal", "-shm"}) std::remove((db + ext).c_str());
   std::remove(log.c_str());
   ASSERT_EQ(run_station("run --sim --gyros 2 --new --db " + db + " --record-can " + log +

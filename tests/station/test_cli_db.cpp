@@ -29,8 +29,9 @@ std::string bytes_of(const std::string& path) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
-const std::vector<std::string> kReadCommands{"fit --serial X --db ", "fit --all --run 1 --db ",
-                                             "export --serial X --db ", "replay /dev/null --db "};
+const std::vector<std::string> kReadCommands{"fit --serial X --db ",     "fit --all --run 1 --db ",
+                                             "fit --all --db ",          "export --serial X --db ",
+                                             "history --serial X --db ", "replay /dev/null --db "};
 
 }  // namespace
 

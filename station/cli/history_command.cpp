@@ -1,0 +1,166 @@
+// `station history --db DB --serial SN [--json]`: every run and fit of one gyro, its
+// coefficients over time, their run-to-run scatter against the reported uncertainties, and
+// calibrations that moved more than their uncertainties allow. Read-only.
+#include <fmt/format.h>
+
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "station/cli/commands.hpp"
+#include "station/common/input_error.hpp"
+#include "station/parts/history.hpp"
+#include "station/parts/verdict.hpp"
+
+namespace station {
+namespace {
+
+using nlohmann::json;
+
+struct HistoryOptions {
+  std::string db, serial;
+  bool json = false;
+};
+
+json opt(const std::optional<double>& v) {
+  return v ? json(*v) : json();
+}
+
+std::optional<Verdict> verdict_of(const SerialFitRow& f) {
+  if (!f.verdict_json) return std::nullopt;
+  return verdict_from_json(json::parse(*f.verdict_json));
+}
+
+json fit_row_json(const SerialFitRow& f) {
+  json coef = json::object(), se = json::object();
+  for (const auto& [n, v] : f.coefficients) coef[n] = v;
+  for (const auto& [n, v] : f.std_errors) se[n] = v;
+  const auto v = verdict_of(f);
+  return {{"fit_id", f.fit_id},
+          {"created_utc", f.created_utc},
+          {"runs", f.runs},
+          {"terms", f.terms},
+          {"bins", f.n_bins},
+          {"coefficients", coef},
+          {"std_errors", se},
+          {"std_after_dph", f.std_after_dph},
+          {"std_ratio", opt(f.std_ratio)},
+          {"part_number", f.part_number ? json(*f.part_number) : json()},
+          {"verdict", v ? verdict_json(*v) : json()}};
+}
+
+json history_json(const std::string& serial, const std::vector<SerialRun>& runs,
+                  const std::vector<SerialFitRow>& fits, const SerialHistoryStats& h) {
+  json jr = json::array(), jf = json::array(), jc = json::array(), js = json::array(),
+       jflags = json::array();
+  for (const auto& r : runs) {
+    jr.push_back({{"run_id", r.run_id},
+                  {"started_utc", r.started_utc},
+                  {"ended_utc", r.ended_utc},
+                  {"state", r.state},
+                  {"protocol", r.protocol_name},
+                  {"station", r.station},
+                  {"operator", r.operator_name},
+                  {"slot", r.slot},
+                  {"part_number", r.part_number ? json(*r.part_number) : json()}});
+  }
+  for (const auto& f : fits) jf.push_back(fit_row_json(f));
+  for (const auto& c : h.calibrations) jc.push_back(c.fit->fit_id);
+  for (const auto& s : h.scatter) {
+    js.push_back({{"coefficient", s.coefficient},
+                  {"n", s.n},
+                  {"mean", s.n > 0 ? json(s.mean) : json()},
+                  {"sample_std", opt(s.sample_std)},
+                  {"rms_se", opt(s.rms_se)},
+                  {"chi2", opt(s.chi2)},
+                  {"birge_ratio", opt(s.birge_ratio)}});
+  }
+  for (const auto& f : h.flags) {
+    jflags.push_back({{"fit_id", f.fit_id},
+                      {"previous_fit_id", f.previous_fit_id},
+                      {"coefficient", f.coefficient},
+                      {"delta", f.delta},
+                      {"zeta", f.zeta}});
+  }
+  return {{"serial", serial},
+          {"runs", jr},
+          {"fits", jf},
+          {"calibrations", jc},
+          {"terms", h.terms},
+          {"scatter", js},
+          {"drift_limit_zeta", kDriftZetaLimit},
+          {"drift", jflags}};
+}
+
+std::string pm(const SerialFitRow& f, const std::string& name) {
+  const auto v = f.coefficient(name), u = f.std_error(name);
+  if (!v) return "-";
+  return u ? fmt::format("{:.4e} +- {:.1e}", *v, *u) : fmt::format("{:.4e}", *v);
+}
+
+void print_history(const std::string& serial, const std::vector<SerialRun>& runs,
+                   const std::vector<SerialFitRow>& fits, const SerialHistoryStats& h) {
+  fmt::print("{}: {} runs, {} fits, {} calibrations\n", serial, runs.size(), fits.size(),
+             h.calibrations.size());
+  for (const auto& r : runs) {
+    fmt::print("  run {:>4} {} {:<10} {:<12} slot {:>2} part {}\n", r.run_id, r.started_utc,
+               r.state, r.protocol_name, r.slot, r.part_number.value_or("-"));
+  }
+  fmt::print("  {:>5} {:<24} {:<10} {:>24} {:>24} {:>7}  verdict\n", "fit", "created", "runs",
+             "k1 deg/h/C", "k0 deg/h/C", "ratio");
+  for (const auto& f : fits) {
+    fmt::print("  {:>5} {:<24} {:<10} {:>24} {:>24} {:>7}  {}\n", f.fit_id, f.created_utc,
+               fmt::format("{}", fmt::join(f.runs, ",")), pm(f, "k1"), pm(f, "k0"),
+               f.std_ratio ? fmt::format("{:.3f}", *f.std_ratio) : "undef",
+               verdict_text(verdict_of(f)));
+  }
+  for (const auto& s : h.scatter) {
+    if (s.n < 2) {
+      fmt::print("  {} scatter: {} calibration(s) with terms {}: nothing to compare\n",
+                 s.coefficient, s.n, h.terms);
+      continue;
+    }
+    fmt::print("  {} scatter over {} calibrations: std {:.2e}, RMS SE {:.2e}, Birge ratio {}\n",
+               s.coefficient, s.n, *s.sample_std, s.rms_se.value_or(0),
+               s.birge_ratio ? fmt::format("{:.2f}", *s.birge_ratio) : "undefined");
+  }
+  for (const auto& f : h.flags) {
+    fmt::print(
+        "  DRIFT: fit {} {} moved {:.3e} from fit {} (zeta {:.1f}, limit {:.0f}): drift or "
+        "a damaged gyro\n",
+        f.fit_id, f.coefficient, f.delta, f.previous_fit_id, f.zeta, kDriftZetaLimit);
+  }
+  if (h.flags.empty() && h.calibrations.size() > 1)
+    fmt::print("  no calibration moved more than {:.0f} combined standard errors\n",
+               kDriftZetaLimit);
+}
+
+void run_history(const HistoryOptions& o) {
+  Store store(o.db, OpenMode::read_only);
+  const auto runs = serial_runs(store, o.serial);
+  const auto fits = serial_fits(store, o.serial);
+  if (runs.empty() && fits.empty())
+    throw InputError(fmt::format("{}: no run or fit of serial '{}'", o.db, o.serial));
+  const auto h = serial_history_stats(fits);
+  if (o.json) {
+    std::cout << history_json(o.serial, runs, fits, h).dump(2) << '\n';
+    return;
+  }
+  print_history(o.serial, runs, fits, h);
+}
+
+}  // namespace
+
+void add_history_command(CLI::App& app, CommandStatus& status) {
+  auto o = std::make_shared<HistoryOptions>();
+  auto* cmd = app.add_subcommand(
+      "history", "Every run and fit of one gyro, the scatter of its coefficients and drift");
+  cmd->add_option("--db", o->db, "SQLite database (opened read-only)")->required();
+  cmd->add_option("--serial", o->serial, "gyro serial number")->required();
+  cmd->add_flag("--json", o->json, "print JSON");
+  cmd->callback([o, &status] {
+    run_history(*o);
+    status.exit_code = 0;
+  });
+}
+
+}  // namespace station
