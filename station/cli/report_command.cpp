@@ -9,7 +9,8 @@ namespace station {
 void add_report_command(CLI::App& app, CommandStatus& status) {
   auto o = std::make_shared<report::ReportOptions>();
   auto* cmd = app.add_subcommand(
-      "report", "Write a run's calibration report: self-contained HTML pages (the paper's figures)");
+      "report",
+      "Write a run's calibration report: self-contained HTML pages (the paper's figures)");
   cmd->add_option("--db", o->db, "SQLite database (opened read-only)")->required();
   cmd->add_option("--run", o->run_id, "run id")->required();
   cmd->add_option("--out", o->out_dir, "output directory (created when missing)")->required();

@@ -1,8 +1,8 @@
 // Writing a run's report: load, prepare, write the pages, optionally print them with Chromium.
 #include "station/report/report.hpp"
 
-#include <fmt/format.h>
 #include <fcntl.h>
+#include <fmt/format.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -46,8 +46,12 @@ std::string find_program(const std::string& name) {
 
 /// Prints `html` to `pdf` with headless Chromium (argv, no shell: paths are not interpreted).
 void print_pdf(const std::string& chromium, const fs::path& html, const fs::path& pdf) {
-  std::vector<std::string> args{chromium, "--headless", "--no-sandbox", "--disable-gpu",
-                                "--no-pdf-header-footer", "--virtual-time-budget=10000",
+  std::vector<std::string> args{chromium,
+                                "--headless",
+                                "--no-sandbox",
+                                "--disable-gpu",
+                                "--no-pdf-header-footer",
+                                "--virtual-time-budget=10000",
                                 "--print-to-pdf=" + pdf.string(),
                                 "file://" + fs::absolute(html).string()};
   std::vector<char*> argv;
@@ -71,8 +75,8 @@ void print_pdf(const std::string& chromium, const fs::path& html, const fs::path
 std::string file_safe(const std::string& serial) {
   std::string out;
   for (const char c : serial) {
-    const bool keep = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') ||
-                      (c >= '0' && c <= '9') || c == '.' || c == '-' || c == '_';
+    const bool keep = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                      c == '.' || c == '-' || c == '_';
     out += keep ? c : '_';
   }
   return out;
@@ -93,8 +97,9 @@ ReportFiles write_report(const ReportOptions& o) {
   ReportFiles files;
   std::vector<std::string> names;
   for (const auto& s : r.serials) {
-    names.push_back(!s.fit ? "" : fmt::format("run-{}-slot{}-{}.html", r.run.id, s.slot.slot,
-                                              file_safe(s.slot.serial)));
+    names.push_back(!s.fit ? ""
+                           : fmt::format("run-{}-slot{}-{}.html", r.run.id, s.slot.slot,
+                                         file_safe(s.slot.serial)));
     if (names.back().empty()) continue;
     write_file(dir / names.back(), serial_html(r, s, assets));
     files.pages.push_back((dir / names.back()).string());

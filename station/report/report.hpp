@@ -11,8 +11,8 @@ namespace station::report {
 struct ReportOptions {
   std::string db, out_dir;
   std::int64_t run_id = 0;
-  bool pdf = false;               ///< also print each page to PDF with headless Chromium
-  std::string dygraphs_dir;       ///< libjs-dygraphs' directory (empty: the Debian path)
+  bool pdf = false;                   ///< also print each page to PDF with headless Chromium
+  std::string dygraphs_dir;           ///< libjs-dygraphs' directory (empty: the Debian path)
   std::string chromium = "chromium";  ///< the browser for --pdf, looked up on PATH
 };
 

@@ -44,6 +44,17 @@ double mean_air(const std::vector<SampleRow>& rows, std::size_t& from, double t0
 
 }  // namespace
 
+Figure make_figure(std::string id, std::string title, std::string x_label, std::string y_label,
+                   std::string y2_label) {
+  Figure f;
+  f.id = std::move(id);
+  f.title = std::move(title);
+  f.x_label = std::move(x_label);
+  f.y_label = std::move(y_label);
+  f.y2_label = std::move(y2_label);
+  return f;
+}
+
 std::size_t Figure::points() const {
   std::size_t n = 0;
   for (const auto& s : series)
@@ -77,8 +88,8 @@ std::vector<RunBin> whole_run_bins(const std::vector<SampleRow>& rows, double bi
 }
 
 Figure figure_2a(const std::vector<RunBin>& bins) {
-  Figure f{"2a", "Bias (600 s bins) and temperatures against time", "time, h", "bias, deg/h",
-           "temperature, \u00b0C"};
+  Figure f = make_figure("2a", "Bias (600 s bins) and temperatures against time", "time, h",
+                         "bias, deg/h", "temperature, \u00b0C");
   Series bias = points("bias", {}, {}), gyro = points("gyro temperature", {}, {}),
          air = points("chamber air", {}, {});
   for (const auto& b : bins) {
@@ -95,8 +106,8 @@ Figure figure_2a(const std::vector<RunBin>& bins) {
 }
 
 Figure figure_2b(const std::vector<RunBin>& bins) {
-  Figure f{"2b", "Bias against temperature: heating and cooling branches", "gyro temperature, \u00b0C",
-           "bias, deg/h"};
+  Figure f = make_figure("2b", "Bias against temperature: heating and cooling branches",
+                         "gyro temperature, \u00b0C", "bias, deg/h");
   Series heating = points("heating", {}, {}), cooling = points("cooling", {}, {}),
          steady = points("steady", {}, {});
   for (const auto& b : bins) {
@@ -111,12 +122,13 @@ Figure figure_2b(const std::vector<RunBin>& bins) {
 }
 
 Figure figure_3(const std::vector<RampRun>& ramps) {
-  Figure f{"3", "Bias against temperature at 0, 10 and 20 \u00b0C/h (hysteresis study)",
-           "gyro temperature, \u00b0C", "bias, deg/h"};
+  Figure f =
+      make_figure("3", "Bias against temperature at 0, 10 and 20 \u00b0C/h (hysteresis study)",
+                  "gyro temperature, \u00b0C", "bias, deg/h");
   std::vector<std::string> missing{"ramp_00", "ramp_10", "ramp_20"};
   for (const auto& r : ramps) {
-    f.series.push_back(points(r.protocol + " (run " + std::to_string(r.run_id) + ")",
-                              r.data.temp_c, r.data.bias_dph));
+    f.series.push_back(points(r.protocol + " (run " + std::to_string(r.run_id) + ")", r.data.temp_c,
+                              r.data.bias_dph));
     std::erase(missing, r.protocol);
   }
   if (ramps.empty()) {
@@ -148,14 +160,13 @@ std::vector<std::string> temperature_terms(const sc::FitResult& fit) {
 }
 
 Figure figure_4(const sc::FitResult& fit, const sc::ModelData& data) {
-  Figure f{"4", "Bias after removing k1\u00b7\u0394T against the gradient \u2207T",
-           "gradient \u2207T = T2 - T1, \u00b0C", "bias - k1\u00b7\u0394T, deg/h"};
+  Figure f = make_figure("4", "Bias after removing k1\u00b7\u0394T against the gradient \u2207T",
+                         "gradient \u2207T = T2 - T1, \u00b0C", "bias - k1\u00b7\u0394T, deg/h");
   const auto temps = model_part(fit, data.view(), temperature_terms(fit));
   std::vector<double> y(data.bias_dph.size());
   for (std::size_t i = 0; i < y.size(); ++i) y[i] = data.bias_dph[i] - temps[i];
   f.series.push_back(points("bias - k1\u00b7\u0394T", data.grad_c, y));
-  const bool has_k0 =
-      std::find(fit.names.begin(), fit.names.end(), "k0") != fit.names.end();
+  const bool has_k0 = std::find(fit.names.begin(), fit.names.end(), "k0") != fit.names.end();
   if (has_k0) {
     Series line = points("B0 + k0\u00b7\u2207T (fit)", data.grad_c,
                          model_part(fit, data.view(), {"B0", "k0"}));
@@ -168,8 +179,8 @@ Figure figure_4(const sc::FitResult& fit, const sc::ModelData& data) {
 }
 
 Figure figure_5a(const sc::FitResult& fit, const sc::ModelData& data) {
-  Figure f{"5a", "Bias before and after compensation against temperature",
-           "gyro temperature, \u00b0C", "bias, deg/h"};
+  Figure f = make_figure("5a", "Bias before and after compensation against temperature",
+                         "gyro temperature, \u00b0C", "bias, deg/h");
   auto kept = temperature_terms(fit);
   kept.insert(kept.begin(), "B0");
   const auto temps = model_part(fit, data.view(), kept);

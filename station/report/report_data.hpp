@@ -17,8 +17,8 @@ namespace station::report {
 struct Series {
   std::string label;
   std::vector<double> x, y, y_low, y_high;
-  bool line = false;       ///< drawn as a line (else points only)
-  bool second_y = false;   ///< on the right-hand axis
+  bool line = false;      ///< drawn as a line (else points only)
+  bool second_y = false;  ///< on the right-hand axis
 };
 
 /// One figure: its id ("2a".."5b"), axes and series; `note` is shown under it (e.g. why it is
@@ -31,13 +31,17 @@ struct Figure {
   std::size_t points() const;
 };
 
+/// A figure with its titles and no series yet.
+Figure make_figure(std::string id, std::string title, std::string x_label, std::string y_label,
+                   std::string y2_label = {});
+
 /// A 600 s bin of the whole run (record window or not), for Figs. 2a/2b.
 struct RunBin {
-  double t_mid_s = 0;         ///< bin centre, s since the run started
-  double bias_dph = 0;        ///< bin mean rate minus Earth rate, deg/h
-  double temp_c = 0;          ///< gyro temperature (sensor A), deg C
-  double air_c = 0;           ///< chamber air, deg C (NaN when the chamber never answered)
-  double dtdt_c_per_h = 0;    ///< least-squares slope of temp_c over the bin, deg C/h
+  double t_mid_s = 0;       ///< bin centre, s since the run started
+  double bias_dph = 0;      ///< bin mean rate minus Earth rate, deg/h
+  double temp_c = 0;        ///< gyro temperature (sensor A), deg C
+  double air_c = 0;         ///< chamber air, deg C (NaN when the chamber never answered)
+  double dtdt_c_per_h = 0;  ///< least-squares slope of temp_c over the bin, deg C/h
 };
 
 /// Bins every usable sample of the run at bin_s (not only the record window: the return to

@@ -40,10 +40,14 @@ json figure_options(const Figure& f, bool bars) {
     labels.push_back(s.label);
     series[s.label] = series_options(s);
   }
-  json o{{"labels", labels},       {"xlabel", f.x_label},
-         {"ylabel", f.y_label},    {"series", series},
-         {"connectSeparatedPoints", true}, {"legend", "always"},
-         {"customBars", bars},     {"sigFigs", 4}};
+  json o{{"labels", labels},
+         {"xlabel", f.x_label},
+         {"ylabel", f.y_label},
+         {"series", series},
+         {"connectSeparatedPoints", true},
+         {"legend", "always"},
+         {"customBars", bars},
+         {"sigFigs", 4}};
   if (!f.y2_label.empty()) o["y2label"] = f.y2_label;
   if (f.log_axes) {
     o["logscale"] = true;
@@ -63,12 +67,23 @@ std::string html_escape(std::string_view text) {
   out.reserve(text.size());
   for (const char c : text) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&#39;"; break;
-      default: out += c;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&#39;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
@@ -108,8 +123,8 @@ json figure_json(const Figure& f) {
         it->second.push_back(s.x[i]);
         for (std::size_t n = 0; n < f.series.size(); ++n) it->second.push_back(nullptr);
       }
-      it->second[k + 1] = bars && !s.y_low.empty() ? json::array({s.y_low[i], s.y[i], s.y_high[i]})
-                                                   : json(s.y[i]);
+      it->second[k + 1] =
+          bars && !s.y_low.empty() ? json::array({s.y_low[i], s.y[i], s.y_high[i]}) : json(s.y[i]);
     }
   }
   json data = json::array();

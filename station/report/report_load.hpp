@@ -29,8 +29,8 @@ struct SerialReport {
   RunSlot slot;
   std::optional<FitRecord> fit;  ///< the newest fit that used this run; empty: none stored
   FitExtras extras;
-  AllanCurves allan;             ///< for the noise terms
-  std::vector<Figure> figures;   ///< 2a, 2b, 3, 4, 5a, 5b (empty without a fit)
+  AllanCurves allan;            ///< for the noise terms
+  std::vector<Figure> figures;  ///< 2a, 2b, 3, 4, 5a, 5b (empty without a fit)
 };
 
 /// One run and its serials.

@@ -110,8 +110,7 @@ std::string noise_table(const AllanCurves& a) {
   t += row({"quantization Q, arcsec", num(b.quantization_arcsec), num(c.quantization_arcsec)});
   t += row({"angle random walk N, deg/\u221ah", num(b.angle_random_walk_deg_rth),
             num(c.angle_random_walk_deg_rth)});
-  t += row({"bias instability B, deg/h", num(b.bias_instability_dph),
-            num(c.bias_instability_dph)});
+  t += row({"bias instability B, deg/h", num(b.bias_instability_dph), num(c.bias_instability_dph)});
   t += row({"at \u03c4, s", num(b.bias_instability_tau_s), num(c.bias_instability_tau_s)});
   t += row({"rate random walk K, deg/h/\u221ah", num(b.rate_random_walk_dph_rth),
             num(c.rate_random_walk_dph_rth)});
@@ -120,10 +119,9 @@ std::string noise_table(const AllanCurves& a) {
 
 std::string serial_summary_row(const RunReport& r, std::size_t i, const std::string& page) {
   const auto& s = r.serials[i];
-  const std::string name =
-      page.empty() ? html_escape(s.slot.serial)
-                   : fmt::format("<a href=\"{}\">{}</a>", html_escape(page),
-                                 html_escape(s.slot.serial));
+  const std::string name = page.empty() ? html_escape(s.slot.serial)
+                                        : fmt::format("<a href=\"{}\">{}</a>", html_escape(page),
+                                                      html_escape(s.slot.serial));
   if (!s.fit) return row({name, std::to_string(s.slot.slot), "no fit stored for this run"});
   const auto& f = s.fit->fit;
   std::string coef;
@@ -145,7 +143,8 @@ std::string verdict_text(const FitExtras& e) {
   const auto failed = e.verdict->value("failed", json::array());
   for (const auto& f : failed) {
     out += fmt::format("{} {}: {} (bound {})", out == "FAIL" ? ":" : ";",
-                       f.value("limit", std::string("?")), f.contains("value") ? f["value"].dump() : "?",
+                       f.value("limit", std::string("?")),
+                       f.contains("value") ? f["value"].dump() : "?",
                        f.contains("bound") ? f["bound"].dump() : "?");
   }
   return out;
@@ -179,9 +178,10 @@ std::string events_html(const RunReport& r) {
 }
 
 std::string index_html(const RunReport& r, const Assets& a, const std::vector<std::string>& pages) {
-  const std::string title = fmt::format("Run {} ({}): calibration report", r.run.id,
-                                        r.run.protocol_name);
-  std::string body = "<h1>" + html_escape(title) + "</h1>\n<section class=\"serials\">\n"
+  const std::string title =
+      fmt::format("Run {} ({}): calibration report", r.run.id, r.run.protocol_name);
+  std::string body = "<h1>" + html_escape(title) +
+                     "</h1>\n<section class=\"serials\">\n"
                      "<h2>Serials</h2>\n<table>\n<tr><th>serial</th><th>slot</th><th>verdict</th>"
                      "<th>coefficients &plusmn; 1&sigma;</th><th>std before, deg/h</th>"
                      "<th>std after, deg/h</th><th>ratio</th><th>bins</th></tr>\n";
@@ -194,16 +194,16 @@ std::string index_html(const RunReport& r, const Assets& a, const std::vector<st
 std::string serial_html(const RunReport& r, const SerialReport& s, const Assets& a) {
   const std::string title =
       fmt::format("Serial {}, run {}: calibration report", s.slot.serial, r.run.id);
-  std::string body = "<h1>" + html_escape(title) + "</h1>\n<p>Verdict: " +
-                     verdict_html(s.extras) + "</p>\n";
+  std::string body =
+      "<h1>" + html_escape(title) + "</h1>\n<p>Verdict: " + verdict_html(s.extras) + "</p>\n";
   json figures = json::array();
   if (s.fit) {
-    body += "<h2>Coefficients</h2>\n<p>Model B = B0 + k1&middot;&Delta;T + k0&middot;&nabla;T "
-            "(Zhou et al. 2013, eq. (4)), &Delta;T = T &minus; " +
-            num(s.fit->fit.spec.ref_temp_c) + " &deg;C.</p>\n" +
-            coefficient_table(*s.fit, s.extras) + evaluation_table(*s.fit) +
-            "<h2>Noise terms of the 1 Hz record</h2>\n" + noise_table(s.allan) +
-            "<h2>Figures</h2>\n<div class=\"figures\">\n";
+    body +=
+        "<h2>Coefficients</h2>\n<p>Model B = B0 + k1&middot;&Delta;T + k0&middot;&nabla;T "
+        "(Zhou et al. 2013, eq. (4)), &Delta;T = T &minus; " +
+        num(s.fit->fit.spec.ref_temp_c) + " &deg;C.</p>\n" + coefficient_table(*s.fit, s.extras) +
+        evaluation_table(*s.fit) + "<h2>Noise terms of the 1 Hz record</h2>\n" +
+        noise_table(s.allan) + "<h2>Figures</h2>\n<div class=\"figures\">\n";
     for (const auto& f : s.figures) {
       body += figure_box(f);
       figures.push_back(figure_json(f));

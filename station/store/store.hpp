@@ -53,7 +53,7 @@ struct RunRecord {
   double t0_wall_s = 0;
   std::string resolved_json;
   RunProgress progress;
-  std::optional<double> last_tick_s;  ///< the last committed tick; empty before the first
+  std::optional<double> last_tick_s;   ///< the last committed tick; empty before the first
   std::string started_utc, ended_utc;  ///< ISO-8601 UTC; ended_utc empty while running
   std::string software_version, operator_name;
 };

@@ -82,8 +82,10 @@ TEST(ReportData, WholeRunBinsCoverTheRunNotOnlyTheRecordWindowAndRemoveEarthRate
 }
 
 TEST(ReportData, Figure2bSplitsHeatingCoolingAndSteadyBinsBySlope) {
-  std::vector<rp::RunBin> bins{{0, 0.1, 20, 21, 5.0},  {600, 0.2, 25, 26, 10.0},
-                               {1200, 0.3, 30, 29, -8.0}, {1800, 0.4, 30, 30, 0.5}};
+  std::vector<rp::RunBin> bins{{0, 0.1, 20, 21, 5.0},
+                               {600, 0.2, 25, 26, 10.0},
+                               {1200, 0.3, 30, 29, -8.0},
+                               {1800, 0.4, 30, 30, 0.5}};
   const auto f = rp::figure_2b(bins);
   ASSERT_EQ(f.series.size(), 3u);
   EXPECT_EQ(f.series[0].y.size(), 2u);  // heating
@@ -98,13 +100,13 @@ TEST(ReportData, Figure3WithoutRampRunsHasNoPointsAndSaysWhy) {
   const auto none = rp::figure_3({});
   EXPECT_EQ(none.points(), 0u);
   EXPECT_NE(none.note.find("ramp_10"), std::string::npos);
-  const auto two =
-      rp::figure_3({{"ramp_00", 3, bins_data(20)}, {"ramp_10", 4, bins_data(66)}});
+  const auto two = rp::figure_3({{"ramp_00", 3, bins_data(20)}, {"ramp_10", 4, bins_data(66)}});
   EXPECT_EQ(two.points(), 86u);
   ASSERT_EQ(two.series.size(), 2u);
   EXPECT_EQ(two.series[1].label, "ramp_10 (run 4)");
   EXPECT_NE(two.note.find("ramp_20"), std::string::npos);  // the missing one is named
-  EXPECT_EQ(rp::figure_3({{"ramp_00", 1, bins_data(5)}, {"ramp_10", 2, bins_data(5)},
+  EXPECT_EQ(rp::figure_3({{"ramp_00", 1, bins_data(5)},
+                          {"ramp_10", 2, bins_data(5)},
                           {"ramp_20", 3, bins_data(5)}})
                 .note,
             "");
@@ -151,8 +153,7 @@ TEST(ReportData, Figure5aBeforeAfterTemperatureOnlyAndAfterTheWholeModel) {
 TEST(ReportData, ModelPartKeepsOnlyTheNamedCoefficients) {
   const auto d = bins_data(10);
   const auto k1 = rp::model_part(known_fit(), d.view(), {"k1"});
-  for (std::size_t i = 0; i < k1.size(); ++i)
-    EXPECT_NEAR(k1[i], kK1 * (d.temp_c[i] - kRef), 1e-16);
+  for (std::size_t i = 0; i < k1.size(); ++i) EXPECT_NEAR(k1[i], kK1 * (d.temp_c[i] - kRef), 1e-16);
   auto cubic = known_fit();
   cubic.names = {"B0", "k1", "k2", "k0"};
   EXPECT_EQ(rp::temperature_terms(cubic), (std::vector<std::string>{"k1", "k2"}));
