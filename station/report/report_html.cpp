@@ -48,10 +48,12 @@ json figure_options(const Figure& f, bool bars) {
          {"legend", "always"},
          {"customBars", bars},
          {"sigFigs", 4}};
+  // Room for tick labels such as "-0.0004" beside the axis title.
+  o["axes"] = {{"y", {{"axisLabelWidth", 64}}}, {"y2", {{"axisLabelWidth", 56}}}};
   if (!f.y2_label.empty()) o["y2label"] = f.y2_label;
   if (f.log_axes) {
     o["logscale"] = true;
-    o["axes"] = {{"x", {{"logscale", true}}}};
+    o["axes"]["x"] = {{"logscale", true}};
   }
   return o;
 }
