@@ -154,7 +154,10 @@ def main():
         check_clean(drv, pages[0])
         shot = os.path.join(a.artifacts, name + ".png")
         drv.save_screenshot(shot)
-        print(f"screenshot {shot}")
+        # The figures alone (docs/report.png is one of these).
+        figures = os.path.join(a.artifacts, name + "-figures.png")
+        drv.find_element(By.CSS_SELECTOR, ".figures").screenshot(figures)
+        print(f"screenshots {shot} {figures}")
     finally:
         drv.quit()
     print("PASS")
