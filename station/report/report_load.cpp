@@ -47,7 +47,7 @@ SerialReport load_serial(Store& store, const RunReport& rr, const RunSlot& slot)
   s.slot = slot;
   s.fit = store.latest_fit_of_run(slot.serial, rr.run.id);
   if (!s.fit) return s;
-  s.extras = fit_extras(*s.fit);
+  s.extras = fit_extras(store, *s.fit);
   const auto samples = store.samples(rr.run.id, slot.serial, false);
   const auto bins = whole_run_bins(samples, rr.bin_s, slot.earth_rate_dph);
   const auto data = store.model_data(slot.serial, s.fit->runs);
@@ -63,9 +63,12 @@ SerialReport load_serial(Store& store, const RunReport& rr, const RunSlot& slot)
 
 }  // namespace
 
-FitExtras fit_extras(const FitRecord& /*rec*/) {
-  // Coming from main / the parts work: rec.fit.std_errors_ols (plain OLS, std_errors becoming
-  // the honest error) and the stored verdict (fits.verdict_json). Fill them in here only.
+FitExtras fit_extras(Store& /*store*/, const FitRecord& /*rec*/) {
+  // Coming from main and the parts work; fill them in here only:
+  //   OLS:     rec.fit.std_errors_ols (std_errors becomes the honest, autocorrelation-aware
+  //            error), e.g. `if (!rec.fit.std_errors_ols.empty()) e.std_errors_ols = ...;`
+  //   verdict: fits.verdict_json of rec.id (the parts branch reads it with
+  //            load_fit_verdict(store, rec.id).verdict_json), parsed into e.verdict.
   return {};
 }
 

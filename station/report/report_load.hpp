@@ -20,9 +20,10 @@ struct FitExtras {
   std::optional<nlohmann::json> verdict;  ///< {"pass": bool, "failed": [{limit, value, bound}]}
 };
 
-/// The one place that reads a fit's OLS errors and verdict for the report. Until
-/// FitResult::std_errors_ols and fits.verdict_json exist, both are empty (shown as "-").
-FitExtras fit_extras(const FitRecord& rec);
+/// The one place that reads a fit's OLS errors and verdict for the report (`store` for the
+/// verdict columns, which are not part of FitRecord). Until FitResult::std_errors_ols and
+/// fits.verdict_json exist, both are empty (shown as "-" and "no verdict").
+FitExtras fit_extras(Store& store, const FitRecord& rec);
 
 /// One serial of the run.
 struct SerialReport {

@@ -21,6 +21,7 @@ th, td { border: 1px solid #bbb; padding: 0.2em 0.6em; text-align: left; }
 td.num { text-align: right; font-family: monospace; }
 .pass { color: #17702a; font-weight: bold; } .fail { color: #b01818; font-weight: bold; }
 .figures { display: grid; grid-template-columns: 1fr 1fr; gap: 1em 2em; }
+.figure { break-inside: avoid; }
 .figure h3 { font-size: 1em; margin: 0.3em 0; }
 .figure .chart { width: 100%; height: 280px; }
 .figure .legend { font-size: 0.8em; min-height: 1.2em; }

@@ -119,6 +119,21 @@ def check_figures(drv, path, ramps):
                 fail(f"{path}: fig 3 has no {r} series: {series}")
 
 
+def check_pdf(bin_path, db, run_id, out_dir, gyros):
+    """--pdf: every page printed by headless Chromium to a PDF file."""
+    shutil.rmtree(out_dir, ignore_errors=True)
+    files = station(bin_path, "report", "--db", db, "--run", str(run_id), "--out", out_dir,
+                    "--pdf").split()
+    pdfs = [f for f in files if f.endswith(".pdf")]
+    if len(pdfs) != 1 + gyros:
+        fail(f"--pdf: expected {1 + gyros} PDFs, got {pdfs}")
+    for pdf in pdfs:
+        with open(pdf, "rb") as f:
+            if f.read(5) != b"%PDF-":
+                fail(f"{pdf}: not a PDF")
+    print(f"--pdf: {len(pdfs)} PDFs")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--station", required=True)
@@ -158,6 +173,8 @@ def main():
         figures = os.path.join(a.artifacts, name + "-figures.png")
         drv.find_element(By.CSS_SELECTOR, ".figures").screenshot(figures)
         print(f"screenshots {shot} {figures}")
+        if not a.ramps:
+            check_pdf(a.station, db, run_id, out_dir + "-pdf", a.gyros)
     finally:
         drv.quit()
     print("PASS")
