@@ -113,14 +113,15 @@ std::string script_json(const json& j) {
 json figure_json(const Figure& f) {
   bool bars = false;
   for (const auto& s : f.series) bars = bars || !s.y_low.empty();
-  // Rows keyed by x: dygraphs wants one row per x, a column per series, null where a series has
-  // no point there.
-  std::map<double, json> rows;
+  // Rows sorted by x, a column per series, null where a series has no point: the n-th point of
+  // each series at an x shares row (x, n), so a series' repeated x is a row more, never lost.
+  std::map<std::pair<double, int>, json> rows;
   for (std::size_t k = 0; k < f.series.size(); ++k) {
     const auto& s = f.series[k];
+    std::map<double, int> seen;
     for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
       if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i])) continue;
-      auto [it, fresh] = rows.try_emplace(s.x[i], json::array());
+      auto [it, fresh] = rows.try_emplace({s.x[i], seen[s.x[i]]++}, json::array());
       if (fresh) {
         it->second.push_back(s.x[i]);
         for (std::size_t n = 0; n < f.series.size(); ++n) it->second.push_back(nullptr);

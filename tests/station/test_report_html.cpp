@@ -43,11 +43,12 @@ TEST(ReportHtml, EscapesEveryMarkupCharacter) {
 
 TEST(ReportHtml, FigureRowsAreSortedByXWithNullWhereASeriesHasNoPoint) {
   auto f = rp::make_figure("2b", "t", "x", "y");
-  f.series = {series("a", {3, 1}, {30, 10}), series("b", {2, 3}, {20, std::nan("")})};
+  f.series = {series("a", {3, 1, 3}, {30, 10, 31}), series("b", {2, 3}, {20, std::nan("")})};
   const json j = rp::figure_json(f);
   EXPECT_EQ(j["id"], "2b");
-  EXPECT_EQ(j["points"], 3);
-  EXPECT_EQ(j["rows"], json::parse("[[1,10,null],[2,null,20],[3,30,null]]"));
+  EXPECT_EQ(j["points"], 4);
+  // The repeated x = 3 of series a is a second row: every counted point is drawn.
+  EXPECT_EQ(j["rows"], json::parse("[[1,10,null],[2,null,20],[3,30,null],[3,31,null]]"));
   EXPECT_EQ(j["options"]["labels"], json::parse(R"(["x","a","b"])"));
   EXPECT_EQ(j["options"]["series"]["a"]["strokeWidth"], 0.0);  // points only
   EXPECT_FALSE(j["options"]["customBars"].get<bool>());
