@@ -102,6 +102,14 @@ std::string source_problem(Term t, double v) {
 // Refuses data the model cannot use: every value finite and within its physical bound, so no
 // entry of the design matrix, and no sum of their squares, can overflow.
 void check_model_input(const ModelInput& in, const ModelSpec& spec) {
+  const std::size_t n = in.bias_dph.size();
+  if ((!in.t_s.empty() && in.t_s.size() != n) || (!in.segment.empty() && in.segment.size() != n))
+    throw DataError("fit: bin times or runs are not given for every bin");
+  for (std::size_t i = 0; i < in.t_s.size(); ++i) {
+    if (!std::isfinite(in.t_s[i]) || (i > 0 && in.t_s[i] <= in.t_s[i - 1] &&
+                                      (in.segment.empty() || in.segment[i] == in.segment[i - 1])))
+      throw DataError("fit: bin " + std::to_string(i) + ": time not finite or not increasing");
+  }
   if (auto p = temp_problem(spec.ref_temp_c); !p.empty())
     throw DataError("fit: reference temperature: " + p);
   for (std::size_t i = 0; i < in.bias_dph.size(); ++i) {
@@ -123,7 +131,7 @@ void check_model_input(const ModelInput& in, const ModelSpec& spec) {
 void check_result(const FitResult& r) {
   for (std::size_t j = 0; j < r.coefficients.size(); ++j) {
     if (!std::isfinite(r.coefficients[j]) || !std::isfinite(r.std_errors[j]) ||
-        !std::isfinite(r.std_errors_hac[j])) {
+        !std::isfinite(r.std_errors_ols[j]) || !std::isfinite(r.std_errors_hac[j])) {
       throw DataError("fit: coefficient " + r.names[j] + " or its standard error is not finite");
     }
   }
@@ -265,7 +273,14 @@ FitResult fit_model(const ModelInput& in, const ModelSpec& spec) {
   const double s2 = rss / static_cast<double>(res.dof);
   const Eigen::MatrixXd r_inv =
       r.triangularView<Eigen::Upper>().solve(Eigen::MatrixXd::Identity(pi, pi));
-  const Eigen::VectorXd var_scaled = (r_inv * r_inv.transpose()).diagonal() * s2;
+  const Eigen::MatrixXd xtx_inv = r_inv * r_inv.transpose();
+  const Eigen::VectorXd var_scaled = xtx_inv.diagonal() * s2;
+  res.error_model = estimate_error_model(x, y, in.t_s, in.segment);
+  // No correlated part: the model's covariance is s^2 I and the errors are the OLS ones exactly.
+  const Eigen::VectorXd var_model =
+      res.error_model.correlated_share > 0
+          ? ols_variances_under(res.error_model, x, xtx_inv, in.t_s, in.segment)
+          : var_scaled;
   // Lag rule of Newey & West (1994): L = floor(4 (n/100)^(2/9)).
   res.hac_lag = static_cast<std::size_t>(
       std::floor(4.0 * std::pow(static_cast<double>(n) / 100.0, 2.0 / 9.0)));
@@ -274,7 +289,8 @@ FitResult fit_model(const ModelInput& in, const ModelSpec& spec) {
   for (Term t : spec.terms) res.names.emplace_back(info(t).coefficient);
   for (Eigen::Index j = 0; j < pi; ++j) {
     res.coefficients.push_back(beta_scaled(j) / scale(j));
-    res.std_errors.push_back(std::sqrt(var_scaled(j)) / scale(j));
+    res.std_errors.push_back(std::sqrt(std::max(var_model(j), 0.0)) / scale(j));
+    res.std_errors_ols.push_back(std::sqrt(var_scaled(j)) / scale(j));
     res.std_errors_hac.push_back(std::sqrt(std::max(var_hac(j), 0.0)) / scale(j));
   }
   const double mean_y = y.mean();

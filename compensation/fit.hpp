@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "compensation/binning.hpp"
+#include "compensation/correlated_errors.hpp"
 
 namespace station::compensation {
 
@@ -40,12 +41,20 @@ struct ModelInput {
   std::span<const double> grad_c;        ///< bin mean gradient, deg C
   std::span<const double> dtdt_c_per_h;  ///< bin temperature slope, deg C/h
   std::span<const double> channel;       ///< bin mean of an extra channel
+  /// Bin times, s, increasing within a run (empty: equally spaced). They set how strongly the
+  /// errors of two bins are correlated (correlated_errors.hpp).
+  std::span<const double> t_s;
+  /// The run each bin came from (empty: one run); bins of different runs are independent.
+  std::span<const int> segment;
 };
 
 /// Owning per-bin series built from bins; view() gives the ModelInput.
 struct ModelData {
   std::vector<double> bias_dph, temp_c, grad_c, dtdt_c_per_h, channel, t_mid_s;
-  ModelInput view() const { return {bias_dph, temp_c, grad_c, dtdt_c_per_h, channel}; }
+  std::vector<int> segment;  ///< run index per bin (empty: one run)
+  ModelInput view() const {
+    return {bias_dph, temp_c, grad_c, dtdt_c_per_h, channel, t_mid_s, segment};
+  }
 };
 
 /// Complete bins only, bias = bin mean rate - earth_rate_dph.
@@ -56,7 +65,14 @@ struct FitResult {
   ModelSpec spec;
   std::vector<std::string> names;
   std::vector<double> coefficients;  ///< deg/h, deg/h/C^i, deg/h/C, deg/h/(C/h), ...
-  std::vector<double> std_errors;    ///< one standard error per coefficient (OLS, iid)
+  /// One standard error per coefficient, honest for correlated bins: the OLS coefficients'
+  /// spread under the error model fitted to the bins (white + Gauss-Markov, REML;
+  /// correlated_errors.hpp). This is the uncertainty the station reports.
+  std::vector<double> std_errors;
+  /// The textbook OLS standard errors s^2 (X'X)^-1, which assume independent bins; kept for
+  /// comparison (they are optimistic when the bins share bias-instability noise).
+  std::vector<double> std_errors_ols;
+  ErrorModel error_model;  ///< the error model behind std_errors
   /// Newey-West (HAC) standard errors: honest when the residuals of neighbouring bins are
   /// correlated (bias instability over hours). Bartlett weights up to hac_lag bins.
   std::vector<double> std_errors_hac;

@@ -5,10 +5,10 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "station/store/calibration.hpp"
 #include "station/cli/commands.hpp"
-#include "station/store/fit_json.hpp"
 #include "station/common/input_error.hpp"
+#include "station/store/calibration.hpp"
+#include "station/store/fit_json.hpp"
 
 namespace station {
 namespace {
@@ -40,9 +40,11 @@ void print_fit(const SerialFit& f) {
   fmt::print("{}: fit {} over runs {} ({} bins)\n", f.serial, f.fit_id, fmt::join(f.runs, ","),
              f.fit.n_points);
   for (std::size_t i = 0; i < f.fit.names.size(); ++i) {
-    fmt::print("  {:<3} {:>13.5e} +- {:.2e} {}\n", f.fit.names[i], f.fit.coefficients[i],
-               f.fit.std_errors[i], unit_of(f.fit.names[i]));
+    fmt::print("  {:<3} {:>13.5e} +- {:.2e} {:<9} (OLS +- {:.2e})\n", f.fit.names[i],
+               f.fit.coefficients[i], f.fit.std_errors[i], unit_of(f.fit.names[i]),
+               f.fit.std_errors_ols[i]);
   }
+  fmt::print("  {}\n", error_model_text(f.fit.error_model));
   fmt::print("  {}\n", evaluation_text(f.eval));
   for (const auto& w : f.fit.warnings) fmt::print("  warning: {}\n", w);
 }
@@ -76,10 +78,11 @@ void run_export(const FitOptions& o) {
         fmt::format("{}: no fit stored for serial '{}' (run `station fit` first)", o.db, o.serial));
   const auto& f = rec->fit;
   if (o.format == "csv") {
-    fmt::print("serial,fit_id,term,value,std_error,unit,ref_temp_c\n");
+    fmt::print("serial,fit_id,term,value,std_error,std_error_ols,unit,ref_temp_c\n");
     for (std::size_t i = 0; i < f.names.size(); ++i) {
-      fmt::print("{},{},{},{:.9e},{:.3e},{},{}\n", o.serial, rec->id, f.names[i], f.coefficients[i],
-                 f.std_errors[i], unit_of(f.names[i]), f.spec.ref_temp_c);
+      const double ols = i < f.std_errors_ols.size() ? f.std_errors_ols[i] : NAN;
+      fmt::print("{},{},{},{:.9e},{:.3e},{:.3e},{},{}\n", o.serial, rec->id, f.names[i],
+                 f.coefficients[i], f.std_errors[i], ols, unit_of(f.names[i]), f.spec.ref_temp_c);
     }
     return;
   }
@@ -97,6 +100,9 @@ void run_export(const FitOptions& o) {
       {"ref_temp_c", f.spec.ref_temp_c},
       {"model", "B = B0 + k1*dT + k2*dT^2 + ... + k0*gradT (dT = T - ref_temp_c, gradT = T2 - T1)"},
       {"coefficients", coef},
+      {"std_errors", std_errors_json(f)},
+      {"std_errors_ols", std_errors_ols_json(f)},
+      {"error_model", error_model_json(f.error_model)},
       {"units", units},
       {"std_ratio", std_ratio_json(rec->eval)}};
   std::cout << j.dump(2) << '\n';

@@ -49,7 +49,12 @@ OneHzRecord one_hz_record(const std::vector<SampleRow>& rows, double earth_rate_
   std::vector<double> dtdt, channel;
   if (has_coefficient(fit, "kr")) dtdt = per_sample_dtdt(t, temp, bin_s);
   if (has_coefficient(fit, "kc")) channel.assign(t.size(), 0.0);  // stored bins carry 0
-  const sc::ModelInput in{r.bias_dph, temp, grad, dtdt, channel};
+  sc::ModelInput in;
+  in.bias_dph = r.bias_dph;
+  in.temp_c = temp;
+  in.grad_c = grad;
+  in.dtdt_c_per_h = dtdt;
+  in.channel = channel;
   r.compensated_dph = sc::compensate(fit, in);  // bias - B(x), paper eq. (4)
   return r;
 }

@@ -63,13 +63,15 @@ SerialReport load_serial(Store& store, const RunReport& rr, const RunSlot& slot)
 
 }  // namespace
 
-FitExtras fit_extras(Store& /*store*/, const FitRecord& /*rec*/) {
-  // Coming from main and the parts work; fill them in here only:
-  //   OLS:     rec.fit.std_errors_ols (std_errors becomes the honest, autocorrelation-aware
-  //            error), e.g. `if (!rec.fit.std_errors_ols.empty()) e.std_errors_ols = ...;`
-  //   verdict: fits.verdict_json of rec.id (the parts branch reads it with
-  //            load_fit_verdict(store, rec.id).verdict_json), parsed into e.verdict.
-  return {};
+FitExtras fit_extras(Store& /*store*/, const FitRecord& rec) {
+  FitExtras e;
+  // std_errors is the honest (error-model) uncertainty; the plain OLS figures sit beside it.
+  if (rec.fit.std_errors_ols.size() == rec.fit.coefficients.size())
+    e.std_errors_ols = rec.fit.std_errors_ols;
+  // Coming from the parts work; fill it in here only: the verdict of fit rec.id
+  // (fits.verdict_json; the parts branch reads it with load_fit_verdict(store, rec.id)),
+  // parsed into e.verdict.
+  return e;
 }
 
 RunReport load_report(Store& store, std::int64_t run_id) {

@@ -96,6 +96,7 @@ std::string evaluation_table(const FitRecord& rec) {
   t += row({"std ratio", html_escape(std_ratio_text(rec.eval))});
   t += row({"bins", std::to_string(rec.fit.n_points)});
   t += row({"R\u00b2", num(rec.fit.r2)});
+  t += row({"uncertainty model", html_escape(error_model_text(rec.fit.error_model))});
   t += row({"fit", fmt::format("{} ({}, runs {})", rec.id, html_escape(rec.created_utc),
                                fmt::join(rec.runs, ","))});
   for (const auto& w : rec.fit.warnings) t += row({"warning", html_escape(w)});

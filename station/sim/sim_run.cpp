@@ -58,6 +58,7 @@ nlohmann::json gyro_report(Store& store, std::int64_t run_id, const sim::SimGyro
   }
   j["fitted"] = coefficients_json(fit->fit);
   j["std_errors"] = std_errors_json(fit->fit);
+  j["std_errors_ols"] = std_errors_ols_json(fit->fit);
   j["bins"] = fit->fit.n_points;
   j["std_before_dph"] = fit->eval.std_before_dph;
   j["std_after_dph"] = fit->eval.std_after_dph;
@@ -192,6 +193,9 @@ void print_sim_report(const nlohmann::json& r) {
                ratio.is_number() ? fmt::format("{:.3f}", ratio.get<double>()) : "undef");
     fmt::print("{:<10} {:>4} {:>11.1e} {:>11.1e} {:>9.1e}\n", "", "+-", se["B0"].get<double>(),
                se["k1"].get<double>(), se["k0"].get<double>());
+    const auto& ols = g["std_errors_ols"];
+    fmt::print("{:<10} {:>4} {:>11.1e} {:>11.1e} {:>9.1e}\n", "", "OLS", ols["B0"].get<double>(),
+               ols["k1"].get<double>(), ols["k0"].get<double>());
   }
 }
 

@@ -25,6 +25,40 @@ nlohmann::json std_errors_json(const compensation::FitResult& fit) {
   return keyed(fit, fit.std_errors);
 }
 
+nlohmann::json std_errors_ols_json(const compensation::FitResult& fit) {
+  return keyed(fit, fit.std_errors_ols);
+}
+
+nlohmann::json error_model_json(const compensation::ErrorModel& m) {
+  return {{"method", m.method},
+          {"corr_time_s", m.corr_time_s},
+          {"correlated_share", m.correlated_share},
+          {"sigma_dph", m.sigma_dph},
+          {"rho_per_bin", m.rho_per_bin}};
+}
+
+std::string error_model_text(const compensation::ErrorModel& m) {
+  if (m.correlated_share <= 0) {
+    return fmt::format("errors: {} (s = {:.2e} deg/h per bin)",
+                       m.method == "iid" ? "independent bins, no correlated noise found" : m.method,
+                       m.sigma_dph);
+  }
+  return fmt::format(
+      "errors: white + Gauss-Markov noise (REML): s = {:.2e} deg/h per bin, {:.0f} % correlated "
+      "with tau {:.0f} s (neighbouring bins {:.2f})",
+      m.sigma_dph, 100.0 * m.correlated_share, m.corr_time_s, m.rho_per_bin);
+}
+
+compensation::ErrorModel error_model_from_json(const nlohmann::json& j) {
+  compensation::ErrorModel m;
+  m.method = j.value("method", m.method);
+  m.corr_time_s = j.value("corr_time_s", 0.0);
+  m.correlated_share = j.value("correlated_share", 0.0);
+  m.sigma_dph = j.value("sigma_dph", 0.0);
+  m.rho_per_bin = j.value("rho_per_bin", 0.0);
+  return m;
+}
+
 nlohmann::json std_errors_hac_json(const compensation::FitResult& fit) {
   return keyed(fit, fit.std_errors_hac);
 }
@@ -33,6 +67,8 @@ nlohmann::json fit_summary_json(const compensation::FitResult& fit,
                                 const compensation::Evaluation& eval) {
   return {{"coefficients", coefficients_json(fit)},
           {"std_errors", std_errors_json(fit)},
+          {"std_errors_ols", std_errors_ols_json(fit)},
+          {"error_model", error_model_json(fit.error_model)},
           {"std_errors_hac", std_errors_hac_json(fit)},
           {"hac_lag", fit.hac_lag},
           {"bins", fit.n_points},

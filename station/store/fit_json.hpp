@@ -15,6 +15,16 @@ nlohmann::json coefficients_json(const compensation::FitResult& fit);
 /// {"B0": std error, "k1": std error, ...}
 nlohmann::json std_errors_json(const compensation::FitResult& fit);
 /// {"B0": Newey-West std error, ...}
+/// {name: OLS standard error} (iid bins; kept for comparison).
+nlohmann::json std_errors_ols_json(const compensation::FitResult& fit);
+/// The error model behind std_errors: {"method","corr_time_s","correlated_share","sigma_dph",
+/// "rho_per_bin"}.
+nlohmann::json error_model_json(const compensation::ErrorModel& model);
+/// One line for people: "errors: white + Gauss-Markov noise, tau 3400 s, 21 % of the variance,
+/// neighbouring bins correlated 0.84 (REML)" or "errors: independent bins (OLS)".
+std::string error_model_text(const compensation::ErrorModel& model);
+/// Reads error_model_json back; missing keys stay at their defaults.
+compensation::ErrorModel error_model_from_json(const nlohmann::json& j);
 nlohmann::json std_errors_hac_json(const compensation::FitResult& fit);
 /// The fit and its evaluation as every command reports them: coefficients, std_errors,
 /// std_errors_hac, hac_lag, bins, r2, residual_rms_dph, condition_number, std_before_dph,

@@ -250,9 +250,10 @@ sc::ModelData Store::model_data(const std::string& serial, const std::vector<std
   auto st = db_.prepare(
       "SELECT bias_dph, temp_c, grad_c, dtdt_c_per_h, t_start_s FROM bins WHERE run_id = ? "
       "AND serial = ? AND complete = 1 ORDER BY t_start_s");
-  for (const auto run : runs) {
-    st.bind(1, run).bind(2, serial);
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    st.bind(1, runs[k]).bind(2, serial);
     while (st.step()) {
+      d.segment.push_back(static_cast<int>(k));
       d.bias_dph.push_back(st.column_double(0));
       d.temp_c.push_back(st.column_double(1));
       d.grad_c.push_back(st.column_double(2));
@@ -282,7 +283,8 @@ std::int64_t Store::save_fit(const std::string& serial, const std::vector<std::i
   auto st = db_.prepare(
       "INSERT INTO fits (serial, created_utc, runs_json, terms, ref_temp_c, coefficients_json, "
       "std_errors_json, n_bins, r2, residual_rms_dph, condition_number, std_before_dph, "
-      "std_after_dph, std_ratio, warnings_json) VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)");
+      "std_after_dph, std_ratio, warnings_json, std_errors_ols_json, error_model_json) "
+      "VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)");
   st.bind(1, serial).bind(2, utc_now_iso()).bind(3, json(runs).dump()).bind(4, terms);
   st.bind(5, fit.spec.ref_temp_c).bind(6, coef.dump()).bind(7, se.dump());
   st.bind(8, static_cast<std::int64_t>(fit.n_points))
@@ -290,6 +292,7 @@ std::int64_t Store::save_fit(const std::string& serial, const std::vector<std::i
       .bind(10, fit.residual_rms_dph);
   st.bind(11, fit.condition_number).bind(12, eval.std_before_dph).bind(13, eval.std_after_dph);
   st.bind(14, eval.std_ratio).bind(15, json(fit.warnings).dump());
+  st.bind(16, std_errors_ols_json(fit).dump()).bind(17, error_model_json(fit.error_model).dump());
   st.step();
   return db_.last_insert_id();
 }
@@ -298,12 +301,12 @@ namespace {
 constexpr const char* kFitColumns =
     "SELECT id, created_utc, runs_json, terms, ref_temp_c, coefficients_json, std_errors_json, "
     "n_bins, r2, residual_rms_dph, condition_number, std_before_dph, std_after_dph, std_ratio, "
-    "warnings_json, serial FROM fits ";
+    "warnings_json, std_errors_ols_json, error_model_json, serial FROM fits ";
 
 FitRecord read_fit(const Statement& st) {
   FitRecord r;
   r.id = st.column_int(0);
-  r.serial = st.column_text(15);
+  r.serial = st.column_text(17);
   r.created_utc = st.column_text(1);
   r.runs = json::parse(st.column_text(2)).get<std::vector<std::int64_t>>();
   r.terms = st.column_text(3);
@@ -326,6 +329,11 @@ FitRecord read_fit(const Statement& st) {
     r.eval.improvement_pct = 100.0 * (1.0 - *r.eval.std_ratio);
   }
   r.fit.warnings = json::parse(st.column_text(14)).get<std::vector<std::string>>();
+  const json se_ols = json::parse(st.column_text(15));
+  for (const auto& n : r.fit.names) {
+    if (se_ols.is_object()) r.fit.std_errors_ols.push_back(se_ols.at(n).get<double>());
+  }
+  r.fit.error_model = error_model_from_json(json::parse(st.column_text(16)));
   return r;
 }
 }  // namespace

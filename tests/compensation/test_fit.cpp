@@ -51,7 +51,7 @@ TEST(Fit, RecoversCoefficientsExactlyFromNoiseFreeData) {
   EXPECT_EQ(fit.dof, 62u);
 }
 
-TEST(Fit, EstimatesScatterAsTheirReportedStandardErrors) {
+TEST(Fit, OlsErrorsEstimateTheScatterOfIndependentBins) {
   // Over many seeded experiments, (estimate - truth) / SE follows Student's t with 63 dof:
   // about 68.3 % within 1 SE (binomial sd over 300 trials: 2.7 %, so +-3 sd = +-8 %), and the
   // mean SE equals the empirical scatter of the estimates within the Monte-Carlo error (~4 %).
@@ -63,9 +63,9 @@ TEST(Fit, EstimatesScatterAsTheirReportedStandardErrors) {
   for (int s = 0; s < trials; ++s) {
     const auto d = scenario(0.02, k1, 0.0, k0, 0.003, 1000 + s);
     const auto fit = sc::fit_model(d.view(), spec);
-    within_k1 += std::abs(fit.coefficients[1] - k1) < fit.std_errors[1];
-    within_k0 += std::abs(fit.coefficients[2] - k0) < fit.std_errors[2];
-    se_k1_sum += fit.std_errors[1];
+    within_k1 += std::abs(fit.coefficients[1] - k1) < fit.std_errors_ols[1];
+    within_k0 += std::abs(fit.coefficients[2] - k0) < fit.std_errors_ols[2];
+    se_k1_sum += fit.std_errors_ols[1];
     err2_k1 += std::pow(fit.coefficients[1] - k1, 2);
   }
   EXPECT_NEAR(within_k1 / double(trials), 0.683, 0.08);
@@ -151,11 +151,15 @@ TEST(Fit, BinsBecomeModelDataWithEarthRateRemoved) {
 
 namespace {
 
+struct Coverages {
+  double ols, hac, honest;
+};
+
 // Coverage of |estimate - truth| < SE over seeded experiments with AR(1) bin noise of
 // correlation rho (the bias instability makes neighbouring 600 s bins alike).
-std::pair<double, double> coverage_ols_hac(double rho, int trials) {
+Coverages coverage_ols_hac(double rho, int trials) {
   const double k1 = 1.0e-3;
-  int ols = 0, hac = 0;
+  int ols = 0, hac = 0, honest = 0;
   sc::ModelSpec spec;
   spec.terms = {sc::Term::dT};
   for (int s = 0; s < trials; ++s) {
@@ -168,10 +172,11 @@ std::pair<double, double> coverage_ols_hac(double rho, int trials) {
       b += e;
     }
     const auto f = sc::fit_model(d.view(), spec);
-    ols += std::abs(f.coefficients[1] - k1) < f.std_errors[1];
+    ols += std::abs(f.coefficients[1] - k1) < f.std_errors_ols[1];
     hac += std::abs(f.coefficients[1] - k1) < f.std_errors_hac[1];
+    honest += std::abs(f.coefficients[1] - k1) < f.std_errors[1];
   }
-  return {ols / double(trials), hac / double(trials)};
+  return {ols / double(trials), hac / double(trials), honest / double(trials)};
 }
 
 }  // namespace
@@ -182,15 +187,23 @@ std::pair<double, double> coverage_ols_hac(double rho, int trials) {
 // still short (lag 3 bins against a ~4-bin correlation time), covers far better (~0.39): the
 // paired difference has sd ~ sqrt(0.15/400) = 2 %, so requiring 10 % keeps a 2.5 sd margin and
 // fails if HAC degenerates to OLS. The four coverages are recorded as a test property.
+// The station's reported errors (REML white + Gauss-Markov model, correlated_errors.hpp) cover
+// ~68 % under the AR(1) noise too (0.675 measured; +-8 % is 3.4 binomial sd). Under white noise
+// they are conservative, never optimistic: REML sometimes reads the slow wobble of the
+// gradient's residual as correlated noise (0.73-0.77 measured, against 0.683): the bound is
+// 0.683 - 0.08 below and 0.85 above.
 TEST(Fit, NeweyWestErrorsStayHonestWhenBinsAreCorrelated) {
-  const auto [ols_white, hac_white] = coverage_ols_hac(0.0, 400);
-  EXPECT_NEAR(ols_white, 0.683, 0.08);
-  EXPECT_NEAR(hac_white, 0.683, 0.12);
-  const auto [ols_ar, hac_ar] = coverage_ols_hac(0.8, 400);
-  RecordProperty("coverage",
-                 testing::PrintToString(std::vector<double>{ols_white, hac_white, ols_ar, hac_ar}));
-  EXPECT_LT(ols_ar, 0.5);
-  EXPECT_GT(hac_ar, ols_ar + 0.10);
+  const auto white = coverage_ols_hac(0.0, 400);
+  EXPECT_NEAR(white.ols, 0.683, 0.08);
+  EXPECT_NEAR(white.hac, 0.683, 0.12);
+  EXPECT_GT(white.honest, 0.683 - 0.08);
+  EXPECT_LT(white.honest, 0.85);
+  const auto ar = coverage_ols_hac(0.8, 400);
+  RecordProperty("coverage", testing::PrintToString(std::vector<double>{
+                                 white.ols, white.hac, white.honest, ar.ols, ar.hac, ar.honest}));
+  EXPECT_LT(ar.ols, 0.5);
+  EXPECT_GT(ar.hac, ar.ols + 0.10);
+  EXPECT_NEAR(ar.honest, 0.683, 0.08);
 }
 
 TEST(Fit, NeweyWestLagFollowsTheRuleOfThumb) {

@@ -138,7 +138,7 @@ TEST(Cli, SimRunThenFitAllAndExport) {
 
   const auto csv = run_station("export --db " + db + " --serial SIM-0002 --format csv", false);
   ASSERT_EQ(csv.status, 0) << csv.out;
-  EXPECT_EQ(csv.out.rfind("serial,fit_id,term,value,std_error,unit,ref_temp_c\n", 0), 0u)
+  EXPECT_EQ(csv.out.rfind("serial,fit_id,term,value,std_error,std_error_ols,unit,ref_temp_c\n", 0), 0u)
       << csv.out;
   EXPECT_NE(csv.out.find("SIM-0002,"), std::string::npos);
   EXPECT_NE(csv.out.find(",k0,"), std::string::npos);  // the latest fit is the dT+gradT one

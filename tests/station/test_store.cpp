@@ -24,13 +24,15 @@ station::RunInfo info() {
 TEST(Store, MigratesToTheLatestVersionInWalMode) {
   const auto path = fresh_db("migrate");
   station::Store s(path);
-  EXPECT_EQ(s.db().schema_version(), 3);
+  const int latest = static_cast<int>(station::schemas::kMigrations.size());
+  EXPECT_GE(latest, 4);  // 4: honest and OLS standard errors of fits
+  EXPECT_EQ(s.db().schema_version(), latest);
   auto st = s.db().prepare("PRAGMA journal_mode");
   ASSERT_TRUE(st.step());
   EXPECT_EQ(st.column_text(0), "wal");
   // Reopening does not re-apply anything.
   station::Store again(path);
-  EXPECT_EQ(again.db().schema_version(), 3);
+  EXPECT_EQ(again.db().schema_version(), latest);
 }
 
 TEST(Store, RefusesADatabaseNewerThanTheSoftware) {
@@ -99,6 +101,8 @@ TEST(Store, FitsRoundTrip) {
   fit.names = {"B0", "k1", "k0"};
   fit.coefficients = {0.05, 1.2e-3, 0.012};
   fit.std_errors = {1e-3, 4e-5, 1e-4};
+  fit.std_errors_ols = {7e-4, 3e-5, 6e-5};
+  fit.error_model = {"ar1+white (REML)", 3400.0, 0.2, 0.008, 0.84};
   fit.n_points = 66;
   fit.r2 = 0.99;
   const sc::Evaluation ev{0.12, 0.007, 0.0583, 94.17};
@@ -109,6 +113,11 @@ TEST(Store, FitsRoundTrip) {
   EXPECT_EQ(got->terms, "dT,gradT");
   EXPECT_DOUBLE_EQ(got->fit.coefficients[1], 1.2e-3);
   EXPECT_DOUBLE_EQ(got->fit.std_errors[2], 1e-4);
+  EXPECT_EQ(got->fit.std_errors_ols, fit.std_errors_ols);
+  EXPECT_EQ(got->fit.error_model.method, "ar1+white (REML)");
+  EXPECT_DOUBLE_EQ(got->fit.error_model.corr_time_s, 3400.0);
+  EXPECT_DOUBLE_EQ(got->fit.error_model.correlated_share, 0.2);
+  EXPECT_DOUBLE_EQ(got->fit.error_model.sigma_dph, 0.008);
   ASSERT_TRUE(got->eval.std_ratio.has_value());
   EXPECT_DOUBLE_EQ(*got->eval.std_ratio, 0.0583);
   EXPECT_FALSE(s.latest_fit("nobody").has_value());
