@@ -118,6 +118,20 @@ TEST(ReportHtml, VerdictTextReadsThePartsShape) {
             "FAIL: std_ratio_max: 0.4 (bound 0.2); k1_range: 0.1 (bound [0,0.05])");
 }
 
+TEST(ReportHtml, TheCoefficientTableShowsTheHonestAndTheOlsUncertainty) {
+  station::Store store(ts::fresh_db("report-extras"));
+  auto r = hostile_report();
+  auto& fit = r.serials[0].fit->fit;
+  EXPECT_FALSE(rp::fit_extras(store, *r.serials[0].fit).std_errors_ols);  // none stored
+  fit.std_errors = {0.00321};
+  fit.std_errors_ols = {0.00123};
+  r.serials[0].extras = rp::fit_extras(store, *r.serials[0].fit);
+  ASSERT_TRUE(r.serials[0].extras.std_errors_ols);
+  EXPECT_EQ(*r.serials[0].extras.std_errors_ols, std::vector<double>{0.00123});
+  const auto page = rp::serial_html(r, r.serials[0], rp::Assets{});
+  EXPECT_NE(page.find("<td>3.210e-03</td><td>1.230e-03</td>"), std::string::npos);
+}
+
 TEST(ReportHtml, AMissingChartingLibraryNamesThePathAndThePackage) {
   try {
     rp::read_dygraphs("/nonexistent/dygraphs");
