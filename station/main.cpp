@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   station::add_fit_commands(app, status);
   station::add_history_command(app, status);
   station::add_replay_command(app, status);
+  station::add_report_command(app, status);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

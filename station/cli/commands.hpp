@@ -25,5 +25,7 @@ void add_fit_commands(CLI::App& app, CommandStatus& status);
 void add_history_command(CLI::App& app, CommandStatus& status);
 /// `station replay LOG --db PATH --run ID`: a recorded session through the driver again.
 void add_replay_command(CLI::App& app, CommandStatus& status);
+/// `station report --db DB --run ID --out DIR [--pdf]`: a run's report as HTML pages.
+void add_report_command(CLI::App& app, CommandStatus& status);
 
 }  // namespace station

@@ -70,8 +70,8 @@ std::int64_t Store::create_run(const RunInfo& info, const std::vector<RunSlot>& 
 namespace {
 constexpr const char* kRunColumns =
     "SELECT id, state, protocol_name, protocol_text, config_text, station, sim_seed, step_index, "
-    "step_started_s, t_s, recording, record_start_s, start_temp_c, t0_wall_s, resolved_json "
-    "FROM runs ";
+    "step_started_s, t_s, recording, record_start_s, start_temp_c, t0_wall_s, resolved_json, "
+    "started_utc, ended_utc, software_version, operator FROM runs ";
 
 RunRecord read_run(const Statement& st) {
   RunRecord r;
@@ -90,6 +90,10 @@ RunRecord read_run(const Statement& st) {
   if (!st.column_is_null(12)) r.progress.start_temp_c = st.column_double(12);
   r.t0_wall_s = st.column_double(13);
   r.resolved_json = st.column_text(14);
+  r.started_utc = st.column_text(15);
+  if (!st.column_is_null(16)) r.ended_utc = st.column_text(16);
+  r.software_version = st.column_text(17);
+  r.operator_name = st.column_text(18);
   return r;
 }
 }  // namespace
@@ -300,17 +304,16 @@ std::int64_t Store::save_fit(const std::string& serial, const std::vector<std::i
   return db_.last_insert_id();
 }
 
-std::optional<FitRecord> Store::latest_fit(const std::string& serial) {
-  auto st = db_.prepare(
-      "SELECT id, created_utc, runs_json, terms, ref_temp_c, coefficients_json, std_errors_json, "
-      "n_bins, r2, residual_rms_dph, condition_number, std_before_dph, std_after_dph, std_ratio, "
-      "warnings_json, std_errors_ols_json, error_model_json FROM fits WHERE serial = ? "
-      "ORDER BY id DESC LIMIT 1");
-  st.bind(1, serial);
-  if (!st.step()) return std::nullopt;
+namespace {
+constexpr const char* kFitColumns =
+    "SELECT id, created_utc, runs_json, terms, ref_temp_c, coefficients_json, std_errors_json, "
+    "n_bins, r2, residual_rms_dph, condition_number, std_before_dph, std_after_dph, std_ratio, "
+    "warnings_json, std_errors_ols_json, error_model_json, serial FROM fits ";
+
+FitRecord read_fit(const Statement& st) {
   FitRecord r;
   r.id = st.column_int(0);
-  r.serial = serial;
+  r.serial = st.column_text(17);
   r.created_utc = st.column_text(1);
   r.runs = json::parse(st.column_text(2)).get<std::vector<std::int64_t>>();
   r.terms = st.column_text(3);
@@ -339,6 +342,23 @@ std::optional<FitRecord> Store::latest_fit(const std::string& serial) {
   }
   r.fit.error_model = error_model_from_json(json::parse(st.column_text(16)));
   return r;
+}
+}  // namespace
+
+std::optional<FitRecord> Store::latest_fit(const std::string& serial) {
+  auto st = db_.prepare(std::string(kFitColumns) + "WHERE serial = ? ORDER BY id DESC LIMIT 1");
+  st.bind(1, serial);
+  if (!st.step()) return std::nullopt;
+  return read_fit(st);
+}
+
+std::optional<FitRecord> Store::latest_fit_of_run(const std::string& serial, std::int64_t run_id) {
+  auto st = db_.prepare(std::string(kFitColumns) +
+                        "WHERE serial = ? AND EXISTS (SELECT 1 FROM json_each(fits.runs_json) "
+                        "WHERE json_each.value = ?) ORDER BY id DESC LIMIT 1");
+  st.bind(1, serial).bind(2, run_id);
+  if (!st.step()) return std::nullopt;
+  return read_fit(st);
 }
 
 void Store::add_event(std::optional<std::int64_t> run_id, double t_s, const std::string& severity,

@@ -54,7 +54,9 @@ struct RunRecord {
   double t0_wall_s = 0;
   std::string resolved_json;
   RunProgress progress;
-  std::optional<double> last_tick_s;  ///< the last committed tick; empty before the first
+  std::optional<double> last_tick_s;   ///< the last committed tick; empty before the first
+  std::string started_utc, ended_utc;  ///< ISO-8601 UTC; ended_utc empty while running
+  std::string software_version, operator_name;
 };
 
 /// One gyro on a run.
@@ -135,6 +137,8 @@ class Store {
   std::int64_t save_fit(const std::string& serial, const std::vector<std::int64_t>& runs,
                         const compensation::FitResult& fit, const compensation::Evaluation& eval);
   std::optional<FitRecord> latest_fit(const std::string& serial);
+  /// The newest fit of `serial` whose runs include `run_id` (the report of that run).
+  std::optional<FitRecord> latest_fit_of_run(const std::string& serial, std::int64_t run_id);
 
   /// One event; `data_json` (column events.data_json, migration 2) is structured detail, e.g. an
   /// outage's {"device","start_s","end_s","ticks_lost"}.

@@ -1,0 +1,121 @@
+// Writing a run's report: load, prepare, write the pages, optionally print them with Chromium.
+#include "station/report/report.hpp"
+
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
+#include "station/common/input_error.hpp"
+#include "station/report/report_html.hpp"
+#include "station/report/report_load.hpp"
+#include "station/store/store.hpp"
+
+extern char** environ;
+
+namespace station::report {
+
+namespace fs = std::filesystem;
+namespace {
+
+void write_file(const fs::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out << text;
+  out.close();
+  if (!out) throw InputError(fmt::format("{}: cannot write", path.string()));
+}
+
+/// `name` on PATH (or `name` itself when it holds a '/'); empty when not found.
+std::string find_program(const std::string& name) {
+  if (name.find('/') != std::string::npos) return access(name.c_str(), X_OK) == 0 ? name : "";
+  const char* path = std::getenv("PATH");
+  std::string dirs = path ? path : "/usr/bin:/bin";
+  for (std::size_t start = 0; start <= dirs.size();) {
+    const auto end = std::min(dirs.find(':', start), dirs.size());
+    const std::string candidate = dirs.substr(start, end - start) + "/" + name;
+    if (end > start && access(candidate.c_str(), X_OK) == 0) return candidate;
+    start = end + 1;
+  }
+  return "";
+}
+
+/// Prints `html` to `pdf` with headless Chromium (argv, no shell: paths are not interpreted).
+void print_pdf(const std::string& chromium, const fs::path& html, const fs::path& pdf) {
+  std::vector<std::string> args{chromium,
+                                "--headless",
+                                "--no-sandbox",
+                                "--disable-gpu",
+                                "--no-pdf-header-footer",
+                                "--virtual-time-budget=10000",
+                                "--print-to-pdf=" + pdf.string(),
+                                "file://" + fs::absolute(html).string()};
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 1, "/dev/null", O_WRONLY, 0);  // Chromium's chatter
+  posix_spawn_file_actions_addopen(&fa, 2, "/dev/null", O_WRONLY, 0);
+  pid_t pid = 0;
+  const int rc = posix_spawn(&pid, chromium.c_str(), &fa, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  int status = 0;
+  if (rc != 0 || waitpid(pid, &status, 0) < 0 || !WIFEXITED(status) || WEXITSTATUS(status) != 0 ||
+      !fs::exists(pdf))
+    throw std::runtime_error(fmt::format("{}: printing {} to PDF failed", chromium, html.string()));
+}
+
+}  // namespace
+
+std::string file_safe(const std::string& serial) {
+  std::string out;
+  for (const char c : serial) {
+    const bool keep = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                      c == '.' || c == '-' || c == '_';
+    out += keep ? c : '_';
+  }
+  return out;
+}
+
+ReportFiles write_report(const ReportOptions& o) {
+  const Assets assets =
+      read_dygraphs(o.dygraphs_dir.empty() ? std::string(kDygraphsDir) : o.dygraphs_dir);
+  const std::string chromium = o.pdf ? find_program(o.chromium) : "";
+  if (o.pdf && chromium.empty())
+    throw InputError(fmt::format(
+        "{}: not found on PATH; --pdf prints with headless Chromium (Debian package chromium)",
+        o.chromium));
+  Store store(o.db, OpenMode::read_only);
+  const RunReport r = load_report(store, o.run_id);
+  fs::create_directories(o.out_dir);
+  const fs::path dir(o.out_dir);
+  ReportFiles files;
+  std::vector<std::string> names;
+  for (const auto& s : r.serials) {
+    names.push_back(!s.fit ? ""
+                           : fmt::format("run-{}-slot{}-{}.html", r.run.id, s.slot.slot,
+                                         file_safe(s.slot.serial)));
+    if (names.back().empty()) continue;
+    write_file(dir / names.back(), serial_html(r, s, assets));
+    files.pages.push_back((dir / names.back()).string());
+  }
+  files.index = (dir / fmt::format("run-{}.html", r.run.id)).string();
+  write_file(files.index, index_html(r, assets, names));
+  if (o.pdf) {
+    std::vector<std::string> all{files.index};
+    all.insert(all.end(), files.pages.begin(), files.pages.end());
+    for (const auto& html : all) {
+      const auto pdf = fs::path(html).replace_extension(".pdf");
+      print_pdf(chromium, html, pdf);
+      files.pdfs.push_back(pdf.string());
+    }
+  }
+  return files;
+}
+
+}  // namespace station::report

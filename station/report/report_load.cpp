@@ -1,0 +1,108 @@
+// Reading a run for the report: run record, events, per serial the fit, bins and samples.
+#include "station/report/report_load.hpp"
+
+#include <fmt/format.h>
+#include <openssl/evp.h>
+
+#include <algorithm>
+#include <array>
+#include <map>
+
+#include "station/common/input_error.hpp"
+#include "station/store/fit_verdicts.hpp"
+
+namespace station::report {
+
+namespace {
+
+/// The run's bin width from its stored meaning; 600 s (the paper's) when not recorded.
+double run_bin_s(const RunRecord& run) {
+  const auto j = nlohmann::json::parse(run.resolved_json, nullptr, false);
+  if (j.is_object() && j.contains("bin_s") && j["bin_s"].is_number()) {
+    const double bin_s = j["bin_s"].get<double>();
+    if (bin_s > 0) return bin_s;
+  }
+  return 600.0;
+}
+
+/// The newest run of each ramp protocol (ramp_00/10/20) that recorded `serial` and has complete
+/// bins, in protocol order.
+std::vector<RampRun> ramp_runs(Store& store, const std::string& serial) {
+  std::map<std::string, std::int64_t> newest;
+  for (const auto id : store.runs_of_serial(serial)) {
+    const auto run = store.find_run(id);
+    if (!run) continue;
+    const auto& p = run->protocol_name;
+    if (p == "ramp_00" || p == "ramp_10" || p == "ramp_20") newest[p] = std::max(newest[p], id);
+  }
+  std::vector<RampRun> out;
+  for (const auto& [protocol, id] : newest) {
+    RampRun r{protocol, id, store.model_data(serial, {id})};
+    if (!r.data.bias_dph.empty()) out.push_back(std::move(r));
+  }
+  return out;
+}
+
+SerialReport load_serial(Store& store, const RunReport& rr, const RunSlot& slot) {
+  SerialReport s;
+  s.slot = slot;
+  s.fit = store.latest_fit_of_run(slot.serial, rr.run.id);
+  if (!s.fit) return s;
+  s.extras = fit_extras(store, *s.fit);
+  const auto samples = store.samples(rr.run.id, slot.serial, false);
+  const auto bins = whole_run_bins(samples, rr.bin_s, slot.earth_rate_dph);
+  const auto data = store.model_data(slot.serial, s.fit->runs);
+  s.allan = allan_curves(one_hz_record(samples, slot.earth_rate_dph, s.fit->fit, rr.bin_s));
+  s.figures = {figure_2a(bins),
+               figure_2b(bins),
+               figure_3(ramp_runs(store, slot.serial)),
+               figure_4(s.fit->fit, data),
+               figure_5a(s.fit->fit, data),
+               figure_5b(s.allan)};
+  return s;
+}
+
+}  // namespace
+
+FitExtras fit_extras(Store& store, const FitRecord& rec) {
+  FitExtras e;
+  // std_errors is the honest (error-model) uncertainty; the plain OLS figures sit beside it.
+  if (rec.fit.std_errors_ols.size() == rec.fit.coefficients.size())
+    e.std_errors_ols = rec.fit.std_errors_ols;
+  // The verdict stored with the fit (fits.verdict_json, migration 5); none for a fit judged
+  // against no part.
+  const StoredVerdict stored = load_fit_verdict(store, rec.id);
+  if (stored.verdict_json) e.verdict = nlohmann::json::parse(*stored.verdict_json);
+  return e;
+}
+
+RunReport load_report(Store& store, std::int64_t run_id) {
+  const auto run = store.find_run(run_id);
+  if (!run) throw InputError(fmt::format("{}: no run {}", store.db().path(), run_id));
+  RunReport rr;
+  rr.run = *run;
+  rr.config_sha256 = sha256_hex(run->config_text);
+  rr.bin_s = run_bin_s(*run);
+  rr.events = store.event_rows(run_id);
+  bool any_fit = false;
+  for (const auto& slot : store.run_slots(run_id)) {
+    rr.serials.push_back(load_serial(store, rr, slot));
+    any_fit = any_fit || rr.serials.back().fit.has_value();
+  }
+  if (!any_fit)
+    throw InputError(fmt::format("{}: run {} has no stored fit (run `station fit --all --run {}`)",
+                                 store.db().path(), run_id, run_id));
+  return rr;
+}
+
+std::string sha256_hex(const std::string& text) {
+  std::array<unsigned char, EVP_MAX_MD_SIZE> md{};
+  unsigned int n = 0;
+  if (EVP_Digest(text.data(), text.size(), md.data(), &n, EVP_sha256(), nullptr) != 1)
+    throw std::runtime_error("SHA-256 failed (OpenSSL EVP_Digest)");
+  std::string hex;
+  for (unsigned int i = 0; i < n; ++i) hex += fmt::format("{:02x}", md[i]);
+  return hex;
+}
+
+}  // namespace station::report

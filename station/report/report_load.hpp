@@ -1,0 +1,53 @@
+// What the report shows, read from the store: the run record, its events and, per serial, the
+// fit of the run and the figures drawn from its samples and bins. Opens nothing itself.
+#pragma once
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "station/report/report_allan.hpp"
+#include "station/report/report_data.hpp"
+#include "station/store/store.hpp"
+
+namespace station::report {
+
+/// What a stored fit carries beyond coefficients and their (honest) standard errors.
+struct FitExtras {
+  std::optional<std::vector<double>> std_errors_ols;  ///< plain OLS errors, per coefficient
+  std::optional<nlohmann::json> verdict;  ///< {"pass": bool, "failed": [{limit, value, bound}]}
+};
+
+/// The one place that reads a fit's OLS errors and verdict for the report (`store` for the
+/// verdict columns, which are not part of FitRecord). A fit stored before migration 4 has no OLS
+/// errors ("-"), one judged against no part no verdict ("no verdict").
+FitExtras fit_extras(Store& store, const FitRecord& rec);
+
+/// One serial of the run.
+struct SerialReport {
+  RunSlot slot;
+  std::optional<FitRecord> fit;  ///< the newest fit that used this run; empty: none stored
+  FitExtras extras;
+  AllanCurves allan;            ///< for the noise terms
+  std::vector<Figure> figures;  ///< 2a, 2b, 3, 4, 5a, 5b (empty without a fit)
+};
+
+/// One run and its serials.
+struct RunReport {
+  RunRecord run;
+  std::string config_sha256;  ///< SHA-256 of the stored configuration text, hex
+  double bin_s = 600.0;       ///< the run's bin width (runs.resolved_json)
+  std::vector<EventRow> events;
+  std::vector<SerialReport> serials;
+};
+
+/// Reads run `run_id` and prepares every figure. Throws InputError naming the database when the
+/// run does not exist or none of its serials has a fit.
+RunReport load_report(Store& store, std::int64_t run_id);
+
+/// SHA-256 of `text` as 64 lowercase hex digits (FIPS 180-4, through OpenSSL).
+std::string sha256_hex(const std::string& text);
+
+}  // namespace station::report

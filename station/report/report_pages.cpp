@@ -1,0 +1,219 @@
+// The report's two kinds of page: the run's index and one page per serial.
+#include "station/report/report_pages.hpp"
+
+#include <fmt/format.h>
+
+#include <optional>
+
+#include "compensation/fit.hpp"
+#include "station/store/fit_json.hpp"
+
+namespace station::report {
+
+using nlohmann::json;
+namespace sc = station::compensation;
+
+const std::string_view kReportCss = R"(
+body { font-family: sans-serif; margin: 1.5em; color: #222; max-width: 1400px; }
+h1 { font-size: 1.5em; } h2 { font-size: 1.15em; margin-top: 1.4em; }
+table { border-collapse: collapse; margin: 0.5em 0; font-size: 0.9em; }
+th, td { border: 1px solid #bbb; padding: 0.2em 0.6em; text-align: left; }
+td.num { text-align: right; font-family: monospace; }
+.pass { color: #17702a; font-weight: bold; } .fail { color: #b01818; font-weight: bold; }
+.figures { display: grid; grid-template-columns: 1fr 1fr; gap: 1em 2em; }
+.figure { break-inside: avoid; }
+.figure h3 { font-size: 1em; margin: 0.3em 0; }
+.figure .chart { width: 100%; height: 280px; }
+.figure .legend { font-size: 0.8em; min-height: 1.2em; }
+.figure .legend .dygraph-legend { position: static; width: auto; background: none; }
+.note { font-style: italic; color: #8a5a00; }
+)";
+
+const std::string_view kRenderJs = R"(
+(function () {
+  "use strict";
+  var figures = JSON.parse(document.getElementById("report-figures").textContent);
+  figures.forEach(function (f) {
+    var box = document.querySelector('[data-figure="' + f.id + '"]');
+    if (!box || f.rows.length === 0) return;
+    var opts = f.options;
+    opts.labelsDiv = box.querySelector(".legend");
+    opts.drawCallback = function (g, initial) {
+      if (initial) box.setAttribute("data-drawn", "true");
+    };
+    new Dygraph(box.querySelector(".chart"), f.rows, opts);
+  });
+})();
+)";
+
+namespace {
+
+std::string num(double v, const char* spec = "{:.5g}") {
+  return std::isfinite(v) ? fmt::format(fmt::runtime(spec), v) : "-";
+}
+std::string num(const std::optional<double>& v, const char* spec = "{:.5g}") {
+  return v ? num(*v, spec) : "-";
+}
+
+std::string row(std::initializer_list<std::string> cells) {
+  std::string out = "<tr>";
+  for (const auto& c : cells) out += "<td>" + c + "</td>";
+  return out + "</tr>\n";
+}
+
+std::string verdict_html(const FitExtras& e) {
+  const std::string cls = !e.verdict ? "" : (e.verdict->value("pass", false) ? "pass" : "fail");
+  return fmt::format("<span class=\"verdict {}\">{}</span>", cls, html_escape(verdict_text(e)));
+}
+
+std::string figure_box(const Figure& f) {
+  return fmt::format(
+      "<div class=\"figure\" data-figure=\"{}\" data-points=\"{}\">\n<h3>Fig. {}: {}</h3>\n"
+      "<div class=\"chart\"></div>\n<div class=\"legend\"></div>\n{}</div>\n",
+      html_escape(f.id), f.points(), html_escape(f.id), html_escape(f.title),
+      f.note.empty() ? "" : "<p class=\"note\">" + html_escape(f.note) + "</p>\n");
+}
+
+std::string coefficient_table(const FitRecord& rec, const FitExtras& e) {
+  std::string t =
+      "<table class=\"coefficients\">\n<tr><th>term</th><th>value</th><th>unit</th>"
+      "<th>uncertainty (1&sigma;)</th><th>OLS uncertainty</th></tr>\n";
+  const auto& f = rec.fit;
+  for (std::size_t i = 0; i < f.names.size(); ++i) {
+    const bool ols = e.std_errors_ols && i < e.std_errors_ols->size();
+    t += row({html_escape(f.names[i]), num(f.coefficients[i], "{:.6e}"),
+              html_escape(std::string(sc::coefficient_unit(f.names[i]))),
+              num(i < f.std_errors.size() ? f.std_errors[i] : NAN, "{:.3e}"),
+              ols ? num((*e.std_errors_ols)[i], "{:.3e}") : "-"});
+  }
+  return t + "</table>\n";
+}
+
+std::string evaluation_table(const FitRecord& rec) {
+  std::string t = "<table class=\"evaluation\">\n";
+  t += row({"std before", num(rec.eval.std_before_dph) + " deg/h"});
+  t += row({"std after", num(rec.eval.std_after_dph) + " deg/h"});
+  t += row({"std ratio", html_escape(std_ratio_text(rec.eval))});
+  t += row({"bins", std::to_string(rec.fit.n_points)});
+  t += row({"R\u00b2", num(rec.fit.r2)});
+  t += row({"uncertainty model", html_escape(error_model_text(rec.fit.error_model))});
+  t += row({"fit", fmt::format("{} ({}, runs {})", rec.id, html_escape(rec.created_utc),
+                               fmt::join(rec.runs, ","))});
+  for (const auto& w : rec.fit.warnings) t += row({"warning", html_escape(w)});
+  return t + "</table>\n";
+}
+
+std::string noise_table(const AllanCurves& a) {
+  std::string t =
+      "<table class=\"noise\">\n<tr><th>noise term (IEEE 952 Table C.2)</th><th>before</th>"
+      "<th>after</th></tr>\n";
+  const auto& b = a.noise_before;
+  const auto& c = a.noise_after;
+  t += row({"quantization Q, arcsec", num(b.quantization_arcsec), num(c.quantization_arcsec)});
+  t += row({"angle random walk N, deg/\u221ah", num(b.angle_random_walk_deg_rth),
+            num(c.angle_random_walk_deg_rth)});
+  t += row({"bias instability B, deg/h", num(b.bias_instability_dph), num(c.bias_instability_dph)});
+  t += row({"at \u03c4, s", num(b.bias_instability_tau_s), num(c.bias_instability_tau_s)});
+  t += row({"rate random walk K, deg/h/\u221ah", num(b.rate_random_walk_dph_rth),
+            num(c.rate_random_walk_dph_rth)});
+  return t + "</table>\n";
+}
+
+std::string serial_summary_row(const RunReport& r, std::size_t i, const std::string& page) {
+  const auto& s = r.serials[i];
+  const std::string name = page.empty() ? html_escape(s.slot.serial)
+                                        : fmt::format("<a href=\"{}\">{}</a>", html_escape(page),
+                                                      html_escape(s.slot.serial));
+  if (!s.fit) return row({name, std::to_string(s.slot.slot), "no fit stored for this run"});
+  const auto& f = s.fit->fit;
+  std::string coef;
+  for (std::size_t k = 0; k < f.names.size(); ++k)
+    coef += fmt::format("{}{} = {} &plusmn; {}", k ? "<br>" : "", html_escape(f.names[k]),
+                        num(f.coefficients[k], "{:.4e}"),
+                        num(k < f.std_errors.size() ? f.std_errors[k] : NAN, "{:.2e}"));
+  return row({name, std::to_string(s.slot.slot), verdict_html(s.extras), coef,
+              num(s.fit->eval.std_before_dph), num(s.fit->eval.std_after_dph),
+              html_escape(std_ratio_text(s.fit->eval)), std::to_string(f.n_points)});
+}
+
+}  // namespace
+
+std::string verdict_text(const FitExtras& e) {
+  if (!e.verdict) return "no verdict (no part limits applied)";
+  if (e.verdict->value("pass", false)) return "PASS";
+  std::string out = "FAIL";
+  const auto failed = e.verdict->value("failed", json::array());
+  for (const auto& f : failed) {
+    out += fmt::format("{} {}: {} (bound {})", out == "FAIL" ? ":" : ";",
+                       f.value("limit", std::string("?")),
+                       f.contains("value") ? f["value"].dump() : "?",
+                       f.contains("bound") ? f["bound"].dump() : "?");
+  }
+  return out;
+}
+
+std::string run_record_html(const RunReport& r) {
+  const auto& run = r.run;
+  std::string t = "<section class=\"run-record\">\n<h2>Run record</h2>\n<table>\n";
+  t += row({"run", std::to_string(run.id)});
+  t += row({"station", html_escape(run.station)});
+  t += row({"software version", html_escape(run.software_version)});
+  t += row({"configuration SHA-256", "<code>" + html_escape(r.config_sha256) + "</code>"});
+  t += row({"operator", html_escape(run.operator_name.empty() ? "-" : run.operator_name)});
+  t += row({"protocol", html_escape(run.protocol_name)});
+  t += row({"state", html_escape(run.state)});
+  t += row({"started (UTC)", html_escape(run.started_utc)});
+  t += row({"ended (UTC)", html_escape(run.ended_utc.empty() ? "-" : run.ended_utc)});
+  if (run.sim_seed) t += row({"simulation seed", std::to_string(*run.sim_seed)});
+  return t + "</table>\n</section>\n";
+}
+
+std::string events_html(const RunReport& r) {
+  std::string t = fmt::format(
+      "<section class=\"events\">\n<h2>Events ({})</h2>\n<table>\n<tr><th>t, s</th>"
+      "<th>severity</th><th>source</th><th>kind</th><th>message</th></tr>\n",
+      r.events.size());
+  for (const auto& e : r.events)
+    t += row({num(e.t_s, "{:.0f}"), html_escape(e.severity), html_escape(e.source),
+              html_escape(e.kind), html_escape(e.message)});
+  return t + "</table>\n</section>\n";
+}
+
+std::string index_html(const RunReport& r, const Assets& a, const std::vector<std::string>& pages) {
+  const std::string title =
+      fmt::format("Run {} ({}): calibration report", r.run.id, r.run.protocol_name);
+  std::string body = "<h1>" + html_escape(title) +
+                     "</h1>\n<section class=\"serials\">\n"
+                     "<h2>Serials</h2>\n<table>\n<tr><th>serial</th><th>slot</th><th>verdict</th>"
+                     "<th>coefficients &plusmn; 1&sigma;</th><th>std before, deg/h</th>"
+                     "<th>std after, deg/h</th><th>ratio</th><th>bins</th></tr>\n";
+  for (std::size_t i = 0; i < r.serials.size(); ++i)
+    body += serial_summary_row(r, i, i < pages.size() ? pages[i] : "");
+  body += "</table>\n</section>\n" + run_record_html(r) + events_html(r);
+  return page_html(title, body, json::array(), a);
+}
+
+std::string serial_html(const RunReport& r, const SerialReport& s, const Assets& a) {
+  const std::string title =
+      fmt::format("Serial {}, run {}: calibration report", s.slot.serial, r.run.id);
+  std::string body =
+      "<h1>" + html_escape(title) + "</h1>\n<p>Verdict: " + verdict_html(s.extras) + "</p>\n";
+  json figures = json::array();
+  if (s.fit) {
+    body +=
+        "<h2>Coefficients</h2>\n<p>Model B = B0 + k1&middot;&Delta;T + k0&middot;&nabla;T "
+        "(Zhou et al. 2013, eq. (4)), &Delta;T = T &minus; " +
+        num(s.fit->fit.spec.ref_temp_c) + " &deg;C.</p>\n" + coefficient_table(*s.fit, s.extras) +
+        evaluation_table(*s.fit) + "<h2>Noise terms of the 1 Hz record</h2>\n" +
+        noise_table(s.allan) + "<h2>Figures</h2>\n<div class=\"figures\">\n";
+    for (const auto& f : s.figures) {
+      body += figure_box(f);
+      figures.push_back(figure_json(f));
+    }
+    body += "</div>\n";
+  }
+  body += run_record_html(r) + events_html(r);
+  return page_html(title, body, figures, a);
+}
+
+}  // namespace station::report

@@ -1,0 +1,32 @@
+// Inside the report room: the page shell and the sections the index and serial pages share.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <string_view>
+
+#include "station/report/report_html.hpp"
+
+namespace station::report {
+
+/// The report's own style sheet (after dygraphs').
+extern const std::string_view kReportCss;
+/// The one script of a page: parses #report-figures and hands each figure to Dygraph; marks its
+/// element data-drawn="true" once drawn. No data is ever written into it.
+extern const std::string_view kRenderJs;
+
+/// A whole page: `body` (already escaped HTML), the figures as JSON, dygraphs inlined.
+std::string page_html(std::string_view title, std::string_view body, const nlohmann::json& figures,
+                      const Assets& a);
+
+/// The verdict for people: "PASS", "FAIL: limit value (bound b); ..." or "no verdict".
+std::string verdict_text(const FitExtras& e);
+
+/// <section> with the run record: station, software, configuration hash, operator, protocol,
+/// state, start and end.
+std::string run_record_html(const RunReport& r);
+
+/// <section> with the run's events in order.
+std::string events_html(const RunReport& r);
+
+}  // namespace station::report

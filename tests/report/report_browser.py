@@ -1,0 +1,184 @@
+#!/usr/bin/env python3
+"""The report in a real browser: a simulated run's database, `station report`, then the index and
+one serial page opened from file:// in headless Chromium (Selenium + chromedriver). Checks that
+every figure element is there with its points, that dygraphs drew it (a canvas inside, the
+page's data-drawn mark), that no resource was fetched and the console logged nothing SEVERE, and
+keeps a screenshot as the test's artifact.
+
+Exit 0 pass, 1 fail, 77 skip (Chromium, chromedriver or python3-selenium absent).
+"""
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import sys
+import time
+
+SKIP = 77
+FIGURES = ["2a", "2b", "3", "4", "5a", "5b"]
+RAMPS = ["ramp_00", "ramp_10", "ramp_20"]
+
+
+def skip(why):
+    print(f"SKIP: {why}")
+    sys.exit(SKIP)
+
+
+def fail(why):
+    print(f"FAIL: {why}")
+    sys.exit(1)
+
+
+def browser():
+    try:
+        from selenium import webdriver
+        from selenium.webdriver.chrome.service import Service
+    except ImportError:
+        skip(f"python3-selenium is not importable by {sys.executable} (Debian: python3-selenium)")
+    chromium = shutil.which("chromium") or shutil.which("chromium-browser")
+    driver = shutil.which("chromedriver")
+    if not chromium or not driver:
+        skip("chromium and chromedriver are needed (Debian: chromium chromium-driver)")
+    opts = webdriver.ChromeOptions()
+    opts.binary_location = chromium
+    for a in ["--headless=new", "--no-sandbox", "--disable-gpu", "--window-size=1400,2400",
+              "--disable-dev-shm-usage"]:
+        opts.add_argument(a)
+    opts.set_capability("goog:loggingPrefs", {"browser": "ALL"})
+    return webdriver.Chrome(service=Service(executable_path=driver), options=opts)
+
+
+def station(bin_path, *args):
+    r = subprocess.run([bin_path, *args], capture_output=True, text=True, timeout=600)
+    if r.returncode != 0:
+        fail(f"station {' '.join(args)}: exit {r.returncode}: {r.stderr.strip()}")
+    return r.stdout
+
+
+def make_db(bin_path, db, gyros, ramps):
+    for ext in ("", "-wal", "-shm", ".lock"):
+        if os.path.exists(db + ext):
+            os.remove(db + ext)
+    for protocol in RAMPS if ramps else []:
+        station(bin_path, "run", "--sim", "--gyros", str(gyros), "--protocol", protocol, "--new",
+                "--db", db, "--json")
+    out = station(bin_path, "run", "--sim", "--gyros", str(gyros), "--new", "--db", db, "--json")
+    return json.loads(out)["run_id"]
+
+
+def load(drv, path):
+    drv.get("file://" + os.path.abspath(path))
+    deadline = time.time() + 20
+    while time.time() < deadline:
+        if drv.execute_script("return document.readyState") == "complete":
+            return
+        time.sleep(0.1)
+    fail(f"{path}: did not load")
+
+
+def check_clean(drv, path):
+    severe = [e for e in drv.get_log("browser") if e.get("level") == "SEVERE"]
+    if severe:
+        fail(f"{path}: console errors: {severe}")
+    fetched = drv.execute_script(
+        "return performance.getEntriesByType('resource').map(function (e) { return e.name; })")
+    if fetched:
+        fail(f"{path}: fetched resources (must be self-contained): {fetched}")
+
+
+def check_figures(drv, path, ramps):
+    from selenium.webdriver.common.by import By
+    for fig in FIGURES:
+        els = drv.find_elements(By.CSS_SELECTOR, f'[data-figure="{fig}"]')
+        if len(els) != 1:
+            fail(f"{path}: {len(els)} elements with data-figure={fig}")
+        el = els[0]
+        points = int(el.get_attribute("data-points"))
+        if fig == "3" and not ramps:
+            note = el.find_elements(By.CSS_SELECTOR, ".note")
+            if points != 0 or not note or not note[0].is_displayed() or "ramp" not in note[0].text:
+                fail(f"{path}: fig 3 without ramp runs: points {points}, no visible note")
+            continue
+        if points <= 0:
+            fail(f"{path}: fig {fig} has data-points {points}")
+        deadline = time.time() + 10
+        while el.get_attribute("data-drawn") != "true" and time.time() < deadline:
+            time.sleep(0.1)
+        if el.get_attribute("data-drawn") != "true":
+            fail(f"{path}: fig {fig} was not drawn by dygraphs")
+        if not el.find_elements(By.CSS_SELECTOR, ".chart canvas"):
+            fail(f"{path}: fig {fig} has no canvas")
+        print(f"fig {fig}: {points} points drawn")
+    if ramps:
+        series = drv.execute_script(
+            "var f = JSON.parse(document.getElementById('report-figures').textContent);"
+            "return f.filter(function (x) { return x.id === '3'; })[0].options.labels;")
+        for r in RAMPS:
+            if not any(label.startswith(r) for label in series):
+                fail(f"{path}: fig 3 has no {r} series: {series}")
+
+
+def check_pdf(bin_path, db, run_id, out_dir, gyros):
+    """--pdf: every page printed by headless Chromium to a PDF file."""
+    shutil.rmtree(out_dir, ignore_errors=True)
+    files = station(bin_path, "report", "--db", db, "--run", str(run_id), "--out", out_dir,
+                    "--pdf").split()
+    pdfs = [f for f in files if f.endswith(".pdf")]
+    if len(pdfs) != 1 + gyros:
+        fail(f"--pdf: expected {1 + gyros} PDFs, got {pdfs}")
+    for pdf in pdfs:
+        with open(pdf, "rb") as f:
+            if f.read(5) != b"%PDF-":
+                fail(f"{pdf}: not a PDF")
+    print(f"--pdf: {len(pdfs)} PDFs")
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--station", required=True)
+    ap.add_argument("--work", required=True, help="scratch directory (database, report)")
+    ap.add_argument("--artifacts", required=True, help="where the screenshot goes")
+    ap.add_argument("--gyros", type=int, default=2)
+    ap.add_argument("--ramps", action="store_true", help="also ramp_00/10/20 runs (Fig. 3)")
+    a = ap.parse_args()
+    drv = browser()
+    try:
+        os.makedirs(a.work, exist_ok=True)
+        os.makedirs(a.artifacts, exist_ok=True)
+        name = "report-ramps" if a.ramps else "report"
+        db = os.path.join(a.work, name + ".db")
+        t0 = time.time()
+        run_id = make_db(a.station, db, a.gyros, a.ramps)
+        print(f"database {db}: run {run_id} in {time.time() - t0:.1f} s")
+        out_dir = os.path.join(a.work, name)
+        shutil.rmtree(out_dir, ignore_errors=True)
+        files = station(a.station, "report", "--db", db, "--run", str(run_id), "--out",
+                        out_dir).split()
+        index, pages = files[0], files[1:]
+        if len(pages) != a.gyros:
+            fail(f"expected {a.gyros} serial pages, got {pages}")
+        load(drv, index)
+        from selenium.webdriver.common.by import By
+        links = drv.find_elements(By.CSS_SELECTOR, ".serials a")
+        if len(links) != a.gyros:
+            fail(f"{index}: {len(links)} serial links, expected {a.gyros}")
+        check_clean(drv, index)
+        load(drv, pages[0])
+        check_figures(drv, pages[0], a.ramps)
+        check_clean(drv, pages[0])
+        shot = os.path.join(a.artifacts, name + ".png")
+        drv.save_screenshot(shot)
+        # The figures alone (docs/report.png is one of these).
+        figures = os.path.join(a.artifacts, name + "-figures.png")
+        drv.find_element(By.CSS_SELECTOR, ".figures").screenshot(figures)
+        print(f"screenshots {shot} {figures}")
+        if not a.ramps:
+            check_pdf(a.station, db, run_id, out_dir + "-pdf", a.gyros)
+    finally:
+        drv.quit()
+    print("PASS")
+
+
+if __name__ == "__main__":
+    main()
