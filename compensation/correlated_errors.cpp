@@ -151,6 +151,7 @@ ErrorModel estimate_error_model(const Eigen::MatrixXd& x, const Eigen::VectorXd&
   pb.z.col(0) = y;
   pb.z.rightCols(p) = x;
   Best best;
+  best.log_tau = lo;
   step_corrs(pb.phi, t_s, segment, n, std::exp(lo));
   best.profile = reml_profile(pb.z, pb.phi, 0.0);  // iid: q = 0
   search(best, pb, lo, hi, 0.0, kMaxShare, kCoarseSteps);
@@ -158,12 +159,18 @@ ErrorModel estimate_error_model(const Eigen::MatrixXd& x, const Eigen::VectorXd&
   double half_tau = (hi - lo) / (kCoarseSteps - 1), half_q = kMaxShare / (kCoarseSteps - 1);
   for (int round = 0; round < kRefinements; ++round) {
     const Best centre = best;
-    search(best, pb, centre.log_tau - half_tau, centre.log_tau + half_tau,
-           std::max(centre.q - half_q, 0.0), std::min(centre.q + half_q, kMaxShare), 5);
+    search(best, pb, std::max(centre.log_tau - half_tau, lo),
+           std::min(centre.log_tau + half_tau, hi), std::max(centre.q - half_q, 0.0),
+           std::min(centre.q + half_q, kMaxShare), 5);
     half_tau /= 2;
     half_q /= 2;
   }
+  if (best.q <= 0) {  // no correlated part found: independent bins
+    model.sigma_dph = std::sqrt(best.profile.sigma2);
+    return model;
+  }
   model.method = "ar1+white (REML)";
+  model.on_search_boundary = best.q >= kMaxShare || best.log_tau >= hi - 1e-9;
   model.corr_time_s = std::exp(best.log_tau);
   model.correlated_share = best.q;
   model.sigma_dph = std::sqrt(best.profile.sigma2);
@@ -171,27 +178,30 @@ ErrorModel estimate_error_model(const Eigen::MatrixXd& x, const Eigen::VectorXd&
   return model;
 }
 
-Eigen::VectorXd ols_variances_under(const ErrorModel& model, const Eigen::MatrixXd& x,
-                                    const Eigen::MatrixXd& xtx_inv, std::span<const double> t_s,
+Eigen::VectorXd ols_variances_under(const ErrorModel& model, const Eigen::MatrixXd& q_basis,
+                                    const Eigen::MatrixXd& r_inv, std::span<const double> t_s,
                                     std::span<const int> segment) {
-  const Eigen::Index n = x.rows();
+  const Eigen::Index n = q_basis.rows();
   const double q = model.correlated_share, tau_s = model.corr_time_s;
-  Eigen::MatrixXd r = Eigen::MatrixXd::Identity(n, n);
+  // C Q with C = (1 - q) I + q P, P_ij = exp(-|t_i - t_j| / tau) (0 across runs), in O(n p):
+  // P v = f + b - v with f_i = v_i + phi_i f_(i-1) and b_i = v_i + phi_(i+1) b_(i+1), as
+  // exp(-|t_i - t_j| / tau) is the product of the step correlations between them. No n x n
+  // matrix is formed: a fit over thousands of bins needs no more memory than its data.
+  Eigen::MatrixXd cq = q_basis;
   if (q > 0 && tau_s > 0) {
-    // exp(-|t_i - t_j| / tau) is the product of the step correlations between them (0 across
-    // runs): one multiplication per pair instead of an exp.
     std::vector<double> phi;
     step_corrs(phi, t_s, segment, n, tau_s);
-    for (Eigen::Index i = 1; i < n; ++i) {
-      double corr = 1.0;
-      for (Eigen::Index j = i - 1; j >= 0 && corr > 0; --j) {
-        corr *= phi[static_cast<std::size_t>(j + 1)];
-        r(i, j) = r(j, i) = q * corr;
-      }
-    }
+    Eigen::MatrixXd fwd = q_basis, bwd = q_basis;
+    for (Eigen::Index i = 1; i < n; ++i)
+      fwd.row(i) += phi[static_cast<std::size_t>(i)] * fwd.row(i - 1);
+    for (Eigen::Index i = n - 2; i >= 0; --i)
+      bwd.row(i) += phi[static_cast<std::size_t>(i + 1)] * bwd.row(i + 1);
+    cq = (1.0 - q) * q_basis + q * (fwd + bwd - q_basis);
   }
-  const Eigen::MatrixXd meat = x.transpose() * r * x;
-  return (xtx_inv * meat * xtx_inv).diagonal() * (model.sigma_dph * model.sigma_dph);
+  // Var(b) = s^2 (X'X)^-1 X' C X (X'X)^-1 = s^2 R^-1 (Q' C Q) R^-T with X = Q R: formed from the
+  // orthonormal Q, it does not cancel as the product with (X'X)^-1 does when X is ill conditioned.
+  const Eigen::MatrixXd meat = q_basis.transpose() * cq;
+  return (r_inv * meat * r_inv.transpose()).diagonal() * (model.sigma_dph * model.sigma_dph);
 }
 
 }  // namespace station::compensation

@@ -27,18 +27,23 @@ struct ErrorModel {
   double correlated_share = 0;  ///< q: share of the error variance in the Gauss-Markov part
   double sigma_dph = 0;         ///< s: total error standard deviation per bin, deg/h
   double rho_per_bin = 0;       ///< exp(-bin spacing / tau): correlation of neighbouring bins
+  /// The estimate sits on the edge of what the search allows (q = 0.99 or tau ten record
+  /// lengths): the bins look like a drift more than noise, and the errors are less certain.
+  bool on_search_boundary = false;
 };
 
-/// Estimates the error model of y = X b + e by REML. `t_s` are the bin times (increasing within
-/// a segment), `segment` the run each bin came from (bins of different runs are independent;
-/// empty: one run). Needs at least p + 4 bins; with fewer the model is "iid" with s^2 = RSS/(n-p).
+/// Estimates the error model of y = X b + e by REML. `x` should be well conditioned (pass the
+/// orthonormal Q of X = Q R: the likelihood depends only on the column space of X). `t_s` are the
+/// bin times (increasing within a segment), `segment` the run each bin came from (bins of different
+/// runs are independent; empty: one run). Needs at least p + 4 bins; with fewer the model is "iid"
+/// with s^2 = RSS/(n-p).
 ErrorModel estimate_error_model(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
                                 std::span<const double> t_s, std::span<const int> segment);
 
-/// Variances of the OLS coefficients of y = X b + e under `model`: the diagonal of
-/// s^2 A X' R X A, A = (X'X)^-1 given as `xtx_inv`.
-Eigen::VectorXd ols_variances_under(const ErrorModel& model, const Eigen::MatrixXd& x,
-                                    const Eigen::MatrixXd& xtx_inv, std::span<const double> t_s,
+/// Variances of the OLS coefficients of y = X b + e under `model`, with X = Q R (thin QR,
+/// Q `q_basis` n x p, `r_inv` = R^-1): the diagonal of s^2 R^-1 Q' C Q R^-T, O(n p).
+Eigen::VectorXd ols_variances_under(const ErrorModel& model, const Eigen::MatrixXd& q_basis,
+                                    const Eigen::MatrixXd& r_inv, std::span<const double> t_s,
                                     std::span<const int> segment);
 
 }  // namespace station::compensation

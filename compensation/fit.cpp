@@ -275,11 +275,14 @@ FitResult fit_model(const ModelInput& in, const ModelSpec& spec) {
       r.triangularView<Eigen::Upper>().solve(Eigen::MatrixXd::Identity(pi, pi));
   const Eigen::MatrixXd xtx_inv = r_inv * r_inv.transpose();
   const Eigen::VectorXd var_scaled = xtx_inv.diagonal() * s2;
-  res.error_model = estimate_error_model(x, y, in.t_s, in.segment);
+  // The error model sees the orthonormal basis Q of the design (same column space, so the same
+  // likelihood) and the sandwich is formed from Q and R^-1: neither squares X's condition.
+  const Eigen::MatrixXd q_basis = qr.householderQ() * Eigen::MatrixXd::Identity(x.rows(), pi);
+  res.error_model = estimate_error_model(q_basis, y, in.t_s, in.segment);
   // No correlated part: the model's covariance is s^2 I and the errors are the OLS ones exactly.
   const Eigen::VectorXd var_model =
       res.error_model.correlated_share > 0
-          ? ols_variances_under(res.error_model, x, xtx_inv, in.t_s, in.segment)
+          ? ols_variances_under(res.error_model, q_basis, r_inv, in.t_s, in.segment)
           : var_scaled;
   // Lag rule of Newey & West (1994): L = floor(4 (n/100)^(2/9)).
   res.hac_lag = static_cast<std::size_t>(
@@ -289,7 +292,7 @@ FitResult fit_model(const ModelInput& in, const ModelSpec& spec) {
   for (Term t : spec.terms) res.names.emplace_back(info(t).coefficient);
   for (Eigen::Index j = 0; j < pi; ++j) {
     res.coefficients.push_back(beta_scaled(j) / scale(j));
-    res.std_errors.push_back(std::sqrt(std::max(var_model(j), 0.0)) / scale(j));
+    res.std_errors.push_back(std::sqrt(var_model(j)) / scale(j));  // NaN if < 0: refused below
     res.std_errors_ols.push_back(std::sqrt(var_scaled(j)) / scale(j));
     res.std_errors_hac.push_back(std::sqrt(std::max(var_hac(j), 0.0)) / scale(j));
   }
@@ -302,6 +305,12 @@ FitResult fit_model(const ModelInput& in, const ModelSpec& spec) {
                            std::to_string(res.condition_number) + " > " +
                            std::to_string(static_cast<int>(kCollinearCondition)) +
                            " (Belsley); coefficients are poorly separated");
+  }
+  if (res.error_model.on_search_boundary) {
+    res.warnings.push_back(
+        "the bins' correlated noise looks like a drift (error model at the edge of its search: " +
+        std::to_string(100 * res.error_model.correlated_share) + " % correlated, tau " +
+        number_text(res.error_model.corr_time_s) + " s); the uncertainties are less certain");
   }
   check_result(res);
   return res;

@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -45,7 +46,19 @@ std::string find_program(const std::string& name) {
 }
 
 /// Prints `html` to `pdf` with headless Chromium (argv, no shell: paths are not interpreted).
+/// file:// URL of an absolute path, every byte outside RFC 3986's unreserved set and '/'
+/// percent-encoded ('#', '%', '?' in a directory name would otherwise end the path).
+std::string file_url(const fs::path& path) {
+  std::string url = "file://";
+  for (const unsigned char c : path.string()) {
+    const bool keep = std::isalnum(c) || c == '/' || c == '-' || c == '.' || c == '_' || c == '~';
+    url += keep ? std::string(1, static_cast<char>(c)) : fmt::format("%{:02X}", c);
+  }
+  return url;
+}
+
 void print_pdf(const std::string& chromium, const fs::path& html, const fs::path& pdf) {
+  fs::remove(pdf);  // a PDF left from an earlier report must not pass for this one
   std::vector<std::string> args{chromium,
                                 "--headless",
                                 "--no-sandbox",
@@ -53,7 +66,7 @@ void print_pdf(const std::string& chromium, const fs::path& html, const fs::path
                                 "--no-pdf-header-footer",
                                 "--virtual-time-budget=10000",
                                 "--print-to-pdf=" + pdf.string(),
-                                "file://" + fs::absolute(html).string()};
+                                file_url(fs::absolute(html))};
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
@@ -79,6 +92,9 @@ std::string file_safe(const std::string& serial) {
                       c == '.' || c == '-' || c == '_';
     out += keep ? c : '_';
   }
+  // A file name is at most 255 bytes: a long serial keeps its first 80 characters (the page
+  // names its slot too, so two such serials still get two files).
+  if (out.size() > 80) out.resize(80);
   return out;
 }
 
@@ -92,7 +108,11 @@ ReportFiles write_report(const ReportOptions& o) {
         o.chromium));
   Store store(o.db, OpenMode::read_only);
   const RunReport r = load_report(store, o.run_id);
-  fs::create_directories(o.out_dir);
+  std::error_code ec;
+  fs::create_directories(o.out_dir, ec);
+  if (ec || !fs::is_directory(o.out_dir))
+    throw InputError(fmt::format("--out {}: cannot create the directory: {}", o.out_dir,
+                                 ec ? ec.message() : "it is not a directory"));
   const fs::path dir(o.out_dir);
   ReportFiles files;
   std::vector<std::string> names;

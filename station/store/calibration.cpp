@@ -3,6 +3,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+
 #include "compensation/binning.hpp"
 #include "station/common/input_error.hpp"
 
@@ -37,6 +39,9 @@ void bin_run(Store& store, std::int64_t run_id, double bin_s) {
 SerialFit fit_serial(Store& store, const std::string& serial, std::vector<std::int64_t> runs,
                      const sc::ModelSpec& spec, std::vector<std::string> warnings) {
   if (runs.empty()) runs = store.runs_of_serial(serial);
+  // A run named twice is one run: its bins counted twice would halve the variances.
+  std::sort(runs.begin(), runs.end());
+  runs.erase(std::unique(runs.begin(), runs.end()), runs.end());
   if (runs.empty())
     throw InputError(fmt::format("{}: no run recorded serial '{}'", store.db().path(), serial));
   SerialFit out;

@@ -34,7 +34,8 @@ nlohmann::json error_model_json(const compensation::ErrorModel& m) {
           {"corr_time_s", m.corr_time_s},
           {"correlated_share", m.correlated_share},
           {"sigma_dph", m.sigma_dph},
-          {"rho_per_bin", m.rho_per_bin}};
+          {"rho_per_bin", m.rho_per_bin},
+          {"on_search_boundary", m.on_search_boundary}};
 }
 
 std::string error_model_text(const compensation::ErrorModel& m) {
@@ -56,6 +57,7 @@ compensation::ErrorModel error_model_from_json(const nlohmann::json& j) {
   m.correlated_share = j.value("correlated_share", 0.0);
   m.sigma_dph = j.value("sigma_dph", 0.0);
   m.rho_per_bin = j.value("rho_per_bin", 0.0);
+  m.on_search_boundary = j.value("on_search_boundary", false);
   return m;
 }
 

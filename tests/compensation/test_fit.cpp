@@ -213,3 +213,23 @@ TEST(Fit, NeweyWestLagFollowsTheRuleOfThumb) {
   ASSERT_EQ(f.std_errors_hac.size(), f.std_errors.size());
   for (double se : f.std_errors_hac) EXPECT_GT(se, 0.0);
 }
+
+// Review finding: with an ill-conditioned design (quartic in dT about a far T_ref, condition
+// ~1e9) the sandwich formed with (X'X)^-1 cancelled to 0 and a part's SE limit passed. Formed
+// from the orthonormal Q it cannot: every honest error is positive and at least the OLS one
+// times sqrt(1 - q) (the white share alone gives that much).
+TEST(Fit, HonestErrorsStayPositiveOnAnIllConditionedDesign) {
+  const auto d = scenario(0.02, 1e-3, 0.0, 0.03, 0.003, 11);
+  sc::ModelSpec spec;
+  spec.terms = {sc::Term::dT, sc::Term::dT2, sc::Term::dT3, sc::Term::dT4, sc::Term::gradT};
+  spec.ref_temp_c = 900.0;
+  const auto f = sc::fit_model(d.view(), spec);
+  ASSERT_GT(f.condition_number, 1e6);
+  const double white = std::sqrt(1.0 - f.error_model.correlated_share);
+  for (std::size_t j = 0; j < f.std_errors.size(); ++j) {
+    EXPECT_GT(f.std_errors[j],
+              0.99 * white * f.std_errors_ols[j] *
+                  (f.error_model.sigma_dph / (f.residual_rms_dph * std::sqrt(66.0 / 60.0))))
+        << f.names[j];
+  }
+}
