@@ -1,10 +1,12 @@
-// Benchmark: a 5-term thermal bias fit (B0, k1, k2, k0, kr) on 10^4 bins, QR path.
+// Benchmarks of one thermal bias fit: 5 terms on 10^4 bins, and the paper's model on a cycle.
 #include <benchmark/benchmark.h>
 
 #include <cmath>
 #include <random>
 
 #include "compensation/fit.hpp"
+#include "sim_devices/sim_world.hpp"
+#include "tests/calibration/paper_cycle.hpp"
 
 namespace {
 
@@ -30,5 +32,19 @@ void BM_Fit5TermsOn10kBins(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_Fit5TermsOn10kBins)->Arg(10000)->Unit(benchmark::kMicrosecond);
+
+// The paper's model (B0, k1, k0) on one simulated gyro's paper cycle (65 bins): what one fit of
+// `station fit` costs, the REML error model of correlated_errors.hpp included.
+void BM_FitPaperCycle(benchmark::State& state) {
+  namespace sc = station::compensation;
+  station::sim::GyroConfig g;
+  g.coefficients = station::sim::sim_coefficients(1, 0);
+  const sc::ModelData d = station::test::paper_cycle_bins(g);
+  for (auto _ : state) {
+    auto fit = sc::fit_model(d.view(), {});
+    benchmark::DoNotOptimize(fit.std_errors.data());
+  }
+}
+BENCHMARK(BM_FitPaperCycle)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
