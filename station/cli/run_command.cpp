@@ -16,6 +16,7 @@
 #include "drivers/can/candump_log.hpp"
 #include "drivers/common/clock.hpp"
 #include "station/cli/commands.hpp"
+#include "station/cli/live_service.hpp"
 #include "station/cli/probe.hpp"
 #include "station/common/logging.hpp"
 #include "station/common/process_lock.hpp"
@@ -30,6 +31,7 @@ namespace station {
 namespace {
 
 std::atomic<bool> g_stop{false};
+std::atomic<bool> g_abort{false};  // the API's abort: end without bins or fit
 
 void on_signal(int) {
   g_stop.store(true);
@@ -52,7 +54,30 @@ struct RunOptions {
   std::uint64_t seed = 1;
   std::string gyro_preset = "station";
   double latitude_deg = 39.9;
+  double speed = 0;  ///< --sim: simulated s per wall s (0: as fast as possible)
+  std::string http;  ///< --http HOST:PORT (empty: no HTTP service)
+  std::string token_file;
 };
+
+/// The live service of this run (HTTP only with --http).
+LiveServiceOptions live_options(const RunOptions& o, const std::string& db,
+                                const std::string& station, bool sim) {
+  LiveServiceOptions lo;
+  lo.listen = o.http;
+  lo.token_file = o.token_file;
+  lo.db_path = db;
+  lo.info.station = station;
+  lo.info.sim = sim;
+  if (sim && o.speed > 0) lo.info.speed = o.speed;
+  return lo;
+}
+
+/// Hooks the live hub into a run's options.
+void attach_live(LiveService& live, SequencerOptions& so) {
+  so.abort = &g_abort;
+  live::attach(live.hub(), so);
+  if (live.serving()) so.http_url = live.hub().status().value("http", "");
+}
 
 /// One daemon per database (and, on a real rig, per device): held until the process ends.
 std::vector<ProcessLock> lock_db_and_devices(const std::string& db, const StationConfig* config) {
@@ -149,9 +174,14 @@ int run_real(const RunOptions& o) {
     so.on_tick = [&session](const TickReport&) { session->after_tick(); };
     so.on_resume = [&session](double last_s, double next_s) { session->resumed(last_s, next_s); };
   }
+  OneRunControl control(g_stop, g_abort);
+  LiveService live(live_options(o, o.db, config.name, false), control);
+  attach_live(live, so);
   Sequencer seq(config, protocol, rig, store, clock, so);
   sd_notify(0, "READY=1");
   const RunOutcome out = seq.run(resume);
+  live.hub().run_ended(out.run_id, out.state);
+  live.shutdown();
   if (session) session->finish(store, out.run_id);
   sd_notify(0, "STOPPING=1");
   fmt::print("run {} {} at t = {:.0f} s after {} ticks\n", out.run_id, out.state, out.t_s,
@@ -188,7 +218,20 @@ int run_sim(const RunOptions& o) {
       throw InputError(fmt::format("--fault '{}': expected TICK:COMMAND, e.g. 3000:door open", f));
     so.faults.emplace_back(at_s, f.substr(colon + 1));
   }
-  const auto report = run_simulated(so);
+  so.speed = o.speed;
+  OneRunControl control(g_stop, g_abort);
+  LiveService live(live_options(o, db, "simulated-rig", true), control);
+  so.extend = [&live](SequencerOptions& s) { attach_live(live, s); };
+  nlohmann::json report;
+  try {
+    report = run_simulated(so);
+  } catch (const std::exception& e) {
+    live.hub().run_ended(live.hub().current_run().value_or(0), fmt::format("failed: {}", e.what()));
+    live.shutdown();
+    throw;
+  }
+  live.hub().run_ended(report["run_id"].get<std::int64_t>(), report["state"].get<std::string>());
+  live.shutdown();
   if (o.json) {
     std::cout << report.dump(2) << '\n';
   } else {
@@ -240,6 +283,15 @@ void add_run_command(CLI::App& app, CommandStatus& status) {
                   "--sim: the simulated gyros' part number (default: the part file's first, in "
                   "sort order)");
   cmd->add_flag("--json", o->json, "print one JSON object at the end (--sim)");
+  cmd->add_option("--speed", o->speed,
+                  "--sim: simulated seconds per wall second, to watch a run live (600: the 13 h "
+                  "cycle in ~80 s; default: as fast as possible)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--http", o->http,
+                  "serve the live page, JSON API and /metrics at HOST:PORT (schemas/api.md); "
+                  "127.0.0.1:0 picks a free port and prints it");
+  cmd->add_option("--token-file", o->token_file,
+                  "the API's bearer token (created 0600 at first start; default DB.token)");
   cmd->callback([o, &status] {
     LogOptions lo;
     lo.console_level = o->sim ? spdlog::level::warn : spdlog::level::info;
@@ -247,6 +299,7 @@ void add_run_command(CLI::App& app, CommandStatus& status) {
     lo.journald = std::getenv("JOURNAL_STREAM") != nullptr;
     setup_logging(lo);
     install_signal_handlers();
+    if (!o->sim && o->speed > 0) throw InputError("--speed is for --sim (a rig runs at 1 Hz)");
     if (!o->sim && (o->config.empty() || o->db.empty())) {
       throw InputError("run: give --config FILE and --db PATH, or --sim");
     }

@@ -61,7 +61,9 @@ void Sequencer::emit(double t_s, const std::string& severity, const std::string&
                    : severity == "warn" ? spdlog::level::warn
                                         : spdlog::level::info;
   log(source)->log(lvl, "{} t_s={:.0f} run={} {}", kind, t_s, run_id_, message);
-  store_.add_event(run_id_, t_s, severity, source, kind, message, data_json);
+  const auto id = store_.add_event(run_id_, t_s, severity, source, kind, message, data_json);
+  if (options_.on_event)
+    options_.on_event({id, run_id_, t_s, severity, source, kind, message, data_json});
 }
 
 void Sequencer::connect_devices() {
@@ -81,11 +83,19 @@ void Sequencer::read_devices(double t_s, TickData& d) {
   // reads measured slower on 2 cores: the simulators' threads compete for them.)
   std::optional<PhaseTimer> timer(std::in_place, phase_s_.can);
   auto counts = rig_.counters->tick(latch_seq_++);
-  if (counts) d.counts = std::move(counts).value();
+  if (counts) {
+    d.counts = std::move(counts).value();
+  } else {
+    d.io_errors.push_back({"can", dr::to_string(counts.error().kind)});
+  }
   note_counters(t_s, d, counts ? std::string() : counts.error().message);
   timer.emplace(phase_s_.chamber);
   auto chamber = rig_.chamber->read();
-  if (chamber) d.chamber = chamber.value();
+  if (chamber) {
+    d.chamber = chamber.value();
+  } else {
+    d.io_errors.push_back({"chamber", dr::to_string(chamber.error().kind)});
+  }
   note_link(t_s, "chamber", chamber.ok(), chamber ? std::string() : chamber.error().message);
   timer.emplace(phase_s_.table);
   if (rig_.turntable) {
@@ -93,6 +103,8 @@ void Sequencer::read_devices(double t_s, TickData& d) {
     if (table) {
       d.table = table.value();
       d.table_interlock_open = d.table->interlock_open;
+    } else {
+      d.io_errors.push_back({"turntable", dr::to_string(table.error().kind)});
     }
     note_link(t_s, "turntable", table.ok(), table ? std::string() : table.error().message);
   }
@@ -180,11 +192,22 @@ void Sequencer::read_gpio(double t_s, TickData& d) {
            fmt::format("{} {}", e.role, e.rising ? "rising" : "falling"));
     }
   }
-  if (auto closed = rig_.gpio->read(dr::gpio::roles::interlock); closed) {
-    d.gpio_interlock_closed = closed.value();
+  const auto has = [this](std::string_view role) {
+    return dr::gpio::find_role(rig_.gpio->config(), role) != nullptr;
+  };
+  if (has(dr::gpio::roles::interlock)) {
+    if (auto closed = rig_.gpio->read(dr::gpio::roles::interlock); closed) {
+      d.gpio_interlock_closed = closed.value();
+    } else {
+      d.io_errors.push_back({"gpio", dr::to_string(closed.error().kind)});
+    }
   }
-  if (auto pressed = rig_.gpio->read(dr::gpio::roles::estop); pressed) {
-    d.gpio_estop_pressed = pressed.value();
+  if (has(dr::gpio::roles::estop)) {
+    if (auto pressed = rig_.gpio->read(dr::gpio::roles::estop); pressed) {
+      d.gpio_estop_pressed = pressed.value();
+    } else {
+      d.io_errors.push_back({"gpio", dr::to_string(pressed.error().kind)});
+    }
   }
 }
 
@@ -310,6 +333,28 @@ void Sequencer::apply_actions(double t_s, const Actions& a) {
       emit(t_s, "warn", "table", "command_failed", r.error().message);
     }
   }
+}
+
+TickReport Sequencer::report(double t_s, const TickData& d) const {
+  TickReport r;
+  r.t_s = t_s;
+  r.step_index = runner_->progress().step_index;
+  r.steps = static_cast<int>(protocol_.steps.size());
+  if (r.step_index >= 0 && r.step_index < r.steps)
+    r.step_label = protocol_.steps[static_cast<std::size_t>(r.step_index)].label;
+  r.recording = runner_->progress().recording;
+  r.safe_hold = safety_.holding();
+  r.air_c = d.obs.air_c;
+  r.run_id = run_id_;
+  r.chamber = d.chamber;
+  r.table = d.table;
+  r.door_closed = d.gpio_interlock_closed;
+  r.estop_pressed = d.gpio_estop_pressed;
+  r.table_interlock_open = d.table_interlock_open;
+  r.rows = &d.rows;
+  r.io_errors = d.io_errors;
+  r.replaying = replaying_;
+  return r;
 }
 
 void Sequencer::tick(double t_s, TickData& d) {

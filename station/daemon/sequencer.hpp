@@ -25,7 +25,13 @@
 
 namespace station {
 
-/// One tick's summary for progress lines and hooks.
+/// One device I/O failure of a tick (metrics): device ("chamber", "turntable", "can", "gpio")
+/// and drivers::ErrorKind by name.
+struct IoError {
+  std::string device, kind;
+};
+
+/// One tick's summary for progress lines, the live page and metrics.
 struct TickReport {
   double t_s = 0;
   int step_index = 0;
@@ -33,6 +39,25 @@ struct TickReport {
   bool recording = false;
   bool safe_hold = false;
   std::optional<double> air_c;
+  std::int64_t run_id = 0;
+  std::string step_label;
+  std::optional<drivers::ChamberState> chamber;  ///< empty: not read this tick
+  std::optional<drivers::TurntableState> table;
+  std::optional<bool> door_closed, estop_pressed, table_interlock_open;  ///< safety inputs
+  const std::vector<SampleRow>* rows = nullptr;  ///< this tick's samples (valid during the call)
+  std::vector<IoError> io_errors;
+  double tick_wall_s = 0;    ///< wall time the tick took (devices, safety, store)
+  std::int64_t skipped = 0;  ///< deadlines missed just before this tick (overrun)
+  bool replaying = false;    ///< a resumed simulation recomputing stored ticks
+};
+
+/// An event as the sequencer stores it (SequencerOptions::on_event).
+struct RunEvent {
+  std::int64_t id = 0;  ///< events.id
+  std::int64_t run_id = 0;
+  double t_s = 0;
+  std::string severity, source, kind, message;
+  std::optional<std::string> data_json;
 };
 
 /// How to run.
@@ -44,6 +69,18 @@ struct SequencerOptions {
   std::function<void(const TickReport&)> on_tick;  ///< progress / tests
   std::function<void()> watchdog;                  ///< systemd WATCHDOG=1 each tick
   const std::atomic<bool>* stop = nullptr;         ///< set by SIGTERM/SIGINT
+  /// Ends the run at the next tick without binning or fitting: state 'aborted' (API abort).
+  const std::atomic<bool>* abort = nullptr;
+  /// Told each stored event (the live page's event stream). Called on the sequencer's thread.
+  std::function<void(const RunEvent&)> on_event;
+  /// Where the live page is served (an 'http' event at the run's start or resume: the port a
+  /// `--http HOST:0` chose is in the run's record).
+  std::string http_url;
+  /// Told the run's id, protocol (as clamped) and slots once it is created or resumed, before
+  /// the first tick.
+  std::function<void(std::int64_t run_id, const Protocol& protocol,
+                     const std::vector<RunSlot>& slots)>
+      on_run_start;
   /// Deterministic simulation resume: replay ticks up to this time without storing them.
   std::optional<double> replay_until_t_s;
   /// A resumed run's first tick as a recorded daemon chose it (from the wall clock): a session
@@ -59,7 +96,7 @@ struct SequencerOptions {
 /// How a run ended.
 struct RunOutcome {
   std::int64_t run_id = 0;
-  std::string state;  ///< completed | stopped
+  std::string state;  ///< completed | incomplete | stopped | aborted
   double t_s = 0;     ///< last tick
   std::int64_t ticks = 0;
 };
@@ -83,7 +120,10 @@ class Sequencer {
     std::optional<bool> table_interlock_open, gpio_interlock_closed, gpio_estop_pressed;
     std::vector<SampleRow> rows;
     Observation obs;
+    std::vector<IoError> io_errors;
   };
+  /// The tick's summary for SequencerOptions::on_tick.
+  TickReport report(double t_s, const TickData& d) const;
   /// The first tick of a resumed run, strictly after its last committed one; logs the resume.
   double resume_first_tick(const RunRecord& resume);
   /// Outages the killed daemon left open go on in this process (one event when they end).
@@ -103,6 +143,8 @@ class Sequencer {
   /// Ends the run: closes open outages, bins and fits; returns the final state ('incomplete'
   /// instead of 'completed' when a slot lost more than max_lost_share of its record window).
   std::string finish(const std::string& state, double t_s);
+  /// Ends the run without bins or fit (SequencerOptions::abort): state 'aborted'.
+  std::string abort(double t_s);
   /// Judges a slot's fit against its part (options_.part_limits): verdict stored and an event.
   void judge(double t_s, const SerialFit& f);
   /// Stores each slot's part and a snapshot of its limits with a new run.

@@ -49,6 +49,18 @@ std::string Sequencer::finish(const std::string& end_state, double t_s) {
   return state;
 }
 
+std::string Sequencer::abort(double t_s) {
+  drive_outputs(t_s, SafetyOutputs{});  // gyro power off, lamps dark
+  for (const auto& o : outages_.close_all(t_s))
+    emit(t_s, "warn", o.device, "outage",
+         fmt::format("still down when the run was aborted: {} lost ticks since t = {:.0f} s ({})",
+                     o.ticks_lost, o.start_s, o.error),
+         outage_json(o));
+  store_.finish_run(run_id_, "aborted");
+  emit(t_s, "warn", "seq", "run_end", fmt::format("run {} aborted (no bins, no fit)", run_id_));
+  return "aborted";
+}
+
 void Sequencer::judge(double t_s, const SerialFit& f) {
   const auto it = options_.part_limits.find(f.serial);
   if (it == options_.part_limits.end()) return;
@@ -141,17 +153,22 @@ RunOutcome Sequencer::run(const std::optional<RunRecord>& resume) {
     for (const auto& n : notes) emit(0, "warn", "safety", "clamp", n);
   }
   runner_.emplace(protocol_, progress);
+  if (options_.on_run_start) options_.on_run_start(run_id_, protocol_, run_slots_of(config_));
+  if (!options_.http_url.empty())
+    emit(t_first, "info", "http", "listen", fmt::format("live page at {}", options_.http_url));
   connect_devices();
   const double start = clock_.now_s();
   std::int64_t ticks = 0;
   for (std::int64_t k = 0;; ++k) {
     const double deadline = start + static_cast<double>(k) * period;
+    std::int64_t skipped = 0;
     if (k > 0) {
       const auto due = static_cast<std::int64_t>(std::floor((clock_.now_s() - start) / period));
       if (due > k) {  // absolute deadlines: a late tick skips, it never shifts the schedule
         log("seq")->warn("overrun: {} tick(s) skipped at t_s={:.0f}", due - k,
                          t_first + k * period);
         rig_.counters->note_skipped_ticks(static_cast<int>(due - k));  // next delta spans them
+        skipped = due - k;
         k = due;
       } else {
         watch_inputs_until(deadline, t_first + static_cast<double>(k - 1) * period);
@@ -166,14 +183,18 @@ RunOutcome Sequencer::run(const std::optional<RunRecord>& resume) {
           std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
     }
     TickData d;
+    const auto w0 = std::chrono::steady_clock::now();
     tick(t_s, d);
     ++ticks;
     if (options_.watchdog) options_.watchdog();
     if (options_.on_tick) {
-      options_.on_tick({t_s, runner_->progress().step_index,
-                        static_cast<int>(protocol_.steps.size()), runner_->progress().recording,
-                        safety_.holding(), d.obs.air_c});
+      TickReport r = report(t_s, d);
+      r.tick_wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
+      r.skipped = skipped;
+      options_.on_tick(r);
     }
+    if (options_.abort != nullptr && options_.abort->load())
+      return {run_id_, abort(t_s), t_s, ticks};
     const bool stop = options_.stop != nullptr && options_.stop->load();
     if (runner_->done() || stop) {
       const std::string state = runner_->done() ? "completed" : "stopped";

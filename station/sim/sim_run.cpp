@@ -20,6 +20,7 @@
 #include "station/daemon/sequencer.hpp"
 #include "station/parts/judged_fit.hpp"
 #include "station/session/session_recording.hpp"
+#include "station/sim/paced_clock.hpp"
 #include "station/store/calibration.hpp"
 #include "station/store/fit_json.hpp"
 
@@ -107,7 +108,10 @@ nlohmann::json run_simulated(const SimRunOptions& o) {
   RigOptions ro;
   sim::SimClock sim_clock;
   drivers::MonotonicClock wall_clock;
-  drivers::Clock& clock = o.wall_clock ? static_cast<drivers::Clock&>(wall_clock) : sim_clock;
+  PacedClock paced(sim_clock, o.speed > 0 ? o.speed : 1.0);
+  drivers::Clock& clock = o.wall_clock  ? static_cast<drivers::Clock&>(wall_clock)
+                          : o.speed > 0 ? static_cast<drivers::Clock&>(paced)
+                                        : sim_clock;
   // Logs are stamped on the run's clock: the simulated one starts at the wall time the
   // simulation started, so a simulated session reads like a recorded one (13 h of traffic
   // spans 13 h of time stamps, not the seconds the simulation took).
@@ -184,6 +188,7 @@ nlohmann::json run_simulated(const SimRunOptions& o) {
                r.t_s / 3600.0, nominal_s / 3600.0, r.step_index + 1, r.steps, r.air_c.value_or(NAN),
                r.recording ? "  recording" : "", r.safe_hold ? "  SAFE HOLD" : "");
   };
+  if (o.extend) o.extend(so);
   Sequencer seq(config, protocol, rig, store, clock, so);
   const RunOutcome out = seq.run(resume);
   if (session) session->finish(store, out.run_id);

@@ -18,6 +18,8 @@ class SimWorld;
 
 namespace station {
 
+struct SequencerOptions;
+
 /// Options of a simulated run.
 struct SimRunOptions {
   int gyros = 4;
@@ -29,6 +31,7 @@ struct SimRunOptions {
   bool fresh = false;              ///< ignore an unfinished run in the database
   bool progress = true;            ///< progress lines on stderr
   bool wall_clock = false;         ///< run at 1 Hz on CLOCK_MONOTONIC instead of simulated time
+  double speed = 0;                ///< simulated s per wall s (0: as fast as possible)
   std::string record_can_path;     ///< write every CAN frame in candump format here (empty: no)
   std::string record_dir;          ///< record the session in this directory (empty: no)
   std::string parts_path;          ///< part file: every simulated gyro is judged (empty: no)
@@ -37,6 +40,8 @@ struct SimRunOptions {
   /// simrig control command (docs/SIMRIG.md), e.g. {3000, "door open"}. In time order.
   std::vector<std::pair<double, std::string>> faults;
   const std::atomic<bool>* stop = nullptr;
+  /// Adds hooks to the sequencer's options before the run (the live hub: live::attach).
+  std::function<void(SequencerOptions&)> extend;
   /// Test hook: called with each tick's time and the world, after it advanced (fault injection).
   std::function<void(double t_s, sim::SimWorld& world)> on_world_tick;
 };

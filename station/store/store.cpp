@@ -361,9 +361,10 @@ std::optional<FitRecord> Store::latest_fit_of_run(const std::string& serial, std
   return read_fit(st);
 }
 
-void Store::add_event(std::optional<std::int64_t> run_id, double t_s, const std::string& severity,
-                      const std::string& source, const std::string& kind,
-                      const std::string& message, const std::optional<std::string>& data_json) {
+std::int64_t Store::add_event(std::optional<std::int64_t> run_id, double t_s,
+                              const std::string& severity, const std::string& source,
+                              const std::string& kind, const std::string& message,
+                              const std::optional<std::string>& data_json) {
   auto st = db_.prepare(
       "INSERT INTO events (run_id, t_s, wall_utc, severity, source, kind, message, data_json) "
       "VALUES (?,?,?,?,?,?,?,?)");
@@ -378,6 +379,7 @@ void Store::add_event(std::optional<std::int64_t> run_id, double t_s, const std:
   else
     st.bind_null(8);
   st.step();
+  return db_.last_insert_id();
 }
 
 std::vector<std::string> Store::events(std::int64_t run_id) {

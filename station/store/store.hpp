@@ -142,9 +142,11 @@ class Store {
 
   /// One event; `data_json` (column events.data_json, migration 2) is structured detail, e.g. an
   /// outage's {"device","start_s","end_s","ticks_lost"}.
-  void add_event(std::optional<std::int64_t> run_id, double t_s, const std::string& severity,
-                 const std::string& source, const std::string& kind, const std::string& message,
-                 const std::optional<std::string>& data_json = std::nullopt);
+  /// Stores an event; returns its id (events.id, increasing).
+  std::int64_t add_event(std::optional<std::int64_t> run_id, double t_s,
+                         const std::string& severity, const std::string& source,
+                         const std::string& kind, const std::string& message,
+                         const std::optional<std::string>& data_json = std::nullopt);
   /// Events of a run as "kind: message" in order.
   std::vector<std::string> events(std::int64_t run_id);
   /// Events of a run, in order, every column.

@@ -1,0 +1,20 @@
+// The API's read side over the database (schemas/api.md): runs, one run, its bins, its events.
+// Each function takes a read-only Store and returns the JSON body, or nullopt for an unknown run.
+#pragma once
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <optional>
+
+#include "station/store/store.hpp"
+
+namespace station::http {
+
+nlohmann::json runs_json(Store& store, int limit);
+std::optional<nlohmann::json> run_json(Store& store, std::int64_t run_id);
+/// Stored bins per serial; `live` (the daemon's live bins of a running run) when none is stored.
+std::optional<nlohmann::json> bins_json(Store& store, std::int64_t run_id,
+                                        const std::optional<nlohmann::json>& live);
+std::optional<nlohmann::json> events_json(Store& store, std::int64_t run_id, std::int64_t since_id);
+
+}  // namespace station::http

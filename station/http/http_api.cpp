@@ -1,0 +1,218 @@
+// The API's routes (schemas/api.md): status, runs, bins, events, control, the event stream and
+// the metrics.
+#include <fmt/format.h>
+
+#include <charconv>
+
+#include "station/common/logging.hpp"
+#include "station/http/api_runs.hpp"
+#include "station/http/http_server.hpp"
+#include "station/store/sqlite.hpp"
+
+// Last: httplib.h pulls in <resolv.h>, whose `_res` macro breaks Eigen headers included after it.
+#include <httplib.h>
+
+namespace station::http {
+
+namespace {
+
+void send_json(httplib::Response& res, int status, const nlohmann::json& body) {
+  res.status = status;
+  res.set_content(body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace),
+                  "application/json");
+}
+
+/// A positive decimal integer, or nullopt.
+std::optional<std::int64_t> positive_int(const std::string& text) {
+  std::int64_t v = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (text.empty() || ec != std::errc() || end != text.data() + text.size() || v <= 0)
+    return std::nullopt;
+  return v;
+}
+
+/// The run id of the path, or a 400 answered.
+std::optional<std::int64_t> run_id_of(const httplib::Request& req, httplib::Response& res) {
+  const auto id = positive_int(req.matches[1].str());
+  if (!id)
+    send_json(
+        res, 400,
+        {{"error", fmt::format("run id '{}': expected a positive integer", req.matches[1].str())}});
+  return id;
+}
+
+/// A string field of a JSON object body: absent -> fallback (nullopt when required), else text.
+std::optional<std::string> string_field(const nlohmann::json& body, const char* key,
+                                        std::size_t max_len, std::string& error) {
+  if (!body.contains(key)) return std::nullopt;
+  if (!body[key].is_string() || body[key].get<std::string>().size() > max_len) {
+    error = fmt::format("field '{}': expected a string of at most {} characters", key, max_len);
+    return std::nullopt;
+  }
+  return body[key].get<std::string>();
+}
+
+}  // namespace
+
+void HttpServer::api_routes() {
+  auto& s = *server_;
+  s.Get("/api/status", [this](const httplib::Request& req, httplib::Response& res) {
+    if (may_read(req, res)) send_json(res, 200, hub_.status());
+  });
+  s.Get("/api/live", [this](const httplib::Request& req, httplib::Response& res) {
+    if (may_read(req, res)) send_json(res, 200, hub_.live());
+  });
+  s.Get("/metrics", [this](const httplib::Request& req, httplib::Response& res) {
+    if (may_read(req, res)) res.set_content(hub_.metrics().text(), "text/plain; version=0.0.4");
+  });
+  // Database reads: one at a time on the read-only connection; a database that cannot be read
+  // (not created yet, locked for longer than the busy timeout) is a 503 naming it.
+  const auto db_read = [this](const httplib::Request& req, httplib::Response& res, auto&& body) {
+    if (!may_read(req, res)) return;
+    try {
+      std::lock_guard lock(store_mu_);
+      body(store());
+    } catch (const SqliteError& e) {
+      store_.reset();
+      send_json(res, 503, {{"error", e.what()}});
+    }
+  };
+  s.Get("/api/runs", [db_read](const httplib::Request& req, httplib::Response& res) {
+    int limit = 100;
+    if (req.has_param("limit")) {
+      const auto v = positive_int(req.get_param_value("limit"));
+      if (!v || *v > 10000) {
+        send_json(res, 400, {{"error", "limit: expected an integer 1..10000"}});
+        return;
+      }
+      limit = static_cast<int>(*v);
+    }
+    db_read(req, res, [&](Store& st) { send_json(res, 200, runs_json(st, limit)); });
+  });
+  s.Get(R"(/api/runs/([^/]+))", [db_read](const httplib::Request& req, httplib::Response& res) {
+    const auto id = run_id_of(req, res);
+    if (!id) return;
+    db_read(req, res, [&](Store& st) {
+      const auto j = run_json(st, *id);
+      send_json(res, j ? 200 : 404,
+                j ? *j : nlohmann::json{{"error", fmt::format("no run {}", *id)}});
+    });
+  });
+  s.Get(R"(/api/runs/([^/]+)/bins)",
+        [this, db_read](const httplib::Request& req, httplib::Response& res) {
+          const auto id = run_id_of(req, res);
+          if (!id) return;
+          const auto live = hub_.live_bins(*id);
+          db_read(req, res, [&](Store& st) {
+            const auto j = bins_json(st, *id, live);
+            send_json(res, j ? 200 : 404,
+                      j ? *j : nlohmann::json{{"error", fmt::format("no run {}", *id)}});
+          });
+        });
+  s.Get(R"(/api/runs/([^/]+)/events)",
+        [db_read](const httplib::Request& req, httplib::Response& res) {
+          const auto id = run_id_of(req, res);
+          if (!id) return;
+          std::int64_t since = 0;
+          if (req.has_param("since")) {
+            const std::string v = req.get_param_value("since");
+            const auto n = v == "0" ? std::optional<std::int64_t>(0) : positive_int(v);
+            if (!n) {
+              send_json(res, 400, {{"error", "since: expected an event id (integer >= 0)"}});
+              return;
+            }
+            since = *n;
+          }
+          db_read(req, res, [&](Store& st) {
+            const auto j = events_json(st, *id, since);
+            send_json(res, j ? 200 : 404,
+                      j ? *j : nlohmann::json{{"error", fmt::format("no run {}", *id)}});
+          });
+        });
+}
+
+void HttpServer::control_routes() {
+  auto& s = *server_;
+  s.Post("/api/runs", [this](const httplib::Request& req, httplib::Response& res) {
+    if (!may_write(req, res)) return;
+    const auto body = nlohmann::json::parse(req.body, nullptr, false);
+    if (body.is_discarded() || !body.is_object()) {
+      send_json(res, 400,
+                {{"error",
+                  "body: expected a JSON object {\"protocol\": NAME, "
+                  "\"operator\": NAME}"}});
+      return;
+    }
+    std::string error;
+    const auto protocol = string_field(body, "protocol", 4096, error);
+    const auto op = string_field(body, "operator", 200, error);
+    if (!error.empty() || !protocol || protocol->empty()) {
+      send_json(res, 400, {{"error", error.empty() ? "field 'protocol' is required" : error}});
+      return;
+    }
+    const ControlReply r = control_.start(*protocol, op.value_or(""));
+    send_json(res, r.status,
+              r.status < 300 ? nlohmann::json{{"accepted", r.message}}
+                             : nlohmann::json{{"error", r.message}});
+  });
+  const auto end_run = [this](bool abort) {
+    return [this, abort](const httplib::Request& req, httplib::Response& res) {
+      if (!may_write(req, res)) return;
+      const auto id = run_id_of(req, res);
+      if (!id) return;
+      const auto current = hub_.current_run();
+      if (current != id) {
+        bool exists = false;
+        try {
+          std::lock_guard lock(store_mu_);
+          exists = run_json(store(), *id).has_value();
+        } catch (const SqliteError&) {
+          store_.reset();
+        }
+        send_json(res, exists ? 409 : 404,
+                  {{"error", exists ? fmt::format("run {} is not running", *id)
+                                    : fmt::format("no run {}", *id)}});
+        return;
+      }
+      const ControlReply r = control_.stop(*id, abort);
+      log("http")->info("run {} {} requested from {}", *id, abort ? "abort" : "stop",
+                        req.remote_addr);
+      send_json(res, r.status,
+                r.status < 300 ? nlohmann::json{{"accepted", r.message}}
+                               : nlohmann::json{{"error", r.message}});
+    };
+  };
+  s.Post(R"(/api/runs/([^/]+)/stop)", end_run(false));
+  s.Post(R"(/api/runs/([^/]+)/abort)", end_run(true));
+}
+
+void HttpServer::stream_route() {
+  server_->Get("/api/events/stream", [this](const httplib::Request& req, httplib::Response& res) {
+    if (!may_read(req, res)) return;
+    if (streams_.fetch_add(1) >= options_.max_streams) {
+      streams_.fetch_sub(1);
+      send_json(res, 503,
+                {{"error", fmt::format("at most {} event streams at once", options_.max_streams)}});
+      return;
+    }
+    hub_.metrics().stream_clients(streams_.load());
+    auto after = std::make_shared<std::uint64_t>(hub_.last_id());
+    res.set_chunked_content_provider(
+        "text/event-stream",
+        [this, after](std::size_t, httplib::DataSink& sink) {
+          std::vector<live::StreamMessage> msgs;
+          if (!hub_.wait(*after, msgs, std::chrono::seconds(15))) return false;  // shutting down
+          if (msgs.empty()) {
+            static constexpr std::string_view kAlive = ": keep-alive\n\n";
+            return sink.write(kAlive.data(), kAlive.size());
+          }
+          std::string text;
+          for (const auto& m : msgs) text += m.text;
+          *after = msgs.back().id;
+          return sink.write(text.data(), text.size());
+        },
+        [this](bool) { hub_.metrics().stream_clients(streams_.fetch_sub(1) - 1); });
+  });
+}
+
+}  // namespace station::http

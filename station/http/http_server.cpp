@@ -1,0 +1,198 @@
+// Server set-up: limits, timeouts, error bodies, the request counter, the page and the stream.
+#include "station/http/http_server.hpp"
+
+#include <fmt/format.h>
+
+#include <charconv>
+#include <fstream>
+#include <sstream>
+
+#include "station/common/input_error.hpp"
+#include "station/common/logging.hpp"
+#include "station/http/token.hpp"
+#include "station/web/builtin_web.hpp"
+
+// Last: httplib.h pulls in <resolv.h>, whose `_res` macro breaks Eigen headers included after it.
+#include <httplib.h>
+
+namespace station::http {
+
+namespace {
+
+void send_json(httplib::Response& res, int status, const nlohmann::json& body) {
+  res.status = status;
+  res.set_content(body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace),
+                  "application/json");
+}
+
+bool is_loopback(const std::string& addr) {
+  return addr == "127.0.0.1" || addr == "::1" || addr.rfind("127.", 0) == 0 ||
+         addr.rfind("::ffff:127.", 0) == 0;
+}
+
+const char* mime_of(std::string_view name) {
+  if (name.ends_with(".html")) return "text/html; charset=utf-8";
+  if (name.ends_with(".js")) return "text/javascript; charset=utf-8";
+  if (name.ends_with(".css")) return "text/css; charset=utf-8";
+  if (name.ends_with(".png")) return "image/png";
+  return "application/octet-stream";
+}
+
+}  // namespace
+
+HttpOptions parse_listen(const std::string& address, const std::string& what) {
+  const auto colon = address.rfind(':');
+  HttpOptions o;
+  if (colon == std::string::npos || colon == 0)
+    throw InputError(
+        fmt::format("{} '{}': expected HOST:PORT, e.g. 127.0.0.1:8080", what, address));
+  o.host = address.substr(0, colon);
+  if (o.host.size() > 2 && o.host.front() == '[' && o.host.back() == ']')
+    o.host = o.host.substr(1, o.host.size() - 2);
+  if (o.host == "localhost") o.host = "127.0.0.1";
+  const std::string port = address.substr(colon + 1);
+  const auto [end, ec] = std::from_chars(port.data(), port.data() + port.size(), o.port);
+  if (port.empty() || ec != std::errc() || end != port.data() + port.size() || o.port < 0 ||
+      o.port > 65535)
+    throw InputError(fmt::format("{} '{}': port must be 0..65535", what, address));
+  return o;
+}
+
+HttpServer::HttpServer(HttpOptions options, live::LiveHub& hub, RunControl& control)
+    : options_(std::move(options)), hub_(hub), control_(control) {}
+
+HttpServer::~HttpServer() {
+  stop();
+}
+
+Store& HttpServer::store() {
+  if (!store_) store_.emplace(options_.db_path, OpenMode::read_only);
+  return *store_;
+}
+
+bool HttpServer::may_read(const httplib::Request& req, httplib::Response& res) const {
+  if (is_loopback(req.remote_addr)) return true;
+  return may_write(req, res);
+}
+
+bool HttpServer::may_write(const httplib::Request& req, httplib::Response& res) const {
+  if (!req.has_header("Authorization")) {
+    res.set_header("WWW-Authenticate", "Bearer");
+    send_json(res, 401,
+              {{"error",
+                "this request needs 'Authorization: Bearer TOKEN' (the "
+                "token file's line)"}});
+    return false;
+  }
+  if (!bearer_matches(req.get_header_value("Authorization"), options_.token)) {
+    send_json(res, 403, {{"error", "token refused"}});
+    return false;
+  }
+  return true;
+}
+
+void HttpServer::static_routes() {
+  auto& s = *server_;
+  s.Get("/", [](const httplib::Request&, httplib::Response& res) {
+    for (const auto& [name, text] : builtin::kWebFiles)
+      if (name == "index.html") res.set_content(std::string(text), mime_of(name));
+  });
+  // Only the embedded files: nothing on disk is reachable by name, so no path can traverse.
+  s.Get(R"(/static/([^/]+))", [](const httplib::Request& req, httplib::Response& res) {
+    for (const auto& [name, text] : builtin::kWebFiles) {
+      if (name == req.matches[1].str()) {
+        res.set_content(std::string(text), mime_of(name));
+        return;
+      }
+    }
+    send_json(res, 404, {{"error", fmt::format("no static file '{}'", req.matches[1].str())}});
+  });
+  s.Get(R"(/static/dygraphs/(dygraph\.min\.(js|css)))", [this](const httplib::Request& req,
+                                                               httplib::Response& res) {
+    const std::string path = options_.dygraphs_dir + "/" + req.matches[1].str();
+    std::ifstream in(path, std::ios::binary);
+    if (!in) {
+      send_json(res, 404, {{"error", fmt::format("{}: not installed (libjs-dygraphs)", path)}});
+      return;
+    }
+    std::ostringstream text;
+    text << in.rdbuf();
+    res.set_content(text.str(), mime_of(path));
+  });
+}
+
+void HttpServer::routes() {
+  auto& s = *server_;
+  s.set_payload_max_length(options_.max_body_bytes);
+  s.set_read_timeout(5);
+  s.set_write_timeout(5);
+  s.set_keep_alive_timeout(5);
+  s.set_default_headers({{"X-Content-Type-Options", "nosniff"},
+                         {"Cache-Control", "no-store"},
+                         {"Content-Security-Policy",
+                          "default-src 'self'; style-src 'self' 'unsafe-inline'; "
+                          "frame-ancestors 'none'"}});
+  s.set_exception_handler(
+      [](const httplib::Request& req, httplib::Response& res, std::exception_ptr ep) {
+        std::string what = "unknown error";
+        try {
+          if (ep) std::rethrow_exception(ep);
+        } catch (const std::exception& e) {
+          what = e.what();
+        } catch (...) {
+        }
+        log("http")->warn("{} {}: {}", req.method, req.path, what);
+        send_json(res, 500, {{"error", what}});
+      });
+  s.set_error_handler([](const httplib::Request& req, httplib::Response& res) {
+    if (!res.body.empty()) return;
+    const std::string what = res.status == 413   ? "request body too large (limit 64 KiB)"
+                             : res.status == 404 ? fmt::format("no such resource: {}", req.path)
+                                                 : fmt::format("HTTP {}", res.status);
+    send_json(res, res.status, {{"error", what}});
+  });
+  s.set_logger([this](const httplib::Request&, const httplib::Response& res) {
+    hub_.metrics().http_request(res.status);
+  });
+  static_routes();
+  api_routes();
+  control_routes();
+  stream_route();
+}
+
+int HttpServer::start() {
+  server_ = std::make_unique<httplib::Server>();
+  // Event streams hold a thread each: room for max_streams of them and the API beside.
+  const auto threads = static_cast<std::size_t>(options_.max_streams + 4);
+  server_->new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
+  routes();
+  if (options_.port == 0) {
+    port_ = server_->bind_to_any_port(options_.host);
+  } else {
+    port_ = server_->bind_to_port(options_.host, options_.port) ? options_.port : -1;
+  }
+  if (port_ <= 0)
+    throw InputError(
+        fmt::format("--http {}:{}: cannot listen there (address in use or not this "
+                    "machine's)",
+                    options_.host, options_.port));
+  thread_ = std::thread([this] { server_->listen_after_bind(); });
+  hub_.set_http_url(url());
+  return port_;
+}
+
+void HttpServer::stop() {
+  if (!server_) return;
+  hub_.close();  // ends the streams' waits
+  server_->stop();
+  if (thread_.joinable()) thread_.join();
+  server_.reset();
+}
+
+std::string HttpServer::url() const {
+  const bool v6 = options_.host.find(':') != std::string::npos;
+  return v6 ? fmt::format("http://[{}]:{}/", options_.host, port_)
+            : fmt::format("http://{}:{}/", options_.host, port_);
+}
+
+}  // namespace station::http

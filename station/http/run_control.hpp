@@ -1,0 +1,25 @@
+// What the API can ask of the daemon that serves it: start a run, end the running one. `serve`
+// implements both; `run` (one run per process) refuses to start another.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace station::http {
+
+/// The answer to a control request: an HTTP status and a one-line message.
+struct ControlReply {
+  int status = 202;
+  std::string message;
+};
+
+/// Control of the daemon's runs. Called on HTTP threads: implementations are thread-safe.
+class RunControl {
+ public:
+  virtual ~RunControl() = default;
+  virtual ControlReply start(const std::string& protocol, const std::string& operator_name) = 0;
+  /// Ends the running run `run_id` (the caller checked it is the running one).
+  virtual ControlReply stop(std::int64_t run_id, bool abort) = 0;
+};
+
+}  // namespace station::http

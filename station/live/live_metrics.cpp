@@ -1,0 +1,105 @@
+// Metric definitions and their updates from tick reports.
+#include "station/live/live_metrics.hpp"
+
+#include <prometheus/text_serializer.h>
+
+#include <cmath>
+#include <sstream>
+
+namespace station::live {
+
+namespace pm = prometheus;
+
+namespace {
+
+pm::Family<pm::Counter>& counter(pm::Registry& r, const std::string& name,
+                                 const std::string& help) {
+  return pm::BuildCounter().Name(name).Help(help).Register(r);
+}
+
+pm::Family<pm::Gauge>& gauge(pm::Registry& r, const std::string& name, const std::string& help) {
+  return pm::BuildGauge().Name(name).Help(help).Register(r);
+}
+
+const char* const kStates[] = {"idle", "running", "hold", "fault"};
+
+}  // namespace
+
+LiveMetrics::LiveMetrics()
+    : registry_(std::make_shared<pm::Registry>()),
+      // Buckets around the 1 s period: a healthy tick takes milliseconds, 1 s is a missed one.
+      tick_duration_(pm::BuildHistogram()
+                         .Name("station_tick_duration_seconds")
+                         .Help("Wall time of one tick: devices, safety, store")
+                         .Register(*registry_)
+                         .Add({}, pm::Histogram::BucketBoundaries{0.001, 0.0025, 0.005, 0.01, 0.025,
+                                                                  0.05, 0.1, 0.25, 0.5, 1.0})),
+      ticks_(counter(*registry_, "station_ticks_total", "Ticks run").Add({})),
+      missed_(counter(*registry_, "station_missed_ticks_total",
+                      "Tick deadlines skipped because a tick overran")
+                  .Add({})),
+      device_errors_(counter(*registry_, "station_device_errors_total",
+                             "Device reads that failed, by device and error kind")),
+      reconnects_(counter(*registry_, "station_device_reconnects_total",
+                          "Devices answering again after an outage")),
+      outage_s_(counter(*registry_, "station_device_outage_seconds_total",
+                        "Run time lost to ended device outages, by device")),
+      safe_hold_(gauge(*registry_, "station_safe_hold", "1 while the rig is in safe hold").Add({})),
+      air_c_(gauge(*registry_, "station_chamber_air_celsius", "Chamber air temperature").Add({})),
+      setpoint_c_(
+          gauge(*registry_, "station_chamber_setpoint_celsius", "Chamber setpoint").Add({})),
+      table_rate_(
+          gauge(*registry_, "station_table_rate_degrees_per_second", "Turntable rate").Add({})),
+      samples_(counter(*registry_, "station_samples_stored_total", "Gyro samples stored").Add({})),
+      run_state_(gauge(*registry_, "station_run_state", "1 for the station's current state")),
+      run_id_(
+          gauge(*registry_, "station_run_id", "Id of the current or last run (0: none)").Add({})),
+      http_requests_(
+          counter(*registry_, "station_http_requests_total", "HTTP requests by status code")),
+      stream_clients_(
+          gauge(*registry_, "station_event_stream_clients", "Clients attached to the event stream")
+              .Add({})) {
+  set_state("idle", 0);
+}
+
+void LiveMetrics::tick(const TickReport& r) {
+  tick_duration_.Observe(r.tick_wall_s);
+  ticks_.Increment();
+  missed_.Increment(static_cast<double>(r.skipped));
+  for (const auto& e : r.io_errors)
+    device_errors_.Add({{"device", e.device}, {"kind", e.kind}}).Increment();
+  safe_hold_.Set(r.safe_hold ? 1 : 0);
+  if (r.chamber) {
+    air_c_.Set(r.chamber->air_c);
+    setpoint_c_.Set(r.chamber->setpoint_c);
+  }
+  if (r.table) table_rate_.Set(r.table->rate_dps);
+  if (r.rows != nullptr) samples_.Increment(static_cast<double>(r.rows->size()));
+}
+
+void LiveMetrics::set_state(const std::string& state, std::int64_t run_id) {
+  for (const char* s : kStates) run_state_.Add({{"state", s}}).Set(state == s ? 1 : 0);
+  run_id_.Set(static_cast<double>(run_id));
+}
+
+void LiveMetrics::reconnect(const std::string& device, double outage_s) {
+  reconnects_.Add({{"device", device}}).Increment();
+  if (std::isfinite(outage_s) && outage_s > 0)
+    outage_s_.Add({{"device", device}}).Increment(outage_s);
+}
+
+void LiveMetrics::http_request(int status) {
+  http_requests_.Add({{"code", std::to_string(status)}}).Increment();
+}
+
+void LiveMetrics::stream_clients(int n) {
+  stream_clients_.Set(n);
+}
+
+std::string LiveMetrics::text() const {
+  std::ostringstream out;
+  pm::TextSerializer().Serialize(out, registry_->Collect());
+  return out.str();
+}
+
+}  // namespace station::live

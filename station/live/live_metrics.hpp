@@ -1,0 +1,53 @@
+// The station's Prometheus metrics (prometheus-cpp core: registry and text serializer; the HTTP
+// room serves them at /metrics). Names follow the Prometheus naming guide: base units (seconds,
+// celsius), _total for counters. Thread-safe: metrics are atomics inside prometheus-cpp.
+#pragma once
+
+#include <prometheus/counter.h>
+#include <prometheus/family.h>
+#include <prometheus/gauge.h>
+#include <prometheus/histogram.h>
+#include <prometheus/registry.h>
+
+#include <memory>
+#include <string>
+
+#include "station/daemon/sequencer.hpp"
+
+namespace station::live {
+
+/// Every metric of the station.
+class LiveMetrics {
+ public:
+  LiveMetrics();
+  /// One tick of a run (not one a resumed simulation recomputes).
+  void tick(const TickReport& r);
+  /// Run state gauge: exactly one of idle, running, hold, fault is 1.
+  void set_state(const std::string& state, std::int64_t run_id);
+  /// A device that answered again after an outage (an 'outage' event).
+  void reconnect(const std::string& device, double outage_s);
+  void http_request(int status);
+  void stream_clients(int n);
+  /// The exposition text (format 0.0.4).
+  std::string text() const;
+
+ private:
+  std::shared_ptr<prometheus::Registry> registry_;
+  prometheus::Histogram& tick_duration_;
+  prometheus::Counter& ticks_;
+  prometheus::Counter& missed_;
+  prometheus::Family<prometheus::Counter>& device_errors_;
+  prometheus::Family<prometheus::Counter>& reconnects_;
+  prometheus::Family<prometheus::Counter>& outage_s_;
+  prometheus::Gauge& safe_hold_;
+  prometheus::Gauge& air_c_;
+  prometheus::Gauge& setpoint_c_;
+  prometheus::Gauge& table_rate_;
+  prometheus::Counter& samples_;
+  prometheus::Family<prometheus::Gauge>& run_state_;
+  prometheus::Gauge& run_id_;
+  prometheus::Family<prometheus::Counter>& http_requests_;
+  prometheus::Gauge& stream_clients_;
+};
+
+}  // namespace station::live

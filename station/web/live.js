@@ -1,0 +1,560 @@
+// The station's live page (schemas/api.md): one GET /api/live for the state so far, then the
+// event stream for everything after it. Nothing polls: the page re-reads /api/live only when a
+// run starts or ends, when the stream reopens after an error, or when the server says 'resync'.
+// Charts are decimated to MAX_POINTS and redrawn at most every DRAW_MS, so a 13 h run stays
+// light. Plain browser JavaScript, no build step.
+(function () {
+  "use strict";
+
+  var MAX_POINTS = 2000;  // per chart
+  var DRAW_MS = 250;      // at most 4 redraws a second
+  var MAX_EVENTS = 50;
+  var TOKEN_KEY = "station.token";
+
+  var S = {
+    status: null,      // the last /api/live status, updated from ticks
+    trend: [],         // [[t_h, air_c, setpoint_c], ...]
+    bins: {},          // serial -> [BIN, ...] sorted by t_mid_s
+    events: [],        // newest first
+    seq: 0,            // last stream id applied
+    runId: null,
+    dirty: {temp: false, bins: false},
+    charts: {},        // id -> Dygraph
+    loading: false,    // a /api/live read is under way: stream messages wait in `held`
+    reloadAgain: false,
+    held: [],
+    busy: false        // a POST is under way
+  };
+
+  function $(id) { return document.getElementById(id); }
+  function num(v, digits) {
+    return (v === null || v === undefined || !isFinite(v)) ? "—" : Number(v).toFixed(digits);
+  }
+  function hm(t_s) {
+    if (t_s === null || t_s === undefined || !isFinite(t_s)) return "—";
+    var m = Math.floor(Math.max(0, t_s) / 60);
+    var h = Math.floor(m / 60);
+    m = m % 60;
+    return h + ":" + (m < 10 ? "0" : "") + m;
+  }
+  function text(id, v) {
+    var el = $(id);
+    if (el.textContent !== v) el.textContent = v;
+  }
+
+  // ---- messages --------------------------------------------------------------------------
+
+  function say(msg, kind) {
+    var el = $("message");
+    el.textContent = msg;
+    el.className = "message " + (kind || "info");
+  }
+
+  // ---- status, steps, banner ---------------------------------------------------------------
+
+  function isActive(state) { return state === "running" || state === "hold"; }
+
+  function renderStatus() {
+    var st = S.status || {};
+    var run = st.run || null;
+    var state = st.state || "—";
+    var stEl = $("state");
+    text("state", state);
+    stEl.className = "state " + state;
+    text("run-id", run ? String(run.id) : "—");
+    text("t-s", run ? hm(run.t_s) : "—");
+    $("t-s").setAttribute("data-t-s", run && run.t_s != null ? String(run.t_s) : "");
+    text("speed", st.speed != null ? "×" + st.speed : "—");
+    text("sim", st.sim === true ? "yes" : st.sim === false ? "no" : "—");
+    text("station", st.station || "—");
+    text("protocol", run ? run.protocol || "" : "");
+    text("operator", run && run.operator ? run.operator : "—");
+    text("step-label", run ? (run.step_label || "—") : "—");
+    $("recording").hidden = !(run && run.recording);
+    renderSteps(run);
+    renderChamber(st);
+    renderSlots(st.slots || []);
+    renderBanner(st);
+    renderButtons(st);
+  }
+
+  var stepsKey = null;
+  function renderSteps(run) {
+    var ol = $("steps");
+    var steps = run && run.steps ? run.steps : [];
+    var key = (run ? run.id : "") + "|" + JSON.stringify(steps);
+    if (key !== stepsKey) {
+      stepsKey = key;
+      while (ol.firstChild) ol.removeChild(ol.firstChild);
+      steps.forEach(function (s) {
+        var li = document.createElement("li");
+        li.appendChild(document.createTextNode(s.label || s.kind || "step"));
+        if (s.label && s.kind) {
+          var k = document.createElement("span");
+          k.className = "kind";
+          k.textContent = " " + s.kind;
+          li.appendChild(k);
+        }
+        ol.appendChild(li);
+      });
+    }
+    var cur = run && run.step_index != null ? run.step_index : -1;
+    for (var i = 0; i < ol.children.length; i++) {
+      var c = i === cur ? "current" : i < cur ? "done" : "";
+      if (ol.children[i].className !== c) ol.children[i].className = c;
+    }
+  }
+
+  function renderChamber(st) {
+    var ch = st.chamber || {};
+    text("air-c", num(ch.air_c, 2) + " °C");
+    text("setpoint-c", num(ch.setpoint_c, 2) + " °C");
+    text("chamber-mode", (ch.mode || "—") + (ch.alarm ? " (ALARM)" : ""));
+    var tb = st.table;
+    text("table", tb ? num(tb.angle_deg, 1) + "°, " + num(tb.rate_dps, 2) + " °/s, " +
+         (tb.mode || "—") + (tb.locked ? ", locked" : "") : "—");
+    var sf = st.safety;
+    if (!sf) { text("safety", "—"); return; }
+    var parts = [];
+    if (sf.door_closed === false) parts.push("door OPEN");
+    if (sf.estop_pressed === true) parts.push("E-STOP");
+    if (sf.table_interlock_open === true) parts.push("table interlock open");
+    if (sf.safe_hold) parts.push("SAFE HOLD");
+    text("safety", parts.length ? parts.join(", ") : "ok");
+  }
+
+  function renderSlots(slots) {
+    var tb = $("slots");
+    if (tb.children.length !== slots.length) {
+      while (tb.firstChild) tb.removeChild(tb.firstChild);
+      slots.forEach(function () {
+        var tr = document.createElement("tr");
+        for (var i = 0; i < 4; i++) tr.appendChild(document.createElement("td"));
+        tb.appendChild(tr);
+      });
+    }
+    slots.forEach(function (s, i) {
+      var td = tb.children[i].children;
+      td[0].textContent = s.serial;
+      td[1].textContent = num(s.bias_dph, 4);
+      td[2].textContent = num(s.temp_c, 2);
+      td[3].textContent = num(s.grad_c, 3);
+    });
+  }
+
+  function renderBanner(st) {
+    var b = $("banner");
+    var hold = st.state === "hold" || (st.safety && st.safety.safe_hold === true);
+    if (hold) {
+      b.textContent = "SAFE HOLD — chamber held at its air temperature, turntable stopped." +
+        " See the events below.";
+      b.className = "banner hold";
+      b.hidden = false;
+    } else if (st.state === "fault") {
+      b.textContent = "FAULT — the last run failed or the devices do not answer." +
+        " See the events below.";
+      b.className = "banner fault";
+      b.hidden = false;
+    } else {
+      b.hidden = true;
+      b.textContent = "";
+      b.className = "banner";
+    }
+  }
+
+  function renderButtons(st) {
+    var active = isActive(st.state) && st.run;
+    $("btn-start").disabled = S.busy || !S.status || !!active;
+    $("btn-stop").disabled = S.busy || !active;
+    $("btn-abort").disabled = S.busy || !active;
+  }
+
+  // ---- data: /api/live and the stream ------------------------------------------------------
+
+  function applyLive(live) {
+    S.status = live.status || {};
+    S.runId = S.status.run ? S.status.run.id : null;
+    S.trend = (live.trend || []).map(function (p) { return [p[0] / 3600, p[1], p[2]]; });
+    thin(S.trend);
+    S.bins = {};
+    var b = live.bins || {};
+    Object.keys(b).forEach(function (serial) {
+      S.bins[serial] = (b[serial] || []).slice().sort(function (x, y) {
+        return x.t_mid_s - y.t_mid_s;
+      });
+    });
+    S.events = (live.events || []).slice().sort(function (x, y) { return y.id - x.id; })
+      .slice(0, MAX_EVENTS);
+    S.seq = live.seq || 0;
+    renderStatus();
+    renderEvents();
+    S.dirty.temp = S.dirty.bins = true;
+    scheduleDraw();
+  }
+
+  // One read of /api/live; stream messages that arrive meanwhile are held and applied after it
+  // (those the snapshot already includes, id <= seq, are dropped).
+  function reload() {
+    if (S.loading) { S.reloadAgain = true; return; }
+    S.loading = true;
+    fetch("/api/live", {cache: "no-store"}).then(function (r) {
+      if (!r.ok) throw new Error("HTTP " + r.status);
+      return r.json();
+    }).then(function (live) {
+      applyLive(live);
+    }).catch(function (e) {
+      say("cannot read /api/live: " + e.message, "error");
+    }).then(function () {
+      S.loading = false;
+      var held = S.held;
+      S.held = [];
+      held.forEach(function (m) { dispatch(m.type, m.id, m.data); });
+      if (S.reloadAgain) { S.reloadAgain = false; reload(); }
+    });
+  }
+
+  function dispatch(type, id, data) {
+    if (S.loading) { S.held.push({type: type, id: id, data: data}); return; }
+    if (id !== null && id <= S.seq) return;
+    if (id !== null) S.seq = id;
+    if (type === "tick") onTick(data);
+    else if (type === "bin") onBin(data);
+    else if (type === "event") onEvent(data);
+    else if (type === "run") onRun(data);
+    else if (type === "resync") reload();
+  }
+
+  function onTick(d) {
+    var st = S.status || (S.status = {});
+    st.state = d.state;
+    if (!st.safety) st.safety = {};
+    st.safety.safe_hold = d.safe_hold;
+    if (!st.chamber) st.chamber = {};
+    st.chamber.air_c = d.air_c;
+    st.chamber.setpoint_c = d.setpoint_c;
+    if (st.run) {
+      st.run.t_s = d.t_s;
+      st.run.step_index = d.step_index;
+      st.run.step_label = d.step_label;
+      st.run.recording = d.recording;
+    }
+    if (d.slots) {
+      var bySerial = {};
+      (st.slots || []).forEach(function (s) { bySerial[s.serial] = s; });
+      st.slots = d.slots.map(function (s) {
+        var o = bySerial[s.serial] || {serial: s.serial};
+        o.bias_dph = s.bias_dph;
+        return o;
+      });
+    }
+    var t_h = d.t_s / 3600;
+    var last = S.trend.length ? S.trend[S.trend.length - 1][0] : -Infinity;
+    if (t_h > last) {
+      S.trend.push([t_h, d.air_c, d.setpoint_c]);
+      thin(S.trend);
+      S.dirty.temp = true;
+      scheduleDraw();
+    }
+    scheduleStatus();
+  }
+
+  function onBin(d) {
+    if (S.runId !== null && d.run_id !== S.runId) return;
+    var list = S.bins[d.serial] || (S.bins[d.serial] = []);
+    var b = d.bin;
+    list = list.filter(function (x) { return Math.abs(x.t_mid_s - b.t_mid_s) > 1e-6; });
+    list.push(b);
+    list.sort(function (x, y) { return x.t_mid_s - y.t_mid_s; });
+    S.bins[d.serial] = list;
+    S.dirty.bins = true;
+    scheduleDraw();
+  }
+
+  function onEvent(e) {
+    if (S.events.some(function (x) { return x.id === e.id; })) return;
+    S.events.unshift(e);
+    if (S.events.length > MAX_EVENTS) S.events.length = MAX_EVENTS;
+    renderEvents();
+  }
+
+  function onRun(d) {
+    var ended = d.state !== "running";
+    var el = $("run-end");
+    el.textContent = "run " + d.run_id + (ended ? " ended: " + d.state : " started");
+    el.setAttribute("data-run-state", d.state);
+    if (S.status && S.runId === d.run_id) {
+      // Shown at once; the snapshot read next says what the station does now.
+      S.status.state = ended ? (/^fail/.test(d.state) ? "fault" : "idle") : "running";
+      renderStatus();
+    }
+    reload();
+  }
+
+  function renderEvents() {
+    var ul = $("events");
+    while (ul.firstChild) ul.removeChild(ul.firstChild);
+    S.events.forEach(function (e) {
+      var li = document.createElement("li");
+      li.className = e.severity || "info";
+      var w = document.createElement("span");
+      w.className = "when";
+      w.textContent = "run " + e.run_id + " " + hm(e.t_s);
+      li.appendChild(w);
+      li.appendChild(document.createTextNode(
+        (e.severity || "info") + " " + (e.source || "") + "/" + (e.kind || "") + ": " +
+        (e.message || "")));
+      ul.appendChild(li);
+    });
+  }
+
+  // Status text is cheap but a fast simulation sends 10 ticks a second: coalesce to frames.
+  var statusPending = false;
+  function scheduleStatus() {
+    if (statusPending) return;
+    statusPending = true;
+    setTimeout(function () { statusPending = false; renderStatus(); }, 100);
+  }
+
+  // ---- charts ------------------------------------------------------------------------------
+
+  // Over MAX_POINTS: drop every other point, keeping the newest (the trend's resolution halves
+  // each time, so a 13 h run ends with ~1000-2000 evenly thinned points).
+  function thin(a) {
+    if (a.length <= MAX_POINTS) return;
+    var lastP = a[a.length - 1];
+    var out = [];
+    for (var i = 0; i < a.length; i += 2) out.push(a[i]);
+    if (out[out.length - 1] !== lastP) out.push(lastP);
+    a.length = 0;
+    Array.prototype.push.apply(a, out);
+  }
+
+  var drawTimer = null, lastDraw = 0;
+  function scheduleDraw() {
+    if (drawTimer !== null) return;
+    var wait = Math.max(0, DRAW_MS - (Date.now() - lastDraw));
+    drawTimer = setTimeout(function () {
+      drawTimer = null;
+      lastDraw = Date.now();
+      draw();
+    }, wait);
+  }
+
+  function hmAxis(v) { return hm(v * 3600); }
+
+  function plot(id, rows, opts, points) {
+    var el = $(id);
+    var note = $(id.replace("chart-", "note-"));
+    if (!rows.length) {
+      if (S.charts[id]) { S.charts[id].destroy(); delete S.charts[id]; }
+      note.hidden = false;
+      el.hidden = true;
+      el.setAttribute("data-points", "0");
+      return;
+    }
+    note.hidden = true;
+    el.hidden = false;
+    var g = S.charts[id];
+    if (g && g.getLabels().join("\u0001") !== opts.labels.join("\u0001")) {
+      g.destroy();
+      delete S.charts[id];
+      g = null;
+    }
+    if (!g) {
+      S.charts[id] = new Dygraph(el, rows, opts);
+    } else {
+      g.updateOptions({file: rows});
+    }
+    el.setAttribute("data-points", String(points));
+  }
+
+  function draw() {
+    if (typeof Dygraph === "undefined") { say("dygraphs did not load", "error"); return; }
+    if (S.dirty.temp) {
+      S.dirty.temp = false;
+      plot("chart-temp", S.trend.slice(), {
+        labels: ["t (h)", "air °C", "setpoint °C"],
+        labelsDiv: $("legend-temp"), legend: "always", labelsSeparateLines: false,
+        xlabel: "t (h)", ylabel: "°C", connectSeparatedPoints: false,
+        colors: ["#1f5fbf", "#d9480f"], strokeWidth: 1.5,
+        axes: {x: {valueFormatter: hmAxis}}
+      }, S.trend.length);
+    }
+    if (S.dirty.bins) {
+      S.dirty.bins = false;
+      var serials = Object.keys(S.bins).sort();
+      var time = binRows(serials, function (b) { return b.t_mid_s / 3600; });
+      var temp = binRows(serials, function (b) { return b.temp_c; });
+      var labelsT = ["t (h)"].concat(serials), labelsC = ["T (°C)"].concat(serials);
+      plot("chart-bias-time", time.rows, {
+        labels: labelsT, labelsDiv: $("legend-bias-time"), legend: "always",
+        xlabel: "t (h)", ylabel: "bias (°/h)", drawPoints: true, pointSize: 2.5,
+        strokeWidth: 1, connectSeparatedPoints: true, xRangePad: 8, axes: {x: {valueFormatter: hmAxis}}
+      }, time.points);
+      plot("chart-bias-temp", temp.rows, {
+        labels: labelsC, labelsDiv: $("legend-bias-temp"), legend: "always",
+        xlabel: "T (°C)", ylabel: "bias (°/h)", drawPoints: true, pointSize: 2.5,
+        strokeWidth: 0, connectSeparatedPoints: false, xRangePad: 8
+      }, temp.points);
+    }
+  }
+
+  // Rows [x, s1, s2, ...] with null where a serial has no bin at that x, sorted by x; at most
+  // MAX_POINTS rows (a 13 h run has ~80 bins per serial, so this only guards odd cases).
+  function binRows(serials, xOf) {
+    var rows = [], points = 0;
+    serials.forEach(function (s, j) {
+      S.bins[s].forEach(function (b) {
+        var x = xOf(b);
+        if (x === null || x === undefined || !isFinite(x)) return;
+        var row = [x];
+        for (var k = 0; k < serials.length; k++) row.push(null);
+        row[j + 1] = b.bias_dph;
+        rows.push(row);
+      });
+    });
+    rows.sort(function (a, b) { return a[0] - b[0]; });
+    // Rows at the same x merge (bins of every serial share their windows' times).
+    var merged = [];
+    rows.forEach(function (r) {
+      var m = merged.length ? merged[merged.length - 1] : null;
+      if (m && m[0] === r[0]) {
+        for (var k = 1; k < r.length; k++) if (r[k] !== null) m[k] = r[k];
+      } else {
+        merged.push(r);
+      }
+    });
+    while (merged.length > MAX_POINTS) {
+      var out = [];
+      for (var i = 0; i < merged.length; i += 2) out.push(merged[i]);
+      merged = out;
+    }
+    merged.forEach(function (r) {
+      for (var k = 1; k < r.length; k++) if (r[k] !== null && r[k] !== undefined) points++;
+    });
+    return {rows: merged, points: points};
+  }
+
+  // ---- the event stream ---------------------------------------------------------------------
+
+  var es = null, errored = false, retryMs = 5000;
+  function openStream() {
+    es = new EventSource("/api/events/stream");
+    ["tick", "bin", "event", "run", "resync"].forEach(function (type) {
+      es.addEventListener(type, function (m) {
+        var id = m.lastEventId ? parseInt(m.lastEventId, 10) : null;
+        var data;
+        if (type === "resync") { dispatch(type, null, {}); return; }
+        try { data = m.data ? JSON.parse(m.data) : {}; } catch (e) {
+          say("unreadable " + type + " message: " + e.message, "error");
+          return;
+        }
+        dispatch(type, isFinite(id) ? id : null, data);
+      });
+    });
+    es.onopen = function () {
+      text("conn", "live");
+      retryMs = 5000;
+      // The stream does not replay what was missed: read the snapshot again once.
+      if (errored) { errored = false; reload(); }
+    };
+    es.onerror = function () {
+      errored = true;
+      if (es.readyState === EventSource.CLOSED) {
+        // The server refused the stream (e.g. 503, too many streams): EventSource gives up, so
+        // open a new one later, backing off.
+        text("conn", "closed; retry in " + Math.round(retryMs / 1000) + " s");
+        es.close();
+        setTimeout(openStream, retryMs);
+        retryMs = Math.min(retryMs * 2, 60000);
+      } else {
+        text("conn", "reconnecting");
+      }
+    };
+  }
+
+  // ---- commands -------------------------------------------------------------------------------
+
+  function token() {
+    var t = sessionStorage.getItem(TOKEN_KEY);
+    if (t) return t;
+    t = window.prompt("Bearer token (the one line of the station's token file, DB.token):", "");
+    if (t === null) return null;
+    t = t.trim();
+    if (!t) return null;
+    sessionStorage.setItem(TOKEN_KEY, t);
+    return t;
+  }
+
+  function post(url, body, what) {
+    var t = token();
+    if (!t) { say(what + ": no token given", "error"); return; }
+    S.busy = true;
+    renderButtons(S.status || {});
+    say(what + "…", "info");
+    fetch(url, {
+      method: "POST",
+      headers: {"Authorization": "Bearer " + t, "Content-Type": "application/json"},
+      body: JSON.stringify(body || {})
+    }).then(function (r) {
+      return r.text().then(function (txt) {
+        var j = null;
+        try { j = txt ? JSON.parse(txt) : null; } catch (e) { j = null; }
+        var err = j && j.error ? j.error : txt.trim();
+        if (r.status === 401 || r.status === 403) {
+          sessionStorage.removeItem(TOKEN_KEY);
+          say(what + ": token refused (HTTP " + r.status + ")" + (err ? ": " + err : "") +
+              ". The next command asks for the token again.", "error");
+        } else if (!r.ok) {
+          say(what + ": HTTP " + r.status + (err ? ": " + err : ""), "error");
+        } else {
+          say(what + ": accepted (HTTP " + r.status + ")", "info");
+        }
+      });
+    }).catch(function (e) {
+      say(what + ": " + e.message, "error");
+    }).then(function () {
+      S.busy = false;
+      renderButtons(S.status || {});
+    });
+  }
+
+  function runId() {
+    return S.status && S.status.run ? S.status.run.id : null;
+  }
+
+  function start() {
+    var protocol = window.prompt("Protocol (a name under the station's protocols):", "paper");
+    if (protocol === null || !protocol.trim()) return;
+    var op = window.prompt("Operator:", sessionStorage.getItem("station.operator") || "");
+    if (op === null) return;
+    sessionStorage.setItem("station.operator", op.trim());
+    post("/api/runs", {protocol: protocol.trim(), operator: op.trim()}, "start " + protocol.trim());
+  }
+
+  function stop() {
+    var id = runId();
+    if (id === null) return;
+    post("/api/runs/" + encodeURIComponent(id) + "/stop", {}, "stop run " + id);
+  }
+
+  function abort() {
+    var id = runId();
+    if (id === null) return;
+    if (!window.confirm("Abort run " + id + "? It ends now without a fit.")) return;
+    post("/api/runs/" + encodeURIComponent(id) + "/abort", {}, "abort run " + id);
+  }
+
+  function init() {
+    $("btn-start").addEventListener("click", start);
+    $("btn-stop").addEventListener("click", stop);
+    $("btn-abort").addEventListener("click", abort);
+    // The stream opens at once; its messages wait until the snapshot is in (see reload), so
+    // nothing between the two is lost.
+    reload();
+    openStream();
+  }
+
+  if (document.readyState === "loading") document.addEventListener("DOMContentLoaded", init);
+  else init();
+})();
