@@ -19,6 +19,8 @@ void add_adev_command(CLI::App& app, CommandStatus& status);
 void add_probe_command(CLI::App& app, CommandStatus& status);
 /// `station run`: run a protocol on a rig (--sim: the embedded simulated rig).
 void add_run_command(CLI::App& app, CommandStatus& status);
+/// `station serve --config FILE --db DB [--http ADDR]`: the long-running service.
+void add_serve_command(CLI::App& app, CommandStatus& status);
 /// `station fit` and `station export`: per-serial fits from the database and their export.
 void add_fit_commands(CLI::App& app, CommandStatus& status);
 /// `station history --db DB --serial SN [--json]`: one gyro's runs, fits, scatter and drift.

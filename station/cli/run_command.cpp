@@ -16,6 +16,7 @@
 #include "drivers/can/candump_log.hpp"
 #include "drivers/common/clock.hpp"
 #include "station/cli/commands.hpp"
+#include "station/cli/daemon_setup.hpp"
 #include "station/cli/live_service.hpp"
 #include "station/cli/probe.hpp"
 #include "station/common/logging.hpp"
@@ -79,19 +80,6 @@ void attach_live(LiveService& live, SequencerOptions& so) {
   if (live.serving()) so.http_url = live.hub().status().value("http", "");
 }
 
-/// One daemon per database (and, on a real rig, per device): held until the process ends.
-std::vector<ProcessLock> lock_db_and_devices(const std::string& db, const StationConfig* config) {
-  std::vector<ProcessLock> locks;
-  locks.push_back(ProcessLock::acquire(db + ".lock", fmt::format("database {}", db)));
-  if (config == nullptr) return locks;
-  std::vector<std::string> endpoints{config->chamber.endpoint, config->can_transport};
-  if (config->turntable) endpoints.push_back(config->turntable->endpoint);
-  for (const auto& e : endpoints) {
-    locks.push_back(ProcessLock::acquire(device_lock_path(e), fmt::format("device {}", e)));
-  }
-  return locks;
-}
-
 /// Forwards to a tap attached later (the CAN log starts after the probe: its SYNC is no tick).
 struct DeferredTap final : drivers::Tap {
   drivers::Tap* target = nullptr;
@@ -99,26 +87,6 @@ struct DeferredTap final : drivers::Tap {
     if (target != nullptr) target->on_exchange(r);
   }
 };
-
-// Whether `db` exists and holds a run to resume (read-only peek: nothing is created or written).
-bool has_unfinished_run(const std::string& db) {
-  if (!std::filesystem::exists(db)) return false;
-  Store peek(db, OpenMode::read_only);
-  return peek.find_unfinished_run().has_value();
-}
-
-/// Each slot's fit and verdict of run `run_id`, one line per slot.
-void print_verdicts(Store& store, std::int64_t run_id) {
-  for (const auto& slot : store.run_slots(run_id)) {
-    const auto fit = store.latest_fit(slot.serial);
-    if (!fit || fit->runs != std::vector<std::int64_t>{run_id}) {
-      fmt::print("  {}: no fit\n", slot.serial);
-      continue;
-    }
-    fmt::print("  {}: fit {}: {}\n", slot.serial, fit->id,
-               verdict_text(stored_verdict(store, fit->id)));
-  }
-}
 
 int run_real(const RunOptions& o) {
   const StationConfig config = load_station_config(o.config);

@@ -166,7 +166,7 @@ void check_slots_unique(const TomlView& root, const std::vector<SlotConfig>& slo
 StationConfig parse_station_config(const std::string& text, const std::string& path) {
   const toml::table tbl = TomlView::parse_text(text, path);
   const TomlView root(tbl, path);
-  root.allow_only({"station", "limits", "chamber", "turntable", "can", "gpio", "slot"});
+  root.allow_only({"station", "limits", "chamber", "turntable", "can", "gpio", "slot", "http"});
   StationConfig c;
   c.path = path;
   c.text = text;
@@ -193,6 +193,22 @@ StationConfig parse_station_config(const std::string& text, const std::string& p
     throw root.error("station", "missing [station] table (latitude_deg is required)");
   }
   if (auto l = root.opt_table("limits")) c.limits = read_limits(*l);
+  if (auto h = root.opt_table("http")) {
+    h->allow_only({"listen", "token_file", "protocol_dir"});
+    const auto beside = [&path](const std::string& p) {
+      return (std::filesystem::path(path).parent_path() / p).string();
+    };
+    c.http.listen = h->opt_string("listen").value_or(c.http.listen);
+    if (c.http.listen.empty()) throw h->error("listen", "must not be empty (HOST:PORT)");
+    if (auto t = h->opt_string("token_file")) {
+      if (t->empty()) throw h->error("token_file", "must not be empty");
+      c.http.token_file = beside(*t);
+    }
+    if (auto d = h->opt_string("protocol_dir")) {
+      if (d->empty()) throw h->error("protocol_dir", "must not be empty");
+      c.http.protocol_dir = beside(*d);
+    }
+  }
   auto chamber = root.opt_table("chamber");
   if (!chamber) throw root.error("chamber", "missing [chamber] table");
   c.chamber = read_modbus_device(*chamber, true);

@@ -50,6 +50,13 @@ struct LimitsConfig {
 };
 
 /// Everything in a station configuration file.
+/// `station serve`'s HTTP service ([http]); paths resolved against the configuration's folder.
+struct HttpConfig {
+  std::string listen = "127.0.0.1:8080";  ///< HOST:PORT (--http overrides)
+  std::string token_file;                 ///< empty: DB.token
+  std::string protocol_dir;  ///< NAME.toml files the API may start, besides the shipped ones
+};
+
 struct StationConfig {
   std::string path;  ///< file it came from
   std::string text;  ///< its full text (snapshot stored with each run)
@@ -71,6 +78,7 @@ struct StationConfig {
   std::optional<drivers::gpio::GpioConfig> gpio;
   LimitsConfig limits;
   std::vector<SlotConfig> slots;
+  HttpConfig http;
 };
 
 /// Reads and validates a configuration file; throws InputError ("FILE:LINE: key 'k': ...").

@@ -146,9 +146,12 @@ void HttpServer::routes() {
       });
   s.set_error_handler([](const httplib::Request& req, httplib::Response& res) {
     if (!res.body.empty()) return;
-    const std::string what = res.status == 413   ? "request body too large (limit 64 KiB)"
-                             : res.status == 404 ? fmt::format("no such resource: {}", req.path)
-                                                 : fmt::format("HTTP {}", res.status);
+    std::string what = fmt::format("HTTP {}", res.status);
+    if (res.status == 413) what = "request body too large (limit 64 KiB)";
+    if (res.status == 404) what = fmt::format("no such resource: {}", req.path);
+    if (res.status == 400 && req.method == "POST" && !req.has_header("Content-Length"))
+      what = "a POST needs a Content-Length header (an empty body: Content-Length: 0)";
+    if (res.status == 400 && what.starts_with("HTTP")) what = "malformed request";
     send_json(res, res.status, {{"error", what}});
   });
   s.set_logger([this](const httplib::Request&, const httplib::Response& res) {

@@ -196,8 +196,10 @@ void LiveHub::run_ended(std::int64_t run_id, const std::string& state) {
 
 void LiveHub::idle_readings(const std::optional<drivers::ChamberState>& chamber,
                             const std::optional<drivers::TurntableState>& table,
-                            const std::string& fault) {
+                            const std::string& fault, const std::vector<IoError>& io_errors) {
   std::lock_guard lock(mu_);
+  metrics_.io_errors(io_errors);
+  if (chamber) metrics_.chamber(*chamber);
   idle_chamber_ = chamber;
   idle_table_ = table;
   fault_ = fault;

@@ -54,7 +54,8 @@ class LiveHub {
   void run_ended(std::int64_t run_id, const std::string& state);
   /// Idle readings (serve between runs): devices as read, or why not ('fault' when set).
   void idle_readings(const std::optional<drivers::ChamberState>& chamber,
-                     const std::optional<drivers::TurntableState>& table, const std::string& fault);
+                     const std::optional<drivers::TurntableState>& table, const std::string& fault,
+                     const std::vector<IoError>& io_errors = {});
 
   nlohmann::json status() const;
   /// status + trend + live bins + latest events + the last stream id they include.

@@ -66,15 +66,21 @@ void LiveMetrics::tick(const TickReport& r) {
   tick_duration_.Observe(r.tick_wall_s);
   ticks_.Increment();
   missed_.Increment(static_cast<double>(r.skipped));
-  for (const auto& e : r.io_errors)
-    device_errors_.Add({{"device", e.device}, {"kind", e.kind}}).Increment();
+  io_errors(r.io_errors);
   safe_hold_.Set(r.safe_hold ? 1 : 0);
-  if (r.chamber) {
-    air_c_.Set(r.chamber->air_c);
-    setpoint_c_.Set(r.chamber->setpoint_c);
-  }
+  if (r.chamber) chamber(*r.chamber);
   if (r.table) table_rate_.Set(r.table->rate_dps);
   if (r.rows != nullptr) samples_.Increment(static_cast<double>(r.rows->size()));
+}
+
+void LiveMetrics::io_errors(const std::vector<IoError>& errors) {
+  for (const auto& e : errors)
+    device_errors_.Add({{"device", e.device}, {"kind", e.kind}}).Increment();
+}
+
+void LiveMetrics::chamber(const drivers::ChamberState& c) {
+  air_c_.Set(c.air_c);
+  setpoint_c_.Set(c.setpoint_c);
 }
 
 void LiveMetrics::set_state(const std::string& state, std::int64_t run_id) {

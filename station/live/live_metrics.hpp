@@ -22,6 +22,9 @@ class LiveMetrics {
   LiveMetrics();
   /// One tick of a run (not one a resumed simulation recomputes).
   void tick(const TickReport& r);
+  /// Device errors of an idle look (serve between runs).
+  void io_errors(const std::vector<IoError>& errors);
+  void chamber(const drivers::ChamberState& c);
   /// Run state gauge: exactly one of idle, running, hold, fault is 1.
   void set_state(const std::string& state, std::int64_t run_id);
   /// A device that answered again after an outage (an 'outage' event).

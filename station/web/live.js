@@ -1,5 +1,5 @@
-// The station's live page (schemas/api.md): one GET /api/live for the state so far, then the
-// event stream for everything after it. Nothing polls: the page re-reads /api/live only when a
+// The station's live page (schemas/api.md): the event stream, and one GET /api/live for the
+// state so far once the stream is open. Nothing polls: the page re-reads /api/live only when a
 // run starts or ends, when the stream reopens after an error, or when the server says 'resync'.
 // Charts are decimated to MAX_POINTS and redrawn at most every DRAW_MS, so a 13 h run stays
 // light. Plain browser JavaScript, no build step.
@@ -13,6 +13,7 @@
 
   var S = {
     status: null,      // the last /api/live status, updated from ticks
+    snapT: null,       // its run time: what ticks do not carry (mode, table, slot T) is as of then
     trend: [],         // [[t_h, air_c, setpoint_c], ...]
     bins: {},          // serial -> [BIN, ...] sorted by t_mid_s
     events: [],        // newest first
@@ -74,6 +75,7 @@
     renderSteps(run);
     renderChamber(st);
     renderSlots(st.slots || []);
+    text("slots-asof", asOf(st) ? "T, ∇T" + asOf(st) + "; bias live" : "");
     renderBanner(st);
     renderButtons(st);
   }
@@ -105,14 +107,22 @@
     }
   }
 
+  // " (at h:mm)" for what the ticks do not update, once the run has moved on since the snapshot.
+  function asOf(st) {
+    var t = st.run ? st.run.t_s : null;
+    return S.snapT !== null && t !== null && hm(t) !== hm(S.snapT) ? " (at " + hm(S.snapT) + ")"
+                                                                  : "";
+  }
+
   function renderChamber(st) {
     var ch = st.chamber || {};
+    var stale = asOf(st);
     text("air-c", num(ch.air_c, 2) + " °C");
     text("setpoint-c", num(ch.setpoint_c, 2) + " °C");
-    text("chamber-mode", (ch.mode || "—") + (ch.alarm ? " (ALARM)" : ""));
+    text("chamber-mode", (ch.mode || "—") + (ch.alarm ? " (ALARM)" : "") + stale);
     var tb = st.table;
     text("table", tb ? num(tb.angle_deg, 1) + "°, " + num(tb.rate_dps, 2) + " °/s, " +
-         (tb.mode || "—") + (tb.locked ? ", locked" : "") : "—");
+         (tb.mode || "—") + (tb.locked ? ", locked" : "") + stale : "—");
     var sf = st.safety;
     if (!sf) { text("safety", "—"); return; }
     var parts = [];
@@ -120,7 +130,7 @@
     if (sf.estop_pressed === true) parts.push("E-STOP");
     if (sf.table_interlock_open === true) parts.push("table interlock open");
     if (sf.safe_hold) parts.push("SAFE HOLD");
-    text("safety", parts.length ? parts.join(", ") : "ok");
+    text("safety", (parts.length ? parts.join(", ") : "ok") + stale);
   }
 
   function renderSlots(slots) {
@@ -174,6 +184,7 @@
   function applyLive(live) {
     S.status = live.status || {};
     S.runId = S.status.run ? S.status.run.id : null;
+    S.snapT = S.status.run ? S.status.run.t_s : null;
     S.trend = (live.trend || []).map(function (p) { return [p[0] / 3600, p[1], p[2]]; });
     thin(S.trend);
     S.bins = {};
@@ -226,6 +237,9 @@
 
   function onTick(d) {
     var st = S.status || (S.status = {});
+    // Entering or leaving a hold (or a fault): the snapshot has the safety inputs and devices.
+    var edge = st.state !== undefined && (st.state !== d.state ||
+      (st.safety && st.safety.safe_hold !== undefined && st.safety.safe_hold !== d.safe_hold));
     st.state = d.state;
     if (!st.safety) st.safety = {};
     st.safety.safe_hold = d.safe_hold;
@@ -244,6 +258,8 @@
       st.slots = d.slots.map(function (s) {
         var o = bySerial[s.serial] || {serial: s.serial};
         o.bias_dph = s.bias_dph;
+        if ("temp_c" in s) o.temp_c = s.temp_c;
+        if ("grad_c" in s) o.grad_c = s.grad_c;
         return o;
       });
     }
@@ -256,6 +272,7 @@
       scheduleDraw();
     }
     scheduleStatus();
+    if (edge) reload();
   }
 
   function onBin(d) {
@@ -437,7 +454,9 @@
 
   // ---- the event stream ---------------------------------------------------------------------
 
-  var es = null, errored = false, retryMs = 5000;
+  // The stream starts at the server's last message when it opens (no replay), so the snapshot
+  // is read after each open: messages it already holds (id <= seq) are dropped, none is missed.
+  var es = null, retryMs = 5000, triedSnapshot = false;
   function openStream() {
     es = new EventSource("/api/events/stream");
     ["tick", "bin", "event", "run", "resync"].forEach(function (type) {
@@ -455,11 +474,12 @@
     es.onopen = function () {
       text("conn", "live");
       retryMs = 5000;
-      // The stream does not replay what was missed: read the snapshot again once.
-      if (errored) { errored = false; reload(); }
+      triedSnapshot = true;
+      reload();
     };
     es.onerror = function () {
-      errored = true;
+      // No stream yet: show the snapshot anyway (once; the next open reads it again).
+      if (!triedSnapshot) { triedSnapshot = true; reload(); }
       if (es.readyState === EventSource.CLOSED) {
         // The server refused the stream (e.g. 503, too many streams): EventSource gives up, so
         // open a new one later, backing off.
@@ -549,9 +569,7 @@
     $("btn-start").addEventListener("click", start);
     $("btn-stop").addEventListener("click", stop);
     $("btn-abort").addEventListener("click", abort);
-    // The stream opens at once; its messages wait until the snapshot is in (see reload), so
-    // nothing between the two is lost.
-    reload();
+    // The stream first, then the snapshot when it opens (see openStream).
     openStream();
   }
 

@@ -267,6 +267,9 @@ def run_checks(drv, st, url, token, artifacts):
                      lambda: (lambda t: t if "ended" in t else None)(text(drv, "run-end")), 30)
     print(f"right token: #state {text(drv, 'state')!r}, #run-end {ended!r},"
           f" #message {text(drv, 'message')!r}")
+    how = drv.execute_script("return document.getElementById('run-end').dataset.runState;")
+    if how != "stopped":
+        fail(f"the run ended {how!r}, expected 'stopped' (the `run` message's state)")
     if drv.execute_script("return window.__prompts.length;") != 1:
         fail(f"expected one token prompt, got {drv.execute_script('return window.__prompts;')}")
     try:

@@ -1,0 +1,45 @@
+// Shared daemon set-up.
+#include "station/cli/daemon_setup.hpp"
+
+#include <fmt/format.h>
+
+#include <filesystem>
+
+#include "station/parts/judged_fit.hpp"
+
+namespace station {
+
+/// One daemon per database (and, on a real rig, per device): held until the process ends.
+std::vector<ProcessLock> lock_db_and_devices(const std::string& db, const StationConfig* config) {
+  std::vector<ProcessLock> locks;
+  locks.push_back(ProcessLock::acquire(db + ".lock", fmt::format("database {}", db)));
+  if (config == nullptr) return locks;
+  std::vector<std::string> endpoints{config->chamber.endpoint, config->can_transport};
+  if (config->turntable) endpoints.push_back(config->turntable->endpoint);
+  for (const auto& e : endpoints) {
+    locks.push_back(ProcessLock::acquire(device_lock_path(e), fmt::format("device {}", e)));
+  }
+  return locks;
+}
+
+// Whether `db` exists and holds a run to resume (read-only peek: nothing is created or written).
+bool has_unfinished_run(const std::string& db) {
+  if (!std::filesystem::exists(db)) return false;
+  Store peek(db, OpenMode::read_only);
+  return peek.find_unfinished_run().has_value();
+}
+
+/// Each slot's fit and verdict of run `run_id`, one line per slot.
+void print_verdicts(Store& store, std::int64_t run_id) {
+  for (const auto& slot : store.run_slots(run_id)) {
+    const auto fit = store.latest_fit(slot.serial);
+    if (!fit || fit->runs != std::vector<std::int64_t>{run_id}) {
+      fmt::print("  {}: no fit\n", slot.serial);
+      continue;
+    }
+    fmt::print("  {}: fit {}: {}\n", slot.serial, fit->id,
+               verdict_text(stored_verdict(store, fit->id)));
+  }
+}
+
+}  // namespace station

@@ -1,0 +1,174 @@
+// `station serve`: the long-running service. The rig stays connected and watched between runs
+// (IdleWatch: lamps amber, faults as events), the live page, API and metrics are served, one
+// protocol runs at a time when the API asks, a run a killed daemon left unfinished resumes at
+// start exactly as `run` resumes it, and a run that fails is recorded and the service goes on.
+// Under systemd: Type=notify (READY once the HTTP service is bound), WATCHDOG=1 every second
+// whether idle or running; SIGTERM ends the running run as 'stopped' and then the service.
+#include <fmt/format.h>
+#include <systemd/sd-daemon.h>
+
+#include <atomic>
+#include <csignal>
+#include <cstdlib>
+
+#include "drivers/common/clock.hpp"
+#include "station/cli/commands.hpp"
+#include "station/cli/daemon_setup.hpp"
+#include "station/cli/live_service.hpp"
+#include "station/cli/serve_control.hpp"
+#include "station/common/logging.hpp"
+#include "station/daemon/idle_watch.hpp"
+#include "station/daemon/resume.hpp"
+#include "station/daemon/rig.hpp"
+#include "station/daemon/sequencer.hpp"
+#include "station/parts/judged_fit.hpp"
+
+namespace station {
+namespace {
+
+std::atomic<bool> g_stop{false};       // SIGTERM/SIGINT: the service ends
+std::atomic<bool> g_run_stop{false};   // the running run ends (API stop, or the signal)
+std::atomic<bool> g_run_abort{false};  // ... without bins or fit (API abort)
+
+void on_signal(int) {
+  g_stop.store(true);
+  g_run_stop.store(true);
+}
+
+struct ServeOptions {
+  std::string config, db, http, token_file, parts, log_file;
+};
+
+/// Everything a serve process holds.
+struct Service {
+  const StationConfig& config;
+  Rig& rig;
+  Store& store;
+  LiveService& live;
+  ServeControl& control;
+  std::map<std::string, PartLimits> part_limits;
+  bool watchdog = false;
+};
+
+/// Runs one protocol (or resumes one); a failure is recorded, never fatal to the service.
+void run_one(Service& s, const Protocol& protocol, const std::optional<RunRecord>& resume,
+             const std::string& operator_name) {
+  drivers::MonotonicClock clock;
+  SequencerOptions so;
+  so.operator_name = operator_name;
+  so.stop = &g_run_stop;
+  so.abort = &g_run_abort;
+  so.part_limits = s.part_limits;
+  if (s.watchdog) so.watchdog = [] { sd_notify(0, "WATCHDOG=1"); };
+  live::attach(s.live.hub(), so);
+  so.http_url = s.live.hub().status().value("http", "");
+  s.control.set_busy(true);
+  try {
+    Sequencer seq(s.config, protocol, s.rig, s.store, clock, so);
+    const RunOutcome out = seq.run(resume);
+    s.live.hub().run_ended(out.run_id, out.state);
+    log("serve")->info("run {} {} at t = {:.0f} s after {} ticks", out.run_id, out.state, out.t_s,
+                       out.ticks);
+  } catch (const std::exception& e) {
+    // The sequencer does not throw for device faults; this is the store or a bug. The run is
+    // closed as aborted with the reason, so the next start does not resume into the same wall.
+    const auto id = s.live.hub().current_run();
+    log("serve")->error("run {} failed: {}", id.value_or(0), e.what());
+    s.live.hub().run_ended(id.value_or(0), fmt::format("failed: {}", e.what()));
+    if (id) {
+      try {
+        s.store.add_event(*id, 0, "error", "serve", "run_failed", e.what());
+        s.store.finish_run(*id, "aborted");
+      } catch (const std::exception& e2) {
+        log("serve")->error("run {} could not be closed: {}", *id, e2.what());
+      }
+    }
+  }
+  if (!g_stop.load()) g_run_stop.store(false);
+  g_run_abort.store(false);
+  s.control.set_busy(false);
+}
+
+void idle_until_stopped(Service& s) {
+  IdleWatch idle(s.rig, s.store);
+  while (!g_stop.load()) {
+    const IdleReading r = idle.look();
+    s.live.hub().idle_readings(r.chamber, r.table, r.fault, r.io_errors);
+    s.control.set_fault(r.fault);
+    if (s.watchdog) sd_notify(0, "WATCHDOG=1");
+    if (auto req = s.control.next(std::chrono::milliseconds(1000))) {
+      run_one(s, req->protocol, std::nullopt, req->operator_name);
+      idle.run_ended();
+    }
+  }
+}
+
+int serve(const ServeOptions& o) {
+  const StationConfig config = load_station_config(o.config);
+  auto part_limits = slot_part_limits(config, o.parts);  // a bad part file stops here
+  const auto locks = lock_db_and_devices(o.db, &config);
+  Rig rig = build_rig(config, {});
+  if (rig.gpio) {
+    if (auto r = rig.gpio->open(); !r) log("serve")->warn("gpio: {}", r.error().message);
+  }
+  Store store(o.db);
+  ServeControl control(config.http.protocol_dir, g_run_stop, g_run_abort);
+  LiveServiceOptions lo;
+  lo.listen = o.http.empty() ? config.http.listen : o.http;
+  lo.token_file = o.token_file.empty() ? config.http.token_file : o.token_file;
+  lo.db_path = o.db;
+  lo.info.station = config.name;
+  lo.info.bin_s = config.bin_s;
+  LiveService live(lo, control);
+  std::uint64_t watchdog_usec = 0;
+  Service s{config,
+            rig,
+            store,
+            live,
+            control,
+            std::move(part_limits),
+            sd_watchdog_enabled(0, &watchdog_usec) > 0};
+  sd_notify(0, "READY=1");
+  // A run a killed daemon left unfinished goes on first, exactly as `station run` resumes it.
+  const ResumeDecision rd = decide_resume(store, config, false, false);
+  if (rd.run) run_one(s, *rd.protocol, rd.run, rd.run->operator_name);
+  idle_until_stopped(s);
+  sd_notify(0, "STOPPING=1");
+  live.shutdown();
+  return 0;
+}
+
+}  // namespace
+
+void add_serve_command(CLI::App& app, CommandStatus& status) {
+  auto o = std::make_shared<ServeOptions>();
+  auto* cmd = app.add_subcommand(
+      "serve",
+      "Run the station as a service: rig watched between runs, live page, JSON API, "
+      "metrics; runs started and stopped over HTTP (schemas/api.md)");
+  cmd->add_option("--config", o->config, "station configuration (TOML)")->required();
+  cmd->add_option("--db", o->db, "SQLite database")->required();
+  cmd->add_option("--http", o->http,
+                  "listen at HOST:PORT (default: [http] listen, else 127.0.0.1:8080; "
+                  "127.0.0.1:0 picks a free port and prints it)");
+  cmd->add_option("--token-file", o->token_file,
+                  "the API's bearer token (created 0600 at first start; default: [http] "
+                  "token_file, else DB.token)");
+  cmd->add_option("--parts", o->parts, "part file (overrides [station] parts)");
+  cmd->add_option("--log-file", o->log_file, "rotating log file");
+  cmd->callback([o, &status] {
+    LogOptions lo;
+    lo.console_level = spdlog::level::info;
+    lo.file = o->log_file;
+    lo.journald = std::getenv("JOURNAL_STREAM") != nullptr;
+    setup_logging(lo);
+    struct sigaction sa {};
+    sa.sa_handler = on_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGTERM, &sa, nullptr);
+    sigaction(SIGINT, &sa, nullptr);
+    status.exit_code = serve(*o);
+  });
+}
+
+}  // namespace station

@@ -1,0 +1,54 @@
+// `station serve`'s run control: the API's start/stop requests handed to the serve loop. A run
+// is started by protocol name only (a shipped one, or NAME.toml in [http] protocol_dir): a
+// request never names a path.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <mutex>
+#include <optional>
+#include <string>
+
+#include "station/config/protocol.hpp"
+#include "station/http/run_control.hpp"
+
+namespace station {
+
+/// A run the API asked for.
+struct StartRequest {
+  Protocol protocol;
+  std::string operator_name;
+};
+
+class ServeControl final : public http::RunControl {
+ public:
+  ServeControl(std::string protocol_dir, std::atomic<bool>& run_stop, std::atomic<bool>& run_abort)
+      : protocol_dir_(std::move(protocol_dir)), run_stop_(run_stop), run_abort_(run_abort) {}
+  http::ControlReply start(const std::string& protocol, const std::string& operator_name) override;
+  http::ControlReply stop(std::int64_t run_id, bool abort) override;
+
+  /// The serve loop: the next start request, waiting up to `timeout` (or until woken).
+  std::optional<StartRequest> next(std::chrono::milliseconds timeout);
+  /// The serve loop: a run is going on (start requests are refused meanwhile).
+  void set_busy(bool busy);
+  /// The serve loop: why the idle rig cannot start a run (empty: it can).
+  void set_fault(const std::string& fault);
+  /// Wakes next() (shutdown).
+  void wake();
+
+ private:
+  /// The protocol called `name`; throws InputError for a bad or unknown name.
+  Protocol find_protocol(const std::string& name) const;
+
+  const std::string protocol_dir_;
+  std::atomic<bool>& run_stop_;
+  std::atomic<bool>& run_abort_;
+  std::mutex mu_;
+  std::condition_variable cv_;
+  std::optional<StartRequest> pending_;
+  bool busy_ = false, woken_ = false;
+  std::string fault_;
+};
+
+}  // namespace station
