@@ -2,6 +2,7 @@
 // the metrics.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <charconv>
 
 #include "station/common/logging.hpp"
@@ -195,13 +196,29 @@ void HttpServer::stream_route() {
                 {{"error", fmt::format("at most {} event streams at once", options_.max_streams)}});
       return;
     }
+    // ?after=SEQ (the `seq` of /api/live): the stream starts right after it, so a page that
+    // read the snapshot first misses nothing; without it, at the newest message.
+    std::uint64_t start = hub_.last_id();
+    if (req.has_param("after")) {
+      const std::string v = req.get_param_value("after");
+      const auto n = v == "0" ? std::optional<std::int64_t>(0) : positive_int(v);
+      if (!n) {
+        streams_.fetch_sub(1);
+        send_json(res, 400, {{"error", "after: expected a stream id (integer >= 0)"}});
+        return;
+      }
+      start = std::min<std::uint64_t>(static_cast<std::uint64_t>(*n), start);
+    }
     hub_.metrics().stream_clients(streams_.load());
-    auto after = std::make_shared<std::uint64_t>(hub_.last_id());
+    auto after = std::make_shared<std::uint64_t>(start);
     res.set_chunked_content_provider(
         "text/event-stream",
         [this, after](std::size_t, httplib::DataSink& sink) {
           std::vector<live::StreamMessage> msgs;
-          if (!hub_.wait(*after, msgs, std::chrono::seconds(15))) return false;  // shutting down
+          if (!hub_.wait(*after, msgs, std::chrono::seconds(15))) {
+            sink.done();  // shutting down: end the chunked stream properly
+            return true;
+          }
           if (msgs.empty()) {
             static constexpr std::string_view kAlive = ": keep-alive\n\n";
             return sink.write(kAlive.data(), kAlive.size());

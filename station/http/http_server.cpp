@@ -97,6 +97,7 @@ void HttpServer::static_routes() {
     for (const auto& [name, text] : builtin::kWebFiles)
       if (name == "index.html") res.set_content(std::string(text), mime_of(name));
   });
+  s.Get("/favicon.ico", [](const httplib::Request&, httplib::Response& res) { res.status = 204; });
   // Only the embedded files: nothing on disk is reachable by name, so no path can traverse.
   s.Get(R"(/static/([^/]+))", [](const httplib::Request& req, httplib::Response& res) {
     for (const auto& [name, text] : builtin::kWebFiles) {

@@ -156,7 +156,12 @@ void LiveHub::tick(const TickReport& r) {
     const auto it = earth_rate_dph_.find(s.serial);
     std::optional<double> bias;
     if (s.rate_dph && it != earth_rate_dph_.end()) bias = *s.rate_dph - it->second;
-    slots.push_back({{"serial", s.serial}, {"bias_dph", num(bias)}});
+    std::optional<double> grad;
+    if (s.temp_c && s.temp2_c) grad = *s.temp2_c - *s.temp_c;
+    slots.push_back({{"serial", s.serial},
+                     {"bias_dph", num(bias)},
+                     {"temp_c", num(s.temp_c)},
+                     {"grad_c", num(grad)}});
   }
   publish("tick",
           {{"t_s", r.t_s},

@@ -1,0 +1,168 @@
+#!/usr/bin/env python3
+"""`station serve` as a service, through plain HTTP: a simrig process (wall clock, real Modbus TCP
+and CAN over a unix socket) stands in for the rig.
+
+  serve_http_test.py STATION SIMRIG
+
+Checks: idle state with the rig read and no run; a run started over the API (token), running;
+a second start refused (409); stop over the API -> idle again with the run 'stopped'; a second
+run started on the same service; SIGKILL mid-run, then a new serve resumes that same run at
+start; a start while the rig is faulted (simrig stopped) is refused with 409 naming the fault,
+and the service keeps answering; SIGTERM -> exit 0. Exit 0 ok, 1 failure.
+"""
+import json
+import os
+import signal
+import sqlite3
+import subprocess
+import sys
+import tempfile
+import time
+import urllib.error
+import urllib.request
+
+FAILURES = []
+
+
+def check(cond, what):
+    if not cond:
+        FAILURES.append(what)
+        print("FAIL:", what, flush=True)
+    return cond
+
+
+def request(base, method, path, token=None, body=None):
+    data = None if body is None else json.dumps(body).encode()
+    req = urllib.request.Request(base + path, data=data, method=method)
+    if token:
+        req.add_header("Authorization", "Bearer " + token)
+    if method == "POST" and data is None:
+        req.add_header("Content-Length", "0")
+    try:
+        with urllib.request.urlopen(req, timeout=10) as r:
+            return r.status, json.loads(r.read() or b"null")
+    except urllib.error.HTTPError as e:
+        return e.code, json.loads(e.read() or b"null")
+
+
+def wait_for(pred, timeout_s, what):
+    end = time.monotonic() + timeout_s
+    while time.monotonic() < end:
+        v = pred()
+        if v:
+            return v
+        time.sleep(0.2)
+    check(False, "timed out waiting for " + what)
+    return None
+
+
+def start_serve(station, work, log_name):
+    err = open(os.path.join(work, log_name), "w")
+    p = subprocess.Popen([station, "serve", "--config", "rig.toml", "--db", "s.db", "--http",
+                          "127.0.0.1:0"], cwd=work, stdout=subprocess.PIPE, stderr=err, text=True)
+    line = p.stdout.readline()
+    if not line.startswith("http: listening on "):
+        p.kill()
+        raise SystemExit("serve did not print its address: %r (see %s)" % (line, log_name))
+    return p, line.split()[-1].rstrip("/")
+
+
+def status(base):
+    return request(base, "GET", "/api/status")[1]
+
+
+def main():
+    station, simrig = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
+    work = tempfile.mkdtemp(prefix="serve-test-")
+    rig_cfg = open(os.path.join(work, "rig.toml"), "w")
+    rig = subprocess.Popen([simrig, "--gyros", "2", "--control", os.path.join(work, "ctl")],
+                           stdout=rig_cfg, stderr=subprocess.DEVNULL, cwd=work)
+    procs = [rig]
+    try:
+        wait_for(lambda: os.path.getsize(os.path.join(work, "rig.toml")) > 200, 10, "simrig")
+        time.sleep(0.3)
+        serve, base = start_serve(station, work, "serve1.log")
+        procs.append(serve)
+        token_path = os.path.join(work, "s.db.token")
+        check(os.stat(token_path).st_mode & 0o777 == 0o600, "token file is 0600")
+        token = open(token_path).read().strip()
+
+        st = wait_for(lambda: (lambda s: s if s["chamber"] else None)(status(base)), 10,
+                      "the idle rig read")
+        check(st["state"] == "idle" and st["run"] is None, "idle with no run: %s" % st["state"])
+        check(abs(st["chamber"]["air_c"] - 25.0) < 5, "chamber air read while idle")
+
+        code, body = request(base, "POST", "/api/runs", None, {"protocol": "paper"})
+        check(code == 401, "start without a token: 401, got %d" % code)
+        code, body = request(base, "POST", "/api/runs", token, {"protocol": "no_such"})
+        check(code == 400 and "unknown" in body["error"], "unknown protocol: 400 %s" % body)
+        code, body = request(base, "POST", "/api/runs", token,
+                             {"protocol": "paper", "operator": "ann"})
+        check(code == 202, "start: 202, got %d %s" % (code, body))
+        st = wait_for(lambda: (lambda s: s if s["state"] == "running" and s["run"] else None)(
+            status(base)), 15, "the run to start")
+        run1 = st["run"]["id"]
+        check(st["run"]["operator"] == "ann" and st["run"]["protocol"] == "paper",
+              "run carries protocol and operator")
+        code, body = request(base, "POST", "/api/runs", token, {"protocol": "paper"})
+        check(code == 409, "a second start while running: 409, got %d" % code)
+        wait_for(lambda: status(base)["ticks"] >= 3, 10, "three ticks")
+
+        code, _ = request(base, "POST", "/api/runs/%d/stop" % run1, token)
+        check(code == 202, "stop: 202, got %d" % code)
+        wait_for(lambda: status(base)["state"] == "idle", 15, "idle after stop")
+        code, run = request(base, "GET", "/api/runs/%d" % run1)
+        check(code == 200 and run["state"] == "stopped", "run 1 stopped: %s" % run.get("state"))
+
+        # A second run on the same service, then the daemon killed mid-run.
+        code, _ = request(base, "POST", "/api/runs", token, {"protocol": "paper"})
+        check(code == 202, "second start: 202, got %d" % code)
+        st = wait_for(lambda: (lambda s: s if s["run"] and s["run"]["id"] != run1 else None)(
+            status(base)), 15, "the second run")
+        run2 = st["run"]["id"] if st else -1
+        wait_for(lambda: status(base)["ticks"] >= 3, 10, "ticks of run 2")
+        serve.send_signal(signal.SIGKILL)
+        serve.wait(10)
+        db = sqlite3.connect(os.path.join(work, "s.db"))
+        state = db.execute("SELECT state FROM runs WHERE id = ?", (run2,)).fetchone()[0]
+        check(state == "running", "killed run left 'running': %s" % state)
+        db.close()
+
+        serve, base = start_serve(station, work, "serve2.log")
+        procs.append(serve)
+        st = wait_for(lambda: (lambda s: s if s["run"] else None)(status(base)), 15,
+                      "the resumed run")
+        check(st and st["run"]["id"] == run2, "the killed run resumes at start")
+        code, ev = request(base, "GET", "/api/runs/%d/events?since=0" % run2)
+        check(any(e["kind"] == "resume" for e in ev["events"]), "a resume event is stored")
+        code, _ = request(base, "POST", "/api/runs/%d/abort" % run2, token)
+        check(code == 202, "abort: 202, got %d" % code)
+        wait_for(lambda: status(base)["state"] in ("idle", "fault"), 15, "idle after abort")
+        code, run = request(base, "GET", "/api/runs/%d" % run2)
+        check(run["state"] == "aborted", "run 2 aborted: %s" % run["state"])
+
+        # The rig goes away: the service reports a fault, refuses a start, keeps answering.
+        rig.send_signal(signal.SIGTERM)
+        rig.wait(10)
+        st = wait_for(lambda: (lambda s: s if s["state"] == "fault" else None)(status(base)), 20,
+                      "fault state with the rig gone")
+        code, body = request(base, "POST", "/api/runs", token, {"protocol": "paper"})
+        check(code == 409 and "not ready" in body.get("error", ""),
+              "start on a faulted rig: 409, got %d %s" % (code, body))
+        serve.send_signal(signal.SIGTERM)
+        rc = serve.wait(15)
+        check(rc == 0, "SIGTERM: exit 0, got %d" % rc)
+    finally:
+        for p in procs:
+            if p.poll() is None:
+                p.kill()
+                p.wait()
+    if FAILURES:
+        print("%d failure(s); logs in %s" % (len(FAILURES), work))
+        return 1
+    print("serve: ok")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
