@@ -215,7 +215,7 @@ void HttpServer::stream_route() {
         "text/event-stream",
         [this, after](std::size_t, httplib::DataSink& sink) {
           std::vector<live::StreamMessage> msgs;
-          if (!hub_.wait(*after, msgs, std::chrono::seconds(15))) {
+          if (!hub_.wait(*after, msgs, std::chrono::seconds(5))) {
             sink.done();  // shutting down: end the chunked stream properly
             return true;
           }

@@ -2,6 +2,7 @@
 #include "station/http/http_server.hpp"
 
 #include <fmt/format.h>
+#include <sys/socket.h>
 
 #include <charconv>
 #include <fstream>
@@ -125,7 +126,14 @@ void HttpServer::static_routes() {
 void HttpServer::routes() {
   auto& s = *server_;
   s.set_payload_max_length(options_.max_body_bytes);
-  s.set_tcp_nodelay(true);  // small JSON answers: Nagle + delayed ACK cost 40 ms each
+  s.set_tcp_nodelay(true);
+  // httplib's default socket options add SO_REUSEPORT: a second daemon would then listen on the
+  // same port beside the first and the kernel would split requests between them. Only
+  // SO_REUSEADDR (a restart may bind while old connections sit in TIME_WAIT).
+  s.set_socket_options([](int sock) {
+    const int yes = 1;
+    ::setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+  });  // small JSON answers: Nagle + delayed ACK cost 40 ms each
   s.set_read_timeout(5);
   s.set_write_timeout(5);
   s.set_keep_alive_timeout(5);
@@ -151,10 +159,37 @@ void HttpServer::routes() {
     std::string what = fmt::format("HTTP {}", res.status);
     if (res.status == 413) what = "request body too large (limit 64 KiB)";
     if (res.status == 404) what = fmt::format("no such resource: {}", req.path);
-    if (res.status == 400 && req.method == "POST" && !req.has_header("Content-Length"))
-      what = "a POST needs a Content-Length header (an empty body: Content-Length: 0)";
     if (res.status == 400 && what.starts_with("HTTP")) what = "malformed request";
     send_json(res, res.status, {{"error", what}});
+  });
+  // Before any body is read (httplib checks its size limit only for Content-Length bodies and
+  // inflates gzip without one): a POST must carry the token and a plain Content-Length within
+  // the limit, no Transfer-Encoding, no Content-Encoding. Refused requests close the connection.
+  s.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
+    if (req.method == "GET" || req.method == "HEAD")
+      return httplib::Server::HandlerResponse::Unhandled;
+    const auto refuse = [&res](int status, const std::string& what) {
+      res.set_header("Connection", "close");
+      send_json(res, status, {{"error", what}});
+      return httplib::Server::HandlerResponse::Handled;
+    };
+    if (req.method != "POST")
+      return refuse(405, fmt::format("method {} not allowed", req.method.substr(0, 16)));
+    if (!may_write(req, res)) {
+      res.set_header("Connection", "close");
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    if (req.has_header("Transfer-Encoding"))
+      return refuse(411, "a POST needs a Content-Length (no Transfer-Encoding)");
+    if (req.has_header("Content-Encoding"))
+      return refuse(415, "a POST body must not be encoded (no Content-Encoding)");
+    const std::string length = req.get_header_value("Content-Length");
+    std::size_t n = 0;
+    const auto [end, ec] = std::from_chars(length.data(), length.data() + length.size(), n);
+    if (length.empty() || ec != std::errc() || end != length.data() + length.size())
+      return refuse(411, "a POST needs a Content-Length header (an empty body: Content-Length: 0)");
+    if (n > options_.max_body_bytes) return refuse(413, "request body too large (limit 64 KiB)");
+    return httplib::Server::HandlerResponse::Unhandled;
   });
   s.set_logger([this](const httplib::Request&, const httplib::Response& res) {
     hub_.metrics().http_request(res.status);

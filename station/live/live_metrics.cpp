@@ -32,9 +32,9 @@ LiveMetrics::LiveMetrics()
                          .Name("station_tick_duration_seconds")
                          .Help("Wall time of one tick: devices, safety, store")
                          .Register(*registry_)
-                         .Add({}, pm::Histogram::BucketBoundaries{
-                             0.0001, 0.00025, 0.0005, 0.001, 0.0025, 0.005, 0.01, 0.025, 0.05, 0.1,
-                             0.25, 0.5, 1.0})),
+                         .Add({}, pm::Histogram::BucketBoundaries{0.0001, 0.00025, 0.0005, 0.001,
+                                                                  0.0025, 0.005, 0.01, 0.025, 0.05,
+                                                                  0.1, 0.25, 0.5, 1.0})),
       ticks_(counter(*registry_, "station_ticks_total", "Ticks run").Add({})),
       missed_(counter(*registry_, "station_missed_ticks_total",
                       "Tick deadlines skipped because a tick overran")
@@ -60,6 +60,13 @@ LiveMetrics::LiveMetrics()
       stream_clients_(
           gauge(*registry_, "station_event_stream_clients", "Clients attached to the event stream")
               .Add({})) {
+  // Every device's series exist from the start (at 0), so a scrape sees them before a fault.
+  for (const char* device : {"chamber", "turntable", "can", "gpio"}) {
+    reconnects_.Add({{"device", device}});
+    outage_s_.Add({{"device", device}});
+    for (const char* kind : {"timeout", "disconnected", "protocol"})
+      device_errors_.Add({{"device", device}, {"kind", kind}});
+  }
   set_state("idle", 0);
 }
 

@@ -6,8 +6,10 @@ Scenario A: `station run --sim --speed 200 --gyros 2 --http 127.0.0.1:0 --db TMP
   its bins and events); /metrics through `promtool check metrics` and specific series; the event
   stream (tick messages, increasing ids, ?after=SEQ with no gap, at most 4 streams: the 5th gets
   503, slots released on close); bad requests (401 + WWW-Authenticate, 403, 409, 400 for bad JSON,
-  fields and ids, 404, 413 for a 1 MiB body with Content-Length and chunked, path traversal,
-  garbage request lines, a 20 KB header, bad percent-encoding; the daemon answering after each);
+  fields and ids, 404, 413 for a 1 MiB body with Content-Length, chunked or gzipped, 400 for
+  Content-Length -1, 401 for a POST without Content-Length, path traversal, garbage request
+  lines, a 20 KB header, bad percent-encoding; the daemon answering after each; each refusal
+  counted in station_http_requests_total);
   no CORS header on any response and no CORS preflight; a second daemon on the same port (exit 2,
   one line naming the address); then the stop over the API (202, exit 0, final table, `stopped`).
 Scenario D: a second run in the same database: the stopped run 1 is 409 for stop, runs newest
@@ -20,8 +22,8 @@ failure is printed as `FAIL: what: expected ..., got ...`.
 
 Usage: api_http_test.py STATION_BINARY       exit 0 pass, 1 fail
 """
-import http.client
 import gzip
+import http.client
 import json
 import os
 import queue
@@ -759,7 +761,8 @@ def check_bad_requests(port, token, run_id):
         port, (f"POST /api/runs HTTP/1.1\r\nHost: 127.0.0.1\r\nAuthorization: Bearer {token}\r\n"
                f"Content-Type: application/json\r\nTransfer-Encoding: chunked\r\n"
                f"Connection: close\r\n\r\n").encode(), chunks=chunks)
-    check(status == 413, "POST /api/runs with a 1 MiB chunked body -> 413 (limit 64 KiB)",
+    check(status == 411, "POST /api/runs with a 1 MiB chunked body -> 411 (a POST needs a "
+          "Content-Length, checked before any body is read)",
           f"got {status} {body[:200]!r} {note}")
     still_up(port, "a 1 MiB chunked body")
     # The same 1 MiB gzipped (~1 KB on the wire): 413 (the body is 1 MiB) or 415 (no encodings).
@@ -821,8 +824,7 @@ def check_bad_requests(port, token, run_id):
              "a %00 in a static name"),
             (b"GET /api/status HTTP/9.9\r\nHost: x\r\nConnection: close\r\n\r\n",
              "HTTP/9.9"),
-            (b"POST /api/runs HTTP/1.1\r\nHost: x\r\nContent-Length: -1\r\n"
-             b"Connection: close\r\n\r\n", "Content-Length -1"),
+
             (b"POST /api/runs HTTP/1.1\r\nHost: x\r\nTransfer-Encoding: chunked\r\n"
              b"Connection: close\r\n\r\nzz\r\n", "a bad chunk size")]:
         try:
@@ -833,6 +835,14 @@ def check_bad_requests(port, token, run_id):
               f"{what}: a 4xx answer or a closed connection",
               f"got {status} {head[:100]!r} {body[:100]!r} {note}")
         still_up(port, what)
+    # A malformed Content-Length is refused at once, not waited for as a body over the limit.
+    t = time.time()
+    status, head, body, note = raw_exchange(
+        port, (f"POST /api/runs HTTP/1.1\r\nHost: x\r\nAuthorization: Bearer {token}\r\n"
+               f"Content-Length: -1\r\nConnection: close\r\n\r\n").encode(), timeout=10)
+    check(status == 411 and time.time() - t < 2, "POST with Content-Length: -1 -> 411 at once",
+          f"got {status} after {time.time() - t:.1f} s: {body[:120]!r} {note}")
+    still_up(port, "Content-Length -1")
 
     # CORS: no header on any answer (checked on every one), no preflight.
     r = request(port, "OPTIONS", "/api/runs",
@@ -1026,7 +1036,7 @@ def scenario_d(binary, tmp, db, stopped_id):
               f"[D] /api/runs/{stopped_id}: state stopped, ended_utc set", r.brief())
         r, bj = get_json(port, f"/api/runs/{stopped_id}/bins")
         ser = bj.get("serials") if isinstance(bj, dict) else None
-        keys = {"t_mid_s", "temp_c", "grad_c", "bias_dph", "n", "complete"}
+        keys = {"t_start_s", "temp_c", "grad_c", "bias_dph", "n", "complete"}
         check(isinstance(bj, dict) and bj.get("provisional") is False and isinstance(ser, dict)
               and len(ser) == 2,
               f"[D] /api/runs/{stopped_id}/bins: stored (provisional false), 2 serials",
@@ -1034,7 +1044,7 @@ def scenario_d(binary, tmp, db, stopped_id):
         if isinstance(ser, dict) and ser:
             first = next(iter(ser.values()))
             check(first and all(keys <= set(b) for b in first),
-                  f"[D] stored bins are BINs {{{', '.join(sorted(keys))}}} (api.md)",
+                  f"[D] stored bins {{{', '.join(sorted(keys))}}} (api.md: t_start_s, not t_mid_s)",
                   f"got {first[:1]!r}")
         r, ev = get_json(port, f"/api/runs/{stopped_id}/events?since=0")
         kinds = [e.get("kind") for e in (ev or {}).get("events", [])]
@@ -1090,6 +1100,8 @@ def main():
     if not os.access(binary, os.X_OK):
         print(f"FAIL: {binary}: not an executable", file=sys.stderr)
         return 1
+    # ctest's timeout sends SIGTERM: unwind through the `finally`s that kill the daemons.
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(1))
     t0 = time.time()
     tmp = tempfile.mkdtemp(prefix="api_http_test.")
     try:
