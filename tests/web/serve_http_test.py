@@ -4,7 +4,8 @@ and CAN over a unix socket) stands in for the rig.
 
   serve_http_test.py STATION SIMRIG
 
-Checks: idle state with the rig read and no run; a run started over the API (token), running;
+Checks: READY=1 and WATCHDOG=1 every second on NOTIFY_SOCKET (what systemd's Type=notify and
+WatchdogSec see); idle state with the rig read and no run; a run started over the API (token), running;
 a second start refused (409); stop over the API -> idle again with the run 'stopped'; a second
 run started on the same service; SIGKILL mid-run, then a new serve resumes that same run at
 start; a start while the rig is faulted (simrig stopped) is refused with 409 naming the fault,
@@ -13,6 +14,7 @@ and the service keeps answering; SIGTERM -> exit 0. Exit 0 ok, 1 failure.
 import json
 import os
 import signal
+import socket
 import sqlite3
 import subprocess
 import sys
@@ -56,10 +58,11 @@ def wait_for(pred, timeout_s, what):
     return None
 
 
-def start_serve(station, work, log_name):
+def start_serve(station, work, log_name, env=None):
     err = open(os.path.join(work, log_name), "w")
     p = subprocess.Popen([station, "serve", "--config", "rig.toml", "--db", "s.db", "--http",
-                          "127.0.0.1:0"], cwd=work, stdout=subprocess.PIPE, stderr=err, text=True)
+                          "127.0.0.1:0"], cwd=work, stdout=subprocess.PIPE, stderr=err, text=True,
+                         env=env)
     line = p.stdout.readline()
     if not line.startswith("http: listening on "):
         p.kill()
@@ -81,8 +84,21 @@ def main():
     try:
         wait_for(lambda: os.path.getsize(os.path.join(work, "rig.toml")) > 200, 10, "simrig")
         time.sleep(0.3)
-        serve, base = start_serve(station, work, "serve1.log")
+        # What systemd would see (Type=notify, WatchdogSec): sd_notify datagrams on NOTIFY_SOCKET.
+        notify = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
+        notify.bind(os.path.join(work, "notify"))
+        notify.settimeout(0.2)
+        env = dict(os.environ, NOTIFY_SOCKET=os.path.join(work, "notify"), WATCHDOG_USEC="10000000")
+        serve, base = start_serve(station, work, "serve1.log", env)
         procs.append(serve)
+        notes, end = [], time.monotonic() + 3.5
+        while time.monotonic() < end:
+            try:
+                notes.append(notify.recv(4096).decode())
+            except socket.timeout:
+                pass
+        check(notes and notes[0] == "READY=1", "READY=1 first: %s" % notes[:3])
+        check(notes.count("WATCHDOG=1") >= 2, "WATCHDOG=1 every second while idle: %s" % notes)
         token_path = os.path.join(work, "s.db.token")
         check(os.stat(token_path).st_mode & 0o777 == 0o600, "token file is 0600")
         token = open(token_path).read().strip()
