@@ -68,6 +68,18 @@ std::string can_socket_problem(const std::string& path) {
   if (!S_ISSOCK(st.st_mode)) {
     return fmt::format("--can-socket {}: exists and is not a socket; refusing to replace it", path);
   }
+  // A socket another simrig still serves is not stale: taking it over would cut that rig's
+  // station off (and delete its socket at exit). Only a socket nobody answers is replaced.
+  const int fd = socket(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0);
+  sockaddr_un addr{};
+  addr.sun_family = AF_UNIX;
+  std::strncpy(addr.sun_path, path.c_str(), sizeof(addr.sun_path) - 1);
+  const bool served =
+      fd >= 0 && connect(fd, reinterpret_cast<const sockaddr*>(&addr), sizeof addr) == 0;
+  if (fd >= 0) close(fd);
+  if (served)
+    return fmt::format("--can-socket {}: another process serves it; refusing to take it over",
+                       path);
   return {};
 }
 

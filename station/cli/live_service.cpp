@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <thread>
 
 #include "station/common/logging.hpp"
@@ -40,8 +41,20 @@ LiveService::LiveService(const LiveServiceOptions& o, http::RunControl& control)
 void LiveService::shutdown() {
   if (!server_) return;
   std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the streams send the run's end
-  server_->stop();
-  server_.reset();
+  if (server_->stop()) {
+    server_.reset();
+  } else {
+    abandoned_ = true;
+    (void)server_.release();  // its detached worker refers to it
+  }
+}
+
+void LiveService::exit_if_abandoned(int rc) {
+  if (!abandoned_) return;
+  std::fflush(stdout);
+  std::fflush(stderr);
+  spdlog::shutdown();
+  std::_Exit(rc);
 }
 
 }  // namespace station

@@ -40,10 +40,15 @@ class LiveService {
   bool serving() const { return server_ != nullptr; }
   /// Lets the event streams send what is queued (a run's end), then stops serving.
   void shutdown();
+  /// After shutdown: if a client held the server past its 3 s, ends the process now with `rc`
+  /// (stdout and logs flushed; committed data is safe, as after a kill) rather than destroy
+  /// what the detached server still uses. Call it last in a command, with nothing unsaved.
+  void exit_if_abandoned(int rc);
 
  private:
   live::LiveHub hub_;
   std::unique_ptr<http::HttpServer> server_;
+  bool abandoned_ = false;
 };
 
 }  // namespace station

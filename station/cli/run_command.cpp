@@ -155,6 +155,7 @@ int run_real(const RunOptions& o) {
   fmt::print("run {} {} at t = {:.0f} s after {} ticks\n", out.run_id, out.state, out.t_s,
              out.ticks);
   print_verdicts(store, out.run_id);
+  live.exit_if_abandoned(0);
   return 0;
 }
 
@@ -205,6 +206,8 @@ int run_sim(const RunOptions& o) {
   } else {
     print_sim_report(report);
   }
+  std::cout.flush();
+  live.exit_if_abandoned(0);
   return 0;
 }
 
@@ -254,7 +257,7 @@ void add_run_command(CLI::App& app, CommandStatus& status) {
   cmd->add_option("--speed", o->speed,
                   "--sim: simulated seconds per wall second, to watch a run live (600: the 13 h "
                   "cycle in ~80 s; default: as fast as possible)")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Range(1.0, 1e6));  // below 1 a stop would wait a whole slowed tick
   cmd->add_option("--http", o->http,
                   "serve the live page, JSON API and /metrics at HOST:PORT (schemas/api.md); "
                   "127.0.0.1:0 picks a free port and prints it");

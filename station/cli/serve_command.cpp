@@ -63,6 +63,9 @@ void run_one(Service& s, const Protocol& protocol, const std::optional<RunRecord
   live::attach(s.live.hub(), so);
   so.http_url = s.live.hub().status().value("http", "");
   s.control.set_busy(true);
+  // A stop or abort meant for an earlier run must not end this one.
+  if (!g_stop.load()) g_run_stop.store(false);
+  g_run_abort.store(false);
   try {
     Sequencer seq(s.config, protocol, s.rig, s.store, clock, so);
     const RunOutcome out = seq.run(resume);
@@ -90,10 +93,10 @@ void run_one(Service& s, const Protocol& protocol, const std::optional<RunRecord
 }
 
 void idle_until_stopped(Service& s) {
-  IdleWatch idle(s.rig, s.store);
+  IdleWatch idle(s.rig, s.store, [&s](const RunEvent& e) { s.live.hub().event(e); });
   while (!g_stop.load()) {
     const IdleReading r = idle.look();
-    s.live.hub().idle_readings(r.chamber, r.table, r.fault, r.io_errors);
+    s.live.hub().idle(r);
     s.control.set_fault(r.fault);
     if (s.watchdog) sd_notify(0, "WATCHDOG=1");
     if (auto req = s.control.next(std::chrono::milliseconds(1000))) {
@@ -135,6 +138,7 @@ int serve(const ServeOptions& o) {
   idle_until_stopped(s);
   sd_notify(0, "STOPPING=1");
   live.shutdown();
+  live.exit_if_abandoned(0);
   return 0;
 }
 

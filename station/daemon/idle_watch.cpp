@@ -13,21 +13,29 @@ namespace dr = station::drivers;
 
 IdleReading IdleWatch::look() {
   IdleReading r;
-  std::vector<std::string> faults;
+  // Each fault as a stable key and a message: a link's message carries its reconnect countdown,
+  // which changes every second; an event is stored when the keys change, not the words.
+  std::vector<std::string> keys, faults;
+  const auto fault = [&](std::string key, std::string message) {
+    keys.push_back(std::move(key));
+    faults.push_back(std::move(message));
+  };
   if (auto c = rig_.chamber->read(); c) {
     r.chamber = c.value();
-    if (r.chamber->alarms.any()) faults.push_back("chamber alarm");
+    if (r.chamber->alarms.any()) fault("chamber alarm", "chamber alarm");
   } else {
     r.io_errors.push_back({"chamber", dr::to_string(c.error().kind)});
-    faults.push_back(fmt::format("chamber: {}", c.error().message));
+    fault(fmt::format("chamber {}", dr::to_string(c.error().kind)), c.error().message);
   }
   if (rig_.turntable) {
     if (auto t = rig_.turntable->read(); t) {
       r.table = t.value();
-      if (r.table->fault) faults.push_back("turntable drive fault");
+      if (r.table->fault) fault("turntable fault", "turntable drive fault");
+      // An e-stop chain that cuts the drive's enable shows here (docs/SIMRIG.md).
+      if (r.table->interlock_open) fault("turntable interlock", "turntable interlock open");
     } else {
       r.io_errors.push_back({"turntable", dr::to_string(t.error().kind)});
-      faults.push_back(fmt::format("turntable: {}", t.error().message));
+      fault(fmt::format("turntable {}", dr::to_string(t.error().kind)), t.error().message);
     }
   }
   if (rig_.gpio) {
@@ -38,23 +46,26 @@ IdleReading IdleWatch::look() {
         out = v.value();
       } else {
         r.io_errors.push_back({"gpio", dr::to_string(v.error().kind)});
-        faults.push_back(fmt::format("gpio {}: {}", role, v.error().message));
+        fault(fmt::format("gpio {} {}", role, dr::to_string(v.error().kind)), v.error().message);
       }
     };
     level(dr::gpio::roles::interlock, r.door_closed);
     level(dr::gpio::roles::estop, r.estop_pressed);
-    if (r.estop_pressed.value_or(false)) faults.push_back("e-stop pressed");
-    if (r.door_closed && !*r.door_closed) faults.push_back("door open");
+    if (r.estop_pressed.value_or(false)) fault("e-stop", "e-stop pressed");
+    if (r.door_closed && !*r.door_closed) fault("door", "door open");
   }
   r.fault = fmt::format("{}", fmt::join(faults, "; "));
-  if (r.fault != last_fault_) {
-    const bool cleared = r.fault.empty();
-    const std::string message = cleared ? fmt::format("idle rig clear (was: {})", last_fault_)
+  r.fault_key = fmt::format("{}", fmt::join(keys, "; "));
+  if (r.fault_key != last_key_) {
+    const bool cleared = r.fault_key.empty();
+    const std::string message = cleared ? fmt::format("idle rig clear (was: {})", last_key_)
                                         : fmt::format("idle rig: {}", r.fault);
     log("serve")->log(cleared ? spdlog::level::info : spdlog::level::warn, "{}", message);
-    store_.add_event(std::nullopt, 0, cleared ? "info" : "warn", "serve",
-                     cleared ? "idle_clear" : "idle_fault", message);
-    last_fault_ = r.fault;
+    const std::string severity = cleared ? "info" : "warn";
+    const std::string kind = cleared ? "idle_clear" : "idle_fault";
+    const auto id = store_.add_event(std::nullopt, 0, severity, "serve", kind, message);
+    if (on_event_) on_event_({id, 0, 0, severity, "serve", kind, message, std::nullopt});
+    last_key_ = r.fault_key;
   }
   drive_lamps(!r.fault.empty());
   return r;

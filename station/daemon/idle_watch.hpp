@@ -4,6 +4,7 @@
 // is sent while idle.
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -20,13 +21,16 @@ struct IdleReading {
   std::optional<drivers::TurntableState> table;
   std::optional<bool> door_closed, estop_pressed;
   std::vector<IoError> io_errors;
-  std::string fault;  ///< empty: every device answered and nothing is alarming
+  std::string fault;      ///< empty: every device answered and nothing is alarming
+  std::string fault_key;  ///< the same as stable names (device: error kind), for change detection
 };
 
 /// Watches an idle rig. Not thread-safe (the serve loop's thread).
 class IdleWatch {
  public:
-  IdleWatch(Rig& rig, Store& store) : rig_(rig), store_(store) {}
+  /// `on_event` is told each event stored (the live page's event list); may be empty.
+  IdleWatch(Rig& rig, Store& store, std::function<void(const RunEvent&)> on_event = {})
+      : rig_(rig), store_(store), on_event_(std::move(on_event)) {}
   /// Reads every device once, drives the lamps, stores an event when the fault text changes.
   IdleReading look();
   /// Forget the lamps written (a run drove them meanwhile): the next look writes them again.
@@ -37,7 +41,8 @@ class IdleWatch {
 
   Rig& rig_;
   Store& store_;
-  std::string last_fault_;
+  std::function<void(const RunEvent&)> on_event_;
+  std::string last_key_;  ///< what is wrong, without the messages' changing details
   bool lamps_written_ = false;
   bool red_ = false;
 };

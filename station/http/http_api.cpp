@@ -70,8 +70,8 @@ void HttpServer::api_routes() {
   // (not created yet, locked for longer than the busy timeout) is a 503 naming it.
   const auto db_read = [this](const httplib::Request& req, httplib::Response& res, auto&& body) {
     if (!may_read(req, res)) return;
+    std::lock_guard lock(store_mu_);  // held across the reset too: no other thread uses store_
     try {
-      std::lock_guard lock(store_mu_);
       body(store());
     } catch (const SqliteError& e) {
       store_.reset();
@@ -103,7 +103,8 @@ void HttpServer::api_routes() {
         [this, db_read](const httplib::Request& req, httplib::Response& res) {
           const auto id = run_id_of(req, res);
           if (!id) return;
-          const auto live = hub_.live_bins(*id);
+          // Live bins stand in only while the run runs: an aborted run stores none and shows none.
+          const auto live = hub_.current_run() == id ? hub_.live_bins(*id) : std::nullopt;
           db_read(req, res, [&](Store& st) {
             const auto j = bins_json(st, *id, live);
             send_json(res, j ? 200 : 404,
@@ -164,11 +165,13 @@ void HttpServer::control_routes() {
       const auto current = hub_.current_run();
       if (current != id) {
         bool exists = false;
-        try {
+        {
           std::lock_guard lock(store_mu_);
-          exists = run_json(store(), *id).has_value();
-        } catch (const SqliteError&) {
-          store_.reset();
+          try {
+            exists = run_json(store(), *id).has_value();
+          } catch (const SqliteError&) {
+            store_.reset();
+          }
         }
         send_json(res, exists ? 409 : 404,
                   {{"error", exists ? fmt::format("run {} is not running", *id)

@@ -5,8 +5,10 @@
 #include <sys/socket.h>
 
 #include <charconv>
+#include <chrono>
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 #include "station/common/input_error.hpp"
 #include "station/common/logging.hpp"
@@ -71,8 +73,23 @@ Store& HttpServer::store() {
   return *store_;
 }
 
+namespace {
+/// Whether a Host header names this machine's loopback (with or without a port). A page of
+/// another site that rebinds its name to 127.0.0.1 (DNS rebinding) sends its own name here.
+bool loopback_host(const std::string& host) {
+  std::string h = host;
+  if (!h.empty() && h.front() == '[') {
+    h = h.substr(0, h.find(']') + 1);
+  } else if (const auto colon = h.rfind(':'); colon != std::string::npos) {
+    h = h.substr(0, colon);
+  }
+  return h == "localhost" || h == "127.0.0.1" || h == "[::1]" || h.rfind("127.", 0) == 0;
+}
+}  // namespace
+
 bool HttpServer::may_read(const httplib::Request& req, httplib::Response& res) const {
-  if (is_loopback(req.remote_addr)) return true;
+  // Token-free only from loopback and addressed to a loopback name.
+  if (is_loopback(req.remote_addr) && loopback_host(req.get_header_value("Host"))) return true;
   return may_write(req, res);
 }
 
@@ -216,17 +233,37 @@ int HttpServer::start() {
         fmt::format("--http {}:{}: cannot listen there (address in use or not this "
                     "machine's)",
                     options_.host, options_.port));
-  thread_ = std::thread([this] { server_->listen_after_bind(); });
+  thread_ = std::thread([this, server = server_.get()] {
+    server->listen_after_bind();
+    done_.store(true);
+  });
   hub_.set_http_url(url());
   return port_;
 }
 
-void HttpServer::stop() {
-  if (!server_) return;
+bool HttpServer::stop() {
+  if (!server_) return true;
+  if (!thread_.joinable()) {  // bound but never served (start() failed): nothing runs
+    server_.reset();
+    return true;
+  }
   hub_.close();  // ends the streams' waits
   server_->stop();
+  // A client trickling its headers holds a worker for as long as it likes (cpp-httplib 0.11
+  // times out each recv, not the request): wait 3 s, then leave the server to the process's
+  // exit rather than hang a daemon's shutdown (systemd would SIGKILL it).
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(3);
+  while (!done_.load() && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  if (!done_.load()) {
+    log("http")->warn("a client still holds a connection: leaving it to the process's exit");
+    thread_.detach();
+    (void)server_.release();  // its worker may still run: never destroyed
+    return false;
+  }
   if (thread_.joinable()) thread_.join();
   server_.reset();
+  return true;
 }
 
 std::string HttpServer::url() const {

@@ -49,8 +49,10 @@ class HttpServer {
 
   /// Binds and starts serving; returns the bound port. Throws InputError when it cannot bind.
   int start();
-  /// Ends every stream and stops serving (idempotent).
-  void stop();
+  /// Ends every stream and stops serving (idempotent). False when a client still held a worker
+  /// after 3 s: the server is then left running detached, and the process must exit without
+  /// destroying what it uses (LiveService::exit_if_abandoned).
+  bool stop();
   /// "http://HOST:PORT/" once started.
   std::string url() const;
 
@@ -73,6 +75,7 @@ class HttpServer {
   std::thread thread_;
   int port_ = 0;
   std::atomic<int> streams_{0};
+  std::atomic<bool> done_{false};  ///< the listen thread has returned
   std::mutex store_mu_;
   std::optional<Store> store_;
 };

@@ -7,10 +7,11 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
+#include <cctype>
 #include <cerrno>
 #include <cstring>
-#include <fstream>
 
 #include "station/common/input_error.hpp"
 
@@ -33,7 +34,9 @@ std::string random_hex(std::size_t bytes) {
 }
 
 void create_token_file(const std::string& path) {
-  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  // Written under a temporary name and linked into place: a crash never leaves an empty token.
+  const std::string tmp = fmt::format("{}.{}.tmp", path, ::getpid());
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0600);
   if (fd < 0) {
     if (errno == EEXIST) return;  // another start created it meanwhile: read that one
     throw InputError(
@@ -43,35 +46,53 @@ void create_token_file(const std::string& path) {
   const bool ok = ::write(fd, line.data(), line.size()) == static_cast<ssize_t>(line.size());
   const bool synced = ::fsync(fd) == 0;
   ::close(fd);
-  if (!ok || !synced) {
-    ::unlink(path.c_str());
-    throw InputError(fmt::format("{}: cannot write the API token file", path));
-  }
+  // link() fails with EEXIST when another start made the file meanwhile: that one is read.
+  const bool linked = ok && synced && (::link(tmp.c_str(), path.c_str()) == 0 || errno == EEXIST);
+  ::unlink(tmp.c_str());
+  if (!linked) throw InputError(fmt::format("{}: cannot write the API token file", path));
 }
 
 }  // namespace
 
 std::string load_or_create_token(const std::string& path) {
-  struct stat st {};
-  if (::stat(path.c_str(), &st) != 0) {
-    if (errno != ENOENT)
-      throw InputError(fmt::format("{}: API token file: {}", path, std::strerror(errno)));
+  // Opened without following a symlink and checked on the open descriptor (no stat/open race):
+  // a regular file, ours, readable by nobody else, one line of >= 32 token characters.
+  int fd = ::open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
+  if (fd < 0 && errno == ENOENT) {
     create_token_file(path);
-    if (::stat(path.c_str(), &st) != 0)
-      throw InputError(fmt::format("{}: API token file: {}", path, std::strerror(errno)));
+    fd = ::open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
   }
-  if (!S_ISREG(st.st_mode)) throw InputError(fmt::format("{}: API token: not a file", path));
+  if (fd < 0)
+    throw InputError(
+        fmt::format("{}: API token file: {}", path,
+                    errno == ELOOP ? "a symbolic link (refused)" : std::strerror(errno)));
+  struct stat st {};
+  std::string text(4096, '\0');
+  const bool stated = ::fstat(fd, &st) == 0;
+  const ssize_t n = stated && S_ISREG(st.st_mode) ? ::read(fd, text.data(), text.size()) : -1;
+  ::close(fd);
+  if (!stated || !S_ISREG(st.st_mode))
+    throw InputError(fmt::format("{}: API token: not a regular file", path));
+  if (st.st_uid != ::geteuid())
+    throw InputError(fmt::format("{}: API token file belongs to uid {}, not to this daemon ({})",
+                                 path, st.st_uid, ::geteuid()));
   if ((st.st_mode & 077) != 0)
     throw InputError(
         fmt::format("{}: API token file is readable by others (mode {:o}); "
                     "chmod 600 it",
                     path, st.st_mode & 0777));
-  std::ifstream in(path);
-  std::string token;
-  std::getline(in, token);
+  if (n < 0) throw InputError(fmt::format("{}: API token file: cannot read", path));
+  text.resize(static_cast<std::size_t>(n));
+  std::string token = text.substr(0, text.find('\n'));
   while (!token.empty() && (token.back() == '\r' || token.back() == ' ')) token.pop_back();
-  if (token.size() < 16)
-    throw InputError(fmt::format("{}: API token must be one line of >= 16 characters", path));
+  const bool plain = std::all_of(token.begin(), token.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.';
+  });
+  if (token.size() < 32 || !plain)
+    throw InputError(
+        fmt::format("{}: API token must be one line of >= 32 letters, digits, "
+                    "'-', '_' or '.' (delete the file: a new one is made)",
+                    path));
   return token;
 }
 

@@ -112,7 +112,7 @@ void LiveHub::run_started(std::int64_t run_id, const Protocol& protocol,
   for (const auto& s : protocol.steps) steps_.emplace_back(s.label, to_string(s.kind));
   last_.reset();
   last_rows_.clear();
-  fault_.clear();
+  run_failure_.clear();
   trend_.clear();
   trend_stride_ = 1;
   trend_seen_ = 0;
@@ -177,7 +177,9 @@ void LiveHub::tick(const TickReport& r) {
 
 void LiveHub::event(const RunEvent& e) {
   std::lock_guard lock(mu_);
-  if (e.kind == "outage" && e.data_json) {
+  // An 'outage' event ends an outage; only "back after …" ones are a device answering again
+  // (the others close outages still open at a run's end or abort).
+  if (e.kind == "outage" && e.data_json && e.message.starts_with("back after")) {
     // {"device","start_s","end_s","ticks_lost"} (sequencer: outage_json)
     const auto j = nlohmann::json::parse(*e.data_json, nullptr, false);
     if (j.is_object() && j.contains("start_s") && j.contains("end_s") && j["start_s"].is_number() &&
@@ -194,26 +196,23 @@ void LiveHub::run_ended(std::int64_t run_id, const std::string& state) {
   std::lock_guard lock(mu_);
   run_id_.reset();
   last_run_id_ = run_id;
-  if (state.rfind("failed", 0) == 0) fault_ = state;
+  if (state.rfind("failed", 0) == 0) run_failure_ = state;
   metrics_.set_state(state_locked(), run_id);
   publish("run", {{"run_id", run_id}, {"state", state}});
 }
 
-void LiveHub::idle_readings(const std::optional<drivers::ChamberState>& chamber,
-                            const std::optional<drivers::TurntableState>& table,
-                            const std::string& fault, const std::vector<IoError>& io_errors) {
+void LiveHub::idle(const IdleReading& r) {
   std::lock_guard lock(mu_);
-  metrics_.io_errors(io_errors);
-  if (chamber) metrics_.chamber(*chamber);
-  idle_chamber_ = chamber;
-  idle_table_ = table;
-  fault_ = fault;
+  metrics_.io_errors(r.io_errors);
+  if (r.chamber) metrics_.chamber(*r.chamber);
+  idle_ = r;
+  fault_ = r.fault;
   metrics_.set_state(state_locked(), last_run_id_.value_or(0));
 }
 
 std::string LiveHub::state_locked() const {
   if (run_id_) return last_ && last_->safe_hold ? "hold" : "running";
-  return fault_.empty() ? "idle" : "fault";
+  return fault_.empty() && run_failure_.empty() ? "idle" : "fault";
 }
 
 nlohmann::json LiveHub::status_locked() const {
@@ -251,18 +250,32 @@ nlohmann::json LiveHub::status_locked() const {
       {"speed", num(info_.speed)},
       {"http", http_url_},
       {"run", run},
-      {"chamber", chamber_json(live ? last_->chamber : idle_chamber_)},
-      {"table", table_json(live ? last_->table : idle_table_)},
+      {"chamber", chamber_json(live    ? last_->chamber
+                               : idle_ ? idle_->chamber
+                                       : std::nullopt)},
+      {"table", table_json(live    ? last_->table
+                           : idle_ ? idle_->table
+                                   : std::nullopt)},
       {"slots", slots},
       {"safety",
        {{"safe_hold", live && last_->safe_hold},
-        {"door_closed", opt_bool(live ? last_->door_closed : std::nullopt)},
-        {"estop_pressed", opt_bool(live ? last_->estop_pressed : std::nullopt)},
-        {"table_interlock_open", opt_bool(live ? last_->table_interlock_open : std::nullopt)}}},
+        {"door_closed", opt_bool(live    ? last_->door_closed
+                                 : idle_ ? idle_->door_closed
+                                         : std::nullopt)},
+        {"estop_pressed", opt_bool(live    ? last_->estop_pressed
+                                   : idle_ ? idle_->estop_pressed
+                                           : std::nullopt)},
+        {"table_interlock_open",
+         opt_bool(live ? last_->table_interlock_open
+                       : (idle_ && idle_->table ? std::optional(idle_->table->interlock_open)
+                                                : std::nullopt))}}},
       {"ticks", ticks_},
       {"last_tick_ms", last_ ? nlohmann::json(last_->tick_wall_s * 1e3) : nlohmann::json(nullptr)},
       {"last_run_id", last_run_id_ ? nlohmann::json(*last_run_id_) : nlohmann::json(nullptr)}};
-  if (!fault_.empty()) j["fault"] = fault_;
+  if (!fault_.empty() || !run_failure_.empty())
+    j["fault"] = run_failure_.empty() ? fault_
+                 : fault_.empty()     ? run_failure_
+                                      : run_failure_ + "; " + fault_;
   return j;
 }
 

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "station/config/protocol.hpp"
+#include "station/daemon/idle_watch.hpp"
 #include "station/daemon/sequencer.hpp"
 #include "station/live/live_bins.hpp"
 #include "station/live/live_metrics.hpp"
@@ -52,10 +53,8 @@ class LiveHub {
   void event(const RunEvent& e);
   /// The run ended in `state` (completed, stopped, aborted, …, or 'failed: why').
   void run_ended(std::int64_t run_id, const std::string& state);
-  /// Idle readings (serve between runs): devices as read, or why not ('fault' when set).
-  void idle_readings(const std::optional<drivers::ChamberState>& chamber,
-                     const std::optional<drivers::TurntableState>& table, const std::string& fault,
-                     const std::vector<IoError>& io_errors = {});
+  /// An idle look at the rig (serve between runs): devices as read, safety inputs, the fault.
+  void idle(const IdleReading& r);
 
   nlohmann::json status() const;
   /// status + trend + live bins + latest events + the last stream id they include.
@@ -91,9 +90,9 @@ class LiveHub {
   std::optional<TickReport> last_;                          ///< last tick (rows pointer cleared)
   std::vector<SampleRow> last_rows_;
   std::int64_t ticks_ = 0;
-  std::string fault_;
-  std::optional<drivers::ChamberState> idle_chamber_;
-  std::optional<drivers::TurntableState> idle_table_;
+  std::string fault_;                ///< the idle rig's fault (serve), empty when clear
+  std::string run_failure_;          ///< why the last run failed; kept until the next run starts
+  std::optional<IdleReading> idle_;  ///< the last idle look (serve)
   // What the page draws
   std::vector<std::array<double, 3>> trend_;  ///< t_s, air_c, setpoint_c
   int trend_stride_ = 1;

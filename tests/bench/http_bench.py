@@ -101,7 +101,7 @@ def tick_bench(station, streams):
 
 def idle_bench(station, simrig, seconds):
     work = tempfile.mkdtemp(prefix="serve-idle-")
-    rig = subprocess.Popen([simrig, "--gyros", "8"], cwd=work, stdout=open(work + "/rig.toml", "w"),
+    rig = subprocess.Popen([simrig, "--gyros", "8", "--can-socket", work + "/can.sock"], cwd=work, stdout=open(work + "/rig.toml", "w"),
                            stderr=subprocess.DEVNULL)
     time.sleep(1.5)
     p = subprocess.Popen([station, "serve", "--config", "rig.toml", "--db", "s.db", "--http",

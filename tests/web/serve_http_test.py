@@ -78,7 +78,8 @@ def main():
     station, simrig = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
     work = tempfile.mkdtemp(prefix="serve-test-")
     rig_cfg = open(os.path.join(work, "rig.toml"), "w")
-    rig = subprocess.Popen([simrig, "--gyros", "2", "--control", os.path.join(work, "ctl")],
+    rig = subprocess.Popen([simrig, "--gyros", "2", "--control", os.path.join(work, "ctl"),
+                            "--can-socket", os.path.join(work, "can.sock")],
                            stdout=rig_cfg, stderr=subprocess.DEVNULL, cwd=work)
     procs = [rig]
     try:
