@@ -60,6 +60,9 @@ void run_one(Service& s, const Protocol& protocol, const std::optional<RunRecord
   so.abort = &g_run_abort;
   so.part_limits = s.part_limits;
   if (s.watchdog) so.watchdog = [] { sd_notify(0, "WATCHDOG=1"); };
+  so.on_run_start = [&s](std::int64_t id, const Protocol&, const std::vector<RunSlot>&) {
+    s.control.started(id);
+  };
   live::attach(s.live.hub(), so);
   so.http_url = s.live.hub().status().value("http", "");
   s.control.set_busy(true);

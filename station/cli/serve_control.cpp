@@ -50,12 +50,17 @@ http::ControlReply ServeControl::start(const std::string& protocol,
   } catch (const InputError& e) {
     return {400, e.what()};
   }
-  std::lock_guard lock(mu_);
+  std::unique_lock lock(mu_);
   if (busy_ || pending_) return {409, "a run is going on; stop it first"};
   if (!fault_.empty()) return {409, fmt::format("the rig is not ready: {}", fault_)};
   pending_ = StartRequest{std::move(p), operator_name};
+  const std::uint64_t mine = ++requests_;
   cv_.notify_all();
-  return {202, fmt::format("starting protocol '{}'", protocol)};
+  // Answer with the run's id once the serve loop created it (it does so before any device I/O),
+  // so a client can stop what it started; a slow start still answers 202, without the id.
+  cv_.wait_for(lock, std::chrono::seconds(5), [&] { return answered_ >= mine; });
+  const std::int64_t id = answered_ >= mine ? started_id_ : 0;
+  return {202, fmt::format("starting protocol '{}'", protocol), id};
 }
 
 http::ControlReply ServeControl::stop(std::int64_t run_id, bool abort) {
@@ -83,6 +88,13 @@ void ServeControl::set_busy(bool busy) {
 void ServeControl::set_fault(const std::string& fault) {
   std::lock_guard lock(mu_);
   fault_ = fault;
+}
+
+void ServeControl::started(std::int64_t run_id) {
+  std::lock_guard lock(mu_);
+  started_id_ = run_id;
+  answered_ = requests_;
+  cv_.notify_all();
 }
 
 void ServeControl::wake() {

@@ -34,6 +34,8 @@ class ServeControl final : public http::RunControl {
   void set_busy(bool busy);
   /// The serve loop: why the idle rig cannot start a run (empty: it can).
   void set_fault(const std::string& fault);
+  /// The serve loop: the run of the last request was created with this id (start() answers it).
+  void started(std::int64_t run_id);
   /// Wakes next() (shutdown).
   void wake();
 
@@ -48,6 +50,8 @@ class ServeControl final : public http::RunControl {
   std::condition_variable cv_;
   std::optional<StartRequest> pending_;
   bool busy_ = false, woken_ = false;
+  std::uint64_t requests_ = 0, answered_ = 0;  ///< start requests taken / whose run exists
+  std::int64_t started_id_ = 0;
   std::string fault_;
 };
 

@@ -153,9 +153,10 @@ void HttpServer::control_routes() {
       return;
     }
     const ControlReply r = control_.start(*protocol, op.value_or(""));
-    send_json(res, r.status,
-              r.status < 300 ? nlohmann::json{{"accepted", r.message}}
-                             : nlohmann::json{{"error", r.message}});
+    nlohmann::json reply = r.status < 300 ? nlohmann::json{{"accepted", r.message}}
+                                          : nlohmann::json{{"error", r.message}};
+    if (r.run_id > 0) reply["run_id"] = r.run_id;
+    send_json(res, r.status, reply);
   });
   const auto end_run = [this](bool abort) {
     return [this, abort](const httplib::Request& req, httplib::Response& res) {

@@ -11,6 +11,7 @@ namespace station::http {
 struct ControlReply {
   int status = 202;
   std::string message;
+  std::int64_t run_id = 0;  ///< a started run's id (0: not known)
 };
 
 /// Control of the daemon's runs. Called on HTTP threads: implementations are thread-safe.

@@ -115,7 +115,8 @@ def main():
         check(code == 400 and "unknown" in body["error"], "unknown protocol: 400 %s" % body)
         code, body = request(base, "POST", "/api/runs", token,
                              {"protocol": "paper", "operator": "ann"})
-        check(code == 202, "start: 202, got %d %s" % (code, body))
+        check(code == 202 and body.get("run_id", 0) > 0, "start: 202 with the run id, got %d %s"
+              % (code, body))
         st = wait_for(lambda: (lambda s: s if s["state"] == "running" and s["run"] else None)(
             status(base)), 15, "the run to start")
         run1 = st["run"]["id"]
