@@ -11,6 +11,7 @@
 
 int main(int argc, char** argv) {
   CLI::App app{"Gyro thermal-calibration test station"};
+  app.set_version_flag("--version", std::string("station ") + STATION_VERSION);
   app.require_subcommand(1);
   // One line per error, like every other input error (CLI11's default adds a second line).
   app.failure_message([](const CLI::App* /*app*/, const CLI::Error& e) {
