@@ -11,6 +11,19 @@ namespace station::drivers {
 /// Servo mode of the table.
 enum class TurntableMode { off, position, rate };
 
+/// "off", "position", "rate".
+constexpr const char* to_string(TurntableMode m) {
+  switch (m) {
+    case TurntableMode::off:
+      return "off";
+    case TurntableMode::position:
+      return "position";
+    case TurntableMode::rate:
+      return "rate";
+  }
+  return "unknown";
+}
+
 /// One reading of the table.
 struct TurntableState {
   TurntableMode mode = TurntableMode::off;

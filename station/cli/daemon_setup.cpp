@@ -3,11 +3,20 @@
 
 #include <fmt/format.h>
 
+#include <csignal>
 #include <filesystem>
 
 #include "station/parts/judged_fit.hpp"
 
 namespace station {
+
+void on_stop_signals(void (*handler)(int)) {
+  struct sigaction sa {};
+  sa.sa_handler = handler;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGTERM, &sa, nullptr);
+  sigaction(SIGINT, &sa, nullptr);
+}
 
 /// One daemon per database (and, on a real rig, per device): held until the process ends.
 std::vector<ProcessLock> lock_db_and_devices(const std::string& db, const StationConfig* config) {

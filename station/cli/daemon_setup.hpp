@@ -12,6 +12,8 @@
 
 namespace station {
 
+/// SIGTERM and SIGINT call `handler` (which only sets atomics): the daemon ends cleanly.
+void on_stop_signals(void (*handler)(int));
 /// One daemon per database (and, on a real rig, per device): held until the process ends.
 std::vector<ProcessLock> lock_db_and_devices(const std::string& db, const StationConfig* config);
 /// Whether `db` exists and holds a run to resume (read-only peek: nothing is created or written).

@@ -38,6 +38,8 @@ class LiveService {
   LiveService(const LiveServiceOptions& options, http::RunControl& control);
   live::LiveHub& hub() { return hub_; }
   bool serving() const { return server_ != nullptr; }
+  /// Where the page is served ("http://HOST:PORT/"); empty without HTTP.
+  std::string url() const { return server_ ? server_->url() : std::string(); }
   /// Lets the event streams send what is queued (a run's end), then stops serving.
   void shutdown();
   /// After shutdown: if a client held the server past its 3 s, ends the process now with `rc`

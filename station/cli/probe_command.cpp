@@ -69,18 +69,6 @@ DeviceReport probe_chamber(dr::Chamber& chamber, const StationConfig& c) {
   return d;
 }
 
-const char* mode_text(dr::TurntableMode m) {
-  switch (m) {
-    case dr::TurntableMode::off:
-      return "off";
-    case dr::TurntableMode::position:
-      return "position";
-    case dr::TurntableMode::rate:
-      return "rate";
-  }
-  return "unknown";
-}
-
 DeviceReport probe_turntable(dr::Turntable& table, const StationConfig& c) {
   auto r = table.read();
   if (!r) return failed("turntable", c.turntable->endpoint, r.error());
@@ -89,10 +77,10 @@ DeviceReport probe_turntable(dr::Turntable& table, const StationConfig& c) {
   d.summary = fmt::format(
       "mode {}, angle {:.4f} deg, rate {:.4f} deg/s, in_position {}, at_rate {}, fault {}, "
       "interlock_open {}",
-      mode_text(s.mode), s.angle_deg, s.rate_dps, yes_no(s.in_position), yes_no(s.at_rate),
+      dr::to_string(s.mode), s.angle_deg, s.rate_dps, yes_no(s.in_position), yes_no(s.at_rate),
       yes_no(s.fault), yes_no(s.interlock_open));
   d.fields = {
-      {"mode", mode_text(s.mode)},         {"angle_deg", s.angle_deg}, {"rate_dps", s.rate_dps},
+      {"mode", dr::to_string(s.mode)},     {"angle_deg", s.angle_deg}, {"rate_dps", s.rate_dps},
       {"in_position", s.in_position},      {"at_rate", s.at_rate},     {"fault", s.fault},
       {"interlock_open", s.interlock_open}};
   return d;

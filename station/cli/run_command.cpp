@@ -38,14 +38,6 @@ void on_signal(int) {
   g_stop.store(true);
 }
 
-void install_signal_handlers() {
-  struct sigaction sa {};
-  sa.sa_handler = on_signal;
-  sigemptyset(&sa.sa_mask);
-  sigaction(SIGTERM, &sa, nullptr);
-  sigaction(SIGINT, &sa, nullptr);
-}
-
 struct RunOptions {
   bool sim = false, json = false, fresh = false;
   std::string config, protocol = "paper", db, operator_name, log_file, record_can, record;
@@ -77,7 +69,7 @@ LiveServiceOptions live_options(const RunOptions& o, const std::string& db,
 void attach_live(LiveService& live, SequencerOptions& so) {
   so.abort = &g_abort;
   live::attach(live.hub(), so);
-  if (live.serving()) so.http_url = live.hub().status().value("http", "");
+  so.http_url = live.url();
 }
 
 /// Forwards to a tap attached later (the CAN log starts after the probe: its SYNC is no tick).
@@ -269,7 +261,7 @@ void add_run_command(CLI::App& app, CommandStatus& status) {
     lo.file = o->log_file;
     lo.journald = std::getenv("JOURNAL_STREAM") != nullptr;
     setup_logging(lo);
-    install_signal_handlers();
+    on_stop_signals(on_signal);
     if (!o->sim && o->speed > 0) throw InputError("--speed is for --sim (a rig runs at 1 Hz)");
     if (!o->sim && (o->config.empty() || o->db.empty())) {
       throw InputError("run: give --config FILE and --db PATH, or --sim");

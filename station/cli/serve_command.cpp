@@ -64,7 +64,7 @@ void run_one(Service& s, const Protocol& protocol, const std::optional<RunRecord
     s.control.started(id);
   };
   live::attach(s.live.hub(), so);
-  so.http_url = s.live.hub().status().value("http", "");
+  so.http_url = s.live.url();
   s.control.set_busy(true);
   // A stop or abort meant for an earlier run must not end this one.
   if (!g_stop.load()) g_run_stop.store(false);
@@ -169,11 +169,7 @@ void add_serve_command(CLI::App& app, CommandStatus& status) {
     lo.file = o->log_file;
     lo.journald = std::getenv("JOURNAL_STREAM") != nullptr;
     setup_logging(lo);
-    struct sigaction sa {};
-    sa.sa_handler = on_signal;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGTERM, &sa, nullptr);
-    sigaction(SIGINT, &sa, nullptr);
+    on_stop_signals(on_signal);
     status.exit_code = serve(*o);
   });
 }

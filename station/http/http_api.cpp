@@ -8,6 +8,7 @@
 #include "station/common/logging.hpp"
 #include "station/http/api_runs.hpp"
 #include "station/http/http_server.hpp"
+#include "station/http/json_reply.hpp"
 #include "station/store/sqlite.hpp"
 
 // Last: httplib.h pulls in <resolv.h>, whose `_res` macro breaks Eigen headers included after it.
@@ -16,12 +17,6 @@
 namespace station::http {
 
 namespace {
-
-void send_json(httplib::Response& res, int status, const nlohmann::json& body) {
-  res.status = status;
-  res.set_content(body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace),
-                  "application/json");
-}
 
 /// A positive decimal integer, or nullopt.
 std::optional<std::int64_t> positive_int(const std::string& text) {

@@ -12,6 +12,7 @@
 
 #include "station/common/input_error.hpp"
 #include "station/common/logging.hpp"
+#include "station/http/json_reply.hpp"
 #include "station/http/token.hpp"
 #include "station/web/builtin_web.hpp"
 
@@ -21,12 +22,6 @@
 namespace station::http {
 
 namespace {
-
-void send_json(httplib::Response& res, int status, const nlohmann::json& body) {
-  res.status = status;
-  res.set_content(body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace),
-                  "application/json");
-}
 
 bool is_loopback(const std::string& addr) {
   return addr == "127.0.0.1" || addr == "::1" || addr.rfind("127.", 0) == 0 ||
@@ -42,6 +37,12 @@ const char* mime_of(std::string_view name) {
 }
 
 }  // namespace
+
+void send_json(httplib::Response& res, int status, const nlohmann::json& body) {
+  res.status = status;
+  res.set_content(body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace),
+                  "application/json");
+}
 
 HttpOptions parse_listen(const std::string& address, const std::string& what) {
   const auto colon = address.rfind(':');

@@ -22,37 +22,11 @@ nlohmann::json opt_bool(const std::optional<bool>& v) {
   return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
 }
 
-const char* mode_name(drivers::ChamberMode m) {
-  switch (m) {
-    case drivers::ChamberMode::off:
-      return "off";
-    case drivers::ChamberMode::constant:
-      return "constant";
-    case drivers::ChamberMode::ramping:
-      return "ramping";
-    case drivers::ChamberMode::hold:
-      return "hold";
-  }
-  return "unknown";
-}
-
-const char* mode_name(drivers::TurntableMode m) {
-  switch (m) {
-    case drivers::TurntableMode::off:
-      return "off";
-    case drivers::TurntableMode::position:
-      return "position";
-    case drivers::TurntableMode::rate:
-      return "rate";
-  }
-  return "unknown";
-}
-
 nlohmann::json chamber_json(const std::optional<drivers::ChamberState>& c) {
   if (!c) return nullptr;
   return {{"air_c", num(c->air_c)},
           {"setpoint_c", num(c->setpoint_c)},
-          {"mode", mode_name(c->mode)},
+          {"mode", drivers::to_string(c->mode)},
           {"alarm", c->alarms.any()}};
 }
 
@@ -61,7 +35,7 @@ nlohmann::json table_json(const std::optional<drivers::TurntableState>& t) {
   return {{"angle_deg", t->angle_deg},
           {"rate_dps", t->rate_dps},
           {"locked", t->locked},
-          {"mode", mode_name(t->mode)}};
+          {"mode", drivers::to_string(t->mode)}};
 }
 
 nlohmann::json bin_json(const LiveBin& b) {
@@ -100,6 +74,25 @@ void attach(LiveHub& hub, SequencerOptions& o) {
   };
 }
 
+nlohmann::json LiveHub::slot_json(const SampleRow& s) const {
+  const auto it = earth_rate_dph_.find(s.serial);
+  std::optional<double> bias, grad;
+  if (s.rate_dph && it != earth_rate_dph_.end()) bias = *s.rate_dph - it->second;
+  if (s.temp_c && s.temp2_c) grad = *s.temp2_c - *s.temp_c;  // calibration.cpp's gradient
+  return {{"serial", s.serial},
+          {"bias_dph", num(bias)},
+          {"temp_c", num(s.temp_c)},
+          {"grad_c", num(grad)}};
+}
+
+void LiveHub::publish_state(std::int64_t run_id) {
+  const std::string state = state_locked();
+  if (state == published_state_ && run_id == published_run_) return;
+  metrics_.set_state(state, run_id);
+  published_state_ = state;
+  published_run_ = run_id;
+}
+
 void LiveHub::run_started(std::int64_t run_id, const Protocol& protocol,
                           const std::string& operator_name, const std::vector<RunSlot>& slots) {
   std::lock_guard lock(mu_);
@@ -117,7 +110,7 @@ void LiveHub::run_started(std::int64_t run_id, const Protocol& protocol,
   trend_stride_ = 1;
   trend_seen_ = 0;
   bins_.emplace(earth_rate_dph_, info_.bin_s);
-  metrics_.set_state("running", run_id);
+  publish_state(run_id);
   publish("run", {{"run_id", run_id}, {"state", "running"}});
 }
 
@@ -131,7 +124,7 @@ void LiveHub::tick(const TickReport& r) {
   last_ = r;
   last_->rows = nullptr;
   if (r.rows != nullptr) last_rows_ = *r.rows;
-  metrics_.set_state(state_locked(), r.run_id);
+  publish_state(r.run_id);
   // The trend: every trend_stride_-th tick; when full, every other point goes and the stride
   // doubles, so a 13 h run ends with <= 2000 evenly spaced points.
   if (trend_seen_++ % trend_stride_ == 0) {
@@ -153,15 +146,7 @@ void LiveHub::tick(const TickReport& r) {
   last_tick_msg_ = now;
   nlohmann::json slots = nlohmann::json::array();
   for (const auto& s : last_rows_) {
-    const auto it = earth_rate_dph_.find(s.serial);
-    std::optional<double> bias;
-    if (s.rate_dph && it != earth_rate_dph_.end()) bias = *s.rate_dph - it->second;
-    std::optional<double> grad;
-    if (s.temp_c && s.temp2_c) grad = *s.temp2_c - *s.temp_c;
-    slots.push_back({{"serial", s.serial},
-                     {"bias_dph", num(bias)},
-                     {"temp_c", num(s.temp_c)},
-                     {"grad_c", num(grad)}});
+    slots.push_back(slot_json(s));
   }
   publish("tick",
           {{"t_s", r.t_s},
@@ -197,7 +182,7 @@ void LiveHub::run_ended(std::int64_t run_id, const std::string& state) {
   run_id_.reset();
   last_run_id_ = run_id;
   if (state.rfind("failed", 0) == 0) run_failure_ = state;
-  metrics_.set_state(state_locked(), run_id);
+  publish_state(run_id);
   publish("run", {{"run_id", run_id}, {"state", state}});
 }
 
@@ -207,7 +192,7 @@ void LiveHub::idle(const IdleReading& r) {
   if (r.chamber) metrics_.chamber(*r.chamber);
   idle_ = r;
   fault_ = r.fault;
-  metrics_.set_state(state_locked(), last_run_id_.value_or(0));
+  publish_state(last_run_id_.value_or(0));
 }
 
 std::string LiveHub::state_locked() const {
@@ -231,16 +216,9 @@ nlohmann::json LiveHub::status_locked() const {
   }
   nlohmann::json slots = nlohmann::json::array();
   for (const auto& s : last_rows_) {
-    const auto it = earth_rate_dph_.find(s.serial);
-    std::optional<double> bias;
-    if (s.rate_dph && it != earth_rate_dph_.end()) bias = *s.rate_dph - it->second;
-    std::optional<double> grad;
-    if (s.temp_c && s.temp2_c) grad = *s.temp2_c - *s.temp_c;
-    slots.push_back({{"serial", s.serial},
-                     {"rate_dph", num(s.rate_dph)},
-                     {"bias_dph", num(bias)},
-                     {"temp_c", num(s.temp_c)},
-                     {"grad_c", num(grad)}});
+    auto j = slot_json(s);
+    j["rate_dph"] = num(s.rate_dph);
+    slots.push_back(std::move(j));
   }
   const bool live = run_id_ && last_;
   nlohmann::json j{

@@ -75,6 +75,10 @@ class LiveHub {
  private:
   void publish(const std::string& event, const nlohmann::json& data);  // lock held
   nlohmann::json status_locked() const;
+  /// A sample as the page shows it: bias (rate − the slot's Earth rate), temperature, gradient.
+  nlohmann::json slot_json(const SampleRow& s) const;
+  /// The run-state metric, written only when the state or run changes (not every tick).
+  void publish_state(std::int64_t run_id);
   std::string state_locked() const;
 
   const StationInfo info_;
@@ -104,6 +108,8 @@ class LiveHub {
   std::uint64_t next_id_ = 1;
   std::chrono::steady_clock::time_point last_tick_msg_{};
   LiveMetrics metrics_;
+  std::string published_state_ = "idle";
+  std::int64_t published_run_ = 0;
 };
 
 }  // namespace station::live
