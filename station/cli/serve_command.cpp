@@ -4,6 +4,9 @@
 // start exactly as `run` resumes it, and a run that fails is recorded and the service goes on.
 // Under systemd: Type=notify (READY once the HTTP service is bound), WATCHDOG=1 every second
 // whether idle or running; SIGTERM ends the running run as 'stopped' and then the service.
+// SIGUSR1 is the hand-over for a package upgrade: the running run is left resumable (everything
+// committed, outputs as they are) and the service exits 75 (EX_TEMPFAIL), which systemd's
+// Restart=on-failure answers by starting the new binary, which resumes the run.
 #include <fmt/format.h>
 #include <systemd/sd-daemon.h>
 
@@ -29,10 +32,19 @@ namespace {
 std::atomic<bool> g_stop{false};       // SIGTERM/SIGINT: the service ends
 std::atomic<bool> g_run_stop{false};   // the running run ends (API stop, or the signal)
 std::atomic<bool> g_run_abort{false};  // ... without bins or fit (API abort)
+std::atomic<bool> g_detach{false};     // SIGUSR1: leave the run resumable, exit for a restart
+
+/// The exit status after SIGUSR1 (sysexits.h EX_TEMPFAIL): "restart me", not a failure of a run.
+constexpr int kExitRestart = 75;
 
 void on_signal(int) {
   g_stop.store(true);
   g_run_stop.store(true);
+}
+
+void on_detach_signal(int) {
+  g_detach.store(true);
+  g_stop.store(true);
 }
 
 struct ServeOptions {
@@ -58,6 +70,7 @@ void run_one(Service& s, const Protocol& protocol, const std::optional<RunRecord
   so.operator_name = operator_name;
   so.stop = &g_run_stop;
   so.abort = &g_run_abort;
+  so.detach = &g_detach;
   so.part_limits = s.part_limits;
   if (s.watchdog) so.watchdog = [] { sd_notify(0, "WATCHDOG=1"); };
   so.on_run_start = [&s](std::int64_t id, const Protocol&, const std::vector<RunSlot>&) {
@@ -141,8 +154,10 @@ int serve(const ServeOptions& o) {
   idle_until_stopped(s);
   sd_notify(0, "STOPPING=1");
   live.shutdown();
-  live.exit_if_abandoned(0);
-  return 0;
+  const int code = g_detach.load() ? kExitRestart : 0;
+  if (code != 0) log("serve")->info("SIGUSR1: exiting {} for a restart (a run resumes)", code);
+  live.exit_if_abandoned(code);
+  return code;
 }
 
 }  // namespace
@@ -170,6 +185,10 @@ void add_serve_command(CLI::App& app, CommandStatus& status) {
     lo.journald = std::getenv("JOURNAL_STREAM") != nullptr;
     setup_logging(lo);
     on_stop_signals(on_signal);
+    struct sigaction sa {};
+    sa.sa_handler = on_detach_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGUSR1, &sa, nullptr);
     status.exit_code = serve(*o);
   });
 }

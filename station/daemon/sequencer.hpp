@@ -71,6 +71,10 @@ struct SequencerOptions {
   const std::atomic<bool>* stop = nullptr;         ///< set by SIGTERM/SIGINT
   /// Ends the run at the next tick without binning or fitting: state 'aborted' (API abort).
   const std::atomic<bool>* abort = nullptr;
+  /// Ends the loop at the next tick leaving the run 'running', exactly as a kill would but with
+  /// everything committed: the next daemon resumes it (a package upgrade's restart, SIGUSR1 to
+  /// `serve`). Outputs stay as they are; no bins, no fit. Outcome state 'detached'.
+  const std::atomic<bool>* detach = nullptr;
   /// Told each stored event (the live page's event stream). Called on the sequencer's thread.
   std::function<void(const RunEvent&)> on_event;
   /// Where the live page is served (an 'http' event at the run's start or resume: the port a
@@ -96,7 +100,7 @@ struct SequencerOptions {
 /// How a run ended.
 struct RunOutcome {
   std::int64_t run_id = 0;
-  std::string state;  ///< completed | incomplete | stopped | aborted
+  std::string state;  ///< completed | incomplete | stopped | aborted | detached
   double t_s = 0;     ///< last tick
   std::int64_t ticks = 0;
 };

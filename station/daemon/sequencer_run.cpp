@@ -195,6 +195,11 @@ RunOutcome Sequencer::run(const std::optional<RunRecord>& resume) {
     }
     if (options_.abort != nullptr && options_.abort->load())
       return {run_id_, abort(t_s), t_s, ticks};
+    if (options_.detach != nullptr && options_.detach->load()) {
+      emit(t_s, "info", "seq", "detach",
+           fmt::format("run {} left resumable at t = {:.0f} s (service restart)", run_id_, t_s));
+      return {run_id_, "detached", t_s, ticks};
+    }
     const bool stop = options_.stop != nullptr && options_.stop->load();
     if (runner_->done() || stop) {
       const std::string state = runner_->done() ? "completed" : "stopped";

@@ -3,6 +3,8 @@
 
 #include <fmt/format.h>
 
+#include <filesystem>
+
 #include "schemas/migrations.hpp"
 
 namespace station {
@@ -148,6 +150,7 @@ void Database::migrate() {
         "or station fit) migrates it",
         path_, have, known));
   }
+  backup_before_migrating(have);
   // Foreign keys off around the migrations: a migration may rebuild a table (SQLite's
   // "generalized ALTER TABLE" procedure, lang_altertable.html section 7). The pragma is a no-op
   // inside a transaction, so it is set before BEGIN and restored after.
@@ -171,6 +174,27 @@ void Database::migrate() {
     throw;
   }
   exec("PRAGMA foreign_keys=ON");
+}
+
+// A copy of the database as the older software left it, before a migration changes it (a
+// package upgrade): `PATH.schema-vN.bak`, written with VACUUM INTO (sqlite.org/lang_vacuum.html,
+// "VACUUM INTO": a consistent, compacted copy, taken inside a read transaction). A copy already
+// there (an earlier attempt, or a second process that got here first) is kept as it is. No copy
+// means no migration: every number measured stays readable by the software that wrote it.
+void Database::backup_before_migrating(int have) {
+  if (have == 0 || path_.empty() || path_ == ":memory:") return;
+  const std::string copy = fmt::format("{}.schema-v{}.bak", path_, have);
+  if (std::filesystem::exists(copy)) return;
+  auto st = prepare("VACUUM INTO ?1");
+  st.bind(1, copy);
+  try {
+    st.step();
+  } catch (const SqliteError& e) {
+    if (std::filesystem::exists(copy)) return;  // another process wrote it meanwhile
+    throw SqliteError(fmt::format(
+        "{}: not migrated from schema version {}: the copy {} could not be written ({})", path_,
+        have, copy, e.what()));
+  }
 }
 
 int Database::check_schema_version(int have, int known) const {

@@ -88,8 +88,9 @@ class Database {
   Statement prepare(std::string_view sql) { return Statement(db_.get(), sql, path_); }
   /// Row id of the last insert.
   std::int64_t last_insert_id() const { return sqlite3_last_insert_rowid(db_.get()); }
-  /// Applies schemas/migrations/*.sql past PRAGMA user_version, each in a transaction.
-  /// Throws when the file is newer than this software.
+  /// Applies schemas/migrations/*.sql past PRAGMA user_version in one transaction, after a
+  /// copy of the file as it was (`PATH.schema-vN.bak`). Throws when the file is newer than this
+  /// software, or when the copy cannot be written.
   void migrate();
   /// PRAGMA user_version.
   int schema_version();
@@ -102,6 +103,8 @@ class Database {
   /// `have` when it is a version this software can migrate from; throws otherwise (a negative
   /// or future user_version must never index the migration table).
   int check_schema_version(int have, int known) const;
+  /// VACUUM INTO `path.schema-vHAVE.bak` before migrating from `have` (unless it exists).
+  void backup_before_migrating(int have);
   std::unique_ptr<sqlite3, SqliteClose> db_;
   std::string path_;
   OpenMode mode_;

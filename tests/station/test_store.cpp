@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <string>
@@ -298,4 +299,32 @@ TEST(Store, MigratesAVersion1DatabaseKeepingItsRunsAndLastTick) {
   EXPECT_EQ(run->resolved_json, "{}");
   s.finish_run(1, "incomplete");  // allowed by version 2
   EXPECT_EQ(s.find_run(1)->state, "incomplete");
+  // The file as version 1 left it is kept beside it, readable, with its run and sample.
+  station::Database copy(path + ".schema-v1.bak", station::OpenMode::existing);
+  EXPECT_EQ(copy.schema_version(), 1);
+  auto st = copy.prepare("SELECT state, (SELECT COUNT(*) FROM samples) FROM runs WHERE id = 1");
+  ASSERT_TRUE(st.step());
+  EXPECT_EQ(st.column_text(0), "running");
+  EXPECT_EQ(st.column_int(1), 1);
+}
+
+TEST(Store, DoesNotMigrateWhenTheCopyCannotBeWritten) {
+  const auto path = fresh_db("v1-nocopy");
+  {
+    station::Database db(path);
+    db.exec(station::schemas::kMigrations[0].second);
+    db.exec("PRAGMA user_version = 1");
+  }
+  // The copy's name is a link into a directory that does not exist: VACUUM INTO fails, so the
+  // open fails naming the copy, and the file is left at version 1.
+  std::filesystem::create_symlink("/nonexistent-station-dir/x", path + ".schema-v1.bak");
+  try {
+    station::Store s(path);
+    ADD_FAILURE() << "migrated without a copy";
+  } catch (const station::SqliteError& e) {
+    EXPECT_NE(std::string(e.what()).find(".schema-v1.bak could not be written"), std::string::npos)
+        << e.what();
+  }
+  station::Database db(path, station::OpenMode::existing);
+  EXPECT_EQ(db.schema_version(), 1);
 }

@@ -153,6 +153,31 @@ def main():
         check(st and st["run"]["id"] == run2, "the killed run resumes at start")
         code, ev = request(base, "GET", "/api/runs/%d/events?since=0" % run2)
         check(any(e["kind"] == "resume" for e in ev["events"]), "a resume event is stored")
+
+        # SIGUSR1, the package upgrade's hand-over: exit 75 with the run left resumable, its
+        # ticks committed; the next serve (systemd's restart) resumes it.
+        wait_for(lambda: status(base)["ticks"] >= 3, 10, "ticks of the resumed run")
+        serve.send_signal(signal.SIGUSR1)
+        rc = serve.wait(15)
+        check(rc == 75, "SIGUSR1: exit 75 (EX_TEMPFAIL, restart me), got %d" % rc)
+        db = sqlite3.connect(os.path.join(work, "s.db"))
+        state = db.execute("SELECT state FROM runs WHERE id = ?", (run2,)).fetchone()[0]
+        check(state == "running", "run left 'running' by SIGUSR1: %s" % state)
+        kinds = [k for (k,) in db.execute("SELECT kind FROM events WHERE run_id = ?", (run2,))]
+        check(kinds and kinds[-1] == "detach", "a detach event is the run's last: %s" % kinds[-3:])
+        n_before = db.execute("SELECT COUNT(*) FROM samples WHERE run_id = ?", (run2,)).fetchone()[0]
+        db.close()
+        serve, base = start_serve(station, work, "serve3.log")
+        procs.append(serve)
+        st = wait_for(lambda: (lambda s: s if s["run"] else None)(status(base)), 15,
+                      "the run resumed after the hand-over")
+        check(st and st["run"]["id"] == run2, "the handed-over run resumes")
+        wait_for(lambda: status(base)["ticks"] >= 2, 10, "ticks after the hand-over")
+        db = sqlite3.connect(os.path.join(work, "s.db"))
+        n_after = db.execute("SELECT COUNT(*) FROM samples WHERE run_id = ?", (run2,)).fetchone()[0]
+        db.close()
+        check(n_before > 0 and n_after > n_before,
+              "samples kept and added across the hand-over: %d -> %d" % (n_before, n_after))
         code, _ = request(base, "POST", "/api/runs/%d/abort" % run2, token)
         check(code == 202, "abort: 202, got %d" % code)
         wait_for(lambda: status(base)["state"] in ("idle", "fault"), 15, "idle after abort")
