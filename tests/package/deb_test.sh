@@ -72,21 +72,24 @@ installed_files_only() {  # simrig, probe, run --sim from /usr/bin, in an empty 
   (cd "$d" && "${as[@]}" station probe --config "$d/rig.toml") >"$WORK/probe.log" 2>&1
   rc=$?
   check '[[ $rc -eq 0 ]] && grep -q "SIM-0002" "$WORK/probe.log"' "installed station probe --config against simrig (exit $rc)"
-  pkill -TERM -P "$rig" simrig 2>/dev/null; kill "$rig" 2>/dev/null; wait "$rig" 2>/dev/null
+  pkill -TERM -u gyro-station -f "simrig --gyros 2 --can-socket $d/can.sock"
+  wait "$rig" 2>/dev/null
   (cd "$d" && "${as[@]}" station run --sim --new --db "$d/sim.db") >"$WORK/run.log" 2>&1
   rc=$?
-  check '[[ $rc -eq 0 ]] && grep -q "std ratio" "$WORK/run.log"' "installed station run --sim (exit $rc)"
-  [[ $FAILS -eq 0 ]] || tail -20 "$WORK/probe.log" "$WORK/run.log"
+  check '[[ $rc -eq 0 ]] && grep -q "(completed)" "$WORK/run.log"' "installed station run --sim (exit $rc)"
+  [[ $FAILS -eq 0 ]] || tail -n 20 "$WORK/probe.log" "$WORK/run.log"
   rm -rf "$d"
 }
 
 start_systemd() {  # SYSTEMCTL/IN: how to reach a systemd; returns 1 (with a message) if none
   if [[ -d /run/systemd/system ]]; then IN=(); return 0; fi
   # Not PID 1 here (a container or a VM's init): boot one in its own PID and mount namespaces,
-  # with its own /tmp and /run, up to sysinit.target only (no network or login units).
+  # with its own /tmp and /run, up to sysinit.target only (no network or login units), /sys and
+  # /proc/sys read-only so that its udev and sysctl units leave the machine's devices alone.
   unshare --pid --fork --mount --uts --propagation private --mount-proc sh -c '
     mount -t tmpfs -o mode=1777 tmpfs /tmp && mount -t tmpfs -o mode=0755 tmpfs /run &&
-    install -d -m 1777 /run/lock &&
+    install -d -m 1777 /run/lock && mount -o remount,bind,ro /sys &&
+    mount --bind /proc/sys /proc/sys && mount -o remount,bind,ro /proc/sys &&
     exec env container=deb-test /lib/systemd/systemd --system --unit=sysinit.target' \
     >"$WORK/systemd.log" 2>&1 &
   local outer=$! st=""
@@ -110,12 +113,17 @@ wait_until() {  # CONDITION SECONDS
   return 1
 }
 
+config_error_logged() {
+  "${IN[@]}" journalctl --no-pager -u gyro-station |
+    grep -q 'station: /etc/gyro-station/station.toml:[0-9]*:[0-9]*: TOML syntax'
+}
+
 the_service() {
   "${IN[@]}" systemctl start gyro-station-simrig gyro-station
   check '"${IN[@]}" systemctl is-active --quiet gyro-station' "the hardened unit starts (Type=notify: READY)"
   local pid user
   pid=$("${IN[@]}" systemctl show -P MainPID gyro-station)
-  user=$(ps -o user= -p "$pid" 2>/dev/null)
+  user=$("${IN[@]}" ps -o user= -p "$pid" 2>/dev/null)
   check '[[ $user == gyro-station ]]' "it runs as gyro-station (pid $pid: $user)"
   check 'wait_until "[[ \$(status_field \"s[\\\"state\\\"]\") == idle ]]" 20' "GET /api/status: idle with the simulated rig read"
   local token run
@@ -137,6 +145,17 @@ the_service() {
   local state
   state=$(sqlite3 /var/lib/gyro-station/station.db "SELECT state FROM runs WHERE id = $run")
   check '[[ $state == stopped ]]' "systemctl stop: the run is closed 'stopped' ($state)"
+  # A configuration error (exit 2) fails the unit once, with the reason in the journal; no loop
+  # (a manual start resets NRestarts, so any restart in the 7 s would show as 1).
+  cp /etc/gyro-station/station.toml "$WORK/station.toml.good"
+  echo "garbage = [" >>/etc/gyro-station/station.toml
+  "${IN[@]}" systemctl start gyro-station 2>/dev/null
+  sleep 7
+  check '"${IN[@]}" systemctl is-failed --quiet gyro-station && [[ $("${IN[@]}" systemctl show -P NRestarts gyro-station) -eq 0 ]]' \
+    "a broken configuration: the unit fails once (RestartPreventExitStatus=2), no restart loop"
+  check 'wait_until config_error_logged 10' "the journal names the file, line and column"
+  cp "$WORK/station.toml.good" /etc/gyro-station/station.toml
+  "${IN[@]}" systemctl reset-failed gyro-station
   [[ $FAILS -eq 0 ]] || "${IN[@]}" journalctl -u gyro-station --no-pager | tail -30
 }
 

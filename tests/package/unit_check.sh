@@ -30,7 +30,7 @@ for u in gyro-station.service gyro-station-simrig.service; do
 done
 for key in User=gyro-station NoNewPrivileges=yes ProtectSystem=strict ProtectHome=yes PrivateTmp=yes \
   "ReadWritePaths=/var/lib/gyro-station /run/lock" CapabilityBoundingSet= DevicePolicy=closed \
-  Type=notify WatchdogSec=10 Restart=on-failure; do
+  Type=notify WatchdogSec=10 Restart=on-failure RestartPreventExitStatus=2; do
   grep -qx -- "$key" "$units/gyro-station.service" || { echo "FAIL: gyro-station.service lacks $key"; exit 1; }
 done
 echo "ok: the promised hardening keys"
