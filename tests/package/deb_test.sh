@@ -51,6 +51,8 @@ install_checks() {
   local v
   v=$(/usr/bin/station --version)
   check '[[ $v == "station $(dpkg-query -W -f="\${Version}" gyro-station)" ]]' "station --version: $v"
+  check '[[ -f /usr/share/man/man1/station.1.gz && -f /usr/share/man/man1/simrig.1.gz ]] && zcat /usr/share/man/man1/station.1.gz | grep -q "^serve"' \
+    "manual pages station(1) and simrig(1), made from --help"
   check 'id -nG gyro-station | grep -qw dialout' "the service user is in dialout: $(id -nG gyro-station)"
   check '[[ $(stat -c "%U:%G %a" /var/lib/gyro-station) == "gyro-station:gyro-station 750" ]]' \
     "/var/lib/gyro-station: $(stat -c '%U:%G %a' /var/lib/gyro-station)"
