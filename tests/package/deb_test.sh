@@ -31,7 +31,8 @@ export DEBIAN_FRONTEND=noninteractive
 WORK=$(mktemp -d /var/tmp/deb-test.XXXXXX)
 chmod 0755 "$WORK"
 NS_PID=""
-SYSTEMCTL=()
+IN=()        # how to run a command where systemd is (nsenter into the namespaced one)
+HAVE_SYSTEMD=0
 cleanup() { [[ -n $NS_PID ]] && kill -KILL "$NS_PID" 2>/dev/null; }
 trap cleanup EXIT
 
@@ -51,7 +52,7 @@ install_checks() {
   local v
   v=$(/usr/bin/station --version)
   check '[[ $v == "station $(dpkg-query -W -f="\${Version}" gyro-station)" ]]' "station --version: $v"
-  check '[[ -f /usr/share/man/man1/station.1.gz && -f /usr/share/man/man1/simrig.1.gz ]] && zcat /usr/share/man/man1/station.1.gz | grep -q "^serve"' \
+  check '[[ -f /usr/share/man/man1/station.1.gz && -f /usr/share/man/man1/simrig.1.gz ]] && grep -q "^serve" <<<"$(zcat /usr/share/man/man1/station.1.gz)"' \
     "manual pages station(1) and simrig(1), made from --help"
   check 'id -nG gyro-station | grep -qw dialout' "the service user is in dialout: $(id -nG gyro-station)"
   check '[[ $(stat -c "%U:%G %a" /var/lib/gyro-station) == "gyro-station:gyro-station 750" ]]' \
@@ -83,7 +84,7 @@ installed_files_only() {  # simrig, probe, run --sim from /usr/bin, in an empty 
   rm -rf "$d"
 }
 
-start_systemd() {  # SYSTEMCTL/IN: how to reach a systemd; returns 1 (with a message) if none
+start_systemd() {  # sets IN (how to reach a systemd); returns 1 (with a message) if none
   if [[ -d /run/systemd/system ]]; then IN=(); return 0; fi
   # Not PID 1 here (a container or a VM's init): boot one in its own PID and mount namespaces,
   # with its own /tmp and /run, up to sysinit.target only (no network or login units), /sys and
@@ -115,9 +116,10 @@ wait_until() {  # CONDITION SECONDS
   return 1
 }
 
-config_error_logged() {
-  "${IN[@]}" journalctl --no-pager -u gyro-station |
-    grep -q 'station: /etc/gyro-station/station.toml:[0-9]*:[0-9]*: TOML syntax'
+config_error_logged() {  # (captured first: grep -q closing the pipe early fails under pipefail)
+  local journal
+  journal=$("${IN[@]}" journalctl --no-pager -u gyro-station)
+  grep -q 'station: /etc/gyro-station/station.toml:[0-9]*:[0-9]*: TOML syntax' <<<"$journal"
 }
 
 the_service() {
@@ -183,11 +185,16 @@ check 'systemd-analyze verify /usr/lib/systemd/system/gyro-station.service /usr/
   "systemd-analyze verify on the installed units: $(cat "$WORK/verify.log" 2>/dev/null)"
 installed_files_only
 echo "== the service under systemd"
-if start_systemd; then the_service; fi
+if start_systemd; then HAVE_SYSTEMD=1; the_service; fi
 echo "== remove and purge"
 remove_and_purge_with_data
 echo "== a second install, purged without data: nothing may be left"
-apt-get install -y "$DEB" >"$WORK/install2.log" 2>&1 && apt-get purge -y gyro-station >"$WORK/purge2.log" 2>&1
+"${IN[@]}" apt-get install -y "$DEB" >"$WORK/install2.log" 2>&1
+if ((HAVE_SYSTEMD)); then  # installed with systemd running: enabled, known to it, not started
+  check '[[ $("${IN[@]}" systemctl is-enabled gyro-station) == enabled ]] && ! "${IN[@]}" systemctl is-active --quiet gyro-station' \
+    "installed under a running systemd: enabled ($("${IN[@]}" systemctl is-enabled gyro-station)), not started"
+fi
+"${IN[@]}" apt-get purge -y gyro-station >"$WORK/purge2.log" 2>&1
 check '[[ -z $(leftovers) ]]' "purge without data leaves nothing: $(leftovers | tr '\n' ' ')"
 if ((FAILS > 0)); then echo "deb_test: $FAILS failure(s); logs in $WORK"; exit 1; fi
 rm -rf "$WORK"
