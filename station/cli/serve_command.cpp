@@ -8,10 +8,12 @@
 // committed, outputs as they are) and the service exits 75 (EX_TEMPFAIL), which systemd's
 // Restart=on-failure answers by starting the new binary, which resumes the run.
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 #include <systemd/sd-daemon.h>
 
 #include <atomic>
 #include <csignal>
+#include <cstdio>
 #include <cstdlib>
 
 #include "drivers/common/clock.hpp"
@@ -38,6 +40,7 @@ std::atomic<bool> g_detach{false};     // SIGUSR1: leave the run resumable, exit
 constexpr int kExitRestart = 75;
 
 void on_signal(int) {
+  g_detach.store(false);  // a stop after a hand-over request wins: the run ends 'stopped'
   g_stop.store(true);
   g_run_stop.store(true);
 }
@@ -154,10 +157,18 @@ int serve(const ServeOptions& o) {
   idle_until_stopped(s);
   sd_notify(0, "STOPPING=1");
   live.shutdown();
-  const int code = g_detach.load() ? kExitRestart : 0;
-  if (code != 0) log("serve")->info("SIGUSR1: exiting {} for a restart (a run resumes)", code);
-  live.exit_if_abandoned(code);
-  return code;
+  if (g_detach.load()) {
+    // Everything is committed (each tick is its own transaction). Leave now, as a kill would:
+    // no destructors, so the GPIO lines keep their levels (the gyros stay powered and the
+    // lamps as they are) until the new process takes the rig over a few seconds later.
+    log("serve")->info("SIGUSR1: exiting {} for a restart (a running run resumes)", kExitRestart);
+    std::fflush(stdout);
+    std::fflush(stderr);
+    spdlog::shutdown();
+    std::_Exit(kExitRestart);
+  }
+  live.exit_if_abandoned(0);
+  return 0;
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <fcntl.h>
 #include <fmt/format.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -24,10 +25,31 @@ std::string read_holder(int fd) {
   return pid.empty() ? "unknown" : pid;
 }
 
+// The lock file, shared by every user that runs a station process (the service's user, an
+// operator, root). flock(2) works on any open descriptor, so an existing file is opened without
+// O_CREAT (read-write to leave the PID note, else read-only): in a world-writable sticky
+// directory such as /run/lock, fs.protected_regular=2 (Debian's default) refuses an O_CREAT open
+// of another user's file even to root. A new file is made readable by all (0644 whatever the
+// umask), so the next user can open it.
+int open_lock_file(const std::string& path) {
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    int fd = ::open(path.c_str(), O_RDWR | O_NOFOLLOW | O_CLOEXEC);
+    if (fd < 0 && errno == EACCES) fd = ::open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
+    if (fd >= 0 || errno != ENOENT) return fd;
+    fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+    if (fd >= 0) {
+      (void)::fchmod(fd, 0644);
+      return fd;
+    }
+    if (errno != EEXIST) return fd;  // another process created it just now: open that one
+  }
+  return -1;
+}
+
 }  // namespace
 
 ProcessLock ProcessLock::acquire(const std::string& lock_path, const std::string& what) {
-  const int fd = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  const int fd = open_lock_file(lock_path);
   if (fd < 0) {
     throw InputError(fmt::format("{}: cannot open the lock file for {}: {}", lock_path, what,
                                  std::strerror(errno)));

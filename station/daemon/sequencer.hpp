@@ -73,7 +73,8 @@ struct SequencerOptions {
   const std::atomic<bool>* abort = nullptr;
   /// Ends the loop at the next tick leaving the run 'running', exactly as a kill would but with
   /// everything committed: the next daemon resumes it (a package upgrade's restart, SIGUSR1 to
-  /// `serve`). Outputs stay as they are; no bins, no fit. Outcome state 'detached'.
+  /// `serve`). No bins, no fit, outputs not driven (serve then leaves with _Exit, so the GPIO
+  /// bank's release does not drive them safe either). Outcome state 'detached'.
   const std::atomic<bool>* detach = nullptr;
   /// Told each stored event (the live page's event stream). Called on the sequencer's thread.
   std::function<void(const RunEvent&)> on_event;

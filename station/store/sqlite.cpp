@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <ctime>
 #include <filesystem>
 
 #include "schemas/migrations.hpp"
@@ -177,23 +178,37 @@ void Database::migrate() {
 }
 
 // A copy of the database as the older software left it, before a migration changes it (a
-// package upgrade): `PATH.schema-vN.bak`, written with VACUUM INTO (sqlite.org/lang_vacuum.html,
-// "VACUUM INTO": a consistent, compacted copy, taken inside a read transaction). A copy already
-// there (an earlier attempt, or a second process that got here first) is kept as it is. No copy
-// means no migration: every number measured stays readable by the software that wrote it.
+// package upgrade): `PATH.schema-vN.YYYYMMDDTHHMMSSZ.bak`, written with VACUUM INTO
+// (sqlite.org/lang_vacuum.html, "VACUUM INTO": a consistent, compacted copy taken inside a read
+// transaction) to `NAME.tmp`, then renamed, so a copy under its final name is always whole (a full
+// disk or a kill mid-copy leaves at most the .tmp, removed on the next attempt). Each migration
+// gets its own copy. No copy, no migration: the error says why.
 void Database::backup_before_migrating(int have) {
   if (have == 0 || path_.empty() || path_ == ":memory:") return;
-  const std::string copy = fmt::format("{}.schema-v{}.bak", path_, have);
-  if (std::filesystem::exists(copy)) return;
-  auto st = prepare("VACUUM INTO ?1");
-  st.bind(1, copy);
+  const std::time_t now = std::time(nullptr);
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  char stamp[32];
+  std::strftime(stamp, sizeof stamp, "%Y%m%dT%H%M%SZ", &utc);
+  const std::string copy = fmt::format("{}.schema-v{}.{}.bak", path_, have, stamp);
+  const std::string tmp = copy + ".tmp";
+  std::error_code ec;
+  std::filesystem::remove(tmp, ec);
   try {
+    auto st = prepare("VACUUM INTO ?1");
+    st.bind(1, tmp);
     st.step();
   } catch (const SqliteError& e) {
-    if (std::filesystem::exists(copy)) return;  // another process wrote it meanwhile
+    std::filesystem::remove(tmp, ec);
     throw SqliteError(fmt::format(
         "{}: not migrated from schema version {}: the copy {} could not be written ({})", path_,
         have, copy, e.what()));
+  }
+  std::filesystem::rename(tmp, copy, ec);
+  if (ec) {
+    std::filesystem::remove(tmp, ec);
+    throw SqliteError(fmt::format("{}: not migrated from schema version {}: the copy {}: {}", path_,
+                                  have, copy, ec.message()));
   }
 }
 

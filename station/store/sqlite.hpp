@@ -89,8 +89,8 @@ class Database {
   /// Row id of the last insert.
   std::int64_t last_insert_id() const { return sqlite3_last_insert_rowid(db_.get()); }
   /// Applies schemas/migrations/*.sql past PRAGMA user_version in one transaction, after a
-  /// copy of the file as it was (`PATH.schema-vN.bak`). Throws when the file is newer than this
-  /// software, or when the copy cannot be written.
+  /// copy of the file as it was (`PATH.schema-vN.STAMP.bak`). Throws when the file is newer than
+  /// this software, or when the copy cannot be written.
   void migrate();
   /// PRAGMA user_version.
   int schema_version();
@@ -103,7 +103,7 @@ class Database {
   /// `have` when it is a version this software can migrate from; throws otherwise (a negative
   /// or future user_version must never index the migration table).
   int check_schema_version(int have, int known) const;
-  /// VACUUM INTO `path.schema-vHAVE.bak` before migrating from `have` (unless it exists).
+  /// VACUUM INTO `path.schema-vHAVE.STAMP.bak` (via a .tmp and a rename) before migrating.
   void backup_before_migrating(int have);
   std::unique_ptr<sqlite3, SqliteClose> db_;
   std::string path_;

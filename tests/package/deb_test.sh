@@ -13,8 +13,9 @@
 # 3. With systemd: the host's when it is PID 1, else a systemd booted in its own PID and mount
 #    namespaces (skipped with a message when that cannot start). gyro-station-simrig and the
 #    hardened gyro-station start and answer /api/status; a run started over the API survives
-#    an upgrade (apt-get install --reinstall: the postinst's SIGUSR1 hand-over, the same run
-#    resumed by the restarted service); `systemctl stop` ends it 'stopped'.
+#    an upgrade (to the same package as version V+upgradetest1: the postinst's SIGUSR1
+#    hand-over, the same run resumed by the restarted service); `systemctl stop` ends it
+#    'stopped'; a broken configuration fails the unit once (no restart loop).
 # 4. apt-get remove keeps the conffile and the data; purge removes what the package created and
 #    keeps the database (and the user owning it); with no data, purge leaves nothing at all.
 set -uo pipefail
@@ -122,6 +123,15 @@ config_error_logged() {  # (captured first: grep -q closing the pipe early fails
   grep -q 'station: /etc/gyro-station/station.toml:[0-9]*:[0-9]*: TOML syntax' <<<"$journal"
 }
 
+next_version_deb() {  # the same package as version V+upgradetest1: a real upgrade for dpkg
+  local d="$WORK/next" v
+  v=$(dpkg-deb -f "$DEB" Version)
+  rm -rf "$d" && dpkg-deb -R "$DEB" "$d"
+  sed -i "s/^Version: .*/Version: ${v}+upgradetest1/" "$d/DEBIAN/control"
+  dpkg-deb -b --root-owner-group "$d" "$WORK/gyro-station_${v}+upgradetest1.deb" >/dev/null
+  echo "$WORK/gyro-station_${v}+upgradetest1.deb"
+}
+
 the_service() {
   "${IN[@]}" systemctl start gyro-station-simrig gyro-station
   check '"${IN[@]}" systemctl is-active --quiet gyro-station' "the hardened unit starts (Type=notify: READY)"
@@ -137,7 +147,11 @@ the_service() {
     python3 -c "import json,sys; print(json.load(sys.stdin).get('run_id', 0))")
   check '[[ $run -gt 0 ]]' "a run started over the API: $run"
   wait_until '[[ $(status_field "s[\"ticks\"]") -ge 3 ]]' 20
-  "${IN[@]}" apt-get install -y --reinstall "$DEB" >"$WORK/upgrade.log" 2>&1
+  local next
+  next=$(next_version_deb)
+  "${IN[@]}" apt-get install -y "$next" >"$WORK/upgrade.log" 2>&1
+  check '[[ $(dpkg-query -W -f="\${Version}" gyro-station) == *+upgradetest1 ]]' \
+    "upgraded to $(dpkg-query -W -f='${Version}' gyro-station)"
   check 'grep -q "handing the running service over" "$WORK/upgrade.log"' "the upgrade hands the service over"
   check 'wait_until "[[ \$(\"\${IN[@]}\" systemctl show -P NRestarts gyro-station) -ge 1 ]] && \"\${IN[@]}\" systemctl is-active --quiet gyro-station" 30' \
     "systemd restarted it (exit 75, Restart=on-failure)"

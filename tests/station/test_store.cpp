@@ -1,12 +1,15 @@
 // Store: migrations, WAL, tick transactions, fits round trip, rollback on failure.
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <vector>
 
 #include "schemas/migrations.hpp"
 #include "station/store/store.hpp"
@@ -15,6 +18,17 @@
 namespace {
 
 using station::testing_support::fresh_db;
+
+// Every file beside `db` whose name starts with its name and ".schema-v" (copies and .tmp).
+std::vector<std::filesystem::path> copies_of(const std::string& db) {
+  const std::filesystem::path p(db);
+  std::vector<std::filesystem::path> out;
+  for (const auto& e : std::filesystem::directory_iterator(p.parent_path())) {
+    const auto name = e.path().filename().string();
+    if (name.rfind(p.filename().string() + ".schema-v", 0) == 0) out.push_back(e.path());
+  }
+  return out;
+}
 
 station::RunInfo info() {
   return {"paper", "[[step]]", "[station]", "0.1.0", "rig", "alice", 42, 0.0, {}};
@@ -299,8 +313,12 @@ TEST(Store, MigratesAVersion1DatabaseKeepingItsRunsAndLastTick) {
   EXPECT_EQ(run->resolved_json, "{}");
   s.finish_run(1, "incomplete");  // allowed by version 2
   EXPECT_EQ(s.find_run(1)->state, "incomplete");
-  // The file as version 1 left it is kept beside it, readable, with its run and sample.
-  station::Database copy(path + ".schema-v1.bak", station::OpenMode::existing);
+  // The file as version 1 left it is kept beside it, whole and readable, with its run and
+  // sample; no temporary is left.
+  const auto copies = copies_of(path);
+  ASSERT_EQ(copies.size(), 1U);
+  EXPECT_EQ(copies[0].extension(), ".bak");
+  station::Database copy(copies[0].string(), station::OpenMode::existing);
   EXPECT_EQ(copy.schema_version(), 1);
   auto st = copy.prepare("SELECT state, (SELECT COUNT(*) FROM samples) FROM runs WHERE id = 1");
   ASSERT_TRUE(st.step());
@@ -314,17 +332,34 @@ TEST(Store, DoesNotMigrateWhenTheCopyCannotBeWritten) {
     station::Database db(path);
     db.exec(station::schemas::kMigrations[0].second);
     db.exec("PRAGMA user_version = 1");
+    db.exec(
+        "INSERT INTO runs (id, started_utc, state, protocol_name, protocol_text, config_text, "
+        "software_version, station) VALUES (1, 'x', 'running', 'p', '', '', '0.1', 'rig');"
+        "WITH RECURSIVE c(x) AS (SELECT 1 UNION ALL SELECT x + 1 FROM c WHERE x < 20000) "
+        "INSERT INTO samples (run_id, serial, t_s, flags, recording) SELECT 1, 'A', x, 0, 0 FROM "
+        "c;");
   }
-  // The copy's name is a link into a directory that does not exist: VACUUM INTO fails, so the
-  // open fails naming the copy, and the file is left at version 1.
-  std::filesystem::create_symlink("/nonexistent-station-dir/x", path + ".schema-v1.bak");
+  ASSERT_GT(std::filesystem::file_size(path), 256 * 1024U);
+  // A full disk, as the process sees it: files may not grow past 128 KiB (EFBIG, no SIGXFSZ).
+  rlimit was{};
+  ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &was), 0);
+  const auto old_handler = std::signal(SIGXFSZ, SIG_IGN);
+  rlimit small = was;
+  small.rlim_cur = 128 * 1024;
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &small), 0);
+  std::string error;
   try {
     station::Store s(path);
-    ADD_FAILURE() << "migrated without a copy";
   } catch (const station::SqliteError& e) {
-    EXPECT_NE(std::string(e.what()).find(".schema-v1.bak could not be written"), std::string::npos)
-        << e.what();
+    error = e.what();
   }
+  setrlimit(RLIMIT_FSIZE, &was);
+  std::signal(SIGXFSZ, old_handler);
+  EXPECT_NE(error.find("not migrated from schema version 1: the copy"), std::string::npos) << error;
+  EXPECT_TRUE(copies_of(path).empty()) << "a partial copy or its .tmp was left";
   station::Database db(path, station::OpenMode::existing);
   EXPECT_EQ(db.schema_version(), 1);
+  // With room again, the next open copies and migrates.
+  station::Store s(path);
+  EXPECT_EQ(copies_of(path).size(), 1U);
 }

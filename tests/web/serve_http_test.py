@@ -8,7 +8,8 @@ Checks: READY=1 and WATCHDOG=1 every second on NOTIFY_SOCKET (what systemd's Typ
 WatchdogSec see); idle state with the rig read and no run; a run started over the API (token), running;
 a second start refused (409); stop over the API -> idle again with the run 'stopped'; a second
 run started on the same service; SIGKILL mid-run, then a new serve resumes that same run at
-start; a start while the rig is faulted (simrig stopped) is refused with 409 naming the fault,
+start; SIGUSR1 (the upgrade hand-over) -> exit 75 with the run resumable, resumed by the next
+serve; SIGUSR1 then SIGTERM -> the run stopped; abort; a start while the rig is faulted (simrig stopped) is refused with 409 naming the fault,
 and the service keeps answering; SIGTERM -> exit 0. Exit 0 ok, 1 failure.
 """
 import json
@@ -178,11 +179,28 @@ def main():
         db.close()
         check(n_before > 0 and n_after > n_before,
               "samples kept and added across the hand-over: %d -> %d" % (n_before, n_after))
-        code, _ = request(base, "POST", "/api/runs/%d/abort" % run2, token)
+        # A stop right after a hand-over request wins: the run ends 'stopped', exit 0.
+        serve.send_signal(signal.SIGUSR1)
+        serve.send_signal(signal.SIGTERM)
+        rc = serve.wait(15)
+        check(rc == 0, "SIGUSR1 then SIGTERM: exit 0, got %d" % rc)
+        db = sqlite3.connect(os.path.join(work, "s.db"))
+        state = db.execute("SELECT state FROM runs WHERE id = ?", (run2,)).fetchone()[0]
+        db.close()
+        check(state == "stopped", "SIGUSR1 then SIGTERM: run 2 stopped: %s" % state)
+
+        serve, base = start_serve(station, work, "serve4.log")
+        procs.append(serve)
+        wait_for(lambda: status(base)["state"] == "idle", 15, "idle on a fourth serve")
+        code, body = request(base, "POST", "/api/runs", token, {"protocol": "paper"})
+        run3 = body.get("run_id", 0) if code == 202 else 0
+        check(run3 > run2, "third run started: %d %s" % (code, body))
+        wait_for(lambda: status(base)["ticks"] >= 2, 10, "ticks of run 3")
+        code, _ = request(base, "POST", "/api/runs/%d/abort" % run3, token)
         check(code == 202, "abort: 202, got %d" % code)
         wait_for(lambda: status(base)["state"] in ("idle", "fault"), 15, "idle after abort")
-        code, run = request(base, "GET", "/api/runs/%d" % run2)
-        check(run["state"] == "aborted", "run 2 aborted: %s" % run["state"])
+        code, run = request(base, "GET", "/api/runs/%d" % run3)
+        check(run["state"] == "aborted", "run 3 aborted: %s" % run["state"])
 
         # The rig goes away: the service reports a fault, refuses a start, keeps answering.
         rig.send_signal(signal.SIGTERM)
