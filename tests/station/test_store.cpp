@@ -30,6 +30,20 @@ std::vector<std::filesystem::path> copies_of(const std::string& db) {
   return out;
 }
 
+// A version-1 database with run 1 'running' and `samples` samples of serial A at t = 41, 42, ...
+void make_v1_db(const std::string& path, int samples) {
+  station::Database db(path);
+  db.exec(station::schemas::kMigrations[0].second);
+  db.exec("PRAGMA user_version = 1");
+  db.exec(
+      "INSERT INTO runs (id, started_utc, state, protocol_name, protocol_text, config_text, "
+      "software_version, station) VALUES (1, 'x', 'running', 'p', '', '', '0.1', 'rig');");
+  db.exec("WITH RECURSIVE c(x) AS (SELECT 41 UNION ALL SELECT x + 1 FROM c WHERE x < " +
+          std::to_string(40 + samples) +
+          ") INSERT INTO samples (run_id, serial, t_s, flags, recording) "
+          "SELECT 1, 'A', x, 0, 0 FROM c;");
+}
+
 station::RunInfo info() {
   return {"paper", "[[step]]", "[station]", "0.1.0", "rig", "alice", 42, 0.0, {}};
 }
@@ -296,15 +310,7 @@ TEST(Store, AUserVersionOutsideTheKnownRangeIsRefused) {
 
 TEST(Store, MigratesAVersion1DatabaseKeepingItsRunsAndLastTick) {
   const auto path = fresh_db("v1");
-  {
-    station::Database db(path);
-    db.exec(station::schemas::kMigrations[0].second);
-    db.exec("PRAGMA user_version = 1");
-    db.exec(
-        "INSERT INTO runs (id, started_utc, state, protocol_name, protocol_text, config_text, "
-        "software_version, station) VALUES (1, 'x', 'running', 'p', '', '', '0.1', 'rig');"
-        "INSERT INTO samples (run_id, serial, t_s, flags, recording) VALUES (1, 'A', 41, 0, 0);");
-  }
+  make_v1_db(path, 1);
   station::Store s(path);
   const auto run = s.find_run(1);
   ASSERT_TRUE(run.has_value());
@@ -328,17 +334,7 @@ TEST(Store, MigratesAVersion1DatabaseKeepingItsRunsAndLastTick) {
 
 TEST(Store, DoesNotMigrateWhenTheCopyCannotBeWritten) {
   const auto path = fresh_db("v1-nocopy");
-  {
-    station::Database db(path);
-    db.exec(station::schemas::kMigrations[0].second);
-    db.exec("PRAGMA user_version = 1");
-    db.exec(
-        "INSERT INTO runs (id, started_utc, state, protocol_name, protocol_text, config_text, "
-        "software_version, station) VALUES (1, 'x', 'running', 'p', '', '', '0.1', 'rig');"
-        "WITH RECURSIVE c(x) AS (SELECT 1 UNION ALL SELECT x + 1 FROM c WHERE x < 20000) "
-        "INSERT INTO samples (run_id, serial, t_s, flags, recording) SELECT 1, 'A', x, 0, 0 FROM "
-        "c;");
-  }
+  make_v1_db(path, 20000);
   ASSERT_GT(std::filesystem::file_size(path), 256 * 1024U);
   // A full disk, as the process sees it: files may not grow past 128 KiB (EFBIG, no SIGXFSZ).
   rlimit was{};

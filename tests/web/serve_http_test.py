@@ -71,6 +71,23 @@ def start_serve(station, work, log_name, env=None):
     return p, line.split()[-1].rstrip("/")
 
 
+def db_query(work, sql, *args):
+    """One row of the service's database, read with its own connection."""
+    db = sqlite3.connect(os.path.join(work, "s.db"))
+    try:
+        return db.execute(sql, args).fetchone()
+    finally:
+        db.close()
+
+
+def run_state(work, run_id):
+    return db_query(work, "SELECT state FROM runs WHERE id = ?", run_id)[0]
+
+
+def samples_of(work, run_id):
+    return db_query(work, "SELECT COUNT(*) FROM samples WHERE run_id = ?", run_id)[0]
+
+
 def status(base):
     return request(base, "GET", "/api/status")[1]
 
@@ -142,10 +159,8 @@ def main():
         wait_for(lambda: status(base)["ticks"] >= 3, 10, "ticks of run 2")
         serve.send_signal(signal.SIGKILL)
         serve.wait(10)
-        db = sqlite3.connect(os.path.join(work, "s.db"))
-        state = db.execute("SELECT state FROM runs WHERE id = ?", (run2,)).fetchone()[0]
+        state = run_state(work, run2)
         check(state == "running", "killed run left 'running': %s" % state)
-        db.close()
 
         serve, base = start_serve(station, work, "serve2.log")
         procs.append(serve)
@@ -161,22 +176,19 @@ def main():
         serve.send_signal(signal.SIGUSR1)
         rc = serve.wait(15)
         check(rc == 75, "SIGUSR1: exit 75 (EX_TEMPFAIL, restart me), got %d" % rc)
-        db = sqlite3.connect(os.path.join(work, "s.db"))
-        state = db.execute("SELECT state FROM runs WHERE id = ?", (run2,)).fetchone()[0]
+        state = run_state(work, run2)
         check(state == "running", "run left 'running' by SIGUSR1: %s" % state)
-        kinds = [k for (k,) in db.execute("SELECT kind FROM events WHERE run_id = ?", (run2,))]
-        check(kinds and kinds[-1] == "detach", "a detach event is the run's last: %s" % kinds[-3:])
-        n_before = db.execute("SELECT COUNT(*) FROM samples WHERE run_id = ?", (run2,)).fetchone()[0]
-        db.close()
+        last = db_query(work, "SELECT kind FROM events WHERE run_id = ? ORDER BY id DESC LIMIT 1",
+                        run2)[0]
+        check(last == "detach", "a detach event is the run's last: %s" % last)
+        n_before = samples_of(work, run2)
         serve, base = start_serve(station, work, "serve3.log")
         procs.append(serve)
         st = wait_for(lambda: (lambda s: s if s["run"] else None)(status(base)), 15,
                       "the run resumed after the hand-over")
         check(st and st["run"]["id"] == run2, "the handed-over run resumes")
         wait_for(lambda: status(base)["ticks"] >= 2, 10, "ticks after the hand-over")
-        db = sqlite3.connect(os.path.join(work, "s.db"))
-        n_after = db.execute("SELECT COUNT(*) FROM samples WHERE run_id = ?", (run2,)).fetchone()[0]
-        db.close()
+        n_after = samples_of(work, run2)
         check(n_before > 0 and n_after > n_before,
               "samples kept and added across the hand-over: %d -> %d" % (n_before, n_after))
         # A stop right after a hand-over request wins: the run ends 'stopped', exit 0.
@@ -184,9 +196,7 @@ def main():
         serve.send_signal(signal.SIGTERM)
         rc = serve.wait(15)
         check(rc == 0, "SIGUSR1 then SIGTERM: exit 0, got %d" % rc)
-        db = sqlite3.connect(os.path.join(work, "s.db"))
-        state = db.execute("SELECT state FROM runs WHERE id = ?", (run2,)).fetchone()[0]
-        db.close()
+        state = run_state(work, run2)
         check(state == "stopped", "SIGUSR1 then SIGTERM: run 2 stopped: %s" % state)
 
         serve, base = start_serve(station, work, "serve4.log")
