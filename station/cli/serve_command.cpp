@@ -39,14 +39,19 @@ std::atomic<bool> g_detach{false};     // SIGUSR1: leave the run resumable, exit
 /// The exit status after SIGUSR1 (sysexits.h EX_TEMPFAIL): "restart me", not a failure of a run.
 constexpr int kExitRestart = 75;
 
+std::atomic<bool> g_terminated{false};  // SIGTERM/SIGINT seen: a stop beats a hand-over
+
+// A stop and a hand-over request both pending: the stop wins whichever handler runs first (the
+// kernel stacks the frames of signals pending together, so the later one's handler runs first).
 void on_signal(int) {
-  g_detach.store(false);  // a stop after a hand-over request wins: the run ends 'stopped'
+  g_terminated.store(true);
+  g_detach.store(false);
   g_stop.store(true);
   g_run_stop.store(true);
 }
 
 void on_detach_signal(int) {
-  g_detach.store(true);
+  if (!g_terminated.load()) g_detach.store(true);
   g_stop.store(true);
 }
 

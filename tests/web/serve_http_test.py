@@ -191,9 +191,13 @@ def main():
         n_after = samples_of(work, run2)
         check(n_before > 0 and n_after > n_before,
               "samples kept and added across the hand-over: %d -> %d" % (n_before, n_after))
-        # A stop right after a hand-over request wins: the run ends 'stopped', exit 0.
+        # A stop right after a hand-over request wins: the run ends 'stopped', exit 0. Both are
+        # made pending while the process is stopped, so both handlers run before its next line
+        # (without that, under load the loop may have left for the hand-over before SIGTERM).
+        serve.send_signal(signal.SIGSTOP)
         serve.send_signal(signal.SIGUSR1)
         serve.send_signal(signal.SIGTERM)
+        serve.send_signal(signal.SIGCONT)
         rc = serve.wait(15)
         check(rc == 0, "SIGUSR1 then SIGTERM: exit 0, got %d" % rc)
         state = run_state(work, run2)
