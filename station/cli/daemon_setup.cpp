@@ -4,18 +4,32 @@
 #include <fmt/format.h>
 
 #include <csignal>
+#include <cstdlib>
 #include <filesystem>
 
+#include "station/common/logging.hpp"
 #include "station/parts/judged_fit.hpp"
 
 namespace station {
 
-void on_stop_signals(void (*handler)(int)) {
+void on_signal(int sig, void (*handler)(int)) {
   struct sigaction sa {};
   sa.sa_handler = handler;
   sigemptyset(&sa.sa_mask);
-  sigaction(SIGTERM, &sa, nullptr);
-  sigaction(SIGINT, &sa, nullptr);
+  sigaction(sig, &sa, nullptr);
+}
+
+void on_stop_signals(void (*handler)(int)) {
+  on_signal(SIGTERM, handler);
+  on_signal(SIGINT, handler);
+}
+
+void setup_daemon_logging(spdlog::level::level_enum console_level, const std::string& log_file) {
+  LogOptions lo;
+  lo.console_level = console_level;
+  lo.file = log_file;
+  lo.journald = std::getenv("JOURNAL_STREAM") != nullptr;
+  setup_logging(lo);
 }
 
 /// One daemon per database (and, on a real rig, per device): held until the process ends.

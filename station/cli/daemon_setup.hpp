@@ -2,6 +2,8 @@
 // for an unfinished run, the verdict lines.
 #pragma once
 
+#include <spdlog/common.h>
+
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -12,8 +14,13 @@
 
 namespace station {
 
-/// SIGTERM and SIGINT call `handler` (which only sets atomics): the daemon ends cleanly.
+/// Signal `sig` calls `handler` (which only sets atomics).
+void on_signal(int sig, void (*handler)(int));
+/// SIGTERM and SIGINT call `handler`: the daemon ends cleanly.
 void on_stop_signals(void (*handler)(int));
+/// The daemon commands' logging: `console_level` on the console, the rotating `log_file` if
+/// given, and the journal's own fields when systemd connected stdout to it (JOURNAL_STREAM).
+void setup_daemon_logging(spdlog::level::level_enum console_level, const std::string& log_file);
 /// One daemon per database (and, on a real rig, per device): held until the process ends.
 std::vector<ProcessLock> lock_db_and_devices(const std::string& db, const StationConfig* config);
 /// Whether `db` exists and holds a run to resume (read-only peek: nothing is created or written).

@@ -34,7 +34,7 @@ namespace {
 std::atomic<bool> g_stop{false};
 std::atomic<bool> g_abort{false};  // the API's abort: end without bins or fit
 
-void on_signal(int) {
+void on_stop_signal(int) {
   g_stop.store(true);
 }
 
@@ -256,12 +256,8 @@ void add_run_command(CLI::App& app, CommandStatus& status) {
   cmd->add_option("--token-file", o->token_file,
                   "the API's bearer token (created 0600 at first start; default DB.token)");
   cmd->callback([o, &status] {
-    LogOptions lo;
-    lo.console_level = o->sim ? spdlog::level::warn : spdlog::level::info;
-    lo.file = o->log_file;
-    lo.journald = std::getenv("JOURNAL_STREAM") != nullptr;
-    setup_logging(lo);
-    on_stop_signals(on_signal);
+    setup_daemon_logging(o->sim ? spdlog::level::warn : spdlog::level::info, o->log_file);
+    on_stop_signals(on_stop_signal);
     if (!o->sim && o->speed > 0) throw InputError("--speed is for --sim (a rig runs at 1 Hz)");
     if (!o->sim && (o->config.empty() || o->db.empty())) {
       throw InputError("run: give --config FILE and --db PATH, or --sim");

@@ -43,7 +43,7 @@ std::atomic<bool> g_terminated{false};  // SIGTERM/SIGINT seen: a stop beats a h
 
 // A stop and a hand-over request both pending: the stop wins whichever handler runs first (the
 // kernel stacks the frames of signals pending together, so the later one's handler runs first).
-void on_signal(int) {
+void on_stop_signal(int) {
   g_terminated.store(true);
   g_detach.store(false);
   g_stop.store(true);
@@ -195,16 +195,9 @@ void add_serve_command(CLI::App& app, CommandStatus& status) {
   cmd->add_option("--parts", o->parts, "part file (overrides [station] parts)");
   cmd->add_option("--log-file", o->log_file, "rotating log file");
   cmd->callback([o, &status] {
-    LogOptions lo;
-    lo.console_level = spdlog::level::info;
-    lo.file = o->log_file;
-    lo.journald = std::getenv("JOURNAL_STREAM") != nullptr;
-    setup_logging(lo);
-    on_stop_signals(on_signal);
-    struct sigaction sa {};
-    sa.sa_handler = on_detach_signal;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGUSR1, &sa, nullptr);
+    setup_daemon_logging(spdlog::level::info, o->log_file);
+    on_stop_signals(on_stop_signal);
+    on_signal(SIGUSR1, on_detach_signal);
     status.exit_code = serve(*o);
   });
 }
