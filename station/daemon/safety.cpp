@@ -80,24 +80,30 @@ std::vector<std::string> Safety::judge(const std::optional<drivers::ChamberState
   return out;
 }
 
-std::optional<std::string> Safety::update(bool interlock_open, bool estop_pressed,
-                                          const std::vector<std::string>& out_of_limits) {
+std::string SafetyCauses::text() const {
+  std::vector<std::string> on;
+  if (chamber_high_limit) on.emplace_back("chamber high-limit trip");
+  if (gpio_estop_pressed) on.emplace_back("e-stop pressed");
+  if (chamber_door_open) on.emplace_back("chamber door open");
+  if (gpio_interlock_open) on.emplace_back("interlock open");
+  if (table_interlock_open) on.emplace_back("turntable interlock open");
+  if (inputs_unreadable) on.emplace_back("interlock / e-stop unreadable");
+  if (!out_of_limits.empty())
+    on.push_back(fmt::format("out of limits: {}", fmt::join(out_of_limits, "; ")));
+  return on.empty() ? std::string("no cause") : fmt::format("{}", fmt::join(on, "; "));
+}
+
+std::optional<std::string> Safety::update(SafetyCauses causes) {
   const bool was = holding_;
-  const bool fault = !out_of_limits.empty();
-  const bool changed =
-      interlock_open != interlock_open_ || estop_pressed != estop_ || fault != limits_fault_;
-  interlock_open_ = interlock_open;
-  estop_ = estop_pressed;
-  limits_fault_ = fault;
-  holding_ = interlock_open_ || estop_ || limits_fault_;
+  const bool changed = !(causes == causes_);
+  const std::string before = causes_.text();
+  causes_ = std::move(causes);
+  limits_fault_ = !causes_.out_of_limits.empty();
+  holding_ = causes_.any();
   if (!changed) return std::nullopt;
-  std::string why = fmt::format("interlock {}, e-stop {}", interlock_open_ ? "open" : "closed",
-                                estop_ ? "pressed" : "released");
-  why += fault ? fmt::format(", out of limits: {}", fmt::join(out_of_limits, "; "))
-               : ", readings inside limits";
-  if (holding_ && !was) return "enter: " + why;
-  if (!holding_ && was) return "clear: " + why;
-  return "still holding: " + why;
+  if (holding_ && !was) return "enter: " + causes_.text();
+  if (!holding_ && was) return fmt::format("clear: every cause read clear (was: {})", before);
+  return "still holding: " + causes_.text();
 }
 
 bool Safety::blind(const SafetyInputs& in) const {
@@ -114,19 +120,21 @@ SafetyDecision Safety::decide(const SafetyInputs& in) {
         {"error", "inputs_unreadable",
          fmt::format("interlock / e-stop unreadable for {} ticks: treated as open", kBlindTicks)});
   }
-  // Each source keeps its last known value when its read fails.
-  bool interlock = in.table_interlock_open.value_or(sources_.table && interlock_open_);
-  if (in.gpio_interlock_closed)
-    interlock = interlock || !*in.gpio_interlock_closed;
-  else if (sources_.gpio_interlock)
-    interlock = interlock || interlock_open_;
-  // The chamber's own door switch counts as an interlock; its high-limit trip as an e-stop.
-  if (in.chamber) interlock = interlock || in.chamber->alarms.door_open;
-  bool estop = in.gpio_estop_pressed.value_or(estop_);
-  if (in.chamber) estop = estop || in.chamber->alarms.high_limit_trip;
-  if (blind_ticks_ >= kBlindTicks) interlock = true;
+  // Each input is judged from its own reading; one that could not be read keeps its own last
+  // known state (an unconfigured one is never a cause). The chamber's door switch counts as an
+  // interlock, its high-limit trip as an e-stop.
+  SafetyCauses c = causes_;
+  if (in.table_interlock_open) c.table_interlock_open = *in.table_interlock_open;
+  if (in.gpio_interlock_closed) c.gpio_interlock_open = !*in.gpio_interlock_closed;
+  if (in.gpio_estop_pressed) c.gpio_estop_pressed = *in.gpio_estop_pressed;
+  if (in.chamber) {
+    c.chamber_door_open = in.chamber->alarms.door_open;
+    c.chamber_high_limit = in.chamber->alarms.high_limit_trip;
+    c.out_of_limits = judge(in.chamber);
+  }
+  c.inputs_unreadable = blind_ticks_ >= kBlindTicks;
   const bool was = holding_;
-  const auto change = update(interlock, estop, judge(in.chamber));
+  const auto change = update(std::move(c));
   finish(d, was, change, in.chamber, in.air_c);
   return d;
 }
@@ -142,11 +150,12 @@ SafetyDecision Safety::decide_between_ticks(std::optional<bool> gpio_interlock_c
     d.outputs = outputs();
     return d;
   }
-  // Readings out of limits are judged at the ticks; between them nothing was read.
-  const std::vector<std::string> faults =
-      limits_fault_ ? std::vector<std::string>{"as at the last tick"} : std::vector<std::string>{};
+  // An edge only adds a cause; readings out of limits are judged at the ticks.
+  SafetyCauses c = causes_;
+  c.gpio_interlock_open = c.gpio_interlock_open || open;
+  c.gpio_estop_pressed = c.gpio_estop_pressed || pressed;
   const bool was = holding_;
-  auto change = update(interlock_open_ || open, estop_ || pressed, faults);
+  auto change = update(std::move(c));
   if (change) *change += " (between ticks)";
   finish(d, was, change, std::nullopt, air_c);
   return d;
@@ -194,7 +203,7 @@ SafetyOutputs Safety::outputs() const {
   // Red: a fault (e-stop, readings out of limits); amber: safe hold; green: running. The gyros
   // are powered while the run goes on and cut in every safe hold (the RLG's discharge supply is
   // high voltage; a hold is when a person may reach into the chamber).
-  o.red = limits_fault_ || estop_;
+  o.red = limits_fault_ || causes_.estop();
   o.amber = holding_ && !o.red;
   o.green = !holding_;
   o.gyro_power = !holding_;

@@ -36,6 +36,26 @@ struct SafetyOutputs {
   bool operator==(const SafetyOutputs&) const = default;
 };
 
+/// Why the rig holds: each input's own last known state (a source that cannot be read keeps its
+/// own last reading, never another source's), so a hold clears once every cause read clear.
+struct SafetyCauses {
+  bool table_interlock_open = false;       ///< the turntable's interlock input
+  bool gpio_interlock_open = false;        ///< the GPIO door interlock line
+  bool chamber_door_open = false;          ///< the chamber's own door alarm
+  bool gpio_estop_pressed = false;         ///< the GPIO e-stop line
+  bool chamber_high_limit = false;         ///< the chamber's high-limit (over-temperature) trip
+  bool inputs_unreadable = false;          ///< interlock / e-stop unreadable for kBlindTicks
+  std::vector<std::string> out_of_limits;  ///< the chamber's readings outside the limits
+  bool interlock_open() const {
+    return table_interlock_open || gpio_interlock_open || chamber_door_open || inputs_unreadable;
+  }
+  bool estop() const { return gpio_estop_pressed || chamber_high_limit; }
+  bool any() const { return interlock_open() || estop() || !out_of_limits.empty(); }
+  /// The active causes in words ("chamber high-limit trip; GPIO e-stop pressed"), or "none".
+  std::string text() const;
+  bool operator==(const SafetyCauses&) const = default;
+};
+
 /// One event to store (source "safety").
 struct SafetyEvent {
   std::string severity, kind, message;
@@ -97,9 +117,8 @@ class Safety {
   SafetyOutputs outputs() const;
 
  private:
-  /// Feeds the combined inputs; a message when the hold state changes.
-  std::optional<std::string> update(bool interlock_open, bool estop_pressed,
-                                    const std::vector<std::string>& out_of_limits);
+  /// Takes the new causes; a message when any cause changed.
+  std::optional<std::string> update(SafetyCauses causes);
   bool blind(const SafetyInputs& in) const;
   /// Applies a state change (or none) to `d`, and the hold's commands.
   void finish(SafetyDecision& d, bool was_holding, const std::optional<std::string>& change,
@@ -108,7 +127,8 @@ class Safety {
   LimitsConfig limits_;
   SafetySources sources_;
   bool holding_ = false;
-  bool interlock_open_ = false, estop_ = false, limits_fault_ = false;
+  SafetyCauses causes_;
+  bool limits_fault_ = false;
   int blind_ticks_ = 0;
   std::optional<double> hold_air_c_;
   bool hold_acknowledged_ = false, table_stopped_ = false;

@@ -258,7 +258,9 @@ TEST(Safety, ASetpointWrittenBySomeoneElseIsCaughtOnTheSimulatedRig) {
   const auto run = r["run_id"].get<std::int64_t>();
   int enters = 0;
   for (const auto& e : store.events(run)) {
-    if (e.find("out of limits: chamber setpoint read back 150.00 C") != std::string::npos) {
+    // The clear names what was wrong too ("clear: ... (was: ...)"); the enters are counted.
+    if (e.find("out of limits: chamber setpoint read back 150.00 C") != std::string::npos &&
+        e.rfind("safe_hold_cleared: ", 0) != 0) {
       EXPECT_EQ(e.rfind("safe_hold: enter: ", 0), 0u) << e;
       ++enters;
     }
@@ -280,4 +282,79 @@ TEST(Safety, ASetpointWrittenBySomeoneElseIsCaughtOnTheSimulatedRig) {
     EXPECT_LE(*s.setpoint_c, 85.0) << s.t_s;
   }
   EXPECT_TRUE(held);
+}
+
+// Issue 19 item 6, as a property: for every input on every rig shape (no GPIO and no table; GPIO
+// lines; GPIO and a table), a trip holds the rig, the event names that input, and one reading
+// with the input clear (the others clear throughout) clears the hold. The old code fed its own
+// combined e-stop back as the GPIO e-stop's "last value": a high-limit trip on a rig without a
+// GPIO e-stop line latched the hold for ever.
+TEST(Safety, EveryInputTrippedThenClearedHoldsThenClears) {
+  struct Trip {
+    const char* name;
+    const char* cause;  ///< the words the hold's event must contain
+    bool needs_gpio, needs_table;
+    void (*apply)(station::SafetyInputs&);
+  };
+  const Trip trips[] = {
+      {"high-limit", "chamber high-limit trip", false, false,
+       [](station::SafetyInputs& in) { in.chamber->alarms.high_limit_trip = true; }},
+      {"chamber door", "chamber door open", false, false,
+       [](station::SafetyInputs& in) { in.chamber->alarms.door_open = true; }},
+      {"setpoint", "out of limits: chamber setpoint", false, false,
+       [](station::SafetyInputs& in) { in.chamber->setpoint_c = 150.0; }},
+      {"air", "out of limits: chamber air", false, false,
+       [](station::SafetyInputs& in) { in.chamber->air_c = 99.0; }},
+      {"gpio e-stop", "e-stop pressed", true, false,
+       [](station::SafetyInputs& in) { in.gpio_estop_pressed = true; }},
+      {"gpio interlock", "interlock open", true, false,
+       [](station::SafetyInputs& in) { in.gpio_interlock_closed = false; }},
+      {"table interlock", "turntable interlock open", false, true,
+       [](station::SafetyInputs& in) { in.table_interlock_open = true; }},
+  };
+  const station::SafetySources shapes[] = {
+      {false, false, false}, {false, true, true}, {true, true, true}};
+  for (const auto& sources : shapes) {
+    for (const auto& trip : trips) {
+      if ((trip.needs_gpio && !sources.gpio_estop) || (trip.needs_table && !sources.table))
+        continue;
+      SCOPED_TRACE(::testing::Message() << trip.name << " on a rig with gpio " << sources.gpio_estop
+                                        << ", table " << sources.table);
+      station::Safety s(limits(), sources);
+      auto clear = inputs(20.0, 25.0);
+      if (!sources.gpio_estop) clear.gpio_estop_pressed.reset();
+      if (!sources.gpio_interlock) clear.gpio_interlock_closed.reset();
+      if (sources.table) clear.table_interlock_open = false;
+      ASSERT_FALSE(s.decide(clear).holding);
+      auto tripped = clear;
+      trip.apply(tripped);
+      auto d = s.decide(tripped);
+      ASSERT_TRUE(d.entered);
+      ASSERT_TRUE(has_event(d, "safe_hold"));
+      EXPECT_NE(d.events.back().message.find(trip.cause), std::string::npos)
+          << d.events.back().message;
+      EXPECT_TRUE(s.decide(tripped).holding);  // still tripped: still holding
+      d = s.decide(clear);
+      EXPECT_TRUE(d.cleared);
+      EXPECT_FALSE(d.holding);
+      EXPECT_TRUE(d.outputs.green);
+      EXPECT_FALSE(s.decide(clear).holding);
+    }
+  }
+}
+
+// A source that cannot be read keeps its own last reading: a high-limit trip on a chamber that
+// then stops answering holds until the chamber answers with the trip gone.
+TEST(Safety, AnUnreadChamberKeepsItsOwnTripUntilItReadsClear) {
+  station::Safety s(limits());
+  auto clear = inputs(20.0, 25.0);
+  clear.gpio_estop_pressed.reset();
+  clear.gpio_interlock_closed.reset();
+  auto trip = clear;
+  trip.chamber->alarms.high_limit_trip = true;
+  ASSERT_TRUE(s.decide(trip).entered);
+  auto unread = clear;
+  unread.chamber.reset();
+  EXPECT_TRUE(s.decide(unread).holding);
+  EXPECT_TRUE(s.decide(clear).cleared);
 }
