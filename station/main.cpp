@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
+#include <csignal>
 #include <cstdio>
 
 #include "station/cli/commands.hpp"
@@ -10,6 +11,10 @@
 #include "station/store/sqlite.hpp"
 
 int main(int argc, char** argv) {
+  // A file size limit (RLIMIT_FSIZE, `prlimit --fsize`) must not kill the daemon silently: with
+  // SIGXFSZ ignored the write fails with EFBIG, SQLite reports it, and it is handled like a full
+  // disk (setrlimit(2), signal(7)).
+  std::signal(SIGXFSZ, SIG_IGN);
   CLI::App app{"Gyro thermal-calibration test station"};
   app.set_version_flag("--version", std::string("station ") + STATION_VERSION);
   app.require_subcommand(1);

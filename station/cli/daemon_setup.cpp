@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 
+#include "station/cli/device_identity.hpp"
 #include "station/common/logging.hpp"
 #include "station/parts/judged_fit.hpp"
 
@@ -35,19 +36,25 @@ void setup_daemon_logging(spdlog::level::level_enum console_level, const std::st
 /// One daemon per database (and, on a real rig, per device): held until the process ends.
 std::vector<ProcessLock> lock_db_and_devices(const std::string& db, const StationConfig* config) {
   std::vector<ProcessLock> locks;
-  locks.push_back(ProcessLock::acquire(db + ".lock", fmt::format("database {}", db)));
+  locks.push_back(ProcessLock::acquire_database(db));
   if (config == nullptr) return locks;
   std::vector<std::string> endpoints{config->chamber.endpoint, config->can_transport};
   if (config->turntable) endpoints.push_back(config->turntable->endpoint);
+  // Keyed on what each endpoint reaches, not on its spelling (device_identity.hpp).
   for (const auto& e : endpoints) {
-    locks.push_back(ProcessLock::acquire(device_lock_path(e), fmt::format("device {}", e)));
+    for (const auto& id : device_identities(e)) {
+      const std::string what = id == e ? fmt::format("device {}", e)
+                                       : fmt::format("device {} (as {})", e, id);
+      locks.push_back(ProcessLock::acquire(device_lock_path(id), what));
+    }
   }
   return locks;
 }
 
 // Whether `db` exists and holds a run to resume (read-only peek: nothing is created or written).
 bool has_unfinished_run(const std::string& db) {
-  if (!std::filesystem::exists(db)) return false;
+  std::error_code ec;
+  if (!std::filesystem::exists(db, ec) || std::filesystem::file_size(db, ec) == 0) return false;
   Store peek(db, OpenMode::read_only);
   return peek.find_unfinished_run().has_value();
 }

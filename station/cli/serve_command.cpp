@@ -8,6 +8,7 @@
 // committed, outputs as they are) and the service exits 75 (EX_TEMPFAIL), which systemd's
 // Restart=on-failure answers by starting the new binary, which resumes the run.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 #include <systemd/sd-daemon.h>
 
@@ -59,6 +60,12 @@ struct ServeOptions {
   std::string config, db, http, token_file, parts, log_file;
 };
 
+/// A run that failed when the store could not write (disk full): closed as soon as it can be.
+struct UnclosedRun {
+  std::int64_t id = 0;
+  std::string reason;
+};
+
 /// Everything a serve process holds.
 struct Service {
   const StationConfig& config;
@@ -68,7 +75,39 @@ struct Service {
   ServeControl& control;
   std::map<std::string, PartLimits> part_limits;
   bool watchdog = false;
+  std::optional<UnclosedRun> unclosed;  ///< a failed run still 'running' in the store
 };
+
+/// Records why run `id` failed and closes it as 'aborted' (with a `run_failed` event); false when
+/// the store still cannot write (the run stays 'running' in the file meanwhile).
+bool close_failed_run(Service& s, const UnclosedRun& u) {
+  try {
+    const auto run = s.store.find_run(u.id);
+    if (!run || run->state != "running") return true;  // closed already
+    s.store.add_event(u.id, run->last_tick_s.value_or(0), "error", "serve", "run_failed",
+                      u.reason);
+    s.store.finish_run(u.id, "aborted");
+    log("serve")->info("run {} closed as aborted (run_failed: {})", u.id, u.reason);
+    return true;
+  } catch (const std::exception& e) {
+    log("serve")->error("run {} cannot be closed yet: {}", u.id, e.what());
+    return false;
+  }
+}
+
+/// A run's failure (the store or a bug; the sequencer does not throw for device faults): the
+/// run is closed with the reason, at once or as soon as the store writes again, so the next
+/// start does not resume into the same wall; an API start that never got its run is answered.
+void run_failed(Service& s, std::optional<std::int64_t> id, const std::string& why) {
+  log("serve")->error("run {} failed: {}", id.value_or(0), why);
+  s.live.hub().run_ended(id.value_or(0), fmt::format("failed: {}", why));
+  if (!id) {
+    s.control.start_failed(why);
+    return;
+  }
+  UnclosedRun u{*id, why};
+  if (!close_failed_run(s, u)) s.unclosed = std::move(u);
+}
 
 /// Runs one protocol (or resumes one); a failure is recorded, never fatal to the service.
 void run_one(Service& s, const Protocol& protocol, const std::optional<RunRecord>& resume,
@@ -81,7 +120,12 @@ void run_one(Service& s, const Protocol& protocol, const std::optional<RunRecord
   so.detach = &g_detach;
   so.part_limits = s.part_limits;
   if (s.watchdog) so.watchdog = [] { sd_notify(0, "WATCHDOG=1"); };
-  so.on_run_start = [&s](std::int64_t id, const Protocol&, const std::vector<RunSlot>&) {
+  // The run this call made or resumed (not the hub's last one: a run that cannot even be
+  // created must not close an earlier run).
+  std::optional<std::int64_t> run_id;
+  if (resume) run_id = resume->id;
+  so.on_run_start = [&s, &run_id](std::int64_t id, const Protocol&, const std::vector<RunSlot>&) {
+    run_id = id;
     s.control.started(id);
   };
   live::attach(s.live.hub(), so);
@@ -97,29 +141,32 @@ void run_one(Service& s, const Protocol& protocol, const std::optional<RunRecord
     log("serve")->info("run {} {} at t = {:.0f} s after {} ticks", out.run_id, out.state, out.t_s,
                        out.ticks);
   } catch (const std::exception& e) {
-    // The sequencer does not throw for device faults; this is the store or a bug. The run is
-    // closed as aborted with the reason, so the next start does not resume into the same wall.
-    const auto id = s.live.hub().current_run();
-    log("serve")->error("run {} failed: {}", id.value_or(0), e.what());
-    s.live.hub().run_ended(id.value_or(0), fmt::format("failed: {}", e.what()));
-    if (id) {
-      try {
-        s.store.add_event(*id, 0, "error", "serve", "run_failed", e.what());
-        s.store.finish_run(*id, "aborted");
-      } catch (const std::exception& e2) {
-        log("serve")->error("run {} could not be closed: {}", *id, e2.what());
-      }
-    }
+    run_failed(s, run_id, e.what());
   }
   if (!g_stop.load()) g_run_stop.store(false);
   g_run_abort.store(false);
   s.control.set_busy(false);
 }
 
+/// What keeps the service from starting a run: the rig's idle faults and the store's.
+std::string service_fault(Service& s, const IdleReading& r) {
+  std::vector<std::string> faults;
+  if (!r.fault.empty()) faults.push_back(r.fault);
+  if (s.unclosed && close_failed_run(s, *s.unclosed)) s.unclosed.reset();
+  if (s.unclosed) {
+    faults.push_back(fmt::format("storage: run {} cannot be closed: {}", s.unclosed->id,
+                                 s.unclosed->reason));
+  } else if (!r.storage_error.empty()) {
+    faults.push_back(fmt::format("storage: {}", r.storage_error));
+  }
+  return fmt::format("{}", fmt::join(faults, "; "));
+}
+
 void idle_until_stopped(Service& s) {
   IdleWatch idle(s.rig, s.store, [&s](const RunEvent& e) { s.live.hub().event(e); });
   while (!g_stop.load()) {
-    const IdleReading r = idle.look();
+    IdleReading r = idle.look();
+    r.fault = service_fault(s, r);
     s.live.hub().idle(r);
     s.control.set_fault(r.fault);
     if (s.watchdog) sd_notify(0, "WATCHDOG=1");
@@ -154,7 +201,8 @@ int serve(const ServeOptions& o) {
             live,
             control,
             std::move(part_limits),
-            sd_watchdog_enabled(0, &watchdog_usec) > 0};
+            sd_watchdog_enabled(0, &watchdog_usec) > 0,
+            std::nullopt};
   sd_notify(0, "READY=1");
   // A run a killed daemon left unfinished goes on first, exactly as `station run` resumes it.
   const ResumeDecision rd = decide_resume(store, config, false, false);

@@ -60,6 +60,8 @@ http::ControlReply ServeControl::start(const std::string& protocol,
   // so a client can stop what it started; a slow start still answers 202, without the id.
   cv_.wait_for(lock, std::chrono::seconds(5), [&] { return answered_ >= mine; });
   const std::int64_t id = answered_ >= mine ? started_id_ : 0;
+  if (answered_ >= mine && id == 0)
+    return {503, fmt::format("the run could not be started: {}", start_error_)};
   return {202, fmt::format("starting protocol '{}'", protocol), id};
 }
 
@@ -93,6 +95,15 @@ void ServeControl::set_fault(const std::string& fault) {
 void ServeControl::started(std::int64_t run_id) {
   std::lock_guard lock(mu_);
   started_id_ = run_id;
+  start_error_.clear();
+  answered_ = requests_;
+  cv_.notify_all();
+}
+
+void ServeControl::start_failed(const std::string& why) {
+  std::lock_guard lock(mu_);
+  started_id_ = 0;
+  start_error_ = why;
   answered_ = requests_;
   cv_.notify_all();
 }

@@ -36,6 +36,8 @@ class ServeControl final : public http::RunControl {
   void set_fault(const std::string& fault);
   /// The serve loop: the run of the last request was created with this id (start() answers it).
   void started(std::int64_t run_id);
+  /// The serve loop: the run of the last request could not be created (start() answers 503).
+  void start_failed(const std::string& why);
   /// Wakes next() (shutdown).
   void wake();
 
@@ -52,6 +54,7 @@ class ServeControl final : public http::RunControl {
   bool busy_ = false, woken_ = false;
   std::uint64_t requests_ = 0, answered_ = 0;  ///< start requests taken / whose run exists
   std::int64_t started_id_ = 0;
+  std::string start_error_;  ///< why the last request's run was not created
   std::string fault_;
 };
 

@@ -63,9 +63,16 @@ IdleReading IdleWatch::look() {
     log("serve")->log(cleared ? spdlog::level::info : spdlog::level::warn, "{}", message);
     const std::string severity = cleared ? "info" : "warn";
     const std::string kind = cleared ? "idle_clear" : "idle_fault";
-    const auto id = store_.add_event(std::nullopt, 0, severity, "serve", kind, message);
-    if (on_event_) on_event_({id, 0, 0, severity, "serve", kind, message, std::nullopt});
-    last_key_ = r.fault_key;
+    try {
+      const auto id = store_.add_event(std::nullopt, 0, severity, "serve", kind, message);
+      if (on_event_) on_event_({id, 0, 0, severity, "serve", kind, message, std::nullopt});
+      last_key_ = r.fault_key;
+      r.storage_error.clear();
+    } catch (const SqliteError& e) {
+      // The store cannot write (disk full): reported with the reading, the event is tried again
+      // at the next look (last_key_ unchanged). Watching the rig never stops for it.
+      r.storage_error = e.what();
+    }
   }
   drive_lamps(!r.fault.empty());
   return r;

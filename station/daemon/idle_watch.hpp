@@ -23,6 +23,7 @@ struct IdleReading {
   std::vector<IoError> io_errors;
   std::string fault;      ///< empty: every device answered and nothing is alarming
   std::string fault_key;  ///< the same as stable names (device: error kind), for change detection
+  std::string storage_error;  ///< this look's event could not be stored (empty: stored or none)
 };
 
 /// Watches an idle rig. Not thread-safe (the serve loop's thread).

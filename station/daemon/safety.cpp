@@ -93,16 +93,28 @@ std::string SafetyCauses::text() const {
   return on.empty() ? std::string("no cause") : fmt::format("{}", fmt::join(on, "; "));
 }
 
+std::string SafetyCauses::cleared_text() const {
+  std::vector<std::string> off;
+  if (chamber_high_limit) off.emplace_back("chamber high-limit trip reset");
+  if (gpio_estop_pressed) off.emplace_back("e-stop released");
+  if (chamber_door_open) off.emplace_back("chamber door closed");
+  if (gpio_interlock_open) off.emplace_back("interlock closed");
+  if (table_interlock_open) off.emplace_back("turntable interlock closed");
+  if (inputs_unreadable) off.emplace_back("interlock / e-stop readable again");
+  if (!out_of_limits.empty()) off.emplace_back("readings back inside limits");
+  return off.empty() ? std::string("no cause") : fmt::format("{}", fmt::join(off, "; "));
+}
+
 std::optional<std::string> Safety::update(SafetyCauses causes) {
   const bool was = holding_;
   const bool changed = !(causes == causes_);
-  const std::string before = causes_.text();
+  const SafetyCauses before = causes_;
   causes_ = std::move(causes);
   limits_fault_ = !causes_.out_of_limits.empty();
   holding_ = causes_.any();
   if (!changed) return std::nullopt;
   if (holding_ && !was) return "enter: " + causes_.text();
-  if (!holding_ && was) return fmt::format("clear: every cause read clear (was: {})", before);
+  if (!holding_ && was) return "clear: " + before.cleared_text() + "; every cause reads clear";
   return "still holding: " + causes_.text();
 }
 

@@ -53,6 +53,8 @@ struct SafetyCauses {
   bool any() const { return interlock_open() || estop() || !out_of_limits.empty(); }
   /// The active causes in words ("chamber high-limit trip; GPIO e-stop pressed"), or "none".
   std::string text() const;
+  /// What each cause that is on reads once it clears ("interlock closed", "e-stop released").
+  std::string cleared_text() const;
   bool operator==(const SafetyCauses&) const = default;
 };
 

@@ -134,6 +134,12 @@ class Sequencer {
   /// Outages the killed daemon left open go on in this process (one event when they end).
   void restore_outages(std::int64_t run_id, double last_s);
   void connect_devices();
+  /// The 1 Hz loop from `t_first` to the run's end.
+  RunOutcome tick_loop(double t_first);
+  /// The run's end after tick `t_s`, if this tick ends it (abort, detach, stop, protocol done).
+  std::optional<RunOutcome> end_of_run(double t_s, std::int64_t ticks);
+  /// `skipped` ticks before `t_s` were missed (the process was stopped or late): a tick_gap event.
+  void note_tick_gap(double t_s, std::int64_t skipped);
   void tick(double t_s, TickData& d);
   void read_devices(double t_s, TickData& d);
   void apply_safety(double t_s, TickData& d);
@@ -175,6 +181,7 @@ class Sequencer {
   Safety safety_;
   std::optional<ProtocolRunner> runner_;
   std::int64_t run_id_ = 0;
+  double last_t_s_ = 0;  ///< the tick being run (where a store failure happened)
   std::uint8_t latch_seq_ = 0;
   bool replaying_ = false;
   int command_failures_ = 0;

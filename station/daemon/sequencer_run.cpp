@@ -123,7 +123,6 @@ void Sequencer::restore_outages(std::int64_t run_id, double last_s) {
 }
 
 RunOutcome Sequencer::run(const std::optional<RunRecord>& resume) {
-  const double period = options_.period_s;
   // Real hardware resumes at the stored protocol position; a simulation replays from t = 0.
   RunProgress progress = resume && !options_.replay_until_t_s ? resume->progress : RunProgress{};
   double t_first = 0;
@@ -157,6 +156,39 @@ RunOutcome Sequencer::run(const std::optional<RunRecord>& resume) {
   if (!options_.http_url.empty())
     emit(t_first, "info", "http", "listen", fmt::format("live page at {}", options_.http_url));
   connect_devices();
+  try {
+    return tick_loop(t_first);
+  } catch (const SqliteError& e) {
+    // The store cannot record (disk full, a file size limit, an I/O error): nothing this run
+    // measures from now on would be kept, so the rig goes to the state a run's end leaves it in
+    // (gyro power off, lamps dark) and the caller decides (serve closes the run once writing
+    // works again; run exits and the run stays resumable).
+    log("seq")->error("run {}: the store failed: {}", run_id_, e.what());
+    try {
+      drive_outputs(last_t_s_, SafetyOutputs{});
+    } catch (const std::exception& e2) {  // an event about the outputs may fail to store as well
+      log("seq")->error("run {}: outputs after the store failed: {}", run_id_, e2.what());
+    }
+    throw;
+  }
+}
+
+void Sequencer::note_tick_gap(double t_s, std::int64_t skipped) {
+  const double period = options_.period_s;
+  const double from_s = t_s - static_cast<double>(skipped) * period;
+  log("seq")->warn("overrun: {} tick(s) skipped at t_s={:.0f}", skipped, t_s);
+  rig_.counters->note_skipped_ticks(static_cast<int>(skipped));  // next delta spans them
+  // In the record, like an outage: which ticks are missing, and why (the process was stopped
+  // or starved; absolute deadlines skip late ticks, they never shift the schedule).
+  emit(t_s, "warn", "seq", "tick_gap",
+       fmt::format("{} tick(s) missed from t = {:.0f} s to {:.0f} s (the daemon was late)",
+                   skipped, from_s, t_s - period),
+       nlohmann::json{{"start_s", from_s}, {"end_s", t_s - period}, {"ticks_lost", skipped}}
+           .dump());
+}
+
+RunOutcome Sequencer::tick_loop(double t_first) {
+  const double period = options_.period_s;
   const double start = clock_.now_s();
   std::int64_t ticks = 0;
   for (std::int64_t k = 0;; ++k) {
@@ -164,10 +196,7 @@ RunOutcome Sequencer::run(const std::optional<RunRecord>& resume) {
     std::int64_t skipped = 0;
     if (k > 0) {
       const auto due = static_cast<std::int64_t>(std::floor((clock_.now_s() - start) / period));
-      if (due > k) {  // absolute deadlines: a late tick skips, it never shifts the schedule
-        log("seq")->warn("overrun: {} tick(s) skipped at t_s={:.0f}", due - k,
-                         t_first + k * period);
-        rig_.counters->note_skipped_ticks(static_cast<int>(due - k));  // next delta spans them
+      if (due > k) {
         skipped = due - k;
         k = due;
       } else {
@@ -175,7 +204,9 @@ RunOutcome Sequencer::run(const std::optional<RunRecord>& resume) {
       }
     }
     const double t_s = t_first + static_cast<double>(k) * period;
+    last_t_s_ = t_s;
     replaying_ = options_.replay_until_t_s && t_s <= *options_.replay_until_t_s;
+    if (skipped > 0) note_tick_gap(t_s, skipped);
     if (options_.before_tick) {
       const auto w0 = std::chrono::steady_clock::now();
       options_.before_tick(t_s);
@@ -193,25 +224,28 @@ RunOutcome Sequencer::run(const std::optional<RunRecord>& resume) {
       r.skipped = skipped;
       options_.on_tick(r);
     }
-    if (options_.abort != nullptr && options_.abort->load())
-      return {run_id_, abort(t_s), t_s, ticks};
-    if (options_.detach != nullptr && options_.detach->load()) {
-      emit(t_s, "info", "seq", "detach",
-           fmt::format("run {} left resumable at t = {:.0f} s (service restart)", run_id_, t_s));
-      return {run_id_, "detached", t_s, ticks};
-    }
-    const bool stop = options_.stop != nullptr && options_.stop->load();
-    if (runner_->done() || stop) {
-      const std::string state = runner_->done() ? "completed" : "stopped";
-      const double n = static_cast<double>(ticks) / 1e6;  // -> microseconds per tick
-      log("seq")->info(
-          "tick phases, mean us: world {:.0f} can {:.0f} chamber {:.0f} table {:.0f} gpio {:.0f} "
-          "store {:.0f}",
-          phase_s_.world / n, phase_s_.can / n, phase_s_.chamber / n, phase_s_.table / n,
-          phase_s_.gpio / n, phase_s_.store / n);
-      return {run_id_, finish(state, t_s), t_s, ticks};
-    }
+    if (auto end = end_of_run(t_s, ticks)) return *end;
   }
+}
+
+std::optional<RunOutcome> Sequencer::end_of_run(double t_s, std::int64_t ticks) {
+  if (options_.abort != nullptr && options_.abort->load())
+    return RunOutcome{run_id_, abort(t_s), t_s, ticks};
+  if (options_.detach != nullptr && options_.detach->load()) {
+    emit(t_s, "info", "seq", "detach",
+         fmt::format("run {} left resumable at t = {:.0f} s (service restart)", run_id_, t_s));
+    return RunOutcome{run_id_, "detached", t_s, ticks};
+  }
+  const bool stop = options_.stop != nullptr && options_.stop->load();
+  if (!runner_->done() && !stop) return std::nullopt;
+  const std::string state = runner_->done() ? "completed" : "stopped";
+  const double n = static_cast<double>(ticks) / 1e6;  // -> microseconds per tick
+  log("seq")->info(
+      "tick phases, mean us: world {:.0f} can {:.0f} chamber {:.0f} table {:.0f} gpio {:.0f} "
+      "store {:.0f}",
+      phase_s_.world / n, phase_s_.can / n, phase_s_.chamber / n, phase_s_.table / n,
+      phase_s_.gpio / n, phase_s_.store / n);
+  return RunOutcome{run_id_, finish(state, t_s), t_s, ticks};
 }
 
 }  // namespace station

@@ -86,7 +86,8 @@ Database::Database(const std::string& path, OpenMode mode) : path_(path), mode_(
   sqlite3_busy_timeout(db_.get(), 5000);
   // Nothing is written to a file before it passes the check (a corrupt record must not grow).
   quick_check();
-  if (mode != OpenMode::create && schema_version() == 0) {
+  // Whose file it is, before any PRAGMA that writes (journal_mode=WAL, a migration's copy).
+  if (identify_empty() && mode != OpenMode::create) {
     throw SqliteError(
         fmt::format("{}: not a station database (empty, or schema version 0); "
                     "nothing was written to it",
@@ -121,6 +122,39 @@ void Database::quick_check() {
   }
 }
 
+bool Database::identify_empty() {
+  auto count = prepare("SELECT count(*) FROM sqlite_master");
+  count.step();
+  const std::int64_t objects = count.column_int(0);
+  auto app = prepare("PRAGMA application_id");
+  app.step();
+  const auto app_id = static_cast<std::int32_t>(app.column_int(0));
+  const int version = schema_version();
+  if (app_id == kStationApplicationId) return false;
+  const auto foreign = [&](const std::string& why) {
+    return SqliteError(fmt::format(
+        "{}: not a station database ({}); nothing was written to it", path_, why));
+  };
+  if (app_id != 0)
+    throw foreign(fmt::format("its application_id is 0x{:08X}, another program's",
+                              static_cast<std::uint32_t>(app_id)));
+  if (objects == 0 && version == 0) return true;  // a new, empty database
+  // Written before the application_id was set: the schema version and the station's tables.
+  auto tables = prepare(
+      "SELECT count(*) FROM sqlite_master WHERE type = 'table' AND name IN "
+      "('runs', 'run_slots', 'samples', 'events', 'gyros')");
+  tables.step();
+  const int known = static_cast<int>(schemas::kMigrations.size());
+  if (version >= 1 && version <= known && tables.column_int(0) == 5) return false;
+  if (version > known && tables.column_int(0) == 5) return false;  // newer: migrate() says so
+  auto names = prepare(
+      "SELECT group_concat(name, ', ') FROM (SELECT name FROM sqlite_master WHERE type = "
+      "'table' ORDER BY name LIMIT 6)");
+  names.step();
+  throw foreign(fmt::format("schema version {}, tables: {}", version,
+                            names.column_is_null(0) ? "none" : names.column_text(0)));
+}
+
 void Database::exec(std::string_view sql) {
   char* err = nullptr;
   const std::string text(sql);
@@ -140,7 +174,10 @@ int Database::schema_version() {
 void Database::migrate() {
   const int known = static_cast<int>(schemas::kMigrations.size());
   const int have = check_schema_version(schema_version(), known);
-  if (have == known) return;  // the common case: no write lock needed
+  if (have == known) {  // the common case: no write lock needed
+    if (mode_ != OpenMode::read_only && have > 0) stamp_application_id();
+    return;
+  }
   if (mode_ != OpenMode::create && have == 0) {
     throw SqliteError(
         fmt::format("{}: not a station database (empty, or schema version 0)", path_));
@@ -164,6 +201,7 @@ void Database::migrate() {
       exec(schemas::kMigrations[static_cast<std::size_t>(v)].second);
       exec(fmt::format("PRAGMA user_version = {}", v + 1));
     }
+    exec(fmt::format("PRAGMA application_id = {}", kStationApplicationId));
     auto fk = prepare("PRAGMA foreign_key_check");
     if (fk.step()) {
       throw SqliteError(fmt::format("{}: migration left a foreign key violation in table '{}'",
@@ -221,6 +259,13 @@ int Database::check_schema_version(int have, int known) const {
   return have;
 }
 
+void Database::stamp_application_id() {
+  auto app = prepare("PRAGMA application_id");
+  app.step();
+  if (app.column_int(0) != kStationApplicationId)
+    exec(fmt::format("PRAGMA application_id = {}", kStationApplicationId));
+}
+
 Transaction::Transaction(Database& db) : db_(db) {
   db_.exec("BEGIN IMMEDIATE");
 }
@@ -235,7 +280,22 @@ Transaction::~Transaction() {
 }
 
 void Transaction::commit() {
-  db_.exec("COMMIT");
+  try {
+    db_.exec("COMMIT");
+  } catch (...) {
+    // A COMMIT that fails (disk full, I/O error, a file size limit) may already have rolled the
+    // transaction back, or may leave it open (sqlite.org/lang_transaction.html, "Response To
+    // Errors Within A Transaction": the application should ROLLBACK). Either way the connection
+    // leaves here outside any transaction, so the next BEGIN starts clean.
+    done_ = true;
+    if (db_.in_transaction()) {
+      try {
+        db_.exec("ROLLBACK");
+      } catch (...) {  // NOLINT(bugprone-empty-catch): the COMMIT's error is the one to report
+      }
+    }
+    throw;
+  }
   done_ = true;
 }
 

@@ -77,6 +77,11 @@ enum class OpenMode {
 
 /// A database file. Checked with PRAGMA quick_check before anything else touches it; opened in
 /// WAL mode with a busy timeout when writable; applies migrations on request.
+/// PRAGMA application_id of a station database ("GTCL", gyro thermal calibration): a file's
+/// header says whose it is (sqlite.org/fileformat2.html, "Application ID"). Files written before
+/// it was set are recognised by their schema version and tables, and get it at the next write.
+inline constexpr std::int32_t kStationApplicationId = 0x4754434C;
+
 class Database {
  public:
   /// Opens `path` as `mode` allows; throws SqliteError naming the path (missing, not a
@@ -96,10 +101,17 @@ class Database {
   int schema_version();
   const std::string& path() const { return path_; }
   OpenMode mode() const { return mode_; }
+  /// True inside BEGIN ... COMMIT (sqlite3_get_autocommit is 0).
+  bool in_transaction() const { return sqlite3_get_autocommit(db_.get()) == 0; }
 
  private:
   /// PRAGMA quick_check: throws SqliteError with the first problem it reports.
   void quick_check();
+  /// Whether the file is empty (true: no schema, a new database) or a station database (false);
+  /// throws SqliteError for anyone else's file. Reads only: decided before any PRAGMA writes.
+  bool identify_empty();
+  /// Sets the application_id on a station file written before it existed.
+  void stamp_application_id();
   /// `have` when it is a version this software can migrate from; throws otherwise (a negative
   /// or future user_version must never index the migration table).
   int check_schema_version(int have, int known) const;

@@ -180,7 +180,14 @@ void Store::write_tick(std::int64_t run_id, double t_s, const std::vector<Sample
 
 void Store::flush() {
   if (!batch_) return;
-  batch_->commit();
+  try {
+    batch_->commit();
+  } catch (...) {
+    // The batch's ticks are lost (never committed); the next tick starts a new transaction.
+    batch_.reset();
+    batch_ticks_ = 0;
+    throw;
+  }
   batch_.reset();
   batch_ticks_ = 0;
 }

@@ -258,7 +258,7 @@ TEST(Safety, ASetpointWrittenBySomeoneElseIsCaughtOnTheSimulatedRig) {
   const auto run = r["run_id"].get<std::int64_t>();
   int enters = 0;
   for (const auto& e : store.events(run)) {
-    // The clear names what was wrong too ("clear: ... (was: ...)"); the enters are counted.
+    // Only the enter names the fault; the clear says what reads clear. The enters are counted.
     if (e.find("out of limits: chamber setpoint read back 150.00 C") != std::string::npos &&
         e.rfind("safe_hold_cleared: ", 0) != 0) {
       EXPECT_EQ(e.rfind("safe_hold: enter: ", 0), 0u) << e;
