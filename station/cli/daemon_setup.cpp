@@ -43,8 +43,8 @@ std::vector<ProcessLock> lock_db_and_devices(const std::string& db, const Statio
   // Keyed on what each endpoint reaches, not on its spelling (device_identity.hpp).
   for (const auto& e : endpoints) {
     for (const auto& id : device_identities(e)) {
-      const std::string what = id == e ? fmt::format("device {}", e)
-                                       : fmt::format("device {} (as {})", e, id);
+      const std::string what =
+          id == e ? fmt::format("device {}", e) : fmt::format("device {} (as {})", e, id);
       locks.push_back(ProcessLock::acquire(device_lock_path(id), what));
     }
   }

@@ -5,6 +5,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <optional>
 
 namespace station {
@@ -43,6 +44,18 @@ CLI::Validator finite_within(double lo, double hi, const std::string& unit) {
 
 CLI::Validator finite_positive(double hi, const std::string& unit) {
   return bounded(0.0, hi, true, unit);
+}
+
+CLI::Validator unsigned_integer() {
+  return CLI::Validator(
+      [](std::string& s) -> std::string {
+        std::uint64_t v = 0;
+        const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+        if (s.empty() || ptr != s.data() + s.size() || ec != std::errc{})
+          return fmt::format("'{}' is not an unsigned integer (0..18446744073709551615)", s);
+        return {};
+      },
+      "UINT");
 }
 
 }  // namespace station

@@ -11,5 +11,8 @@ namespace station {
 CLI::Validator finite_within(double lo, double hi, const std::string& unit);
 /// Accepts a finite number in (0, hi].
 CLI::Validator finite_positive(double hi, const std::string& unit);
+/// Accepts decimal digits only (an unsigned integer that fits 64 bits): `-1` is refused, not
+/// wrapped to 18446744073709551615.
+CLI::Validator unsigned_integer();
 
 }  // namespace station

@@ -18,6 +18,7 @@
 #include "station/cli/commands.hpp"
 #include "station/cli/daemon_setup.hpp"
 #include "station/cli/live_service.hpp"
+#include "station/cli/number_options.hpp"
 #include "station/cli/probe.hpp"
 #include "station/common/logging.hpp"
 #include "station/common/process_lock.hpp"
@@ -218,7 +219,9 @@ void add_run_command(CLI::App& app, CommandStatus& status) {
   cmd->add_option("--gyros", o->gyros, "simulated gyros")
       ->capture_default_str()
       ->check(CLI::Range(1, 16));
-  cmd->add_option("--seed", o->seed, "simulation seed")->capture_default_str();
+  cmd->add_option("--seed", o->seed, "simulation seed")
+      ->check(unsigned_integer())
+      ->capture_default_str();
   cmd->add_option("--gyro-preset", o->gyro_preset,
                   "simulated gyros: station (strong thermal effect) or paper (the paper's "
                   "proportions: std ratio ~0.13)")
@@ -249,7 +252,7 @@ void add_run_command(CLI::App& app, CommandStatus& status) {
   cmd->add_option("--speed", o->speed,
                   "--sim: simulated seconds per wall second, to watch a run live (600: the 13 h "
                   "cycle in ~80 s; default: as fast as possible)")
-      ->check(CLI::Range(1.0, 1e6));  // below 1 a stop would wait a whole slowed tick
+      ->check(finite_within(1.0, 1e6, "x"));  // below 1 a stop would wait a whole slowed tick
   cmd->add_option("--http", o->http,
                   "serve the live page, JSON API and /metrics at HOST:PORT (schemas/api.md); "
                   "127.0.0.1:0 picks a free port and prints it");

@@ -84,8 +84,7 @@ bool close_failed_run(Service& s, const UnclosedRun& u) {
   try {
     const auto run = s.store.find_run(u.id);
     if (!run || run->state != "running") return true;  // closed already
-    s.store.add_event(u.id, run->last_tick_s.value_or(0), "error", "serve", "run_failed",
-                      u.reason);
+    s.store.add_event(u.id, run->last_tick_s.value_or(0), "error", "serve", "run_failed", u.reason);
     s.store.finish_run(u.id, "aborted");
     log("serve")->info("run {} closed as aborted (run_failed: {})", u.id, u.reason);
     return true;
@@ -154,8 +153,8 @@ std::string service_fault(Service& s, const IdleReading& r) {
   if (!r.fault.empty()) faults.push_back(r.fault);
   if (s.unclosed && close_failed_run(s, *s.unclosed)) s.unclosed.reset();
   if (s.unclosed) {
-    faults.push_back(fmt::format("storage: run {} cannot be closed: {}", s.unclosed->id,
-                                 s.unclosed->reason));
+    faults.push_back(
+        fmt::format("storage: run {} cannot be closed: {}", s.unclosed->id, s.unclosed->reason));
   } else if (!r.storage_error.empty()) {
     faults.push_back(fmt::format("storage: {}", r.storage_error));
   }

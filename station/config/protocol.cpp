@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -58,6 +59,7 @@ void read_set_temperature(const TomlView& v, Step& s) {
     throw v.error("setpoint_c", "give exactly one of setpoint_c or to_start = true");
   }
   s.ramp_c_per_h = number_in(v, "ramp_c_per_h", 0.0, kMaxRampCPerH, "C/h");
+  s.ramp_line = static_cast<int>(v.line_of("ramp_c_per_h"));
   s.wait = v.opt_bool("wait").value_or(true);
   s.tolerance_c = number_in(v, "tolerance_c", 1.0, kMaxToleranceC, "C");
 }
@@ -130,6 +132,7 @@ Protocol parse_protocol(const std::string& text, const std::string& path) {
     }
     if (start || stop) recording = start;
   }
+  p.check_step_times(std::nullopt, std::nullopt);
   return p;
 }
 
@@ -166,6 +169,30 @@ double Protocol::nominal_duration_s(double start_c) const {
     }
   }
   return t;
+}
+
+void Protocol::check_step_times(std::optional<double> lo_c, std::optional<double> hi_c) const {
+  std::optional<double> temp;  // the chamber's temperature when the step starts, if fixed
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    const Step& s = steps[i];
+    if (s.kind != StepKind::set_temperature) continue;
+    const std::optional<double> target = s.to_start ? std::nullopt : s.setpoint_c;
+    std::optional<double> span_c;
+    if (temp && target) {
+      span_c = std::abs(*target - *temp);
+    } else if (const auto known = target ? target : temp; known && lo_c && hi_c) {
+      // The other end is the run's start temperature, somewhere within the limits.
+      span_c = std::max(std::abs(*known - *lo_c), std::abs(*known - *hi_c));
+    }
+    const double ramp_s = s.ramp_c_per_h > 0 && span_c ? *span_c / s.ramp_c_per_h * 3600.0 : 0;
+    if (ramp_s > kMaxStepS) {
+      throw InputError(fmt::format(
+          "{}:{}: key 'step[{}].ramp_c_per_h': {:g} C/h over {:g} C takes {:g} days, longer than "
+          "the longest step ({:g} days)",
+          path, s.ramp_line, i, s.ramp_c_per_h, *span_c, ramp_s / 86400.0, kMaxStepS / 86400.0));
+    }
+    temp = target;
+  }
 }
 
 }  // namespace station

@@ -28,6 +28,7 @@ struct Step {
   std::optional<double> setpoint_c;  ///< set_temperature: target, deg C
   bool to_start = false;             ///< set_temperature: target is the run's start temperature
   double ramp_c_per_h = 0;           ///< set_temperature: ramp rate, 0 = step
+  int ramp_line = 0;                 ///< set_temperature: line of ramp_c_per_h (or the step's)
   bool wait = true;                  ///< set_temperature: wait for the air to arrive
   double tolerance_c = 1.0;          ///< set_temperature/soak: band around the setpoint
   double duration_s = 0;             ///< soak: time stable; hold: time
@@ -41,6 +42,12 @@ struct Protocol {
   std::vector<Step> steps;
   /// Sum of the nominal durations (ramps at their rate from `start_c`), s: for progress.
   double nominal_duration_s(double start_c) const;
+  /// Refuses a step that would take longer than the longest step allowed (7 days): a ramp is
+  /// judged over the span from the previous step's setpoint, or, where that is the run's start
+  /// temperature (the first ramp, `to_start`), over the widest span within [lo_c, hi_c] (the
+  /// station's setpoint limits; without them, only spans the protocol itself fixes are judged).
+  /// Throws InputError "FILE:LINE: key 'step[N].ramp_c_per_h': ...".
+  void check_step_times(std::optional<double> lo_c, std::optional<double> hi_c) const;
 };
 
 /// Parses protocol text labelled `path`; throws InputError ("FILE:LINE: key 'step[3].x': ...").

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 namespace station {
 namespace {
@@ -62,7 +63,10 @@ std::optional<double> TomlView::opt_number(std::string_view key) const {
   const toml::node* n = find(key);
   if (n == nullptr) return std::nullopt;
   if (!n->is_number()) throw error(key, "expected a number");
-  const double v = *n->value<double>();
+  // toml++ converts an integer to double only when exact: 9223372036854775807 gives no value
+  // (read as 0 before), so integers are converted here.
+  const double v =
+      n->is_integer() ? static_cast<double>(*n->value<std::int64_t>()) : *n->value<double>();
   // TOML allows inf and nan; no setting of ours means either.
   if (!std::isfinite(v)) throw error(key, "must be a finite number");
   return v;

@@ -130,6 +130,8 @@ RunOutcome Sequencer::run(const std::optional<RunRecord>& resume) {
     run_id_ = resume->id;
     t_first = resume_first_tick(*resume);
   } else {
+    // A ramp that would take longer than any step may is refused before the run exists.
+    protocol_.check_step_times(config_.limits.min_setpoint_c, config_.limits.max_setpoint_c);
     RunInfo info{protocol_.name,
                  protocol_.text,
                  config_.text,
@@ -180,11 +182,11 @@ void Sequencer::note_tick_gap(double t_s, std::int64_t skipped) {
   rig_.counters->note_skipped_ticks(static_cast<int>(skipped));  // next delta spans them
   // In the record, like an outage: which ticks are missing, and why (the process was stopped
   // or starved; absolute deadlines skip late ticks, they never shift the schedule).
-  emit(t_s, "warn", "seq", "tick_gap",
-       fmt::format("{} tick(s) missed from t = {:.0f} s to {:.0f} s (the daemon was late)",
-                   skipped, from_s, t_s - period),
-       nlohmann::json{{"start_s", from_s}, {"end_s", t_s - period}, {"ticks_lost", skipped}}
-           .dump());
+  emit(
+      t_s, "warn", "seq", "tick_gap",
+      fmt::format("{} tick(s) missed from t = {:.0f} s to {:.0f} s (the daemon was late)", skipped,
+                  from_s, t_s - period),
+      nlohmann::json{{"start_s", from_s}, {"end_s", t_s - period}, {"ticks_lost", skipped}}.dump());
 }
 
 RunOutcome Sequencer::tick_loop(double t_first) {
@@ -195,12 +197,14 @@ RunOutcome Sequencer::tick_loop(double t_first) {
     const double deadline = start + static_cast<double>(k) * period;
     std::int64_t skipped = 0;
     if (k > 0) {
+      // Wait for tick k's deadline (at once when it has passed). A tick whose slot is over when
+      // the wait ends (the process was stopped or starved) is skipped, never run late under its
+      // own time: absolute deadlines, the schedule never shifts.
+      watch_inputs_until(deadline, t_first + static_cast<double>(k - 1) * period);
       const auto due = static_cast<std::int64_t>(std::floor((clock_.now_s() - start) / period));
       if (due > k) {
         skipped = due - k;
         k = due;
-      } else {
-        watch_inputs_until(deadline, t_first + static_cast<double>(k - 1) * period);
       }
     }
     const double t_s = t_first + static_cast<double>(k) * period;

@@ -89,6 +89,28 @@ std::optional<std::string> sim_part_number(const SimRunOptions& o) {
   return o.part_number;
 }
 
+namespace {
+
+/// The one wording of a refused --fault command, whether found before the run or at its tick.
+InputError fault_error(double at_s, const std::string& command, const std::string& reply) {
+  return InputError(fmt::format("--fault {:.0f}:{}: {}", at_s, command, reply));
+}
+
+/// Every --fault command tried on a throwaway world of the run's shape before the run exists:
+/// a command simrig would refuse is exit 2 with nothing recorded, not a 'running' run left
+/// behind at its tick.
+void check_fault_commands(const SimRunOptions& o, const sim::SimWorldConfig& wc) {
+  if (o.faults.empty()) return;
+  sim::SimWorld probe(wc);
+  for (const auto& [at_s, command] : o.faults) {
+    if (command == "kill") continue;
+    const std::string reply = sim::run_fault_command(probe, command);
+    if (reply.rfind("ok", 0) != 0) throw fault_error(at_s, command, reply);
+  }
+}
+
+}  // namespace
+
 nlohmann::json run_simulated(const SimRunOptions& o) {
   const auto wall_start = std::chrono::steady_clock::now();
   const auto part = sim_part_number(o);
@@ -102,6 +124,7 @@ nlohmann::json run_simulated(const SimRunOptions& o) {
   }
   wc.preset = *preset;
   wc.earth_rate_dph = compensation::earth_rate_along_axis_dph(o.latitude_deg, {0, 0, 1});
+  check_fault_commands(o, wc);
   sim::SimWorld world(wc);
   const StationConfig config =
       parse_station_config(sim_config_text(world, o, part), "sim:station.toml");
@@ -166,8 +189,7 @@ nlohmann::json run_simulated(const SimRunOptions& o) {
       // the rest is lost, a later `run` resumes. For recording resumed sessions.
       if (command == "kill") ::raise(SIGKILL);
       const std::string reply = sim::run_fault_command(world, command);
-      if (reply.rfind("ok", 0) != 0)
-        throw InputError(fmt::format("--fault {:.0f}:{}: {}", at_s, command, reply));
+      if (reply.rfind("ok", 0) != 0) throw fault_error(at_s, command, reply);
     }
     if (o.on_world_tick) o.on_world_tick(t_s, world);
   };

@@ -131,7 +131,7 @@ TEST(LiveHub, StateFollowsRunHoldAndFault) {
   EXPECT_EQ(hub.current_run(), 4);
   hub.run_ended(4, "stopped");
   EXPECT_EQ(hub.status()["state"], "fault");  // the last idle look still said so
-  hub.idle(IdleReading{});                      // the next one is clear
+  hub.idle(IdleReading{});                    // the next one is clear
   EXPECT_EQ(hub.status()["state"], "idle");
   hub.run_started(5, p, "", {});
   hub.run_ended(5, "failed: disk full");  // a failed run is a fault until the next run starts

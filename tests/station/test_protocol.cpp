@@ -69,6 +69,40 @@ TEST(Protocol, BadFilesNameLineAndKey) {
   EXPECT_THROW(station::load_protocol("/no/such/protocol.toml"), station::InputError);
 }
 
+// Issue 19 item 13: an integer too large for a double was read as 0 s (a hold of
+// 9223372036854775807 s ended at once); a ramp that would take longer than a step may is refused
+// with file, line and key, whether its span is fixed by the protocol or by the station's limits.
+TEST(Protocol, StepsLongerThanAWeekAreRefusedWithFileLineAndKey) {
+  EXPECT_NE(error_of("name = \"x\"\n[[step]]\ntype = \"hold\"\nduration_s = 9223372036854775807\n")
+                .find("p.toml:4: key 'step[0].duration_s': 9.22337e+18 s is longer than"),
+            std::string::npos);
+  const std::string two_ramps =
+      "name = \"x\"\n[[step]]\ntype = \"set_temperature\"\nsetpoint_c = -40\n"
+      "[[step]]\ntype = \"set_temperature\"\nsetpoint_c = 70\nramp_c_per_h = ";
+  // 110 C at 1 C/h is 4.6 days: allowed. At 0.5 C/h, 9.2 days: refused at parse, span known.
+  EXPECT_EQ(error_of(two_ramps + "1\n"), "");
+  EXPECT_NE(
+      error_of(two_ramps + "0.5\n")
+          .find("p.toml:8: key 'step[1].ramp_c_per_h': 0.5 C/h over 110 C takes 9.16667 days"),
+      std::string::npos)
+      << error_of(two_ramps + "0.5\n");
+  // The first ramp starts wherever the chamber is: judged at run start over the limits.
+  const auto first = station::parse_protocol(
+      "name = \"x\"\n[[step]]\ntype = \"set_temperature\"\nsetpoint_c = -40\n"
+      "ramp_c_per_h = 1e-300\n",
+      "p.toml");
+  try {
+    first.check_step_times(-55.0, 85.0);
+    ADD_FAILURE() << "a ramp of 1e-300 C/h was accepted";
+  } catch (const station::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("p.toml:5: key 'step[0].ramp_c_per_h': 1e-300 C/h over "
+                                         "125 C takes"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_NO_THROW(station::load_protocol("paper").check_step_times(-55.0, 85.0));
+}
+
 TEST(ProtocolRunner, RampsAlongTheStationsProfileAndWaitsForTheAir) {
   const auto p = station::parse_protocol(
       "name = \"t\"\n[[step]]\ntype = \"set_temperature\"\nsetpoint_c = 35.0\nramp_c_per_h = 36.0\n"

@@ -12,8 +12,8 @@
 #include <string>
 #include <thread>
 
-#include "station/config/config.hpp"
 #include "station/cli/probe.hpp"
+#include "station/config/config.hpp"
 
 namespace {
 

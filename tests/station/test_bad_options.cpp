@@ -1,0 +1,56 @@
+// Issue 19 item 13: every option of `run` is checked before the run is created. A fault command
+// simrig would refuse was found only at its tick and left a 'running' run behind; `--speed nan`
+// and `--seed -1` were accepted; a protocol whose first ramp would take years ran.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <fstream>
+
+#include "station/store/store.hpp"
+#include "tests/station/rig_process.hpp"
+#include "tests/station/temp_db.hpp"
+
+namespace {
+
+namespace ts = station::testing_support;
+
+struct Outcome {
+  int status = -1;
+  std::string out;
+};
+
+Outcome station_cmd(const std::string& args) {
+  const std::string out = ::testing::TempDir() + "bad-opt-" + std::to_string(getpid()) + ".out";
+  const int rc = std::system((ts::kStationBin + " " + args + " >" + out + " 2>&1").c_str());
+  return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, ts::slurp(out)};
+}
+
+/// Runs in the database at `db` (0 when there is no database).
+std::int64_t runs_in(const std::string& db) {
+  if (access(db.c_str(), F_OK) != 0) return 0;
+  station::Store s(db, station::OpenMode::read_only);
+  auto st = s.db().prepare("SELECT count(*) FROM runs");
+  return st.step() ? st.column_int(0) : -1;
+}
+
+}  // namespace
+
+TEST(BadOptions, EachIsExit2NamingItBeforeAnyRunExists) {
+  const std::string slow = ::testing::TempDir() + "slow-ramp.toml";
+  std::ofstream(slow) << "name = \"slow\"\n[[step]]\ntype = \"set_temperature\"\n"
+                         "setpoint_c = -40\nramp_c_per_h = 1e-300\n";
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {"--fault 10:explode", "--fault 10:explode: error: unknown command 'explode'"},
+      {"--fault '20:board 99 reset'", "--fault 20:board 99 reset: error: node '99'"},
+      {"--speed nan", "--speed: 'nan' is not a finite number"},
+      {"--seed -1", "--seed: '-1' is not an unsigned integer"},
+      {"--protocol " + slow, slow + ":5: key 'step[0].ramp_c_per_h': 1e-300 C/h"},
+  };
+  for (const auto& [args, says] : cases) {
+    const auto db = ts::fresh_db("bad-opt");
+    const auto o = station_cmd("run --sim --gyros 1 --db " + db + " " + args);
+    EXPECT_EQ(o.status, 2) << args << ": " << o.out;
+    EXPECT_NE(o.out.find(says), std::string::npos) << args << ": " << o.out;
+    EXPECT_EQ(runs_in(db), 0) << args << " left a run behind";
+  }
+}
