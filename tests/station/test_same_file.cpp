@@ -148,8 +148,21 @@ TEST(SameFile, ASecondConfigurationNamingTheChamberAsLocalhostExits2) {
       db_a + ".out", db_a + ".err");
   ASSERT_TRUE(ts::wait_until([&] { return samples_of(db_a) >= 2; }, std::chrono::seconds(15)))
       << ts::slurp(db_a + ".err");
-  for (std::size_t at = 0; (at = text.find("127.0.0.1", at)) != std::string::npos;)
-    text.replace(at, 9, "localhost");
+  // Rig B is a second simrig (its own turntable and CAN bus) whose configuration names rig A's
+  // chamber as `localhost`: no endpoint string of B equals one of A's; the chamber resolves to
+  // the same address and port.
+  const auto chamber_endpoint_at = [](const std::string& config) {
+    return config.find("endpoint = \"", config.find("[chamber]")) + 12;
+  };
+  const auto at_a = chamber_endpoint_at(text);
+  const std::string chamber_a = text.substr(at_a, text.find('"', at_a) - at_a);
+  ASSERT_EQ(chamber_a.rfind("tcp://127.0.0.1:", 0), 0u) << text;
+  ts::SimrigProcess rig_b;
+  ASSERT_TRUE(rig_b.start("same-dev-b")) << ts::slurp(rig_b.err);
+  text = ts::slurp(rig_b.config_path);
+  const auto at_b = chamber_endpoint_at(text);
+  text.replace(at_b, text.find('"', at_b) - at_b,
+               "tcp://localhost:" + chamber_a.substr(chamber_a.rfind(':') + 1));
   const std::string config_b = (dir / "b.toml").string();
   std::ofstream(config_b) << text;
   const Exit e = station_exit({"run", "--config", config_b, "--protocol", hold, "--db", db_b},
