@@ -153,10 +153,18 @@ void add_replay_command(CLI::App& app, CommandStatus& status) {
                   "session: keep the replayed database in this new file; CAN log: the run's "
                   "database");
   cmd->add_option("--run", o->run, "CAN log: run id")->capture_default_str();
+  // A NaN or infinite tolerance would accept any value: a replay that cannot fail (exit 2).
+  const CLI::Validator finite_tolerance(
+      [](const std::string& text) {
+        double v = NAN;
+        const bool ok = CLI::detail::lexical_cast(text, v) && std::isfinite(v) && v >= 0;
+        return ok ? std::string() : "a tolerance is a finite number >= 0, not " + text;
+      },
+      "FINITE>=0");
   cmd->add_option("--rtol", o->rtol, "session: relative tolerance per value (default exact)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(finite_tolerance);
   cmd->add_option("--atol", o->atol, "session: absolute tolerance per value (default exact)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(finite_tolerance);
   cmd->add_flag("--json", o->json, "print one JSON object");
   cmd->callback([o, &status] {
     if (std::filesystem::is_directory(o->log)) {

@@ -240,7 +240,8 @@ void add_run_command(CLI::App& app, CommandStatus& status) {
   cmd->add_option("--fault", o->faults,
                   "--sim: at tick T (s) inject a simrig fault command, T:COMMAND "
                   "(docs/SIMRIG.md), e.g. '3000:door open', or T:kill (the daemon SIGKILLs "
-                  "itself before tick T, to record a killed and resumed run); repeatable");
+                  "itself before tick T, to record a killed and resumed run) or T:sigint (it raises SIGINT "
+                  "after tick T: the operator's stop); repeatable");
   cmd->add_option("--parts", o->parts,
                   "part file (TOML, schemas/parts.schema.json): each fit gets a verdict against "
                   "its slot's part (overrides [station] parts; with --sim: applied to every "

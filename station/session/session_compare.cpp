@@ -27,6 +27,10 @@ struct Comparer {
   // One value: numbers within the tolerances, everything else equal.
   void value(const std::string& quantity, const json& a, const json& b, const json& where) {
     if (a.is_object() && b.is_object()) return object(a, b, where, quantity + ".");
+    if (a.is_array() && b.is_array() && a.size() == b.size()) {  // element by element
+      for (std::size_t i = 0; i < a.size(); ++i) value(quantity, a[i], b[i], where);
+      return;
+    }
     if (a.is_number() && b.is_number()) {
       const double x = a.get<double>(), y = b.get<double>();
       const double d = std::abs(x - y);
@@ -45,11 +49,11 @@ struct Comparer {
   }
 };
 
-// "run 7 completed" and "run 1 completed" say the same: the replay's database numbers its run
-// afresh.
+// "run 7 completed" and "run 1 completed" (or a fit's "runs 7") say the same: the replay's
+// database numbers its run afresh.
 // Likewise the database a message names ("f.db: serial ...") is the replay's own.
 std::string without_run_ids(const std::string& message) {
-  static const std::regex run_id(R"(\brun \d+\b)");
+  static const std::regex run_id(R"(\bruns? \d+(,\d+)*\b)");
   static const std::regex db_path(R"(\S+\.db\b)");
   return std::regex_replace(std::regex_replace(message, run_id, "run #"), db_path, "DB");
 }
@@ -141,25 +145,68 @@ void compare_list(Comparer& c, const char* what, const json& rec, const json& re
     c.differ({{"at", what}, {"recorded", rec.size()}, {"replayed", rep.size()}});
 }
 
-void compare_events(Comparer& c, const json& rec, const json& rep) {
-  const auto key = [](const json& e) {
-    return fmt::format("t={} {} {} {}: {}", e["t_s"].dump(), e["severity"].get<std::string>(),
-                       e["source"].get<std::string>(), e["kind"].get<std::string>(),
-                       without_run_ids(e["message"].get<std::string>()));
+// What of an event must be the same: everything, its message without the run's id and database.
+json event_key(const json& e) {
+  json k = e;
+  if (k.is_object() && k.contains("message") && k["message"].is_string())
+    k["message"] = without_run_ids(k["message"].get<std::string>());
+  return k;
+}
+
+std::string event_text(const json& e) {
+  const auto str = [&e](const char* key) {
+    return e.contains(key) && e[key].is_string() ? e[key].get<std::string>() : std::string();
   };
-  std::vector<std::string> a, b;
-  for (const auto& e : rec) a.push_back(key(e));
-  for (const auto& e : rep) b.push_back(key(e));
-  json missing = json::array(), extra = json::array();
-  for (const auto& e : a)
-    if (std::find(b.begin(), b.end(), e) == b.end()) missing.push_back(e);
-  for (const auto& e : b)
-    if (std::find(a.begin(), a.end(), e) == a.end()) extra.push_back(e);
-  if (!missing.empty() || !extra.empty()) {
-    c.differ({{"at", "events"}, {"missing", missing}, {"extra", extra}});
-    for (const auto& m : missing) c.r.notes.push_back("missing event: " + m.get<std::string>());
-    for (const auto& x : extra) c.r.notes.push_back("extra event: " + x.get<std::string>());
+  return fmt::format("t={} {} {} {}: {} {}", e.value("t_s", json()).dump(), str("severity"),
+                     str("source"), str("kind"), without_run_ids(str("message")),
+                     e.value("data", json()).dump());
+}
+
+// The events of the run's rig and protocol. The recording daemon's HTTP service (the address
+// its live page listened at: source 'http') is no part of what a replay re-derives from the
+// logs; its bytes are still proven by the digest over result.json.
+json rig_events(const json& events) {
+  json out = json::array();
+  for (const auto& e : events)
+    if (!(e.is_object() && e.value("source", "") == "http")) out.push_back(e);
+  return out;
+}
+
+// The events as an ordered list: the i-th recorded event is the i-th replayed one, its data
+// included. The notes name the events missing from or extra in the replay (with duplicates).
+void compare_events(Comparer& c, const json& rec_all, const json& rep_all) {
+  const json rec = rig_events(rec_all), rep = rig_events(rep_all);
+  for (std::size_t i = 0; i < std::max(rec.size(), rep.size()); ++i) {
+    const json a = i < rec.size() ? rec[i] : json(), b = i < rep.size() ? rep[i] : json();
+    if (event_key(a) == event_key(b)) continue;
+    c.differ({{"at", {{"event", i}}}, {"quantity", "event"}, {"recorded", a}, {"replayed", b}});
+    c.r.notes.push_back(
+        fmt::format("event {}: recorded {}", i, a.is_null() ? "none" : event_text(a)));
+    c.r.notes.push_back(
+        fmt::format("event {}: replayed {}", i, b.is_null() ? "none" : event_text(b)));
+    break;
   }
+  std::vector<std::string> missing, extra;
+  for (const auto& e : rec) missing.push_back(event_text(e));
+  for (const auto& e : rep) {
+    const auto text = event_text(e);
+    const auto at = std::find(missing.begin(), missing.end(), text);
+    if (at != missing.end())
+      missing.erase(at);
+    else
+      extra.push_back(text);
+  }
+  for (const auto& m : missing) c.r.notes.push_back("missing event: " + m);
+  for (const auto& x : extra) c.r.notes.push_back("extra event: " + x);
+}
+
+// Every field of every fit; the warnings' texts without the run's id and database.
+json fits_for_comparison(json fits) {
+  for (auto& f : fits)
+    if (f.is_object() && f.contains("warnings") && f["warnings"].is_array())
+      for (auto& w : f["warnings"])
+        if (w.is_string()) w = without_run_ids(w.get<std::string>());
+  return fits;
 }
 
 }  // namespace
@@ -192,14 +239,14 @@ ReplayReport compare_with_store(const RecordedResult& recorded_result,
   r.bins = static_cast<std::int64_t>(replayed["bins"].size());
   r.events = static_cast<std::int64_t>(replayed["events"].size());
   r.fits = static_cast<std::int64_t>(replayed["fits"].size());
+  // The header of the ticks: their columns' names and order are what gives each value its meaning.
+  c.value("sample_columns", recorded.value("sample_columns", json()), replayed["sample_columns"],
+          "run");
   c.value("state", recorded.value("state", json()), replayed["state"], "run");
   compare_list(c, "bin", recorded.value("bins", json::array()), replayed["bins"], "bin ");
   compare_events(c, recorded.value("events", json::array()), replayed["events"]);
-  json fits_a = recorded.value("fits", json::array()), fits_b = replayed["fits"];
-  for (auto* f : {&fits_a, &fits_b})
-    for (auto& x : *f)
-      if (x.is_object()) x.erase("warnings");  // texts; their numbers are compared as values
-  compare_list(c, "fit", fits_a, fits_b, "fit ");
+  compare_list(c, "fit", fits_for_comparison(recorded.value("fits", json::array())),
+               fits_for_comparison(replayed["fits"]), "fit ");
   return r;
 }
 

@@ -228,6 +228,29 @@ std::vector<SessionResume> read_session_resumes(const std::string& path) {
   return out;
 }
 
+void append_session_end(const std::string& dir, const SessionEnd& end) {
+  const auto path = std::filesystem::path(dir) / "session.toml";
+  const toml::table t{{"state", end.state}, {"last_tick_s", end.last_tick_s}};
+  std::ofstream out(path, std::ios::app);
+  out << "\n[[end]]  # how the run ended (schemas/session.md)\n" << t << '\n';
+  if (!out) throw InputError(fmt::format("{}: cannot append the end", path.string()));
+}
+
+SessionEnd read_session_end(const std::string& path) {
+  const toml::table t = toml::parse_file(path);
+  const auto* ends = t["end"].as_array();
+  // The last one: a run that was ended, marked running again and resumed ended twice.
+  const toml::table* e = ends != nullptr && !ends->empty() ? ends->back().as_table() : nullptr;
+  const auto state = e != nullptr ? (*e)["state"].value<std::string>() : std::nullopt;
+  const auto last = e != nullptr ? (*e)["last_tick_s"].value<double>() : std::nullopt;
+  if (!state || !last || !std::isfinite(*last))
+    throw InputError(
+        fmt::format("{}: no [[end]] with 'state' and 'last_tick_s' (the run did not "
+                    "end, or the file was cut)",
+                    path));
+  return {*state, *last};
+}
+
 json session_result_head_json(Store& store, std::int64_t run_id) {
   const auto run = store.find_run(run_id);
   const auto slots = store.run_slots(run_id);

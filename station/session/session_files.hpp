@@ -14,7 +14,7 @@
 namespace station {
 
 /// The session format's version (schemas/session.md, "Versions").
-inline constexpr int kSessionFormatVersion = 2;
+inline constexpr int kSessionFormatVersion = 3;
 
 /// What session.toml holds.
 struct SessionHeader {
@@ -46,6 +46,20 @@ void append_session_resume(const std::string& dir, double after_tick_s, double n
 
 /// The [[resume]] tables of a session.toml (empty for a run recorded without a restart).
 std::vector<SessionResume> read_session_resumes(const std::string& session_toml_path);
+
+/// How the run ended (session.toml [[end]], the last one): its state and the tick it ended at. A
+/// replay stops (or aborts) its run at that tick, as the operator's stop did.
+struct SessionEnd {
+  std::string state;  ///< completed | incomplete | stopped | aborted
+  double last_tick_s = 0;
+};
+
+/// Appends an [[end]] table to `dir`/session.toml. Throws InputError.
+void append_session_end(const std::string& dir, const SessionEnd& end);
+
+/// The last [[end]] table of a session.toml; throws InputError naming the file when it is missing
+/// or malformed (a session whose run did not end cannot be replayed).
+SessionEnd read_session_end(const std::string& session_toml_path);
 
 /// What run `run_id` stored, as result.json holds it: every tick's samples, every bin, every
 /// event and every fit of the run.

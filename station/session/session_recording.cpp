@@ -7,6 +7,7 @@
 #include <chrono>
 
 #include "station/daemon/resume.hpp"
+#include "station/session/session_digest.hpp"
 #include "station/session/session_files.hpp"
 
 #ifndef STATION_VERSION
@@ -35,9 +36,17 @@ void SessionRecording::start(const StationConfig& config, const Protocol& protoc
 }
 
 void SessionRecording::finish(Store& store, std::int64_t run_id) {
+  // The run has ended: what the daemon does after it (the GPIO bank releasing its outputs as
+  // the rig is torn down) is no part of the session, and the digest below is final.
+  recorder_.pause(true);
   recorder_.flush();
   store.flush();
   write_session_result(store, run_id, dir_);
+  const auto run = store.find_run(run_id);
+  append_session_end(dir_, {run ? run->state : std::string("unknown"),
+                            run ? run->last_tick_s.value_or(0.0) : 0.0});
+  // Last: the digest covers session.toml (with its [end]), the logs and result.json.
+  write_session_digest(dir_);
 }
 
 }  // namespace station

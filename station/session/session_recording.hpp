@@ -34,7 +34,8 @@ class SessionRecording {
   }
   /// After every tick: the logs reach the disk, so a kill loses at most one tick of log.
   void after_tick() { recorder_.flush(); }
-  /// Writes result.json from what the run stored.
+  /// Ends the session: nothing more is logged; writes result.json from what the run stored,
+  /// the [[end]] table (state, last tick) and digest.txt.
   void finish(Store& store, std::int64_t run_id);
 
   const std::string& dir() const { return dir_; }

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <future>
@@ -24,8 +25,10 @@
 #include "station/session/replay_clock.hpp"
 #include "station/session/replay_gpio.hpp"
 #include "station/session/replay_modbus.hpp"
+#include "station/session/session_digest.hpp"
 #include "station/session/session_files.hpp"
 #include "station/session/session_log.hpp"
+#include "station/session/session_metadata.hpp"
 
 namespace station {
 namespace {
@@ -38,6 +41,7 @@ struct Session {
   StationConfig config;
   Protocol protocol;
   std::optional<std::int64_t> sim_seed;
+  SessionEnd end;
 };
 
 std::string required_text(const toml::table& t, const std::string& path, const char* key) {
@@ -46,27 +50,35 @@ std::string required_text(const toml::table& t, const std::string& path, const c
   return *v;
 }
 
-Session read_header(const std::string& dir) {
-  const std::string path = (fs::path(dir) / "session.toml").string();
+toml::table parse_header(const std::string& path) {
   if (!fs::exists(path)) throw InputError(fmt::format("{}: no such file (not a session)", path));
-  toml::table t;
   try {
-    t = toml::parse_file(path);
+    return toml::parse_file(path);
   } catch (const toml::parse_error& e) {
     throw InputError(fmt::format("{}:{}:{}: {}", path, e.source().begin.line,
                                  e.source().begin.column, e.description()));
   }
+}
+
+/// Refuses a session of another format version (one line naming the file).
+void check_version(const std::string& path, const toml::table& t) {
   const auto version = t["format_version"].value<std::int64_t>();
-  if (version != kSessionFormatVersion) {
-    throw InputError(
-        fmt::format("{}: key 'format_version': {} is not a version this station "
-                    "reads ({})",
-                    path, version ? std::to_string(*version) : "missing", kSessionFormatVersion));
-  }
-  Session s{parse_station_config(required_text(t, path, "config"), path + "[config]"),
-            parse_protocol(required_text(t, path, "protocol"), path + "[protocol]"),
-            t["sim_seed"].value<std::int64_t>()};
-  return s;
+  if (version == kSessionFormatVersion) return;
+  if (version && *version == 2)
+    throw InputError(fmt::format(
+        "{}: key 'format_version': 2 has no digest and no [end]: nothing proves its logs are "
+        "the run's; re-record it (or replay it with the station that recorded it)",
+        path));
+  throw InputError(
+      fmt::format("{}: key 'format_version': {} is not a version this station reads "
+                  "({})",
+                  path, version ? std::to_string(*version) : "missing", kSessionFormatVersion));
+}
+
+Session read_session(const std::string& path, const toml::table& t) {
+  return {parse_station_config(required_text(t, path, "config"), path + "[config]"),
+          parse_protocol(required_text(t, path, "protocol"), path + "[protocol]"),
+          t["sim_seed"].value<std::int64_t>(), read_session_end(path)};
 }
 
 std::string fresh_db_path(const ReplayOptions& o) {
@@ -249,8 +261,16 @@ std::int64_t replay_daemons(const ReplayOptions& o, const Session& session, Stor
       else  // a rig continued where the wall clock was when it came back
         so.resume_at_t_s = resumes[k - 1].next_tick_s;
     }
+    // The operator's stop or abort (session.toml [end]) takes effect after the tick it did.
+    std::atomic<bool> stop{false}, abort{false};
+    so.stop = &stop;
+    so.abort = &abort;
     so.on_tick = [&](const TickReport& r) {
       last_tick_s = r.t_s;
+      if (!killed && r.t_s >= session.end.last_tick_s) {
+        stop = session.end.state == "stopped";
+        abort = session.end.state == "aborted";
+      }
       if (!killed || r.t_s < resumes[k].after_tick_s) return;
       store.flush();  // what the killed daemon had committed
       if (session.sim_seed) devices.consumed(modbus_prefix, gpio_prefix, can_prefix);
@@ -279,13 +299,28 @@ std::int64_t replay_daemons(const ReplayOptions& o, const Session& session, Stor
   return 0;
 }
 
-}  // namespace
+/// The report of a session whose files are not what its digest says.
+ReplayReport not_the_recording(const DigestMismatch& m) {
+  ReplayReport r;
+  r.same = false;
+  nlohmann::json at{{"file", m.file}};
+  if (m.line) at["line"] = *m.line;
+  r.first_difference = {{"at", at}, {"quantity", "digest"}, {"recorded", m.what}};
+  r.notes.push_back(m.message());
+  return r;
+}
 
-ReplayReport replay_session(const ReplayOptions& o) {
-  const Session session = read_header(o.dir);
-  const std::string result_path = (fs::path(o.dir) / "result.json").string();
-  if (!fs::exists(result_path) && !fs::exists(result_path + ".gz"))
-    throw InputError(fmt::format("{}: cannot open (the run did not end?)", result_path));
+ReplayReport header_differs(const std::string& header_path, const nlohmann::json& d) {
+  ReplayReport r;
+  r.same = false;
+  r.first_difference = d;
+  r.notes.push_back(fmt::format("{}: key '{}': not what its config and protocol say", header_path,
+                                d["at"]["key"].get<std::string>()));
+  return r;
+}
+
+ReplayReport replay_and_compare(const ReplayOptions& o, const Session& session,
+                                const std::string& result_path) {
   const std::string db = fresh_db_path(o);
   // result.json is parsed on another thread while the daemon replays.
   auto recorded =
@@ -305,6 +340,37 @@ ReplayReport replay_session(const ReplayOptions& o) {
     for (const char* suffix : {"", "-wal", "-shm"}) fs::remove(db + suffix, ec);
   }
   return report;
+}
+
+}  // namespace
+
+ReplayReport replay_session(const ReplayOptions& o) {
+  if (!(o.rtol >= 0) || !(o.atol >= 0) || !std::isfinite(o.rtol) || !std::isfinite(o.atol))
+    throw InputError(
+        fmt::format("--rtol {} --atol {}: tolerances are finite and not negative", o.rtol, o.atol));
+  const fs::path dir(o.dir);
+  const std::string header_path = (dir / "session.toml").string();
+  if (!fs::exists(header_path))
+    throw InputError(fmt::format("{}: no such file (not a session)", header_path));
+  const std::string result_path = (dir / "result.json").string();
+  if (!fs::exists(result_path) && !fs::exists(result_path + ".gz"))
+    throw InputError(fmt::format("{}: cannot open (the run did not end?)", result_path));
+  // The recording is the one the run made before anything in it is read for its meaning: a
+  // changed byte anywhere, session.toml included, is a difference naming file and line. Without
+  // a digest, the version says first why (version 2 wrote none).
+  const bool has_digest = fs::exists(dir / "digest.txt") || fs::exists(dir / "digest.txt.gz");
+  if (o.verify && has_digest) {
+    if (auto m = verify_session_digest(o.dir)) return not_the_recording(*m);
+  }
+  const toml::table header = parse_header(header_path);
+  check_version(header_path, header);
+  if (o.verify && !has_digest) {
+    if (auto m = verify_session_digest(o.dir)) return not_the_recording(*m);
+  }
+  const Session session = read_session(header_path, header);
+  if (auto d = header_difference(header_path, session.config, session.protocol))
+    return header_differs(header_path, *d);
+  return replay_and_compare(o, session, result_path);
 }
 
 }  // namespace station

@@ -19,6 +19,9 @@ struct ReplayOptions {
   std::string db;   ///< keep the replayed database here (must not exist); empty: a temp file
   double rtol = 0;  ///< relative tolerance per value (0: exact)
   double atol = 0;  ///< absolute tolerance per value (0: exact)
+  /// Check the files against digest.txt first (a mismatch: differs, naming the file and line).
+  /// Off only in tests that change a recording on purpose to see what the daemon makes of it.
+  bool verify = true;
 };
 
 /// What a replay found.

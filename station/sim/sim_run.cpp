@@ -103,7 +103,7 @@ void check_fault_commands(const SimRunOptions& o, const sim::SimWorldConfig& wc)
   if (o.faults.empty()) return;
   sim::SimWorld probe(wc);
   for (const auto& [at_s, command] : o.faults) {
-    if (command == "kill") continue;
+    if (command == "kill" || command == "sigint") continue;  // the daemon's own process, below
     const std::string reply = sim::run_fault_command(probe, command);
     if (reply.rfind("ok", 0) != 0) throw fault_error(at_s, command, reply);
   }
@@ -188,6 +188,10 @@ nlohmann::json run_simulated(const SimRunOptions& o) {
       // The daemon itself killed before the tick (what a power cut does): committed ticks stay,
       // the rest is lost, a later `run` resumes. For recording resumed sessions.
       if (command == "kill") ::raise(SIGKILL);
+      if (command == "sigint") {  // the operator's Ctrl-C: the run ends 'stopped' after this tick
+        ::raise(SIGINT);
+        continue;
+      }
       const std::string reply = sim::run_fault_command(world, command);
       if (reply.rfind("ok", 0) != 0) throw fault_error(at_s, command, reply);
     }

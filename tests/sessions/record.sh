@@ -15,7 +15,7 @@ run_sim() {
     --protocol "$here/session_cycle.toml" --record "$here/$name" "$@" >/dev/null
 }
 finish() {
-  gzip -9 -n "$here/$1"/*.log "$here/$1/result.json"
+  gzip -9 -n "$here/$1"/*.log "$here/$1/result.json" "$here/$1/digest.txt"
   "$station" replay "$here/$1"
 }
 record() {
@@ -38,3 +38,18 @@ rm -rf "${here:?}/killed_resumed"
 run_sim killed_resumed --new --fault "1230:kill" 2>/dev/null || [ $? -eq 137 ]
 run_sim killed_resumed 2>/dev/null
 finish killed_resumed
+# The operator's Ctrl-C (SIGINT, raised by the daemon itself before tick 2400): the run ends
+# 'stopped' after that tick, bins and fits what it recorded; the replay stops where it stopped.
+record stopped_sigint --fault "2400:sigint"
+# The API's abort on a run paced at 100x (POST /api/runs/1/abort about 20 s of wall time in):
+# 'aborted', no bins, no fit. The tick it took effect is whichever the wall clock chose; the
+# recording says which.
+rm -rf "${here:?}/aborted_api"
+port=$((20000 + RANDOM % 20000))
+run_sim aborted_api --new --speed 100 --http "127.0.0.1:$port" &
+daemon=$!
+sleep 20
+curl -fsS -X POST --data "" -H "Authorization: Bearer $(cat "$tmp/aborted_api.db.token")" \
+  "http://127.0.0.1:$port/api/runs/1/abort" >/dev/null
+wait "$daemon"
+finish aborted_api

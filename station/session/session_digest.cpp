@@ -1,0 +1,156 @@
+// digest.txt: SHA-256 (OpenSSL libcrypto) of each session file's decompressed bytes, its line
+// count, and a 16-bit tag per line.
+#include "station/session/session_digest.hpp"
+
+#include <fmt/format.h>
+#include <openssl/evp.h>
+#include <zlib.h>
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string_view>
+
+#include "station/common/input_error.hpp"
+#include "station/session/session_log.hpp"
+
+namespace station {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr std::size_t kTagsPerRow = 64;  // tags per "tags" line of digest.txt
+
+struct MdCtxFree {
+  void operator()(EVP_MD_CTX* c) const noexcept { EVP_MD_CTX_free(c); }
+};
+using MdCtx = std::unique_ptr<EVP_MD_CTX, MdCtxFree>;
+
+struct GzClose {
+  void operator()(gzFile f) const noexcept { gzclose(f); }
+};
+using GzHandle = std::unique_ptr<std::remove_pointer_t<gzFile>, GzClose>;
+
+MdCtx sha256_ctx() {
+  MdCtx c(EVP_MD_CTX_new());
+  if (!c || EVP_DigestInit_ex(c.get(), EVP_sha256(), nullptr) != 1)
+    throw std::runtime_error("SHA-256 unavailable (OpenSSL EVP)");
+  return c;
+}
+
+std::array<unsigned char, EVP_MAX_MD_SIZE> finish(EVP_MD_CTX* c) {
+  std::array<unsigned char, EVP_MAX_MD_SIZE> md{};
+  unsigned n = 0;
+  EVP_DigestFinal_ex(c, md.data(), &n);
+  EVP_DigestInit_ex(c, EVP_sha256(), nullptr);  // ready for the next line
+  return md;
+}
+
+/// `dir`/`name`, or `dir`/`name`.gz when only that exists (as the replay's readers resolve it).
+std::string resolved(const std::string& dir, const std::string& name) {
+  const fs::path plain = fs::path(dir) / name;
+  if (!fs::exists(plain) && fs::exists(plain.string() + ".gz")) return plain.string() + ".gz";
+  return plain.string();
+}
+
+/// Calls `each` with the decompressed bytes of `file` (zlib reads a plain file as it is); throws
+/// InputError for corrupt compressed data after handing out what came before it.
+void for_each_chunk(const std::string& file, const std::function<void(std::string_view)>& each) {
+  GzHandle in(gzopen(file.c_str(), "rb"));
+  if (!in) throw InputError(fmt::format("{}: cannot open", file));
+  std::vector<char> buf(std::size_t{1} << 16);
+  int n = 0;
+  while ((n = gzread(in.get(), buf.data(), static_cast<unsigned>(buf.size()))) > 0)
+    each(std::string_view(buf.data(), static_cast<std::size_t>(n)));
+  int err = Z_OK;
+  gzerror(in.get(), &err);
+  if (n < 0 || (err != Z_OK && err != Z_STREAM_END))
+    throw InputError(fmt::format("{}: corrupt compressed data", file));
+}
+
+FileDigest digest_path(const std::string& file, std::string name, std::string* corrupt) {
+  FileDigest d{std::move(name), 0, {}, {}};
+  const MdCtx whole = sha256_ctx(), line = sha256_ctx();
+  bool open_line = false;
+  const auto end_line = [&] {
+    const auto md = finish(line.get());
+    d.tags.push_back(static_cast<std::uint16_t>(md[0] << 8 | md[1]));
+    open_line = false;
+  };
+  const auto chunk = [&](std::string_view bytes) {
+    EVP_DigestUpdate(whole.get(), bytes.data(), bytes.size());
+    while (!bytes.empty()) {
+      const auto nl = bytes.find('\n');
+      const auto take = nl == std::string_view::npos ? bytes.size() : nl + 1;
+      EVP_DigestUpdate(line.get(), bytes.data(), take);
+      open_line = true;
+      if (nl != std::string_view::npos) end_line();
+      bytes.remove_prefix(take);
+    }
+  };
+  try {
+    for_each_chunk(file, chunk);
+  } catch (const InputError& e) {
+    if (corrupt == nullptr) throw;
+    *corrupt = "corrupt compressed data";  // the complete lines before it are kept
+    open_line = false;
+  }
+  if (open_line) end_line();  // a last line without its newline is a line too
+  d.lines = static_cast<std::int64_t>(d.tags.size());
+  const auto md = finish(whole.get());
+  for (int i = 0; i < 32; ++i)
+    d.sha256_hex += fmt::format("{:02x}", md[static_cast<std::size_t>(i)]);
+  return d;
+}
+
+std::string digest_text(const std::vector<FileDigest>& files) {
+  std::string out =
+      "# The digest of this session's files, written when the run ended (schemas/session.md):\n"
+      "# file NAME LINES SHA-256; tags NAME FIRST_LINE TAG... (per line, 4 hex digits)\n";
+  for (const auto& f : files) out += fmt::format("file {} {} {}\n", f.name, f.lines, f.sha256_hex);
+  for (const auto& f : files) {
+    for (std::size_t i = 0; i < f.tags.size(); i += kTagsPerRow) {
+      out += fmt::format("tags {} {} ", f.name, i + 1);
+      for (std::size_t k = i; k < std::min(f.tags.size(), i + kTagsPerRow); ++k)
+        out += fmt::format("{:04x}", f.tags[k]);
+      out += '\n';
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+const std::vector<std::string>& digested_files() {
+  static const std::vector<std::string> files{"session.toml", "can.log", "gpio.log", "modbus.log",
+                                              "result.json"};
+  return files;
+}
+
+FileDigest digest_file(const std::string& dir, const std::string& name, std::string* corrupt) {
+  return digest_path(resolved(dir, name), name, corrupt);
+}
+
+void write_session_digest(const std::string& dir) {
+  std::vector<FileDigest> files;
+  for (const auto& name : digested_files()) files.push_back(digest_file(dir, name));
+  const auto path = fs::path(dir) / "digest.txt";
+  const auto tmp = fs::path(dir) / "digest.txt.tmp";
+  {
+    std::ofstream out(tmp);
+    out << digest_text(files);
+    if (!out) throw InputError(fmt::format("{}: cannot write the session digest", tmp.string()));
+  }
+  fs::rename(tmp, path);
+}
+
+std::string DigestMismatch::message() const {
+  return line ? fmt::format("{}:{}: {}", file, *line, what) : fmt::format("{}: {}", file, what);
+}
+
+}  // namespace station
