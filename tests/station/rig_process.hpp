@@ -3,11 +3,13 @@
 #pragma once
 
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -24,6 +26,20 @@ inline std::string slurp(const std::string& path) {
   std::stringstream ss;
   ss << in.rdbuf();
   return ss.str();
+}
+
+/// A `station` command's exit status (-1 when it did not exit normally) and its stdout+stderr.
+struct StationOutcome {
+  int status = -1;
+  std::string out;
+};
+
+/// Runs `station ARGS` through the shell (ARGS quoted as a shell would need), `tag` naming its
+/// output file; waits for it.
+inline StationOutcome station_command(const std::string& args, const std::string& tag) {
+  const std::string out = ::testing::TempDir() + tag + "-" + std::to_string(getpid()) + ".out";
+  const int rc = std::system((kStationBin + " " + args + " >" + out + " 2>&1").c_str());
+  return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, slurp(out)};
 }
 
 /// Forks and execs `args[0]` with stdout to `out` and stderr to `err`; the child's pid.

@@ -14,17 +14,6 @@ namespace {
 
 namespace ts = station::testing_support;
 
-struct Outcome {
-  int status = -1;
-  std::string out;
-};
-
-Outcome station_cmd(const std::string& args) {
-  const std::string out = ::testing::TempDir() + "bad-opt-" + std::to_string(getpid()) + ".out";
-  const int rc = std::system((ts::kStationBin + " " + args + " >" + out + " 2>&1").c_str());
-  return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, ts::slurp(out)};
-}
-
 /// Runs in the database at `db` (0 when there is no database).
 std::int64_t runs_in(const std::string& db) {
   if (access(db.c_str(), F_OK) != 0) return 0;
@@ -48,7 +37,7 @@ TEST(BadOptions, EachIsExit2NamingItBeforeAnyRunExists) {
   };
   for (const auto& [args, says] : cases) {
     const auto db = ts::fresh_db("bad-opt");
-    const auto o = station_cmd("run --sim --gyros 1 --db " + db + " " + args);
+    const auto o = ts::station_command("run --sim --gyros 1 --db " + db + " " + args, "bad-opt");
     EXPECT_EQ(o.status, 2) << args << ": " << o.out;
     EXPECT_NE(o.out.find(says), std::string::npos) << args << ": " << o.out;
     EXPECT_EQ(runs_in(db), 0) << args << " left a run behind";

@@ -13,17 +13,6 @@ namespace {
 
 namespace ts = station::testing_support;
 
-struct Outcome {
-  int status = -1;
-  std::string out;
-};
-
-Outcome station_cmd(const std::string& args) {
-  const std::string out = ::testing::TempDir() + "cli-db-" + std::to_string(getpid()) + ".out";
-  const int rc = std::system((ts::kStationBin + " " + args + " >" + out + " 2>&1").c_str());
-  return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, ts::slurp(out)};
-}
-
 std::string bytes_of(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
@@ -38,7 +27,7 @@ const std::vector<std::string> kReadCommands{"fit --serial X --db ",     "fit --
 TEST(CliDatabase, ReadCommandsOnAMissingPathExit2AndCreateNothing) {
   const auto db = ts::fresh_db("cli-missing");
   for (const auto& cmd : kReadCommands) {
-    const auto o = station_cmd(cmd + db);
+    const auto o = ts::station_command(cmd + db, "cli-db");
     EXPECT_EQ(o.status, 2) << cmd << o.out;
     EXPECT_NE(o.out.find(db), std::string::npos) << cmd << o.out;
     EXPECT_EQ(std::count(o.out.begin(), o.out.end(), '\n'), 1) << cmd << o.out;
@@ -54,7 +43,7 @@ TEST(CliDatabase, ReadCommandsOnAnEmptyOrForeignFileExit2AndLeaveItAlone) {
   for (const auto& path : {empty, foreign}) {
     const std::string before = bytes_of(path);
     for (const auto& cmd : kReadCommands) {
-      const auto o = station_cmd(cmd + path);
+      const auto o = ts::station_command(cmd + path, "cli-db");
       EXPECT_EQ(o.status, 2) << cmd << o.out;
       EXPECT_NE(o.out.find(path), std::string::npos) << cmd << o.out;
     }
@@ -67,7 +56,7 @@ TEST(CliDatabase, RunRefusesAForeignFileWithoutWritingIt) {
   const auto foreign = ts::fresh_db("cli-run-foreign");
   std::ofstream(foreign) << std::string(8192, 'x');
   const std::string before = bytes_of(foreign);
-  const auto o = station_cmd("run --sim --gyros 1 --db " + foreign);
+  const auto o = ts::station_command("run --sim --gyros 1 --db " + foreign, "cli-db");
   EXPECT_EQ(o.status, 2) << o.out;
   EXPECT_NE(o.out.find(foreign), std::string::npos) << o.out;
   EXPECT_EQ(bytes_of(foreign), before);
