@@ -13,11 +13,12 @@
 #include "station/common/input_error.hpp"
 #include "station/common/logging.hpp"
 #include "station/http/json_reply.hpp"
+#include "station/http/request_rules.hpp"
 #include "station/http/token.hpp"
 #include "station/web/builtin_web.hpp"
 
 // Last: httplib.h pulls in <resolv.h>, whose `_res` macro breaks Eigen headers included after it.
-#include <httplib.h>
+#include "station/http/bounded_server.hpp"
 
 namespace station::http {
 
@@ -73,20 +74,6 @@ Store& HttpServer::store() {
   if (!store_) store_.emplace(options_.db_path, OpenMode::read_only);
   return *store_;
 }
-
-namespace {
-/// Whether a Host header names this machine's loopback (with or without a port). A page of
-/// another site that rebinds its name to 127.0.0.1 (DNS rebinding) sends its own name here.
-bool loopback_host(const std::string& host) {
-  std::string h = host;
-  if (!h.empty() && h.front() == '[') {
-    h = h.substr(0, h.find(']') + 1);
-  } else if (const auto colon = h.rfind(':'); colon != std::string::npos) {
-    h = h.substr(0, colon);
-  }
-  return h == "localhost" || h == "127.0.0.1" || h == "[::1]" || h.rfind("127.", 0) == 0;
-}
-}  // namespace
 
 bool HttpServer::may_read(const httplib::Request& req, httplib::Response& res) const {
   // Token-free only from loopback and addressed to a loopback name.
@@ -219,10 +206,10 @@ void HttpServer::routes() {
 }
 
 int HttpServer::start() {
-  server_ = std::make_unique<httplib::Server>();
-  // Event streams hold a thread each: room for max_streams of them and the API beside.
-  const auto threads = static_cast<std::size_t>(options_.max_streams + 4);
-  server_->new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
+  // A thread per connection, bounded in number, per address and in time (bounded_server.hpp):
+  // the event streams and slow clients hold only their own.
+  server_ = std::make_unique<BoundedServer>(
+      ConnectionLimits{}, [this](int status) { hub_.metrics().http_request(status); });
   routes();
   if (options_.port == 0) {
     port_ = server_->bind_to_any_port(options_.host);
@@ -250,8 +237,8 @@ bool HttpServer::stop() {
   }
   hub_.close();  // ends the streams' waits
   server_->stop();
-  // A client trickling its headers holds a worker for as long as it likes (cpp-httplib 0.11
-  // times out each recv, not the request): wait 3 s, then leave the server to the process's
+  // Head reads end within 100 ms of the stop and every request within its deadline; should a
+  // worker still run after 3 s (a handler blocked writing), leave the server to the process's
   // exit rather than hang a daemon's shutdown (systemd would SIGKILL it).
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(3);
   while (!done_.load() && std::chrono::steady_clock::now() < deadline)

@@ -57,10 +57,13 @@ void create_token_file(const std::string& path) {
 std::string load_or_create_token(const std::string& path) {
   // Opened without following a symlink and checked on the open descriptor (no stat/open race):
   // a regular file, ours, readable by nobody else, one line of >= 32 token characters.
-  int fd = ::open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
+  // O_NONBLOCK: opening a FIFO (or a device) must not wait for a writer; it is then refused as
+  // not a regular file before any read.
+  constexpr int kFlags = O_RDONLY | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK;
+  int fd = ::open(path.c_str(), kFlags);
   if (fd < 0 && errno == ENOENT) {
     create_token_file(path);
-    fd = ::open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
+    fd = ::open(path.c_str(), kFlags);
   }
   if (fd < 0)
     throw InputError(

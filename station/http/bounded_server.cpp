@@ -1,0 +1,234 @@
+// The bounded server (see bounded_server.hpp): a thread per connection up to a total, a cap per
+// client address, one request per connection whose head is read here under a deadline and the
+// head rules, then handed to httplib with the bytes already read in front of the socket.
+#include "station/http/bounded_server.hpp"
+
+#include <arpa/inet.h>
+#include <fmt/format.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <condition_variable>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+namespace station::http {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+/// Set on a connection's thread when it was opened above the total: answer 503 and close.
+thread_local bool over_capacity = false;
+
+/// A thread per connection (a slow client holds only its own); above `max` the connection still
+/// gets a thread, which only answers 503. shutdown() waits for every thread to end.
+class ConnectionQueue final : public httplib::TaskQueue {
+ public:
+  explicit ConnectionQueue(int max) : max_(max) {}
+  void enqueue(std::function<void()> fn) override {
+    std::unique_lock lock(state_->mu);
+    const bool over = state_->running >= max_;
+    ++state_->running;
+    lock.unlock();
+    auto run = [st = state_, over](const std::function<void()>& f) {
+      over_capacity = over;
+      f();
+      std::lock_guard done(st->mu);
+      if (--st->running == 0) st->idle.notify_all();
+    };
+    try {
+      std::thread(run, std::move(fn)).detach();
+    } catch (const std::system_error&) {  // no thread to be had: refuse on the accept thread
+      over_capacity = true;
+      run(fn);
+      over_capacity = false;
+    }
+  }
+  void shutdown() override {
+    std::unique_lock lock(state_->mu);
+    state_->idle.wait(lock, [this] { return state_->running == 0; });
+  }
+
+ private:
+  struct State {  // shared with the threads: the last one may end after the queue is gone
+    std::mutex mu;
+    std::condition_variable idle;
+    int running = 0;
+  };
+  std::shared_ptr<State> state_ = std::make_shared<State>();
+  int max_;
+};
+
+std::string address_of(const sockaddr_storage& sa) {
+  char text[INET6_ADDRSTRLEN] = "";
+  const void* in =
+      sa.ss_family == AF_INET6
+          ? static_cast<const void*>(&reinterpret_cast<const sockaddr_in6&>(sa).sin6_addr)
+          : static_cast<const void*>(&reinterpret_cast<const sockaddr_in&>(sa).sin_addr);
+  return ::inet_ntop(sa.ss_family, in, text, sizeof text) != nullptr ? text : "";
+}
+
+int port_of(const sockaddr_storage& sa) {
+  return ntohs(sa.ss_family == AF_INET6 ? reinterpret_cast<const sockaddr_in6&>(sa).sin6_port
+                                        : reinterpret_cast<const sockaddr_in&>(sa).sin_port);
+}
+
+/// Waits for `events` on `sock` until `until`; true when they came.
+bool wait_for(socket_t sock, short events, Clock::time_point until) {
+  pollfd p{sock, events, 0};
+  const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(until - Clock::now());
+  if (left.count() <= 0) return false;
+  return ::poll(&p, 1, static_cast<int>(left.count())) > 0 && (p.revents & events) != 0;
+}
+
+/// The socket as httplib reads it: the bytes already read first, then reads until the request's
+/// deadline (a body trickled past it ends the request); writes time out per write.
+class DeadlineStream final : public httplib::Stream {
+ public:
+  DeadlineStream(socket_t sock, std::string read, Clock::time_point deadline)
+      : sock_(sock), read_(std::move(read)), deadline_(deadline) {}
+  bool is_readable() const override {
+    return at_ < read_.size() || wait_for(sock_, POLLIN, deadline_);
+  }
+  bool is_writable() const override {
+    return wait_for(sock_, POLLOUT, Clock::now() + kWriteTimeout);
+  }
+  ssize_t read(char* ptr, size_t size) override {
+    if (at_ < read_.size()) {
+      const std::size_t n = std::min(size, read_.size() - at_);
+      std::copy_n(read_.data() + at_, n, ptr);
+      at_ += n;
+      return static_cast<ssize_t>(n);
+    }
+    return wait_for(sock_, POLLIN, deadline_) ? ::recv(sock_, ptr, size, 0) : -1;
+  }
+  ssize_t write(const char* ptr, size_t size) override {
+    return is_writable() ? ::send(sock_, ptr, size, MSG_NOSIGNAL) : -1;
+  }
+  void get_remote_ip_and_port(std::string& ip, int& port) const override {
+    name_of(::getpeername, ip, port);
+  }
+  void get_local_ip_and_port(std::string& ip, int& port) const override {
+    name_of(::getsockname, ip, port);
+  }
+  socket_t socket() const override { return sock_; }
+
+ private:
+  static constexpr auto kWriteTimeout = std::chrono::seconds(5);
+  template <class F>
+  void name_of(F get, std::string& ip, int& port) const {
+    sockaddr_storage sa{};
+    socklen_t len = sizeof sa;
+    if (get(sock_, reinterpret_cast<sockaddr*>(&sa), &len) != 0) return;
+    ip = address_of(sa);
+    port = port_of(sa);
+  }
+  socket_t sock_;
+  std::string read_;
+  std::size_t at_ = 0;
+  Clock::time_point deadline_;
+};
+
+const char* reason_phrase(int status) {
+  switch (status) {
+    case 400:
+      return "Bad Request";
+    case 408:
+      return "Request Timeout";
+    case 414:
+      return "URI Too Long";
+    case 431:
+      return "Request Header Fields Too Large";
+    default:
+      return "Service Unavailable";
+  }
+}
+
+}  // namespace
+
+BoundedServer::BoundedServer(ConnectionLimits limits, std::function<void(int)> refused)
+    : limits_(limits), refused_(std::move(refused)) {
+  const int max = limits_.max_connections;
+  new_task_queue = [max] { return new ConnectionQueue(max); };
+}
+
+bool BoundedServer::admit(const std::string& address) {
+  std::lock_guard lock(mu_);
+  int& n = per_address_[address];
+  if (n >= limits_.max_per_address) {
+    if (n == 0) per_address_.erase(address);
+    return false;
+  }
+  ++n;
+  return true;
+}
+
+void BoundedServer::release(const std::string& address) {
+  std::lock_guard lock(mu_);
+  if (--per_address_[address] <= 0) per_address_.erase(address);
+}
+
+HeadVerdict BoundedServer::read_head(socket_t sock, Clock::time_point deadline,
+                                     std::string& buffer) const {
+  char chunk[4096];
+  while (true) {
+    if (const auto end = head_end(buffer)) {
+      return check_request_head(std::string_view(buffer).substr(0, *end), limits_.head);
+    }
+    if (buffer.size() > limits_.head.max_bytes) return oversized_head(buffer, limits_.head);
+    // In slices, so that a stopping server does not wait out a slow client's deadline.
+    const auto slice = std::min(deadline, Clock::now() + std::chrono::milliseconds(100));
+    if (!is_running()) return {-1, "the server is stopping"};
+    if (Clock::now() >= deadline)
+      return {408, fmt::format("the request did not arrive within {} s",
+                               limits_.request_deadline.count() / 1000.0)};
+    if (!wait_for(sock, POLLIN, slice)) continue;
+    const ssize_t n = ::recv(sock, chunk, sizeof chunk, 0);
+    if (n <= 0) return {-1, "the client closed the connection"};
+    buffer.append(chunk, static_cast<std::size_t>(n));
+  }
+}
+
+void BoundedServer::refuse(socket_t sock, const HeadVerdict& v) const {
+  const std::string body = nlohmann::json{{"error", v.reason}}.dump();
+  const std::string reply = fmt::format(
+      "HTTP/1.1 {} {}\r\nContent-Type: application/json\r\nContent-Length: {}\r\n"
+      "Connection: close\r\n{}\r\n{}",
+      v.status, reason_phrase(v.status), body.size(), v.status == 503 ? "Retry-After: 1\r\n" : "",
+      body);
+  if (wait_for(sock, POLLOUT, Clock::now() + std::chrono::seconds(1)))
+    (void)::send(sock, reply.data(), reply.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
+  if (refused_) refused_(v.status);
+}
+
+bool BoundedServer::process_and_close_socket(socket_t sock) {
+  const auto deadline = Clock::now() + limits_.request_deadline;
+  sockaddr_storage peer{};
+  socklen_t len = sizeof peer;
+  const std::string address =
+      ::getpeername(sock, reinterpret_cast<sockaddr*>(&peer), &len) == 0 ? address_of(peer) : "";
+  if (over_capacity) {
+    refuse(sock, {503, fmt::format("more than {} connections", limits_.max_connections)});
+  } else if (!admit(address)) {
+    refuse(sock, {503, fmt::format("more than {} connections from {}", limits_.max_per_address,
+                                   address)});
+  } else {
+    std::string buffer;
+    const HeadVerdict v = read_head(sock, deadline, buffer);
+    if (v.status == 0) {
+      DeadlineStream stream(sock, std::move(buffer), deadline);
+      bool closed = false;
+      process_request(stream, true, closed, nullptr);
+    } else if (v.status > 0) {
+      refuse(sock, v);
+    }
+    release(address);
+  }
+  ::shutdown(sock, SHUT_RDWR);
+  ::close(sock);
+  return true;
+}
+
+}  // namespace station::http
