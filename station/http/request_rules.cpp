@@ -106,6 +106,8 @@ HeadVerdict check_request_head(std::string_view head, const HeadLimits& limits) 
     const std::string_view line = lines[i];
     if (line.front() == ' ' || line.front() == '\t')
       return {400, fmt::format("header line {}: obs-fold continuation line (RFC 9112 5.2)", i)};
+    if (line.find_first_of(std::string_view("\0\r", 2)) != std::string_view::npos)
+      return {400, fmt::format("header line {}: a NUL or bare CR (RFC 9110 5.5)", i)};
     const auto colon = line.find(':');
     if (colon == std::string_view::npos || !is_token(line.substr(0, colon)))
       return {400, fmt::format("header line {}: not 'name: value' (RFC 9112 5.1)", i)};
@@ -127,6 +129,11 @@ HeadVerdict check_request_head(std::string_view head, const HeadLimits& limits) 
 }
 
 bool loopback_host(std::string_view host) {
+  // Only what a loopback name, literal and port are made of: inet_pton reads a C string, so a
+  // NUL ("127.0.0.1\0.evil.com", found by fuzz_request_head) must not reach it.
+  static constexpr std::string_view kAllowed =
+      "0123456789abcdefABCDEFlocLOC.:[]htsHTS";  // hex digits, "localhost", separators
+  if (host.find_first_not_of(kAllowed) != std::string_view::npos) return false;
   if (host.starts_with('[')) {
     const auto close = host.find(']');
     return close != std::string_view::npos && port_ok(host.substr(close + 1)) &&

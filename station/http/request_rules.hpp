@@ -32,6 +32,7 @@ HeadVerdict oversized_head(std::string_view buffer, const HeadLimits& limits);
 
 /// Checks a complete head (as cut by head_end): at most `max_fields` fields (431); each field
 /// line `name:value` with a token name and no whitespace before the colon (RFC 9112 §5.1), no
+/// NUL or bare CR in it (RFC 9110 §5.5), no
 /// obs-fold continuation line (§5.2), one Host at most (§3.2), Content-Length a decimal number
 /// whose repeats all agree (RFC 9110 §8.6), not beside Transfer-Encoding (RFC 9112 §6.3): 400.
 HeadVerdict check_request_head(std::string_view head, const HeadLimits& limits);

@@ -64,6 +64,17 @@ Snapshot snapshot_of_run(station::Store& s, std::int64_t run_id) {
   return out;
 }
 
+// Samples committed so far (0 while the database does not exist yet).
+std::int64_t committed_samples(const std::string& db) {
+  try {
+    station::Store s(db, station::OpenMode::read_only);
+    auto st = s.db().prepare("SELECT count(*) FROM samples");
+    return st.step() ? st.column_int(0) : 0;
+  } catch (const std::exception&) {
+    return 0;
+  }
+}
+
 // Every sample of the run a killed daemon left unfinished.
 Snapshot snapshot(const std::string& db) {
   station::Store s(db);
@@ -78,12 +89,21 @@ TEST(KillResume, KillNineTwiceLosesNothingAndEndsWithTheSameFit) {
   ASSERT_EQ(wait_exit(spawn_run(clean_db)), 0);
 
   const auto db = fresh_db("killed");
-  std::mt19937 rng(20260);  // seeded: the kill instants are reproducible
-  std::uniform_int_distribution<int> kill_ms(150, 900);
+  // Seeded: each kill comes after a drawn number of further samples is committed (of 16,202 in
+  // the run) and a drawn delay of up to 10 ms, so it lands mid-run whatever the machine's
+  // speed (a kill on the wall clock alone found a fast run already finished), and anywhere
+  // between two commits.
+  std::mt19937 rng(20260);
+  std::uniform_int_distribution<std::int64_t> more_samples(1000, 5000);
+  std::uniform_int_distribution<int> delay_us(0, 10'000);
   Snapshot committed;  // every sample seen committed after any of the kills
   for (int k = 0; k < 2; ++k) {
+    const std::int64_t target = committed_samples(db) + more_samples(rng);
     const pid_t pid = spawn_run(db);
-    std::this_thread::sleep_for(std::chrono::milliseconds(kill_ms(rng)));
+    const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (committed_samples(db) < target && std::chrono::steady_clock::now() < give_up)
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    std::this_thread::sleep_for(std::chrono::microseconds(delay_us(rng)));
     kill(pid, SIGKILL);
     ASSERT_EQ(wait_exit(pid), -SIGKILL);
     const Snapshot before = snapshot(db);

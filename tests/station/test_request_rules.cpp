@@ -32,6 +32,8 @@ TEST(RequestRules, MalformedFieldsAre400AndTooManyAre431) {
   EXPECT_EQ(verdict("Content-Length: -1\r\n"), 400);
   EXPECT_EQ(verdict("Content-Length: 1\r\nTransfer-Encoding: chunked\r\n"), 400);
   EXPECT_EQ(verdict("Host: evil.com\r\n"), 400);
+  EXPECT_EQ(verdict(std::string("X-A: a\0b\r\n", 10)), 400);
+  EXPECT_EQ(verdict("X-A: a\rb\r\n"), 400);
   std::string fields;
   for (int i = 0; i < 99; ++i) fields += "X-" + std::to_string(i) + ": a\r\n";
   EXPECT_EQ(verdict(fields), 0);  // 100 with Host
@@ -52,4 +54,8 @@ TEST(RequestRules, OnlyLoopbackLiteralsAndLocalhostAreLoopbackHosts) {
                         "localhost.evil.com", "[::1].evil.com", "[::2]", "127.0.0.1:80x",
                         "127.0.0.1:123456", "10.0.0.1", "", "[::1", "::1"})
     EXPECT_FALSE(sh::loopback_host(h)) << h;
+  // inet_pton reads up to a NUL: the rest of the name must not be dropped (fuzz finding).
+  using namespace std::string_view_literals;
+  EXPECT_FALSE(sh::loopback_host("127.0.0.1\0.evil.com"sv));
+  EXPECT_FALSE(sh::loopback_host("[::1\0\0]:80"sv));
 }
