@@ -11,6 +11,7 @@
 #include "station/daemon/safety.hpp"
 #include "station/sim/sim_run.hpp"
 #include "station/store/store.hpp"
+#include "tests/station/sim_options.hpp"
 #include "tests/station/temp_db.hpp"
 
 namespace {
@@ -234,12 +235,7 @@ TEST(Safety, BetweenTicksAnEdgeEntersButNeverClears) {
 // the recorded ramp (limit 85 C) -> one error event, safe hold, red lamp, setpoint back inside.
 TEST(Safety, ASetpointWrittenBySomeoneElseIsCaughtOnTheSimulatedRig) {
   const auto db = station::testing_support::fresh_db("foreign_setpoint");
-  station::SimRunOptions o;
-  o.db_path = db;
-  o.protocol = std::string(STATION_TEST_DATA_DIR) + "/short_cycle.toml";
-  o.progress = false;
-  o.fresh = true;
-  o.gyros = 1;
+  station::SimRunOptions o = station::testing_support::short_cycle_run(db, 1);
   std::optional<bool> red_after, green_after, red_before, power_before, power_held, power_after;
   o.on_world_tick = [&](double t_s, station::sim::SimWorld& w) {
     if (t_s == 2999) red_before = w.gpio_chips()->pin_level("TOWER_R");

@@ -16,6 +16,7 @@
 #include "station/session/session_files.hpp"
 #include "station/sim/sim_run.hpp"
 #include "station/store/store.hpp"
+#include "tests/station/sim_options.hpp"
 #include "tests/station/temp_db.hpp"
 #include "tests/station/text_file.hpp"
 
@@ -39,12 +40,7 @@ class SessionRecord : public ::testing::Test {
     db_ = new std::string(station::testing_support::fresh_db("session_record"));
     dir_ = new fs::path(*db_ + ".session");
     fs::remove_all(*dir_);
-    station::SimRunOptions o;
-    o.db_path = *db_;
-    o.protocol = std::string(STATION_TEST_DATA_DIR) + "/short_cycle.toml";
-    o.progress = false;
-    o.fresh = true;
-    o.gyros = 2;
+    station::SimRunOptions o = station::testing_support::short_cycle_run(*db_, 2);
     o.record_dir = dir_->string();
     report_ = new nlohmann::json(station::run_simulated(o));
   }
@@ -148,12 +144,7 @@ TEST(SessionRecordResume, AResumedSimulationAppendsEachExchangeOnce) {
   const fs::path dir = db + ".session";
   fs::remove_all(dir);
   std::atomic<bool> stop{false};
-  station::SimRunOptions o;
-  o.db_path = db;
-  o.protocol = std::string(STATION_TEST_DATA_DIR) + "/short_cycle.toml";
-  o.progress = false;
-  o.fresh = true;
-  o.gyros = 1;
+  station::SimRunOptions o = station::testing_support::short_cycle_run(db, 1);
   o.record_dir = dir.string();
   o.stop = &stop;
   o.on_world_tick = [&stop](double t_s, station::sim::SimWorld&) {

@@ -20,6 +20,7 @@
 #include "station/session/session_files.hpp"
 #include "station/session/session_replay.hpp"
 #include "station/sim/sim_run.hpp"
+#include "tests/station/sim_options.hpp"
 #include "tests/station/temp_db.hpp"
 #include "tests/station/text_file.hpp"
 
@@ -54,12 +55,7 @@ class SessionReplay : public ::testing::Test {
     const auto db = station::testing_support::fresh_db("session_replay");
     dir_ = new fs::path(db + ".session");
     fs::remove_all(*dir_);
-    station::SimRunOptions o;
-    o.db_path = db;
-    o.protocol = std::string(STATION_TEST_DATA_DIR) + "/short_cycle.toml";
-    o.progress = false;
-    o.fresh = true;
-    o.gyros = 2;
+    station::SimRunOptions o = station::testing_support::short_cycle_run(db, 2);
     o.record_dir = dir_->string();
     station::run_simulated(o);
   }

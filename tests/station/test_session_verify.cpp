@@ -20,6 +20,7 @@
 #include "station/session/session_files.hpp"
 #include "station/session/session_replay.hpp"
 #include "station/sim/sim_run.hpp"
+#include "tests/station/sim_options.hpp"
 #include "tests/station/temp_db.hpp"
 #include "tests/station/text_file.hpp"
 
@@ -37,12 +38,7 @@ fs::path record(const std::string& name, const std::string& how = "", double end
   const fs::path dir = db + ".session";
   fs::remove_all(dir);
   std::atomic<bool> stop{false}, abort{false};
-  station::SimRunOptions o;
-  o.db_path = db;
-  o.protocol = std::string(STATION_TEST_DATA_DIR) + "/short_cycle.toml";
-  o.progress = false;
-  o.fresh = true;
-  o.gyros = 1;
+  station::SimRunOptions o = station::testing_support::short_cycle_run(db, 1);
   o.record_dir = dir.string();
   o.stop = &stop;
   o.extend = [&abort](station::SequencerOptions& s) { s.abort = &abort; };
