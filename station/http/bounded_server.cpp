@@ -154,6 +154,10 @@ BoundedServer::BoundedServer(ConnectionLimits limits, std::function<void(int)> r
   new_task_queue = [max] { return new ConnectionQueue(max); };
 }
 
+void BoundedServer::set_backlog(int connections) {
+  if (svr_sock_ != INVALID_SOCKET) ::listen(svr_sock_, connections);
+}
+
 bool BoundedServer::admit(const std::string& address) {
   std::lock_guard lock(mu_);
   int& n = per_address_[address];

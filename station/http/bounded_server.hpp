@@ -32,6 +32,10 @@ class BoundedServer : public httplib::Server {
  public:
   /// `refused(status)` is called for every connection answered here (metrics).
   BoundedServer(ConnectionLimits limits, std::function<void(int)> refused);
+  /// After a bind: listen(2) again with a backlog of `connections` (cpp-httplib 0.11 listens
+  /// with 5, so a burst beyond it waits for SYN retransmits of 1 s and more before the caps
+  /// above can even answer it).
+  void set_backlog(int connections);
 
  private:
   bool process_and_close_socket(socket_t sock) override;

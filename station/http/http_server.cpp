@@ -208,8 +208,11 @@ void HttpServer::routes() {
 int HttpServer::start() {
   // A thread per connection, bounded in number, per address and in time (bounded_server.hpp):
   // the event streams and slow clients hold only their own.
-  server_ = std::make_unique<BoundedServer>(
-      ConnectionLimits{}, [this](int status) { hub_.metrics().http_request(status); });
+  const ConnectionLimits limits;
+  auto bounded = std::make_unique<BoundedServer>(
+      limits, [this](int status) { hub_.metrics().http_request(status); });
+  BoundedServer& server = *bounded;
+  server_ = std::move(bounded);
   routes();
   if (options_.port == 0) {
     port_ = server_->bind_to_any_port(options_.host);
@@ -221,6 +224,7 @@ int HttpServer::start() {
         fmt::format("--http {}:{}: cannot listen there (address in use or not this "
                     "machine's)",
                     options_.host, options_.port));
+  server.set_backlog(limits.max_connections);
   thread_ = std::thread([this, server = server_.get()] {
     server->listen_after_bind();
     done_.store(true);
