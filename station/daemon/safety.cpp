@@ -80,29 +80,43 @@ std::vector<std::string> Safety::judge(const std::optional<drivers::ChamberState
   return out;
 }
 
+namespace {
+
+/// Each cause's name while it is on and once it clears, in the order events list them.
+struct CauseWords {
+  bool SafetyCauses::*flag;
+  const char* on;
+  const char* cleared;
+};
+constexpr CauseWords kCauseWords[] = {
+    {&SafetyCauses::chamber_high_limit, "chamber high-limit trip", "chamber high-limit trip reset"},
+    {&SafetyCauses::gpio_estop_pressed, "e-stop pressed", "e-stop released"},
+    {&SafetyCauses::chamber_door_open, "chamber door open", "chamber door closed"},
+    {&SafetyCauses::gpio_interlock_open, "interlock open", "interlock closed"},
+    {&SafetyCauses::table_interlock_open, "turntable interlock open", "turntable interlock closed"},
+    {&SafetyCauses::inputs_unreadable, "interlock / e-stop unreadable",
+     "interlock / e-stop readable again"},
+};
+
+std::string words_of(const SafetyCauses& c, bool cleared) {
+  std::vector<std::string> words;
+  for (const auto& w : kCauseWords)
+    if (c.*w.flag) words.emplace_back(cleared ? w.cleared : w.on);
+  if (!c.out_of_limits.empty()) {
+    words.push_back(cleared ? std::string("readings back inside limits")
+                            : fmt::format("out of limits: {}", fmt::join(c.out_of_limits, "; ")));
+  }
+  return words.empty() ? std::string("no cause") : fmt::format("{}", fmt::join(words, "; "));
+}
+
+}  // namespace
+
 std::string SafetyCauses::text() const {
-  std::vector<std::string> on;
-  if (chamber_high_limit) on.emplace_back("chamber high-limit trip");
-  if (gpio_estop_pressed) on.emplace_back("e-stop pressed");
-  if (chamber_door_open) on.emplace_back("chamber door open");
-  if (gpio_interlock_open) on.emplace_back("interlock open");
-  if (table_interlock_open) on.emplace_back("turntable interlock open");
-  if (inputs_unreadable) on.emplace_back("interlock / e-stop unreadable");
-  if (!out_of_limits.empty())
-    on.push_back(fmt::format("out of limits: {}", fmt::join(out_of_limits, "; ")));
-  return on.empty() ? std::string("no cause") : fmt::format("{}", fmt::join(on, "; "));
+  return words_of(*this, false);
 }
 
 std::string SafetyCauses::cleared_text() const {
-  std::vector<std::string> off;
-  if (chamber_high_limit) off.emplace_back("chamber high-limit trip reset");
-  if (gpio_estop_pressed) off.emplace_back("e-stop released");
-  if (chamber_door_open) off.emplace_back("chamber door closed");
-  if (gpio_interlock_open) off.emplace_back("interlock closed");
-  if (table_interlock_open) off.emplace_back("turntable interlock closed");
-  if (inputs_unreadable) off.emplace_back("interlock / e-stop readable again");
-  if (!out_of_limits.empty()) off.emplace_back("readings back inside limits");
-  return off.empty() ? std::string("no cause") : fmt::format("{}", fmt::join(off, "; "));
+  return words_of(*this, true);
 }
 
 std::optional<std::string> Safety::update(SafetyCauses causes) {
