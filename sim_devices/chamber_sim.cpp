@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "drivers/chamber/chamber_map.hpp"
+#include "drivers/chamber/generic_plc/generic_plc_map.hpp"
 
 namespace station::sim {
 namespace cm = drivers::chamber_map;
@@ -106,6 +106,36 @@ void ChamberSim::set_run_locked(bool run) {
   // A Watlow ramp starts from the process value when the output is enabled.
   if (run && !run_) effective_sp_c_ = air_c_;
   run_ = run;
+}
+
+bool ChamberSim::run() const {
+  std::lock_guard lock(mutex_);
+  return run_;
+}
+
+void ChamberSim::set_run(bool run) {
+  std::lock_guard lock(mutex_);
+  set_run_locked(run);
+}
+
+double ChamberSim::ramp_c_per_min() const {
+  std::lock_guard lock(mutex_);
+  return ramp_c_per_min_;
+}
+
+void ChamberSim::set_ramp_c_per_min(double ramp) {
+  std::lock_guard lock(mutex_);
+  if (std::isfinite(ramp) && ramp >= 0) ramp_c_per_min_ = ramp;
+}
+
+int ChamberSim::status() const {
+  std::lock_guard lock(mutex_);
+  return status_locked();
+}
+
+bool ChamberSim::air_sensor_failed() const {
+  std::lock_guard lock(mutex_);
+  return sensor_failed_;
 }
 
 int ChamberSim::status_locked() const {

@@ -6,7 +6,7 @@
 #include <mutex>
 
 #include "drivers/modbus/register_map.hpp"
-#include "sim_devices/modbus_server.hpp"
+#include "sim_devices/servers/modbus_server.hpp"
 
 namespace station::sim {
 
@@ -61,6 +61,18 @@ class ChamberSim final : public ModbusDeviceModel {
   /// Alarm bits as the alarm register shows them (chamber_map::AlarmBit). Injected alarms stay
   /// until cleared by their setter: the model never rewrites them.
   unsigned alarms() const;
+
+  /// The model as every dialect face serves it (sim_devices/faces/): run state, ramp, status
+  /// (0 off, 1 constant, 2 ramping, 3 hold), the sensor fault, the configuration.
+  bool run() const;
+  /// Enables/disables the output (a ramp restarts from the air temperature, as a Watlow's does).
+  void set_run(bool run);
+  double ramp_c_per_min() const;
+  /// Setpoint ramp rate, C/min (0 = step); negative or non-finite values are ignored.
+  void set_ramp_c_per_min(double ramp);
+  int status() const;
+  bool air_sensor_failed() const;
+  const ChamberSimConfig& config() const { return cfg_; }
 
   const drivers::modbus::RegisterMap& register_map() const override { return map_; }
   /// Run enable not 0/1, a negative or non-finite ramp or a non-finite setpoint: 03.

@@ -86,7 +86,7 @@ bool pick(std::string_view s, std::string_view on, std::string_view off, std::st
   return false;
 }
 
-std::string modbus_fault(ModbusServer& server, const Args& a, std::string_view dev) {
+std::string modbus_fault(SimServer& server, const Args& a, std::string_view dev) {
   const std::string syntax = fmt::format("{} stall|exception|disconnect|clear ...", dev);
   if (a.size() < 2) usage(syntax);
   if (a[1] == "stall" && a.size() == 3) {

@@ -12,7 +12,7 @@
 #include <string_view>
 #include <vector>
 
-#include "drivers/can/unique_fd.hpp"
+#include "drivers/common/unique_fd.hpp"
 #include "drivers/gpio/gpio_bank.hpp"
 
 namespace station::sim {
@@ -111,7 +111,7 @@ class GpioSimBank final : public drivers::gpio::GpioBank {
   std::string device_;
   drivers::Tap* tap_ = nullptr;
   std::vector<Slot> slots_;
-  drivers::can::UniqueFd efd_;
+  drivers::UniqueFd efd_;
   std::mutex mu_;  // guards pending_ and the eventfd counter
   std::deque<drivers::gpio::GpioEdge> pending_;
 };

@@ -11,8 +11,8 @@
 #include <random>
 #include <stdexcept>
 
-#include "drivers/chamber/chamber_map.hpp"
-#include "drivers/turntable/turntable_map.hpp"
+#include "drivers/chamber/generic_plc/generic_plc_map.hpp"
+#include "drivers/turntable/generic_plc/generic_plc_map.hpp"
 
 namespace station::sim {
 
@@ -82,12 +82,10 @@ std::vector<GpioSimChipSpec> gpio_lines(int gyros) {
 SimWorld::SimWorld(const SimWorldConfig& config) : config_(config) {
   if (config_.gyros < 1 || config_.gyros > 16) throw std::invalid_argument("simworld: 1..16 gyros");
   config_.chamber.initial_c = config_.initial_c;
-  chamber_ = std::make_unique<ChamberSim>(drivers::chamber_map::watlow_f4(1), config_.chamber);
-  table_ = std::make_unique<TurntableSim>(drivers::turntable_map::default_map(1));
-  chamber_server_ = std::make_unique<ModbusServer>(*chamber_, 1);
-  table_server_ = std::make_unique<ModbusServer>(*table_, 1);
-  chamber_server_->start_tcp(config_.chamber_port);
-  table_server_->start_tcp(config_.turntable_port);
+  chamber_sim_ = std::make_unique<ChamberSim>(drivers::chamber_map::generic_plc(1), config_.chamber);
+  table_sim_ = std::make_unique<TurntableSim>(drivers::turntable_map::generic_plc(1));
+  chamber_ = serve_chamber(config_.chamber_model, *chamber_sim_, config_.panel, config_.chamber_port);
+  table_ = serve_turntable(config_.turntable_model, *table_sim_, config_.turntable_port);
   gpio_ = std::make_shared<GpioSimChips>(gpio_lines(config_.gyros));
   gpio_->set_input("DOOR_SW", true);  // door closed
   gpio_->set_input("ESTOP", false);   // not pressed
@@ -146,13 +144,13 @@ void SimWorld::check_node(std::uint8_t node) const {
 void SimWorld::set_door_open(bool open) {
   door_open_ = open;
   gpio_->set_input("DOOR_SW", !open);
-  chamber_->set_door_open(open);
+  chamber_sim_->set_door_open(open);
 }
 
 void SimWorld::set_estop(bool pressed) {
   estop_ = pressed;
   gpio_->set_input("ESTOP", pressed);
-  table_->set_interlock_open(pressed);
+  table_sim_->set_interlock_open(pressed);
 }
 
 void SimWorld::set_can_fault_rates(const BusFaultRates& rates) {
@@ -185,11 +183,11 @@ void SimWorld::set_board_answering(std::uint8_t node, bool answering) {
 void SimWorld::clear_faults() {
   set_door_open(false);
   set_estop(false);
-  chamber_->set_high_limit_trip(false);
-  chamber_->set_air_sensor_failed(false);
-  table_->set_fault(false);
-  chamber_server_->clear_faults();
-  table_server_->clear_faults();
+  chamber_sim_->set_high_limit_trip(false);
+  chamber_sim_->set_air_sensor_failed(false);
+  table_sim_->set_fault(false);
+  chamber_.server->clear_faults();
+  table_.server->clear_faults();
   can_rates_ = {};
   if (bus_) bus_->clear_faults();
   for (const auto& g : gyros_) {
@@ -207,17 +205,26 @@ bool SimWorld::accept_station(int timeout_ms) {
   if (bus_) bus_->stop();  // the previous station's bus; its boards go with it
   bus_ = std::make_unique<CounterBoardBus>(fd);
   add_boards();
-  bus_->step_to(now_s_, chamber_->air_c());
+  bus_->step_to(now_s_, chamber_sim_->air_c());
   bus_->start();
   return true;
 }
 
 void SimWorld::advance_to(double t_s) {
   if (t_s <= now_s_) return;
-  chamber_->step_to(t_s);
-  table_->step_to(t_s);
-  if (bus_) bus_->step_to(t_s, chamber_->air_c());
+  chamber_sim_->step_to(t_s);
+  table_sim_->step_to(t_s);
+  if (bus_) bus_->step_to(t_s, chamber_sim_->air_c());
   now_s_ = t_s;
+}
+
+}  // namespace station::sim
+
+namespace station::sim {
+
+std::string SimWorld::devices_toml() const {
+  return device_toml("chamber", config_.chamber_model, chamber_endpoint(), &config_.panel) + "\n" +
+         device_toml("turntable", config_.turntable_model, turntable_endpoint(), nullptr);
 }
 
 }  // namespace station::sim

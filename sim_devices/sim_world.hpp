@@ -13,9 +13,10 @@
 #include <vector>
 
 #include "sim_devices/chamber_sim.hpp"
+#include "sim_devices/faces/sim_dialects.hpp"
 #include "sim_devices/counter_board_sim.hpp"
 #include "sim_devices/gpio_sim.hpp"
-#include "sim_devices/modbus_server.hpp"
+#include "sim_devices/servers/modbus_server.hpp"
 #include "sim_devices/turntable_sim.hpp"
 
 namespace station::sim {
@@ -41,6 +42,10 @@ struct SimWorldConfig {
   int chamber_port = 0;       ///< chamber Modbus TCP port on 127.0.0.1, 0 = ephemeral
   int turntable_port = 0;     ///< turntable Modbus TCP port on 127.0.0.1, 0 = ephemeral
   ChamberSimConfig chamber;   ///< chamber model
+  /// Dialects the chamber and table are served in (drivers/registry model names).
+  std::string chamber_model = "generic_plc";
+  std::string turntable_model = "generic_plc";
+  WatlowPanel panel;  ///< a simulated Watlow's decimals, units and run event
 };
 
 /// One simulated gyro as the station will see it.
@@ -61,8 +66,10 @@ class SimWorld {
   SimWorld& operator=(const SimWorld&) = delete;
 
   /// tcp://127.0.0.1:PORT of the chamber and turntable servers.
-  std::string chamber_endpoint() const { return chamber_server_->endpoint(); }
-  std::string turntable_endpoint() const { return table_server_->endpoint(); }
+  std::string chamber_endpoint() const { return chamber_.server->endpoint(); }
+  std::string turntable_endpoint() const { return table_.server->endpoint(); }
+  /// The [chamber] and [turntable] tables of a station config for this world: model, endpoint.
+  std::string devices_toml() const;
   /// CAN transport spec for the station: "fd:N" (socketpair end) or "unix:PATH".
   std::string can_transport() const { return can_transport_; }
   /// With can_unix_path: blocks up to timeout_ms for the station to connect, then serves; after
@@ -98,10 +105,10 @@ class SimWorld {
   double now_s() const { return now_s_; }
 
   const std::vector<SimGyro>& gyros() const { return gyros_; }
-  ChamberSim& chamber() { return *chamber_; }
-  TurntableSim& turntable() { return *table_; }
-  ModbusServer& chamber_server() { return *chamber_server_; }
-  ModbusServer& turntable_server() { return *table_server_; }
+  ChamberSim& chamber() { return *chamber_sim_; }
+  TurntableSim& turntable() { return *table_sim_; }
+  SimServer& chamber_server() { return *chamber_.server; }
+  SimServer& turntable_server() { return *table_.server; }
   CounterBoardBus* bus() { return bus_.get(); }
 
  private:
@@ -110,9 +117,9 @@ class SimWorld {
 
   SimWorldConfig config_;
   std::vector<SimGyro> gyros_;
-  std::unique_ptr<ChamberSim> chamber_;
-  std::unique_ptr<TurntableSim> table_;
-  std::unique_ptr<ModbusServer> chamber_server_, table_server_;
+  std::unique_ptr<ChamberSim> chamber_sim_;
+  std::unique_ptr<TurntableSim> table_sim_;
+  ServedDevice chamber_, table_;  // faces and servers (destroyed before the models)
   std::unique_ptr<CounterBoardBus> bus_;
   std::shared_ptr<GpioSimChips> gpio_;
   std::string can_transport_;

@@ -38,6 +38,8 @@ struct Options {
   std::uint64_t seed = 1;
   int chamber_port = 0;
   int turntable_port = 0;
+  std::string chamber_model = "generic_plc";    // dialect the chamber speaks
+  std::string turntable_model = "generic_plc";  // dialect the table speaks
   std::string can_socket = "/tmp/simrig-can.sock";
   double latitude_deg = 39.9;
   std::string control;            // fault-injection control socket, "" = none
@@ -90,11 +92,11 @@ void print_config(const sim::SimWorld& world, const Options& o) {
       "# GPIO lines are simulated inside simrig only: this config has no [gpio].\n"
       "[station]\nname = \"simrig\"\nlatitude_deg = {}\nref_temp_c = 25.0\nbin_s = 600\n\n"
       "[limits]\nmin_setpoint_c = -45.0\nmax_setpoint_c = 85.0\nmax_ramp_c_per_min = 3.0\n\n"
-      "[chamber]\nendpoint = \"{}\"\npreset = \"watlow_f4\"\nunit_id = 1\ntimeout_s = 0.5\n\n"
-      "[turntable]\nendpoint = \"{}\"\ntimeout_s = 0.5\n\n"
+      "{}\n"
       "[can]\ntransport = \"{}\"\ntick_timeout_ms = 200\n",
-      o.seed, o.gyros, world.chamber_endpoint(), world.turntable_endpoint(), world.can_transport(),
-      o.latitude_deg, world.chamber_endpoint(), world.turntable_endpoint(), world.can_transport());
+      o.seed, o.gyros, o.chamber_model + " " + world.chamber_endpoint(),
+      o.turntable_model + " " + world.turntable_endpoint(), world.can_transport(), o.latitude_deg,
+      world.devices_toml(), world.can_transport());
   if (!o.control.empty())
     fmt::print("# fault commands: simrig --control {} --send 'help'\n", o.control);
   for (const auto& g : world.gyros()) {
@@ -163,6 +165,12 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::Range(1, 16));
   app.add_option("--seed", o.seed, "seed of coefficients and noise")->capture_default_str();
+  app.add_option("--chamber", o.chamber_model,
+                 "chamber dialect: generic_plc, watlow_f4, watlow_f4t, watlow_f4t_map2, "
+                 "watlow_f4p, espec_p300")
+      ->capture_default_str();
+  app.add_option("--turntable", o.turntable_model, "turntable dialect: generic_plc, acutrol3000")
+      ->capture_default_str();
   app.add_option("--chamber-port", o.chamber_port, "chamber Modbus TCP port, 0 = ephemeral")
       ->capture_default_str()
       ->check(CLI::Range(0, 65535));
@@ -202,6 +210,8 @@ int main(int argc, char** argv) {
   sigaction(SIGTERM, &sa, nullptr);
   try {
     sim::SimWorldConfig c;
+    c.chamber_model = o.chamber_model;
+    c.turntable_model = o.turntable_model;
     c.gyros = o.gyros;
     c.seed = o.seed;
     c.chamber_port = o.chamber_port;

@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "drivers/turntable/turntable_map.hpp"
+#include "drivers/turntable/generic_plc/generic_plc_map.hpp"
 
 namespace station::sim {
 namespace tm = drivers::turntable_map;
@@ -91,6 +91,49 @@ unsigned TurntableSim::status_locked() const {
   if (fault_) bits |= tm::kFault;
   if (interlock_open_) bits |= tm::kInterlockOpen;
   return bits;
+}
+
+int TurntableSim::mode() const {
+  std::lock_guard lock(mutex_);
+  return mode_;
+}
+
+bool TurntableSim::set_mode(int mode) {
+  std::lock_guard lock(mutex_);
+  if (mode < 0 || mode > 2 || interlock_open_ || fault_) return false;
+  mode_ = mode;
+  stopping_ = false;
+  return true;
+}
+
+double TurntableSim::position_demand_deg() const {
+  std::lock_guard lock(mutex_);
+  return position_demand_deg_;
+}
+
+double TurntableSim::rate_demand_dps() const {
+  std::lock_guard lock(mutex_);
+  return rate_demand_dps_;
+}
+
+void TurntableSim::set_position_demand_deg(double deg) {
+  std::lock_guard lock(mutex_);
+  if (std::isfinite(deg)) position_demand_deg_ = wrap360(deg);
+}
+
+void TurntableSim::set_rate_demand_dps(double dps) {
+  std::lock_guard lock(mutex_);
+  if (std::isfinite(dps)) rate_demand_dps_ = dps;
+}
+
+bool TurntableSim::interlock_open() const {
+  std::lock_guard lock(mutex_);
+  return interlock_open_;
+}
+
+bool TurntableSim::fault() const {
+  std::lock_guard lock(mutex_);
+  return fault_;
 }
 
 int TurntableSim::register_count() const {

@@ -6,7 +6,7 @@
 #include <mutex>
 
 #include "drivers/modbus/register_map.hpp"
-#include "sim_devices/modbus_server.hpp"
+#include "sim_devices/servers/modbus_server.hpp"
 
 namespace station::sim {
 
@@ -22,7 +22,7 @@ struct TurntableSimConfig {
 /// The table model; thread-safe.
 class TurntableSim final : public ModbusDeviceModel {
  public:
-  /// `map`: turntable_map::default_map() (possibly overridden). No I/O.
+  /// `map`: turntable_map::generic_plc() (possibly overridden). No I/O.
   explicit TurntableSim(drivers::modbus::RegisterMap map, TurntableSimConfig cfg = {});
 
   /// Integrates motion up to `sim_time_s` in fixed steps.
@@ -40,6 +40,18 @@ class TurntableSim final : public ModbusDeviceModel {
   /// Mode demand not 0..2, lock or stop not 0/1, a non-finite demand: 03.
   std::uint8_t check_write(const RegisterWrite& write) const override;
   int register_count() const override;
+  /// The model as every dialect face serves it: mode 0 off, 1 position, 2 rate.
+  int mode() const;
+  /// Changes the mode; refused (false) while the interlock is open or a fault is active.
+  bool set_mode(int mode);
+  double position_demand_deg() const;
+  double rate_demand_dps() const;
+  void set_position_demand_deg(double deg);
+  void set_rate_demand_dps(double dps);
+  bool interlock_open() const;
+  bool fault() const;
+  const TurntableSimConfig& config() const { return cfg_; }
+
   void publish(modbus_mapping_t& regs) override;
   void on_write(const modbus_mapping_t& regs, std::uint16_t pdu_address, int count) override;
 

@@ -9,7 +9,7 @@
 #include <string_view>
 #include <vector>
 
-#include "drivers/can/unique_fd.hpp"
+#include "drivers/common/unique_fd.hpp"
 #include "drivers/common/clock.hpp"
 #include "drivers/common/result.hpp"
 #include "drivers/common/tap.hpp"

@@ -1,5 +1,7 @@
-// The thermal-chamber device interface: one bounded transaction per call, none blocks past its
-// timeout. Real (ModbusChamber) and simulated chambers live behind it.
+// The thermal-chamber device interface, independent of any wire: what a chamber is (air, product,
+// setpoint, ramp, run, alarms, limits). One bounded transaction set per call, none blocks past
+// its timeout. Each dialect (drivers/chamber/<dialect>/, registered in drivers/registry/) and the
+// simulated chambers live behind it.
 #pragma once
 
 #include <optional>
@@ -9,8 +11,9 @@
 
 namespace station::drivers {
 
-/// What the chamber controller is doing.
-enum class ChamberMode { off, constant, ramping, hold };
+/// What the chamber controller is doing. `profile`: a profile (program) started at the panel
+/// runs, not the station's setpoint; `manual`: the loop is in manual (open-loop) output.
+enum class ChamberMode { off, constant, ramping, hold, profile, manual };
 
 /// Alarm flags as the controller reports them.
 struct AlarmBits {
@@ -18,8 +21,9 @@ struct AlarmBits {
   bool sensor_break = false;     ///< air sensor open/failed (air_c is then NaN)
   bool door_open = false;        ///< door switch open
   bool high_limit_trip = false;  ///< independent over-temperature limit tripped
+  bool other = false;  ///< another alarm the controller raises (e.g. an ESPEC P300 ALARM? code)
   /// True if any flag is set.
-  bool any() const { return deviation || sensor_break || door_open || high_limit_trip; }
+  bool any() const { return deviation || sensor_break || door_open || high_limit_trip || other; }
 };
 
 /// One reading of the chamber. A driver may read the command registers and the informational points
@@ -42,6 +46,17 @@ struct ChamberCommand {
   std::optional<bool> run{};               ///< enable/disable the controller output
 };
 
+/// What a chamber says about itself at probe (identify()): model, units and scaling as read
+/// from the controller, so a unit in deg F or with other decimals is read correctly or refused.
+struct ChamberIdentity {
+  std::string model;        ///< dialect name, e.g. "watlow_f4t"
+  std::string identity;     ///< what the controller reports (part number, ROM, model code)
+  std::string units;        ///< "C" or "F" as the controller displays temperatures
+  int decimals = -1;        ///< decimal places of its integers (-1: floats / text)
+  double setpoint_low_c = 0, setpoint_high_c = 0;  ///< the controller's setpoint limits, C
+  std::string notes;        ///< anything the station adapts to (units converted, no product)
+};
+
 /// A thermal chamber. Every call is one bounded transaction; none blocks past its timeout.
 class Chamber {
  public:
@@ -54,9 +69,15 @@ class Chamber {
   virtual Result<void> command(const ChamberCommand& c) = 0;
   /// Device name for logs and records.
   virtual std::string name() const = 0;
+  /// Reads what the controller says about itself (probe); the default knows nothing.
+  virtual Result<ChamberIdentity> identify() { return ChamberIdentity{}; }
+  /// True when the controller ramps its setpoint itself at a commanded rate (a constant-mode
+  /// ramp); false (Watlow F4, ESPEC P300) and the station ramps by moving the setpoint each tick
+  /// (ProtocolRunner) and ignores ramp commands. No I/O.
+  virtual bool controller_ramp() const { return true; }
 };
 
-/// "off", "constant", "ramping", "hold".
+/// "off", "constant", "ramping", "hold", "profile", "manual".
 constexpr const char* to_string(ChamberMode m) {
   switch (m) {
     case ChamberMode::off:
@@ -67,6 +88,10 @@ constexpr const char* to_string(ChamberMode m) {
       return "ramping";
     case ChamberMode::hold:
       return "hold";
+    case ChamberMode::profile:
+      return "profile";
+    case ChamberMode::manual:
+      return "manual";
   }
   return "unknown";
 }

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,11 @@ class Tap {
   virtual ~Tap() = default;
   virtual void on_exchange(const TapRecord& record) noexcept = 0;
 };
+
+/// A failure's errno (libmodbus's EMB* codes included) as 4 big-endian bytes, and back: the
+/// payload of an "error" event record on every transport, so replay fails the same way.
+std::vector<std::uint8_t> errno_bytes(int err);
+int errno_of_bytes(std::span<const std::uint8_t, 4> bytes);
 
 /// Wall-clock seconds (CLOCK_REALTIME) for stamping tap records.
 double tap_wall_time_s();

@@ -7,7 +7,7 @@
 #include <string_view>
 #include <vector>
 
-#include "drivers/can/unique_fd.hpp"
+#include "drivers/common/unique_fd.hpp"
 #include "drivers/gpio/gpio_bank.hpp"
 #include "drivers/gpio/gpiod_handles.hpp"
 
@@ -52,7 +52,7 @@ class LibgpiodBank final : public GpioBank {
   // Declared before slots_ so the chips outlive the requested lines on destruction.
   std::map<std::string, ChipHandle> chips_;
   std::vector<Slot> slots_;
-  can::UniqueFd epoll_;
+  UniqueFd epoll_;
 };
 
 }  // namespace station::drivers::gpio

@@ -39,15 +39,4 @@ std::vector<std::uint8_t> read_reply_adu(int unit, int fc, std::span<const std::
   return out;
 }
 
-std::vector<std::uint8_t> errno_bytes(int err) {
-  const auto u = static_cast<std::uint32_t>(err);
-  return {static_cast<std::uint8_t>(u >> 24), static_cast<std::uint8_t>(u >> 16),
-          static_cast<std::uint8_t>(u >> 8), static_cast<std::uint8_t>(u)};
-}
-
-int errno_of_bytes(std::span<const std::uint8_t, 4> b) {
-  return static_cast<int>(std::uint32_t{b[0]} << 24 | std::uint32_t{b[1]} << 16 |
-                          std::uint32_t{b[2]} << 8 | b[3]);
-}
-
 }  // namespace station::drivers::modbus

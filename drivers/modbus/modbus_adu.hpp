@@ -4,6 +4,8 @@
 // does not expose its raw frames, so both sides rebuild them with these. No I/O.
 #pragma once
 
+#include "drivers/common/tap.hpp"
+
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -19,8 +21,8 @@ std::vector<std::uint8_t> write_request_adu(int unit, std::uint16_t addr,
 /// A read reply: unit, fc, byte count, words.
 std::vector<std::uint8_t> read_reply_adu(int unit, int fc, std::span<const std::uint16_t> words);
 
-/// A failure's errno (libmodbus's EMB* codes included) as 4 big-endian bytes, and back.
-std::vector<std::uint8_t> errno_bytes(int err);
-int errno_of_bytes(std::span<const std::uint8_t, 4> bytes);
+/// errno_bytes / errno_of_bytes: drivers/common/tap.hpp (every transport's error records).
+using drivers::errno_bytes;
+using drivers::errno_of_bytes;
 
 }  // namespace station::drivers::modbus

@@ -58,6 +58,8 @@ class Turntable {
   virtual Result<void> stop() = 0;
   /// Device name for logs and records.
   virtual std::string name() const = 0;
+  /// What the controller says about itself (probe); the default knows nothing.
+  virtual Result<std::string> identify() { return std::string{}; }
 };
 
 }  // namespace station::drivers

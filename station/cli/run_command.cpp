@@ -1,6 +1,8 @@
 // `station run`: the daemon. --sim runs the embedded simulated rig; otherwise a real rig from
 // --config. SIGTERM/SIGINT end the run cleanly; under systemd it notifies READY and the watchdog.
 #include <fmt/format.h>
+
+#include "drivers/registry/dialects.hpp"
 #include <fmt/ranges.h>
 #include <systemd/sd-daemon.h>
 
@@ -47,6 +49,8 @@ struct RunOptions {
   int gyros = 4;
   std::uint64_t seed = 1;
   std::string gyro_preset = "station";
+  std::string chamber_model = "generic_plc";
+  std::string turntable_model = "generic_plc";
   double latitude_deg = 39.9;
   double speed = 0;  ///< --sim: simulated s per wall s (0: as fast as possible)
   std::string http;  ///< --http HOST:PORT (empty: no HTTP service)
@@ -162,6 +166,8 @@ int run_sim(const RunOptions& o) {
   so.gyros = o.gyros;
   so.seed = o.seed;
   so.gyro_preset = o.gyro_preset;
+  so.chamber_model = o.chamber_model;
+  so.turntable_model = o.turntable_model;
   so.latitude_deg = o.latitude_deg;
   so.protocol = o.protocol;
   so.db_path = db;
@@ -221,6 +227,14 @@ void add_run_command(CLI::App& app, CommandStatus& status) {
       ->check(CLI::Range(1, 16));
   cmd->add_option("--seed", o->seed, "simulation seed")
       ->check(unsigned_integer())
+      ->capture_default_str();
+  cmd->add_option("--chamber", o->chamber_model,
+                  "--sim: the dialect the simulated chamber speaks (" +
+                      drivers::chamber_models() + ")")
+      ->capture_default_str();
+  cmd->add_option("--turntable", o->turntable_model,
+                  "--sim: the dialect the simulated table speaks (" +
+                      drivers::turntable_models() + ")")
       ->capture_default_str();
   cmd->add_option("--gyro-preset", o->gyro_preset,
                   "simulated gyros: station (strong thermal effect) or paper (the paper's "

@@ -12,9 +12,7 @@
 
 #include "compensation/limits.hpp"
 #include "drivers/can/can_transport.hpp"
-#include "drivers/chamber/chamber_map.hpp"
 #include "drivers/modbus/endpoint.hpp"
-#include "drivers/turntable/turntable_map.hpp"
 #include "station/config/toml_reader.hpp"
 
 namespace station {
@@ -59,27 +57,43 @@ mb::PointOverride read_override(const TomlView& v) {
   return o;
 }
 
-ModbusDeviceConfig read_modbus_device(const TomlView& v, bool is_chamber) {
-  v.allow_only({"endpoint", "preset", "unit_id", "timeout_s", "readback_every", "point"});
-  ModbusDeviceConfig d;
+// [chamber] / [turntable]: the model picks the dialect (drivers/registry), which says what
+// endpoint and keys it takes; everything is checked here, before anything moves.
+DeviceConfig read_device(const TomlView& v, bool is_chamber) {
+  v.allow_only({"endpoint", "model", "preset", "unit_id", "timeout_s", "readback_every", "point",
+                "run_event"});
+  DeviceConfig d;
+  d.name = is_chamber ? "chamber" : "turntable";
+  if (v.opt_string("model") && v.opt_string("preset"))
+    throw v.error("preset", "give `model` only (`preset` is its old name)");
+  const char* model_key = v.opt_string("preset") ? "preset" : "model";
+  d.model = v.opt_string(model_key).value_or("generic_plc");
   d.endpoint = v.get_string("endpoint");
-  at_key(v, "endpoint", [&] { return mb::parse_endpoint(d.endpoint); });
-  d.preset = v.opt_string("preset").value_or(is_chamber ? "watlow_f4" : "default");
   d.unit_id = static_cast<int>(v.opt_integer_in("unit_id", 0, 247).value_or(1));
   d.timeout_s = v.opt_number("timeout_s").value_or(0.5);
   if (!(d.timeout_s > 0 && d.timeout_s <= 10)) throw v.error("timeout_s", "must be in (0, 10] s");
   d.readback_every =
       static_cast<int>(v.opt_integer_in("readback_every", 1, 600).value_or(d.readback_every));
+  d.run_event = static_cast<int>(v.opt_integer_in("run_event", 1, 8).value_or(1));
   for (const auto& p : v.table_array("point")) d.overrides.push_back(read_override(p));
-  // Build the map now so a bad preset or override fails before anything moves.
-  auto map = at_key(v, "preset", [&] {
-    return is_chamber ? drivers::chamber_map::preset(d.preset, d.unit_id)
-                      : drivers::turntable_map::preset(d.preset, d.unit_id);
-  });
-  at_key(v, "point", [&] {
-    mb::apply_overrides(map, d.overrides);
-    return 0;
-  });
+  const auto check = [&](const auto* dialect) {
+    d.model = std::string(dialect->model);
+    at_key(v, "endpoint", [&] {
+      if (dialect->transport == drivers::Transport::modbus)
+        (void)mb::parse_endpoint(d.endpoint);
+      else
+        (void)drivers::ascii::parse_line_endpoint(d.endpoint);
+      return 0;
+    });
+    at_key(v, "point", [&] {
+      drivers::validate(*dialect, d);
+      return 0;
+    });
+  };
+  if (is_chamber)
+    check(at_key(v, model_key, [&] { return &drivers::chamber_dialect(d.model); }));
+  else
+    check(at_key(v, model_key, [&] { return &drivers::turntable_dialect(d.model); }));
   return d;
 }
 
@@ -211,8 +225,8 @@ StationConfig parse_station_config(const std::string& text, const std::string& p
   }
   auto chamber = root.opt_table("chamber");
   if (!chamber) throw root.error("chamber", "missing [chamber] table");
-  c.chamber = read_modbus_device(*chamber, true);
-  if (auto t = root.opt_table("turntable")) c.turntable = read_modbus_device(*t, false);
+  c.chamber = read_device(*chamber, true);
+  if (auto t = root.opt_table("turntable")) c.turntable = read_device(*t, false);
   auto can = root.opt_table("can");
   if (!can) throw root.error("can", "missing [can] table");
   can->allow_only({"transport", "tick_timeout_ms"});

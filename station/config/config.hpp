@@ -12,21 +12,14 @@
 #include "drivers/gpio/gpio_bank.hpp"
 #include "drivers/modbus/map_overrides.hpp"
 #include "drivers/modbus/readback.hpp"
+#include "drivers/registry/dialects.hpp"
 #include "station/common/input_error.hpp"
 
 namespace station {
 
-/// A Modbus device: endpoint, register-map preset and point overrides.
-struct ModbusDeviceConfig {
-  std::string endpoint;    ///< tcp://HOST:PORT or rtu:/dev/ttyX?baud=...
-  std::string preset;      ///< register-map preset name
-  int unit_id = 1;         ///< Modbus unit id 0..247
-  double timeout_s = 0.5;  ///< response timeout of one transaction, s
-  /// Command registers (setpoint, ramp, run; a table's lock) read back every this many reads,
-  /// and on the read after a write or reconnect (drivers/modbus/readback.hpp), 1..600.
-  int readback_every = drivers::modbus::ReadbackSchedule::kDefaultEvery;
-  std::vector<drivers::modbus::PointOverride> overrides;
-};
+/// A chamber or turntable: its model (a dialect of drivers/registry/dialects.hpp), endpoint
+/// and the knobs of its dialect ([chamber] / [turntable]; `preset` is the old name of `model`).
+using DeviceConfig = drivers::DeviceSpec;
 
 /// One gyro position on the rig.
 struct SlotConfig {
@@ -70,8 +63,8 @@ struct StationConfig {
   /// Part file ([station] parts, station/parts/part_file.hpp) resolved against the folder of
   /// this file; empty when the key is absent.
   std::string parts_path;
-  ModbusDeviceConfig chamber;
-  std::optional<ModbusDeviceConfig> turntable;
+  DeviceConfig chamber;
+  std::optional<DeviceConfig> turntable;
   std::string can_transport;  ///< socketcan:can0 | unix:PATH | fd:N
   int can_tick_timeout_ms = 200;
   /// GPIO lines by role ([gpio] and the slots' relays); unset when the rig has none.

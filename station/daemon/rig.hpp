@@ -12,6 +12,7 @@
 #include "drivers/counters/counter_boards.hpp"
 #include "drivers/gpio/gpio_bank.hpp"
 #include "drivers/modbus/modbus_wire.hpp"
+#include "drivers/registry/dialects.hpp"
 #include "drivers/turntable/turntable.hpp"
 #include "station/config/config.hpp"
 
@@ -21,9 +22,9 @@ namespace station {
 using GpioFactory =
     std::function<std::unique_ptr<drivers::gpio::GpioBank>(const drivers::gpio::GpioConfig&)>;
 
-/// Makes the link under a Modbus device's client (default: libmodbus to the endpoint).
-using ModbusWireFactory = std::function<std::unique_ptr<drivers::modbus::ModbusWire>(
-    const std::string& device, const drivers::modbus::Endpoint& endpoint)>;
+/// Makes the link under a Modbus / ASCII device's client (default: the real link).
+using ModbusWireFactory = drivers::ModbusWireFactory;
+using LineWireFactory = drivers::LineWireFactory;
 /// Makes the counter boards' CAN transport (default: the configured one, reconnecting).
 using CanTransportFactory = std::function<std::unique_ptr<drivers::can::CanTransport>()>;
 
@@ -35,6 +36,7 @@ struct RigOptions {
   /// clock so reconnects happen at the same simulated ticks every time). Not owned.
   const drivers::Clock* clock = nullptr;
   ModbusWireFactory modbus_wire_factory;      ///< empty: libmodbus (replay: the recording)
+  LineWireFactory line_wire_factory;          ///< empty: sockets / termios (replay: recording)
   CanTransportFactory can_transport_factory;  ///< empty: the config's transport
   /// A replayed CAN log: a latch's answers end where the log's next SYNC begins, not at a
   /// wall-clock deadline.

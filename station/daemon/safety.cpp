@@ -35,7 +35,8 @@ drivers::ChamberCommand Safety::clamp(drivers::ChamberCommand cmd,
   return cmd;
 }
 
-Protocol Safety::clamp_protocol(const Protocol& p, std::vector<std::string>& notes) const {
+Protocol Safety::clamp_protocol(const Protocol& p, std::vector<std::string>& notes,
+                                bool controller_ramp) const {
   Protocol out = p;
   const double max_ramp_c_per_h = 60.0 * limits_.max_ramp_c_per_min;
   for (std::size_t i = 0; i < out.steps.size(); ++i) {
@@ -49,6 +50,12 @@ Protocol Safety::clamp_protocol(const Protocol& p, std::vector<std::string>& not
             *s.setpoint_c, v, limits_.min_setpoint_c, limits_.max_setpoint_c));
         s.setpoint_c = v;
       }
+    }
+    if (!controller_ramp && s.kind == StepKind::set_temperature && s.ramp_c_per_h <= 0) {
+      notes.push_back(fmt::format("{}: step ramped by the station at {:.1f} C/h (the chamber has "
+                                  "no ramp of its own)",
+                                  where, max_ramp_c_per_h));
+      s.ramp_c_per_h = max_ramp_c_per_h;
     }
     if (s.ramp_c_per_h > max_ramp_c_per_h) {
       notes.push_back(fmt::format("{}: ramp {:.1f} C/h clamped to {:.1f} C/h (station limit)",

@@ -89,8 +89,11 @@ class Safety {
   /// `cmd` with setpoint and ramp clamped to the limits; a note per clamp in `notes`.
   drivers::ChamberCommand clamp(drivers::ChamberCommand cmd, std::vector<std::string>& notes) const;
 
-  /// A copy of `p` with every setpoint and ramp inside the limits; a note per change.
-  Protocol clamp_protocol(const Protocol& p, std::vector<std::string>& notes) const;
+  /// A copy of `p` with every setpoint and ramp inside the limits; a note per change. With
+  /// `controller_ramp` false (a chamber that cannot ramp by itself: Watlow F4, ESPEC P300) a
+  /// step becomes a station ramp at the maximum rate, the rate a step is bounded to anyway.
+  Protocol clamp_protocol(const Protocol& p, std::vector<std::string>& notes,
+                          bool controller_ramp = true) const;
 
   /// What the chamber reported this tick that lies outside the limits, one phrase each (read-back
   /// setpoint outside the setpoint limits; air beyond them by more than the air margin). Empty

@@ -149,7 +149,7 @@ RunOutcome Sequencer::run(const std::optional<RunRecord>& resume) {
   }
   // The safety layer's limits apply to the whole protocol before anything moves.
   std::vector<std::string> notes;
-  protocol_ = safety_.clamp_protocol(protocol_, notes);
+  protocol_ = safety_.clamp_protocol(protocol_, notes, rig_.chamber->controller_ramp());
   if (!resume) {
     for (const auto& n : notes) emit(0, "warn", "safety", "clamp", n);
   }

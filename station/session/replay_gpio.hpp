@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "drivers/can/unique_fd.hpp"
+#include "drivers/common/unique_fd.hpp"
 #include "drivers/gpio/gpio_bank.hpp"
 #include "station/session/session_log.hpp"
 
@@ -44,7 +44,7 @@ class ReplayGpioBank final : public drivers::gpio::GpioBank {
   drivers::gpio::GpioConfig config_;
   std::vector<SessionLogLine> lines_;
   std::size_t next_ = 0;
-  drivers::can::UniqueFd efd_;
+  drivers::UniqueFd efd_;
   bool readable_ = false;  ///< what the event fd holds (only this bank reads or writes it)
   bool open_ = false;
   std::vector<double> sync_times_s_;

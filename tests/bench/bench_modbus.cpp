@@ -2,11 +2,11 @@
 // transaction, and one full ModbusChamber::read() of 7 points: 4 block reads on watlow_f4).
 #include <benchmark/benchmark.h>
 
-#include "drivers/chamber/chamber_map.hpp"
-#include "drivers/chamber/modbus_chamber.hpp"
+#include "drivers/chamber/generic_plc/generic_plc_map.hpp"
+#include "drivers/chamber/generic_plc/modbus_chamber.hpp"
 #include "drivers/modbus/modbus_client.hpp"
 #include "sim_devices/chamber_sim.hpp"
-#include "sim_devices/modbus_server.hpp"
+#include "sim_devices/servers/modbus_server.hpp"
 
 namespace {
 

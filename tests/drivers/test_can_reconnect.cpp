@@ -28,22 +28,22 @@ class Listener {
     sockaddr_un addr{};
     addr.sun_family = AF_UNIX;
     std::strncpy(addr.sun_path, path_.c_str(), sizeof addr.sun_path - 1);
-    fd_ = can::UniqueFd(::socket(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0));
+    fd_ = UniqueFd(::socket(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0));
     if (::bind(fd_.get(), reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0 ||
         ::listen(fd_.get(), 4) != 0)
       throw std::runtime_error("listen " + path_);
   }
   ~Listener() { ::unlink(path_.c_str()); }
   // The next station connection (waits at most 1 s).
-  can::UniqueFd accept() {
+  UniqueFd accept() {
     pollfd p{fd_.get(), POLLIN, 0};
-    if (::poll(&p, 1, 1000) != 1) return can::UniqueFd();
-    return can::UniqueFd(::accept4(fd_.get(), nullptr, nullptr, SOCK_CLOEXEC));
+    if (::poll(&p, 1, 1000) != 1) return UniqueFd();
+    return UniqueFd(::accept4(fd_.get(), nullptr, nullptr, SOCK_CLOEXEC));
   }
 
  private:
   std::string path_;
-  can::UniqueFd fd_;
+  UniqueFd fd_;
 };
 
 // One SYNC received by the bus side (a timed-out read gives latch 255).

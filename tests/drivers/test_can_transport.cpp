@@ -23,11 +23,11 @@ struct RecordingTap : Tap {
   void on_exchange(const TapRecord& r) noexcept override { records.push_back(r); }
 };
 
-std::pair<can::UniqueFd, can::UniqueFd> seqpacket_pair() {
+std::pair<UniqueFd, UniqueFd> seqpacket_pair() {
   int sv[2];
   if (::socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, sv) != 0)
     throw std::runtime_error("socketpair");
-  return {can::UniqueFd(sv[0]), can::UniqueFd(sv[1])};
+  return {UniqueFd(sv[0]), UniqueFd(sv[1])};
 }
 
 }  // namespace
@@ -110,7 +110,7 @@ TEST(CanTransport, UnixSeqpacketPath) {
   char dir[] = "/tmp/can_transport_XXXXXX";
   ASSERT_NE(::mkdtemp(dir), nullptr);
   const std::string path = std::string(dir) + "/bus.sock";
-  can::UniqueFd listener(::socket(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0));
+  UniqueFd listener(::socket(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0));
   sockaddr_un addr{};
   addr.sun_family = AF_UNIX;
   std::strncpy(addr.sun_path, path.c_str(), sizeof addr.sun_path - 1);
@@ -118,7 +118,7 @@ TEST(CanTransport, UnixSeqpacketPath) {
   ASSERT_EQ(::listen(listener.get(), 1), 0);
   auto t = can::open_can_transport(can::parse_can_spec("unix:" + path));
   ASSERT_TRUE(t.ok()) << t.error().message;
-  can::UniqueFd server(::accept(listener.get(), nullptr, nullptr));
+  UniqueFd server(::accept(listener.get(), nullptr, nullptr));
   ASSERT_TRUE(server.valid());
   auto peer = can::make_fd_transport(std::move(server));
   ASSERT_TRUE(t.value()->send(counters::encode(counters::SyncFrame{9})).ok());

@@ -5,11 +5,11 @@
 #include <cmath>
 #include <thread>
 
-#include "drivers/chamber/chamber_map.hpp"
-#include "drivers/chamber/modbus_chamber.hpp"
+#include "drivers/chamber/generic_plc/generic_plc_map.hpp"
+#include "drivers/chamber/generic_plc/modbus_chamber.hpp"
 #include "drivers/modbus/read_plan.hpp"
 #include "sim_devices/chamber_sim.hpp"
-#include "sim_devices/modbus_server.hpp"
+#include "sim_devices/servers/modbus_server.hpp"
 
 namespace mb = station::drivers::modbus;
 namespace cm = station::drivers::chamber_map;

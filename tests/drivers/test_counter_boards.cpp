@@ -33,7 +33,7 @@ sim::BoardConfig board_config(std::uint8_t node, std::uint64_t seed) {
 struct Rig {
   std::unique_ptr<sim::CounterBoardBus> bus;
   std::unique_ptr<c::CounterBoards> driver;
-  can::UniqueFd driver_side;  // a second descriptor of the driver's socket, to jam its tx queue
+  UniqueFd driver_side;  // a second descriptor of the driver's socket, to jam its tx queue
   double t_s = 0;
 
   explicit Rig(std::vector<sim::BoardConfig> boards) {
@@ -46,8 +46,8 @@ struct Rig {
       bus->add_board(b);
       cfg.slots.push_back({b.node, "RLG-" + std::to_string(b.node), b.gyro.pulse_weight_arcsec});
     }
-    driver_side = can::UniqueFd(::dup(sv[0]));
-    driver = std::make_unique<c::CounterBoards>(can::make_fd_transport(can::UniqueFd(sv[0])), cfg);
+    driver_side = UniqueFd(::dup(sv[0]));
+    driver = std::make_unique<c::CounterBoards>(can::make_fd_transport(UniqueFd(sv[0])), cfg);
   }
   // One second of simulated time, then one latch answered by the simulator.
   c::TickResult tick(std::uint8_t seq, double air_c = 25.0) {
@@ -68,7 +68,7 @@ TEST(CounterBoards, ConfigIsValidatedWithoutIo) {
   ASSERT_EQ(::socketpair(AF_UNIX, SOCK_SEQPACKET, 0, sv), 0);
   ::close(sv[1]);
   auto make = [&](std::vector<c::CounterSlot> slots) {
-    return c::CounterBoards(can::make_fd_transport(can::UniqueFd(::dup(sv[0]))), {slots});
+    return c::CounterBoards(can::make_fd_transport(UniqueFd(::dup(sv[0]))), {slots});
   };
   EXPECT_THROW(make({{17, "x", 1.5}}), std::invalid_argument);
   EXPECT_THROW(make({{1, "x", 0.0}}), std::invalid_argument);
@@ -222,8 +222,8 @@ TEST(CounterBoards, MissingAnnouncedTempsIsFlaggedNotLost) {
   int sv[2];
   ASSERT_EQ(::socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, sv), 0);
   c::CounterBoardsConfig cfg{{{4, "RLG-4", 2.0}}, 50ms, 1.0};
-  c::CounterBoards driver(can::make_fd_transport(can::UniqueFd(sv[0])), cfg);
-  auto board = can::make_fd_transport(can::UniqueFd(sv[1]));
+  c::CounterBoards driver(can::make_fd_transport(UniqueFd(sv[0])), cfg);
+  auto board = can::make_fd_transport(UniqueFd(sv[1]));
   const std::uint8_t follows = c::kFollowsCounts | c::kFollowsTemps;
   auto answer = [&](std::uint8_t seq, std::uint32_t up, std::uint32_t down, std::uint32_t t_us) {
     ASSERT_TRUE(driver.send_sync(seq).ok());
@@ -341,8 +341,8 @@ TEST(CounterBoards, LateStaleStatusDoesNotDiscardCurrentCounts) {
   int sv[2];
   ASSERT_EQ(::socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, sv), 0);
   c::CounterBoardsConfig cfg{{{4, "RLG-4", 1.5}}, 50ms, 1.0};
-  c::CounterBoards driver(can::make_fd_transport(can::UniqueFd(sv[0])), cfg);
-  auto board = can::make_fd_transport(can::UniqueFd(sv[1]));
+  c::CounterBoards driver(can::make_fd_transport(UniqueFd(sv[0])), cfg);
+  auto board = can::make_fd_transport(UniqueFd(sv[1]));
   auto status = [&](std::uint8_t seq, std::uint32_t t_us) {
     ASSERT_TRUE(board->send(c::encode(c::StatusFrame{4, seq, 0, t_us, c::kFollowsCounts})).ok());
   };
@@ -374,8 +374,8 @@ TEST(CounterBoards, StaleStatusBeforeCurrentKeepsFollowersStale) {
   int sv[2];
   ASSERT_EQ(::socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, sv), 0);
   c::CounterBoardsConfig cfg{{{4, "RLG-4", 1.5}}, 50ms, 1.0};
-  c::CounterBoards driver(can::make_fd_transport(can::UniqueFd(sv[0])), cfg);
-  auto board = can::make_fd_transport(can::UniqueFd(sv[1]));
+  c::CounterBoards driver(can::make_fd_transport(UniqueFd(sv[0])), cfg);
+  auto board = can::make_fd_transport(UniqueFd(sv[1]));
   ASSERT_TRUE(driver.send_sync(7).ok());
   ASSERT_TRUE(board->receive(1000ms).ok());
   ASSERT_TRUE(board->send(c::encode(c::StatusFrame{4, 6, 0, 1, c::kFollowsCounts})).ok());

@@ -26,8 +26,8 @@ struct OneBoard {
     int sv[2];
     if (::socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, sv) != 0) throw std::exception();
     c::CounterBoardsConfig cfg{{{4, "RLG-4", 1.5}}, 50ms, 1.0};
-    driver = std::make_unique<c::CounterBoards>(can::make_fd_transport(can::UniqueFd(sv[0])), cfg);
-    board = can::make_fd_transport(can::UniqueFd(sv[1]));
+    driver = std::make_unique<c::CounterBoards>(can::make_fd_transport(UniqueFd(sv[0])), cfg);
+    board = can::make_fd_transport(UniqueFd(sv[1]));
   }
   // One latch answered with these counts, board clock and flags.
   c::CounterReading latch(std::uint8_t seq, std::uint32_t up, std::uint32_t down,

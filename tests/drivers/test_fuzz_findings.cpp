@@ -11,7 +11,7 @@
 #include <stdexcept>
 #include <thread>
 
-#include "drivers/chamber/chamber_map.hpp"
+#include "drivers/chamber/generic_plc/generic_plc_map.hpp"
 #include "drivers/modbus/map_overrides.hpp"
 #include "drivers/modbus/modbus_client.hpp"
 #include "drivers/modbus/read_plan.hpp"

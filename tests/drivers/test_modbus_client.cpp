@@ -5,10 +5,10 @@
 #include <chrono>
 #include <vector>
 
-#include "drivers/chamber/chamber_map.hpp"
+#include "drivers/chamber/generic_plc/generic_plc_map.hpp"
 #include "drivers/modbus/modbus_client.hpp"
 #include "sim_devices/chamber_sim.hpp"
-#include "sim_devices/modbus_server.hpp"
+#include "sim_devices/servers/modbus_server.hpp"
 
 namespace mb = station::drivers::modbus;
 namespace cm = station::drivers::chamber_map;

@@ -3,11 +3,11 @@
 
 #include <cmath>
 
-#include "drivers/chamber/chamber_map.hpp"
+#include "drivers/chamber/generic_plc/generic_plc_map.hpp"
 #include "drivers/modbus/endpoint.hpp"
 #include "drivers/modbus/map_overrides.hpp"
 #include "drivers/modbus/register_map.hpp"
-#include "drivers/turntable/turntable_map.hpp"
+#include "drivers/turntable/generic_plc/generic_plc_map.hpp"
 
 namespace mb = station::drivers::modbus;
 namespace cm = station::drivers::chamber_map;
@@ -106,7 +106,7 @@ TEST(ChamberMap, PresetsByNameAndUnknownNameIsNamed) {
   EXPECT_EQ(f4t.at(cm::kAir).order, mb::WordOrder::cdab);
   EXPECT_NE(error_of([] { cm::preset("espec"); }).find("'espec'"), std::string::npos);
   EXPECT_NE(error_of([&] { (void)f4.at("nope"); }).find("'nope'"), std::string::npos);
-  EXPECT_EQ(station::drivers::turntable_map::default_map().points().size(), 9u);
+  EXPECT_EQ(station::drivers::turntable_map::generic_plc().points().size(), 9u);
 }
 
 TEST(ChamberMap, OverridesChangeOnlyNamedFieldsAndAreChecked) {

@@ -6,11 +6,11 @@
 #include <cstdio>
 #include <string>
 
-#include "drivers/chamber/chamber_map.hpp"
+#include "drivers/chamber/generic_plc/generic_plc_map.hpp"
 #include "drivers/common/backoff.hpp"
 #include "drivers/modbus/modbus_client.hpp"
 #include "sim_devices/chamber_sim.hpp"
-#include "sim_devices/modbus_server.hpp"
+#include "sim_devices/servers/modbus_server.hpp"
 #include "tests/drivers/manual_clock.hpp"
 
 namespace mb = station::drivers::modbus;

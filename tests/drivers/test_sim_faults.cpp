@@ -17,11 +17,11 @@
 #include <thread>
 #include <vector>
 
-#include "drivers/chamber/chamber_map.hpp"
-#include "drivers/chamber/modbus_chamber.hpp"
+#include "drivers/chamber/generic_plc/generic_plc_map.hpp"
+#include "drivers/chamber/generic_plc/modbus_chamber.hpp"
 #include "drivers/counters/counter_frames.hpp"
-#include "drivers/turntable/modbus_turntable.hpp"
-#include "drivers/turntable/turntable_map.hpp"
+#include "drivers/turntable/generic_plc/modbus_turntable.hpp"
+#include "drivers/turntable/generic_plc/generic_plc_map.hpp"
 #include "sim_devices/fault_commands.hpp"
 #include "sim_devices/sim_world.hpp"
 
@@ -43,9 +43,9 @@ sim::SimWorldConfig two_gyros() {
 struct Rig {
   sim::SimWorld world{two_gyros()};
   dr::ModbusChamber chamber{"chamber", mb::parse_endpoint(world.chamber_endpoint()),
-                            dr::chamber_map::watlow_f4(), 0.2};
+                            dr::chamber_map::generic_plc(), 0.2};
   dr::ModbusTurntable table{"table", mb::parse_endpoint(world.turntable_endpoint()),
-                            dr::turntable_map::default_map(), dr::TurntableLimits{}, 0.2};
+                            dr::turntable_map::generic_plc(), dr::TurntableLimits{}, 0.2};
   int can_fd = std::stoi(world.can_transport().substr(3));  // "fd:N"
   std::uint8_t seq = 0;
 

@@ -8,11 +8,11 @@
 #include <memory>
 #include <string>
 
-#include "drivers/chamber/chamber_map.hpp"
-#include "drivers/turntable/turntable_map.hpp"
+#include "drivers/chamber/generic_plc/generic_plc_map.hpp"
+#include "drivers/turntable/generic_plc/generic_plc_map.hpp"
 #include "sim_devices/chamber_sim.hpp"
-#include "sim_devices/modbus_server.hpp"
-#include "sim_devices/modbus_strict.hpp"
+#include "sim_devices/servers/modbus_server.hpp"
+#include "sim_devices/servers/modbus_strict.hpp"
 #include "sim_devices/turntable_sim.hpp"
 
 namespace cm = station::drivers::chamber_map;

@@ -21,8 +21,8 @@
 #include <thread>
 #include <vector>
 
-#include "drivers/chamber/chamber_map.hpp"
-#include "drivers/chamber/modbus_chamber.hpp"
+#include "drivers/chamber/generic_plc/generic_plc_map.hpp"
+#include "drivers/chamber/generic_plc/modbus_chamber.hpp"
 #include "sim_devices/control_socket.hpp"
 
 namespace sim = station::sim;
@@ -174,7 +174,7 @@ TEST(SimrigControl, SendDeliversFaultCommandsToARunningSimrig) {
   EXPECT_EQ(replies, "ok\nok\n");
   namespace mb = station::drivers::modbus;
   station::drivers::ModbusChamber chamber("chamber", mb::parse_endpoint(chamber_endpoint),
-                                          station::drivers::chamber_map::watlow_f4(), 0.5);
+                                          station::drivers::chamber_map::generic_plc(), 0.5);
   auto s = chamber.read();
   ASSERT_TRUE(s) << s.error().message;
   EXPECT_TRUE(s.value().alarms.high_limit_trip);

@@ -3,9 +3,9 @@
 
 #include <cmath>
 
-#include "drivers/turntable/modbus_turntable.hpp"
-#include "drivers/turntable/turntable_map.hpp"
-#include "sim_devices/modbus_server.hpp"
+#include "drivers/turntable/generic_plc/modbus_turntable.hpp"
+#include "drivers/turntable/generic_plc/generic_plc_map.hpp"
+#include "sim_devices/servers/modbus_server.hpp"
 #include "sim_devices/turntable_sim.hpp"
 
 namespace mb = station::drivers::modbus;
@@ -21,7 +21,7 @@ struct Rig {
     server.start_tcp();
     table = std::make_unique<ModbusTurntable>("table", mb::parse_endpoint(server.endpoint()), map);
   }
-  mb::RegisterMap map = station::drivers::turntable_map::default_map();
+  mb::RegisterMap map = station::drivers::turntable_map::generic_plc();
   station::sim::TurntableSim sim;
   station::sim::ModbusServer server;
   std::unique_ptr<ModbusTurntable> table;

@@ -22,10 +22,10 @@
 #include <thread>
 #include <vector>
 
-#include "drivers/chamber/chamber_map.hpp"
-#include "drivers/chamber/modbus_chamber.hpp"
-#include "drivers/turntable/modbus_turntable.hpp"
-#include "drivers/turntable/turntable_map.hpp"
+#include "drivers/chamber/generic_plc/generic_plc_map.hpp"
+#include "drivers/chamber/generic_plc/modbus_chamber.hpp"
+#include "drivers/turntable/generic_plc/modbus_turntable.hpp"
+#include "drivers/turntable/generic_plc/generic_plc_map.hpp"
 #include "fuzz_check.hpp"
 
 namespace dr = station::drivers;
@@ -178,9 +178,9 @@ auto bounded(const char* what, F&& call) {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static FakeDevice device;
   const auto endpoint = mb::parse_endpoint("tcp://127.0.0.1:" + std::to_string(device.port()));
-  static dr::ModbusChamber f4("f4", endpoint, dr::chamber_map::watlow_f4(), kTimeoutS);
+  static dr::ModbusChamber f4("f4", endpoint, dr::chamber_map::generic_plc(), kTimeoutS);
   static dr::ModbusChamber f4t("f4t", endpoint, dr::chamber_map::f4t(), kTimeoutS);
-  static dr::ModbusTurntable table("table", endpoint, dr::turntable_map::default_map(), {},
+  static dr::ModbusTurntable table("table", endpoint, dr::turntable_map::generic_plc(), {},
                                    kTimeoutS);
   if (size < 1) return 0;
   device.set_replies(parse_replies(data + 1, size - 1));

@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
-#include "drivers/chamber/chamber_map.hpp"
+#include "drivers/chamber/generic_plc/generic_plc_map.hpp"
 #include "drivers/modbus/map_overrides.hpp"
 #include "drivers/modbus/read_plan.hpp"
-#include "drivers/turntable/turntable_map.hpp"
+#include "drivers/turntable/generic_plc/generic_plc_map.hpp"
 #include "fuzz_check.hpp"
 
 namespace mb = station::drivers::modbus;
@@ -37,11 +37,11 @@ struct Reader {
 mb::RegisterMap preset(std::uint8_t which) {
   switch (which % 3) {
     case 0:
-      return station::drivers::chamber_map::watlow_f4();
+      return station::drivers::chamber_map::generic_plc();
     case 1:
       return station::drivers::chamber_map::f4t();
     default:
-      return station::drivers::turntable_map::default_map();
+      return station::drivers::turntable_map::generic_plc();
   }
 }
 

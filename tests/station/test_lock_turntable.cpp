@@ -4,9 +4,9 @@
 
 #include <cmath>
 
-#include "drivers/turntable/modbus_turntable.hpp"
-#include "drivers/turntable/turntable_map.hpp"
-#include "sim_devices/modbus_server.hpp"
+#include "drivers/turntable/generic_plc/modbus_turntable.hpp"
+#include "drivers/turntable/generic_plc/generic_plc_map.hpp"
+#include "sim_devices/servers/modbus_server.hpp"
 #include "sim_devices/turntable_sim.hpp"
 #include "station/daemon/protocol_runner.hpp"
 
@@ -15,7 +15,7 @@ using station::drivers::TurntableMode;
 
 // Issue 7 item 10: a table parked and locked at 90 deg, a protocol locking it at 0 deg.
 TEST(LockTurntable, ATableLockedAt90IsMovedTo0ThenLocked) {
-  const auto map = station::drivers::turntable_map::default_map();
+  const auto map = station::drivers::turntable_map::generic_plc();
   station::sim::TurntableSim sim(map);
   station::sim::ModbusServer server(sim);
   server.start_tcp();

@@ -9,10 +9,10 @@
 #include <fstream>
 #include <string>
 
-#include "drivers/chamber/chamber_map.hpp"
+#include "drivers/chamber/generic_plc/generic_plc_map.hpp"
 #include "drivers/modbus/modbus_client.hpp"
 #include "sim_devices/chamber_sim.hpp"
-#include "sim_devices/modbus_server.hpp"
+#include "sim_devices/servers/modbus_server.hpp"
 #include "station/common/input_error.hpp"
 #include "station/session/replay_modbus.hpp"
 #include "station/session/session_log.hpp"

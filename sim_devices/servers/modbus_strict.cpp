@@ -1,5 +1,5 @@
 // request_exception: a register-by-register check of a request PDU against a register map.
-#include "sim_devices/modbus_strict.hpp"
+#include "sim_devices/servers/modbus_strict.hpp"
 
 #include <array>
 

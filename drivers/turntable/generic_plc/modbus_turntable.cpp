@@ -1,11 +1,11 @@
 // ModbusTurntable: decodes table state and range-checks demands.
-#include "drivers/turntable/modbus_turntable.hpp"
+#include "drivers/turntable/generic_plc/modbus_turntable.hpp"
 
 #include <fmt/format.h>
 
 #include <cmath>
 
-#include "drivers/turntable/turntable_map.hpp"
+#include "drivers/turntable/generic_plc/generic_plc_map.hpp"
 
 namespace station::drivers {
 namespace tm = turntable_map;

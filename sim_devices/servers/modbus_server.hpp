@@ -16,7 +16,8 @@
 #include <vector>
 
 #include "drivers/modbus/register_map.hpp"
-#include "sim_devices/modbus_strict.hpp"
+#include "sim_devices/servers/modbus_strict.hpp"
+#include "sim_devices/servers/sim_server.hpp"
 
 namespace station::sim {
 
@@ -48,11 +49,11 @@ class ModbusDeviceModel {
 /// Serves one model as a strict device: requests outside its map get exception 01/02/03, and on
 /// RTU a request for another unit id gets no answer at all. start_*() spawns the thread; the
 /// destructor stops and joins it (the loop polls with a 100 ms timeout, so shutdown never hangs).
-class ModbusServer {
+class ModbusServer final : public SimServer {
  public:
   /// Stores the model (not owned; must outlive the server) and unit id; no I/O.
   explicit ModbusServer(ModbusDeviceModel& model, int unit_id = 1);
-  ~ModbusServer();
+  ~ModbusServer() override;
   ModbusServer(const ModbusServer&) = delete;
   ModbusServer& operator=(const ModbusServer&) = delete;
 
@@ -61,33 +62,33 @@ class ModbusServer {
   /// Opens a pty pair and serves RTU on its master; clients open pty_path(). Throws on failure.
   void start_rtu_pty(int baud = 19200);
   /// Stops the thread and closes every descriptor; blocks at most ~100 ms. Idempotent.
-  void stop();
+  void stop() override;
 
   /// TCP port chosen by the kernel (0 before start_tcp).
   int port() const { return port_; }
   /// Pty slave path (empty before start_rtu_pty).
   const std::string& pty_path() const { return pty_path_; }
   /// Endpoint string for drivers: tcp://127.0.0.1:PORT or rtu:/dev/pts/N?baud=..&parity=N&...
-  std::string endpoint() const;
+  std::string endpoint() const override;
   /// Requests received so far (including faulted ones).
-  std::uint64_t requests() const { return requests_.load(); }
+  std::uint64_t requests() const override { return requests_.load(); }
 
   /// The next `n` requests get no reply at all (the client times out).
-  void inject_timeouts(int n);
+  void inject_timeouts(int n) override;
   /// The next `n` requests get exception reply `code` (e.g.
   /// MODBUS_EXCEPTION_SLAVE_OR_SERVER_FAILURE); n < 0: every request until clear_faults().
-  void inject_exception(int code, int n = 1);
+  void inject_exception(int code, int n = 1) override;
   /// The next `n` requests make the server close the connection without replying (TCP; on RTU
   /// this is a missing reply).
-  void inject_drop(int n = 1);
+  void inject_drop(int n = 1) override;
   /// Every request received in the next `seconds` (wall clock) gets no reply; 0 ends a stall.
-  void stall_for(double seconds);
+  void stall_for(double seconds) override;
   /// Closes every client connection now and stops listening for `seconds` (wall clock): a
   /// connect meanwhile is refused, as by a device that is powered off. On RTU the line is silent
   /// for that time. Then it listens again on the same port.
-  void disconnect_for(double seconds);
+  void disconnect_for(double seconds) override;
   /// Ends every injected fault (timeouts, exceptions, drops, stall, disconnect).
-  void clear_faults();
+  void clear_faults() override;
 
  private:
   enum class Fault { none, timeout, exception, drop };

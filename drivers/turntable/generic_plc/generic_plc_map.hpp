@@ -1,6 +1,9 @@
 // Turntable register map (wire definition shared by ModbusTurntable and TurntableSim).
 //
-// The station's own map for a Modbus TCP servo controller, unit 1, 0-based addresses:
+// The station's own map, "generic_plc", for a table whose servo drive is fronted by a PLC or a
+// Modbus TCP gateway programmed for the station. NOT a table maker's map (rate tables such as the
+// ACUTROL3000 speak their own command languages: drivers/turntable/acutrol3000/); documented in
+// docs/DEVICES.md as the station's definition. Unit 1, 0-based addresses:
 //   holding (fc 3/6/16, rw)                     input (fc 4, ro)
 //     0     mode demand: 0 off, 1 position, 2 rate  100-101 angle, float32 ABCD, deg [0,360)
 //     2-3   position demand, float32 ABCD, deg       102-103 rate, float32 ABCD, deg/s
@@ -43,8 +46,8 @@ enum StatusBit : unsigned {
   kInterlockOpen = 1u << 3
 };
 
-/// The default turntable map (see file comment).
-inline RegisterMap default_map(int unit_id = 1) {
+/// The generic PLC turntable map (see file comment).
+inline RegisterMap generic_plc(int unit_id = 1) {
   auto p = [unit_id](const char* n, std::uint16_t a, PointType t, FunctionCode fc, Access acc) {
     return Point{n, a, t, 1.0, WordOrder::abcd, fc, unit_id, false, acc};
   };
@@ -52,20 +55,12 @@ inline RegisterMap default_map(int unit_id = 1) {
   constexpr auto I = FunctionCode::input;
   constexpr auto F = PointType::float32;
   constexpr auto U = PointType::uint16;
-  return RegisterMap("turntable",
+  return RegisterMap("generic_plc",
                      {p(kModeDemand, 0, U, H, Access::rw), p(kPositionDemand, 2, F, H, Access::rw),
                       p(kRateDemand, 4, F, H, Access::rw), p(kLock, 6, U, H, Access::rw),
                       p(kStop, 7, U, H, Access::rw), p(kAngle, 100, F, I, Access::ro),
                       p(kRate, 102, F, I, Access::ro), p(kStatus, 104, U, I, Access::ro),
                       p(kModeActual, 105, U, I, Access::ro)});
-}
-
-/// Preset by name (only "default" so far); throws std::invalid_argument naming the bad name, so a
-/// `preset` key in the config is never accepted and then ignored.
-inline RegisterMap preset(const std::string& name, int unit_id = 1) {
-  if (name == "default") return default_map(unit_id);
-  throw std::invalid_argument("unknown turntable register-map preset '" + name +
-                              "' (expected default)");
 }
 
 }  // namespace station::drivers::turntable_map

@@ -1,5 +1,5 @@
 // ModbusChamber: decodes chamber state from the register map and range-checks commands.
-#include "drivers/chamber/modbus_chamber.hpp"
+#include "drivers/chamber/generic_plc/modbus_chamber.hpp"
 
 #include <fmt/format.h>
 
@@ -7,7 +7,7 @@
 #include <cmath>
 #include <limits>
 
-#include "drivers/chamber/chamber_map.hpp"
+#include "drivers/chamber/generic_plc/generic_plc_map.hpp"
 
 namespace station::drivers {
 namespace cm = chamber_map;

@@ -5,7 +5,7 @@
 
 #include <utility>
 
-namespace station::drivers::can {
+namespace station::drivers {
 
 /// RAII holder of one file descriptor (-1 = none). Move-only.
 class UniqueFd {
@@ -38,4 +38,4 @@ class UniqueFd {
   int fd_ = -1;
 };
 
-}  // namespace station::drivers::can
+}  // namespace station::drivers

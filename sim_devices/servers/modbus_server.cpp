@@ -1,5 +1,5 @@
 // ModbusServer: a poll()-driven libmodbus server thread, TCP or RTU-on-pty, with fault injection.
-#include "sim_devices/modbus_server.hpp"
+#include "sim_devices/servers/modbus_server.hpp"
 
 #include <arpa/inet.h>
 #include <fcntl.h>
@@ -15,7 +15,7 @@
 #include <stdexcept>
 #include <utility>
 
-#include "sim_devices/rtu_framing.hpp"
+#include "sim_devices/servers/rtu_framing.hpp"
 
 namespace station::sim {
 namespace {

@@ -1,5 +1,5 @@
 // RTU framing: CRC-16, silence-delimited frame reads and the unit-id filter.
-#include "sim_devices/rtu_framing.hpp"
+#include "sim_devices/servers/rtu_framing.hpp"
 
 #include <poll.h>
 #include <unistd.h>

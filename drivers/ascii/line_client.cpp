@@ -1,0 +1,138 @@
+// LineClient: exchanges, error translation, reconnect and tap records.
+#include "drivers/ascii/line_client.hpp"
+
+#include <fmt/format.h>
+
+#include <cerrno>
+#include <cstring>
+#include <variant>
+
+namespace station::drivers::ascii {
+
+Error translate_line_error(int err, const std::string& what) {
+  std::string msg = what + ": " + (err == EMSGSIZE ? "reply line too long" : std::strerror(err));
+  switch (err) {
+    case ETIMEDOUT:
+    case EAGAIN:
+      return make_error(ErrorKind::timeout, msg);
+    case EMSGSIZE:
+    case EBADMSG:
+      return make_error(ErrorKind::protocol, msg);
+    case ECONNRESET:
+    case ECONNREFUSED:
+    case ECONNABORTED:
+    case EPIPE:
+    case ENOTCONN:
+    case EBADF:
+    case ENOENT:
+    case EHOSTUNREACH:
+    case ENETUNREACH:
+    case EIO:  // a serial adapter that vanished, a pty whose master closed
+    case ENXIO:
+    case ENODEV:
+    case ESHUTDOWN:  // the peer closed the link (end of stream)
+      return make_error(ErrorKind::disconnected, msg);
+    default:
+      return make_error(ErrorKind::io, msg);
+  }
+}
+
+LineClient::LineClient(std::string device, LineEndpoint endpoint, LineFraming framing,
+                       std::unique_ptr<LineWire> wire, double timeout_s)
+    : device_(std::move(device)),
+      endpoint_(std::move(endpoint)),
+      framing_(std::move(framing)),
+      timeout_s_(timeout_s),
+      wire_(wire ? std::move(wire) : std::make_unique<FdLineWire>(endpoint_)) {}
+
+Result<void> LineClient::connect() {
+  disconnect();
+  if (wire_->open(timeout_s_) == -1) {
+    const int err = errno;
+    auto e = translate_line_error(err, device_ + " connect " + to_string(endpoint_));
+    if (e.kind != ErrorKind::timeout) e.kind = ErrorKind::disconnected;
+    tap(TapDirection::event, "error",
+        std::string_view(reinterpret_cast<const char*>(errno_bytes(err).data()), 4), e.message);
+    backoff_.failed();
+    last_connect_error_ = e.message;
+    return e;
+  }
+  backoff_.succeeded();
+  connected_ = true;
+  ++connects_;
+  consecutive_timeouts_ = 0;
+  tap(TapDirection::event, "connect", {}, to_string(endpoint_));
+  return {};
+}
+
+void LineClient::disconnect() {
+  if (connected_) tap(TapDirection::event, "disconnect", {}, to_string(endpoint_));
+  wire_->close();
+  connected_ = false;
+}
+
+Result<void> LineClient::ensure_connected() {
+  if (connected_) return {};
+  if (!backoff_.due())
+    return make_error(ErrorKind::disconnected,
+                      fmt::format("{}: not connected, next attempt in {:.1f} s ({})", device_,
+                                  backoff_.wait_s(), last_connect_error_));
+  return connect();
+}
+
+Error LineClient::fail(int err, const std::string& what) {
+  Error e = translate_line_error(err, device_ + " " + what);
+  consecutive_timeouts_ = e.kind == ErrorKind::timeout ? consecutive_timeouts_ + 1 : 0;
+  // A rebooted TCP peer leaves our socket half-open (see ModbusClient::fail).
+  const bool stale_tcp = consecutive_timeouts_ >= kTimeoutsBeforeReconnect &&
+                         std::holds_alternative<LineTcp>(endpoint_);
+  if (stale_tcp)
+    e.message += fmt::format(" ({} timeouts in a row: reconnecting)", consecutive_timeouts_);
+  const auto eb = errno_bytes(err);
+  tap(TapDirection::event, "error", std::string_view(reinterpret_cast<const char*>(eb.data()), 4),
+      e.message);
+  if (e.kind == ErrorKind::disconnected || stale_tcp) {
+    consecutive_timeouts_ = 0;
+    disconnect();
+  } else if (connected_) {
+    wire_->flush();  // a late reply must not be read as the next command's
+  }
+  return e;
+}
+
+Result<void> LineClient::transmit(std::string_view command) {
+  if (auto c = ensure_connected(); !c) return c.error();
+  wire_->flush();
+  tap(TapDirection::tx, "ascii", command, {});
+  std::string bytes(command);
+  bytes += framing_.command_terminator;
+  if (wire_->send(bytes, timeout_s_) == -1)
+    return fail(errno, fmt::format("send '{}'", command));
+  return {};
+}
+
+Result<std::string> LineClient::query(std::string_view command) {
+  if (auto t = transmit(command); !t) return t.error();
+  std::string line;
+  if (wire_->receive(line, framing_.reply_terminator, timeout_s_, framing_.max_reply_bytes) == -1)
+    return fail(errno, fmt::format("reply to '{}'", command));
+  consecutive_timeouts_ = 0;
+  tap(TapDirection::rx, "ascii", line, {});
+  return line;
+}
+
+Result<void> LineClient::send(std::string_view command) {
+  if (auto t = transmit(command); !t) return t;
+  consecutive_timeouts_ = 0;
+  return {};
+}
+
+void LineClient::tap(TapDirection dir, const char* kind, std::string_view bytes,
+                     std::string detail) {
+  if (tap_ == nullptr) return;
+  tap_->on_exchange(TapRecord{tap_wall_time_s(), device_, dir, kind,
+                              std::vector<std::uint8_t>(bytes.begin(), bytes.end()),
+                              std::move(detail)});
+}
+
+}  // namespace station::drivers::ascii

@@ -1,0 +1,55 @@
+// A Watlow Series F4 on Modbus RTU/TCP (dialects "watlow_f4" and "watlow_f4t_map2"): int16 with
+// the unit's decimal places, deg C or deg F read from the controller, run through a configured
+// event output. The F4 has no constant-mode ramp: controller_ramp() is false and the station
+// ramps by moving the setpoint. Constructor does no I/O.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "drivers/chamber/chamber.hpp"
+#include "drivers/chamber/scaled_temperature.hpp"
+#include "drivers/modbus/modbus_client.hpp"
+#include "drivers/modbus/readback.hpp"
+#include "drivers/modbus/register_map.hpp"
+
+namespace station::drivers {
+
+class WatlowF4Chamber final : public Chamber {
+ public:
+  /// `model` names the dialect in identify(); `map` is watlow_f4::map() (possibly overridden).
+  WatlowF4Chamber(std::string name, std::string model, modbus::Endpoint endpoint,
+                  modbus::RegisterMap map, double response_timeout_s,
+                  std::unique_ptr<modbus::ModbusWire> wire = nullptr);
+
+  Result<void> connect() override { return client_.connect(); }
+  Result<ChamberState> read() override;
+  /// Setpoint (checked against 602/603) and run (the event output); a ramp is not the F4's to
+  /// apply and is ignored (the station ramps: controller_ramp()).
+  Result<void> command(const ChamberCommand& c) override;
+  std::string name() const override { return name_; }
+  Result<ChamberIdentity> identify() override;
+  bool controller_ramp() const override { return false; }
+
+  void set_tap(Tap* tap) { client_.set_tap(tap); }
+  void set_readback_every(int reads) { readback_.set_every(reads); }
+  modbus::ModbusClient& client() { return client_; }
+
+ private:
+  Result<TemperatureScale> scale();
+  Result<double> temperature_c(const char* point, const TemperatureScale& s);
+
+  std::string name_, model_;
+  modbus::RegisterMap map_;
+  modbus::ModbusClient client_;
+  std::optional<TemperatureScale> scale_, product_scale_;  // read once per connection
+  std::uint64_t scale_connects_ = 0;
+  modbus::ReadbackSchedule readback_;
+  ChamberMode mode_ = ChamberMode::off;
+  double product_c_ = 0;
+  bool run_enabled_ = false;
+};
+
+}  // namespace station::drivers

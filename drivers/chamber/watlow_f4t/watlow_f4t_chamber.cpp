@@ -1,0 +1,188 @@
+// WatlowF4tChamber: Data Map 1 points, Watlow enumerations and the controller's ramp.
+#include "drivers/chamber/watlow_f4t/watlow_f4t_chamber.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "drivers/chamber/watlow_f4t/f4t_map.hpp"
+
+namespace station::drivers {
+namespace f4t = watlow_f4t;
+
+namespace {
+
+bool alarm_active(int state) {
+  return std::find(f4t::kAlarmInactive.begin(), f4t::kAlarmInactive.end(), state) ==
+         f4t::kAlarmInactive.end();
+}
+
+ChamberMode mode_of(int loop_mode, int profile_state, bool ramping) {
+  if (profile_state == f4t::kProfileRunning) return ChamberMode::profile;
+  if (profile_state == f4t::kProfilePaused) return ChamberMode::hold;
+  if (loop_mode == f4t::kOff) return ChamberMode::off;
+  if (loop_mode == f4t::kManual) return ChamberMode::manual;
+  return ramping ? ChamberMode::ramping : ChamberMode::constant;
+}
+
+}  // namespace
+
+WatlowF4tChamber::WatlowF4tChamber(std::string name, modbus::Endpoint endpoint,
+                                   modbus::RegisterMap map, double response_timeout_s,
+                                   std::unique_ptr<modbus::ModbusWire> wire)
+    : name_(std::move(name)),
+      map_(std::move(map)),
+      client_(name_, endpoint,
+              wire ? std::move(wire) : std::make_unique<modbus::LibmodbusWire>(endpoint),
+              response_timeout_s) {
+  for (const char* p : {f4t::kAir, f4t::kProduct, f4t::kSetpoint, f4t::kWorkingSetpoint,
+                        f4t::kSetpointLow, f4t::kSetpointHigh, f4t::kLoopMode, f4t::kRampAction,
+                        f4t::kRampScale, f4t::kRampRate, f4t::kProfileState, f4t::kAlarm1,
+                        f4t::kRunEvent, f4t::kUnits})
+    (void)map_.at(p);
+}
+
+Result<double> WatlowF4tChamber::value(const char* point) { return client_.read(map_.at(point)); }
+
+// The display unit (CCL __profile_units: 15 deg C, 30 deg F), read once per connection; any
+// other value is refused rather than guessed.
+Result<TemperatureScale> WatlowF4tChamber::scale() {
+  if (scale_ && scale_connects_ == client_.connects()) return *scale_;
+  auto u = value(f4t::kUnits);
+  if (!u) return u.error();
+  const int units = static_cast<int>(u.value());
+  if (units != f4t::kCelsius && units != f4t::kFahrenheit)
+    return make_error(ErrorKind::protocol,
+                      fmt::format("{}: units register {} = {} (F4T: 15 deg C, 30 deg F): refusing "
+                                  "to read temperatures",
+                                  name_, map_.at(f4t::kUnits).address, units));
+  scale_ = TemperatureScale{-1, units == f4t::kFahrenheit};
+  scale_connects_ = client_.connects();
+  return *scale_;
+}
+
+Result<double> WatlowF4tChamber::temperature_c(const char* point, const TemperatureScale& s) {
+  auto v = value(point);
+  if (!v) return v.error();
+  return s.to_c(v.value());
+}
+
+// The points read with the command registers: mode, profile, ramp, run, product.
+Result<void> WatlowF4tChamber::read_commands(const TemperatureScale& s) {
+  auto mode = value(f4t::kLoopMode);
+  auto profile = mode ? value(f4t::kProfileState) : mode;
+  auto action = profile ? value(f4t::kRampAction) : profile;
+  auto rate = action ? value(f4t::kRampRate) : action;
+  auto scale = rate ? value(f4t::kRampScale) : rate;
+  auto run = scale ? value(f4t::kRunEvent) : scale;
+  if (!run) return run.error();
+  const bool ramp_on = static_cast<int>(action.value()) != f4t::kOff;
+  const double per = static_cast<int>(scale.value()) == f4t::kHours ? 1.0 / 60.0 : 1.0;
+  ramp_c_per_min_ = ramp_on ? s.delta_to_c(rate.value()) * per : 0.0;
+  run_enabled_ = static_cast<int>(run.value()) == f4t::kOn;
+  mode_ = mode_of(static_cast<int>(mode.value()), static_cast<int>(profile.value()), false);
+  if (has_product_) {
+    auto product = temperature_c(f4t::kProduct, s);
+    if (product) {
+      product_c_ = product.value();
+    } else if (product.error().kind == ErrorKind::exception) {
+      has_product_ = false;  // a one-loop controller: no loop 2 (Modbus exception 02)
+      product_c_ = std::numeric_limits<double>::quiet_NaN();
+    } else {
+      return product.error();
+    }
+  }
+  return {};
+}
+
+Result<ChamberState> WatlowF4tChamber::read() {
+  auto sc = scale();
+  if (!sc) return sc.error();
+  const bool full = readback_.due(client_.connects());
+  auto alarm = value(f4t::kAlarm1);
+  auto air = alarm ? temperature_c(f4t::kAir, sc.value()) : alarm;
+  auto sp = air ? temperature_c(f4t::kSetpoint, sc.value()) : air;
+  auto wsp = sp ? temperature_c(f4t::kWorkingSetpoint, sc.value()) : sp;
+  Result<void> cmds = wsp ? (full ? read_commands(sc.value()) : Result<void>{}) : wsp.error();
+  readback_.read_done(cmds.ok(), full, client_.connects());
+  if (!cmds) return cmds.error();
+  ChamberState s;
+  s.alarms.deviation = alarm_active(static_cast<int>(alarm.value()));
+  s.alarms.sensor_break = !std::isfinite(air.value());
+  s.air_c = s.alarms.sensor_break ? std::numeric_limits<double>::quiet_NaN() : air.value();
+  s.setpoint_c = sp.value();
+  s.product_c = product_c_;
+  s.ramp_c_per_min = ramp_c_per_min_;
+  s.run_enabled = run_enabled_;
+  // The working setpoint still moving towards the target: the controller ramps.
+  s.mode = mode_ == ChamberMode::constant && std::abs(wsp.value() - sp.value()) > 0.05
+               ? ChamberMode::ramping
+               : mode_;
+  return s;
+}
+
+Result<void> WatlowF4tChamber::command(const ChamberCommand& c) {
+  readback_.invalidate();
+  auto sc = scale();
+  if (!sc) return sc.error();
+  if (c.ramp_c_per_min && !(*c.ramp_c_per_min >= 0 && std::isfinite(*c.ramp_c_per_min)))
+    return make_error(ErrorKind::range,
+                      fmt::format("{}: ramp {} C/min must be >= 0", name_, *c.ramp_c_per_min));
+  if (c.setpoint_c) {
+    auto lo = temperature_c(f4t::kSetpointLow, sc.value());
+    auto hi = lo ? temperature_c(f4t::kSetpointHigh, sc.value()) : lo;
+    if (!hi) return hi.error();
+    if (!std::isfinite(*c.setpoint_c) || *c.setpoint_c < lo.value() - 1e-6 ||
+        *c.setpoint_c > hi.value() + 1e-6)
+      return make_error(ErrorKind::range,
+                        fmt::format("{}: setpoint {} C outside the chamber limits [{}, {}] C",
+                                    name_, *c.setpoint_c, lo.value(), hi.value()));
+  }
+  if (c.ramp_c_per_min) {
+    const bool step = *c.ramp_c_per_min == 0;
+    if (!step) {
+      if (auto ok = client_.write(map_.at(f4t::kRampScale), f4t::kMinutes); !ok) return ok;
+      const double rate = sc.value().delta_from_c(*c.ramp_c_per_min);
+      if (auto ok = client_.write(map_.at(f4t::kRampRate), rate); !ok) return ok;
+    }
+    const int action = step ? f4t::kOff : f4t::kRampSetpoint;
+    if (auto ok = client_.write(map_.at(f4t::kRampAction), action); !ok) return ok;
+  }
+  if (c.setpoint_c) {
+    const double sp = sc.value().from_c(*c.setpoint_c);
+    if (auto ok = client_.write(map_.at(f4t::kSetpoint), sp); !ok) return ok;
+  }
+  if (c.run) {
+    const int v = *c.run ? f4t::kOn : f4t::kOff;
+    if (auto ok = client_.write(map_.at(f4t::kRunEvent), v); !ok) return ok;
+  }
+  return {};
+}
+
+Result<ChamberIdentity> WatlowF4tChamber::identify() {
+  auto sc = scale();
+  if (!sc) return sc.error();
+  auto words = client_.read_registers(modbus::FunctionCode::holding, map_.at(f4t::kUnits).unit_id,
+                                      f4t::kPartNumberAddress, f4t::kPartNumberRegisters);
+  if (!words) return words.error();
+  std::string part;
+  for (auto w : words.value())
+    if (w >= 0x20 && w < 0x7f) part += static_cast<char>(w);  // one character per register
+  auto lo = temperature_c(f4t::kSetpointLow, sc.value());
+  auto hi = lo ? temperature_c(f4t::kSetpointHigh, sc.value()) : lo;
+  if (!hi) return hi.error();
+  ChamberIdentity id;
+  id.model = "watlow_f4t";
+  id.identity = part.empty() ? "F4T (part number empty)" : "F4T part number " + part;
+  id.units = sc.value().fahrenheit ? "F" : "C";
+  id.setpoint_low_c = lo.value();
+  id.setpoint_high_c = hi.value();
+  id.notes = fmt::format("{}run = event output at register {}; ramps by the controller",
+                         sc.value().fahrenheit ? "deg F converted to deg C; " : "",
+                         map_.at(f4t::kRunEvent).address);
+  return id;
+}
+
+}  // namespace station::drivers

@@ -1,0 +1,53 @@
+// A single-axis rate table on an Acutronic ACUTROL3000 (dialect "acutrol3000"), ASCII command
+// language over TCP (port 9878) or a serial line (through the MOXA server the maker ships, TM-9411).
+// The ACUTROL has no axis-lock register: the station's "lock" is a position-mode servo hold,
+// reported locked once the axis is in position. Constructor does no I/O.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "drivers/ascii/line_client.hpp"
+#include "drivers/modbus/readback.hpp"
+#include "drivers/turntable/turntable.hpp"
+
+namespace station::drivers {
+
+class Acutrol3000Table final : public Turntable {
+ public:
+  /// In position: |angle - demand| below this, deg, and |rate| below kSettledRateDps.
+  static constexpr double kInPositionDeg = 0.01, kSettledRateDps = 0.01;
+
+  Acutrol3000Table(std::string name, ascii::LineEndpoint endpoint, double timeout_s,
+                   std::unique_ptr<ascii::LineWire> wire = nullptr);
+
+  Result<void> connect() override;
+  Result<TurntableState> read() override;
+  /// Closes an open interlock, sets the demand, then the mode; a rate beyond the unit's rate
+  /// limit (:Limit:Rate? R,1, read at connect) is ErrorKind::range and nothing is sent. A
+  /// latched interlock fault is an error: it needs :Interlock:Reset, an operator's decision.
+  Result<void> command(const TurntableCommand& c) override;
+  /// :Mode:Off 1, the unit's controlled stop ([ACL] p. 150).
+  Result<void> stop() override;
+  std::string name() const override { return name_; }
+  /// *IDN? ([ACL] p. 15) and the rate limit, for probe.
+  Result<std::string> identify() override;
+
+  void set_tap(Tap* tap) { client_.set_tap(tap); }
+  void set_clock(const Clock* clock) { client_.set_clock(clock); }
+  void set_readback_every(int reads) { readback_.set_every(reads); }
+
+ private:
+  Result<std::string> ask(std::string_view command);
+  Result<void> set(std::string_view command);
+  Result<double> number(std::string_view query);
+
+  std::string name_;
+  ascii::LineClient client_;
+  modbus::ReadbackSchedule readback_;
+  std::optional<double> rate_limit_dps_;
+  double position_demand_deg_ = 0, rate_demand_dps_ = 0;
+};
+
+}  // namespace station::drivers

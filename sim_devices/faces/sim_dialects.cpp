@@ -1,0 +1,80 @@
+// The simulator's dialect table.
+#include "sim_devices/faces/sim_dialects.hpp"
+
+#include <fmt/format.h>
+
+#include <stdexcept>
+
+#include "sim_devices/faces/ascii_faces.hpp"
+#include "sim_devices/servers/line_server.hpp"
+#include "sim_devices/servers/modbus_server.hpp"
+
+namespace station::sim {
+namespace {
+
+template <typename Face>
+ServedDevice modbus(std::unique_ptr<Face> face, int port) {
+  auto server = std::make_unique<ModbusServer>(*face, 1);
+  server->start_tcp(port);
+  ServedDevice d;
+  d.face = {face.release(), [](void* p) { delete static_cast<Face*>(p); }};
+  d.server = std::move(server);
+  return d;
+}
+
+template <typename Face>
+ServedDevice lines(std::unique_ptr<Face> face, int port) {
+  auto server = std::make_unique<LineServer>(*face);
+  server->start_tcp(port);
+  ServedDevice d;
+  d.face = {face.release(), [](void* p) { delete static_cast<Face*>(p); }};
+  d.server = std::move(server);
+  return d;
+}
+
+}  // namespace
+
+ServedDevice serve_chamber(std::string_view model, ChamberSim& chamber, const WatlowPanel& panel,
+                           int port) {
+  if (model == "generic_plc") {
+    auto server = std::make_unique<ModbusServer>(chamber, 1);
+    server->start_tcp(port);
+    ServedDevice d;
+    d.server = std::move(server);
+    return d;
+  }
+  if (model == "watlow_f4") return modbus(std::make_unique<F4Face>(chamber, panel), port);
+  if (model == "watlow_f4t_map2")
+    return modbus(std::make_unique<F4Face>(chamber, panel, 1, "watlow_f4t_map2"), port);
+  if (model == "watlow_f4t") return modbus(std::make_unique<F4tFace>(chamber, panel), port);
+  if (model == "watlow_f4p") return modbus(std::make_unique<F4pFace>(chamber, panel), port);
+  if (model == "espec_p300") return lines(std::make_unique<P300Face>(chamber, 1), port);
+  throw std::invalid_argument(fmt::format(
+      "no simulated chamber '{}' (known: generic_plc, watlow_f4, watlow_f4t, watlow_f4t_map2, "
+      "watlow_f4p, espec_p300)",
+      model));
+}
+
+ServedDevice serve_turntable(std::string_view model, TurntableSim& table, int port) {
+  if (model == "generic_plc") {
+    auto server = std::make_unique<ModbusServer>(table, 1);
+    server->start_tcp(port);
+    ServedDevice d;
+    d.server = std::move(server);
+    return d;
+  }
+  if (model == "acutrol3000") return lines(std::make_unique<AcutrolFace>(table), port);
+  throw std::invalid_argument(
+      fmt::format("no simulated turntable '{}' (known: generic_plc, acutrol3000)", model));
+}
+
+std::string device_toml(const char* section, std::string_view model, const std::string& endpoint,
+                        const WatlowPanel* panel) {
+  std::string out = fmt::format("[{}]\nmodel = \"{}\"\nendpoint = \"{}\"\n", section, model, endpoint);
+  if (panel != nullptr && panel->run_event != 1 &&
+      (model == "watlow_f4" || model == "watlow_f4t" || model == "watlow_f4t_map2"))
+    out += fmt::format("run_event = {}\n", panel->run_event);
+  return out;
+}
+
+}  // namespace station::sim

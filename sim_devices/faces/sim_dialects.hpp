@@ -1,0 +1,32 @@
+// Which face serves the simulated chamber and table for each dialect (the simulator's side of
+// drivers/registry/dialects.cpp): one line per model.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "sim_devices/chamber_sim.hpp"
+#include "sim_devices/faces/watlow_faces.hpp"
+#include "sim_devices/servers/sim_server.hpp"
+#include "sim_devices/turntable_sim.hpp"
+
+namespace station::sim {
+
+/// A face and the server speaking it, started on 127.0.0.1:port (0: ephemeral).
+struct ServedDevice {
+  std::unique_ptr<void, void (*)(void*)> face{nullptr, [](void*) {}};
+  std::unique_ptr<SimServer> server;
+};
+
+/// The chamber model served as `model` (a drivers/registry chamber model); throws
+/// std::invalid_argument for a model without a simulator face.
+ServedDevice serve_chamber(std::string_view model, ChamberSim& chamber, const WatlowPanel& panel,
+                           int port);
+/// The table model served as `model`.
+ServedDevice serve_turntable(std::string_view model, TurntableSim& table, int port);
+/// The [chamber] / [turntable] table text a station config needs for a served model.
+std::string device_toml(const char* section, std::string_view model, const std::string& endpoint,
+                        const WatlowPanel* panel);
+
+}  // namespace station::sim

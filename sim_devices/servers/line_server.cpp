@@ -1,0 +1,236 @@
+// LineServer: a poll()-driven thread serving request lines over TCP or a pty master.
+#include "sim_devices/servers/line_server.hpp"
+
+#include <arpa/inet.h>
+#include <fcntl.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <stdexcept>
+#include <utility>
+
+namespace station::sim {
+namespace {
+
+[[noreturn]] void sys_fail(const std::string& what) {
+  throw std::runtime_error("line server: " + what + ": " + std::strerror(errno));
+}
+
+std::chrono::steady_clock::time_point wall_after(double seconds) {
+  const std::chrono::duration<double> d(std::max(0.0, seconds));
+  return std::chrono::steady_clock::now() +
+         std::chrono::duration_cast<std::chrono::steady_clock::duration>(d);
+}
+
+int listen_on(int port) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0);
+  if (fd == -1) sys_fail("socket");
+  const int one = 1;
+  ::setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_port = htons(static_cast<std::uint16_t>(port));
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == -1 || ::listen(fd, 8) == -1) {
+    ::close(fd);
+    sys_fail("bind/listen 127.0.0.1:" + std::to_string(port));
+  }
+  return fd;
+}
+
+void write_all(int fd, const std::string& bytes) {
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n > 0) {
+      done += static_cast<std::size_t>(n);
+    } else if (n < 0 && (errno == EINTR || errno == EAGAIN)) {
+      pollfd p{fd, POLLOUT, 0};
+      if (::poll(&p, 1, 100) <= 0) return;
+    } else {
+      return;
+    }
+  }
+}
+
+}  // namespace
+
+LineServer::~LineServer() { stop(); }
+
+void LineServer::start_tcp(int port) {
+  listen_fd_ = listen_on(port);
+  sockaddr_in a{};
+  socklen_t len = sizeof a;
+  ::getsockname(listen_fd_, reinterpret_cast<sockaddr*>(&a), &len);
+  port_ = ntohs(a.sin_port);
+  thread_ = std::thread([this] { run(); });
+}
+
+void LineServer::start_pty(int baud) {
+  baud_ = baud;
+  pty_master_ = ::posix_openpt(O_RDWR | O_NOCTTY | O_CLOEXEC | O_NONBLOCK);
+  if (pty_master_ == -1) sys_fail("posix_openpt");
+  if (::grantpt(pty_master_) == -1 || ::unlockpt(pty_master_) == -1) sys_fail("grantpt");
+  char name[128];
+  if (::ptsname_r(pty_master_, name, sizeof name) != 0) sys_fail("ptsname_r");
+  pty_path_ = name;
+  // Held open so the master never reads a hang-up between clients.
+  pty_slave_ = ::open(name, O_RDWR | O_NOCTTY | O_CLOEXEC);
+  if (pty_slave_ == -1) sys_fail("open " + pty_path_);
+  clients_[pty_master_] = {};
+  thread_ = std::thread([this] { run(); });
+}
+
+void LineServer::stop() {
+  stop_ = true;
+  if (thread_.joinable()) thread_.join();
+  for (auto& [fd, buf] : clients_)
+    if (fd != pty_master_) ::close(fd);
+  clients_.clear();
+  for (int* fd : {&listen_fd_, &pty_master_, &pty_slave_}) {
+    if (*fd != -1) ::close(*fd);
+    *fd = -1;
+  }
+}
+
+std::string LineServer::endpoint() const {
+  if (!pty_path_.empty()) return "serial:" + pty_path_ + "?baud=" + std::to_string(baud_);
+  return "tcp://127.0.0.1:" + std::to_string(port_);
+}
+
+void LineServer::inject_timeouts(int n) {
+  std::lock_guard lock(fault_mutex_);
+  timeouts_ = n;
+}
+void LineServer::inject_exception(int code, int n) {
+  std::lock_guard lock(fault_mutex_);
+  exception_code_ = code;
+  exceptions_ = n;
+}
+void LineServer::inject_drop(int n) {
+  std::lock_guard lock(fault_mutex_);
+  drops_ = n;
+}
+void LineServer::stall_for(double seconds) {
+  std::lock_guard lock(fault_mutex_);
+  stall_until_ = wall_after(seconds);
+}
+void LineServer::disconnect_for(double seconds) {
+  std::lock_guard lock(fault_mutex_);
+  down_until_ = wall_after(seconds);
+  kick_clients_ = true;
+}
+void LineServer::clear_faults() {
+  std::lock_guard lock(fault_mutex_);
+  timeouts_ = exceptions_ = drops_ = 0;
+  stall_until_ = down_until_ = {};
+}
+
+LineServer::Fault LineServer::take_fault(int& code) {
+  std::lock_guard lock(fault_mutex_);
+  const auto now = std::chrono::steady_clock::now();
+  if (now < stall_until_ || now < down_until_) return Fault::timeout;  // a pty: a silent line
+  if (timeouts_ > 0) return --timeouts_, Fault::timeout;
+  if (drops_ > 0) return --drops_, Fault::drop;
+  if (exceptions_ != 0) {
+    code = exception_code_;
+    if (exceptions_ > 0) --exceptions_;
+    return Fault::exception;
+  }
+  return Fault::none;
+}
+
+// Applies an injected disconnect (TCP): drops clients and listener, listens again on the same
+// port when the down time is over. False while down.
+bool LineServer::link_up() {
+  if (pty_master_ != -1) return true;
+  SteadyTime down_until;
+  bool kick = false;
+  {
+    std::lock_guard lock(fault_mutex_);
+    kick = std::exchange(kick_clients_, false);
+    down_until = down_until_;
+  }
+  if (kick) {
+    for (auto& [fd, buf] : clients_) ::close(fd);
+    clients_.clear();
+    if (listen_fd_ != -1) ::close(listen_fd_);
+    listen_fd_ = -1;
+  }
+  if (listen_fd_ != -1) return true;
+  if (std::chrono::steady_clock::now() < down_until) return false;
+  try {
+    listen_fd_ = listen_on(port_);
+  } catch (const std::runtime_error&) {
+    return false;  // the port is still in TIME_WAIT somewhere: try again next turn
+  }
+  return true;
+}
+
+// Reads what `fd` has, answers every complete line. `close_it` when the peer went away or a
+// drop was injected.
+void LineServer::serve_bytes(int fd, std::string& buffer, bool& close_it) {
+  char chunk[512];
+  const ssize_t n = ::read(fd, chunk, sizeof chunk);
+  if (n == 0 || (n < 0 && errno != EAGAIN && errno != EINTR && errno != EIO)) {
+    close_it = fd != pty_master_;
+    return;
+  }
+  if (n < 0) return;
+  buffer.append(chunk, static_cast<std::size_t>(n));
+  const std::string term = device_.request_terminator();
+  const std::string reply_end = device_.reply_terminator();
+  for (auto end = buffer.find(term); end != std::string::npos; end = buffer.find(term)) {
+    const std::string request = buffer.substr(0, end);
+    buffer.erase(0, end + term.size());
+    ++requests_;
+    int code = 0;
+    switch (take_fault(code)) {
+      case Fault::timeout:
+        continue;
+      case Fault::drop:
+        close_it = fd != pty_master_;
+        if (close_it) return;
+        continue;
+      case Fault::exception:
+        write_all(fd, device_.error_reply(request, code) + reply_end);
+        continue;
+      case Fault::none:
+        break;
+    }
+    if (auto reply = device_.handle(request)) write_all(fd, *reply + reply_end);
+  }
+  if (buffer.size() > kMaxLine) buffer.clear();
+}
+
+void LineServer::run() {
+  while (!stop_) {
+    const bool up = link_up();
+    std::vector<pollfd> fds;
+    if (up && listen_fd_ != -1) fds.push_back({listen_fd_, POLLIN, 0});
+    for (auto& [fd, buf] : clients_) fds.push_back({fd, POLLIN, 0});
+    if (::poll(fds.data(), fds.size(), 50) <= 0) continue;
+    for (const auto& p : fds) {
+      if (p.revents == 0) continue;
+      if (p.fd == listen_fd_) {
+        const int c = ::accept4(listen_fd_, nullptr, nullptr, SOCK_CLOEXEC | SOCK_NONBLOCK);
+        if (c != -1) clients_[c] = {};
+        continue;
+      }
+      auto it = clients_.find(p.fd);
+      if (it == clients_.end()) continue;
+      bool close_it = false;
+      serve_bytes(p.fd, it->second, close_it);
+      if (close_it) {
+        ::close(p.fd);
+        clients_.erase(it);
+      }
+    }
+  }
+}
+
+}  // namespace station::sim

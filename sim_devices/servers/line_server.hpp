@@ -1,0 +1,86 @@
+// A line-oriented ASCII device server (ESPEC P300, ACUTROL3000 faces) over TCP on 127.0.0.1 or a
+// pty standing in for the serial line, with the same fault injection as ModbusServer.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <thread>
+#include <vector>
+
+#include "sim_devices/servers/sim_server.hpp"
+
+namespace station::sim {
+
+/// A device that answers command lines. Called from the server thread only.
+class LineDevice {
+ public:
+  virtual ~LineDevice() = default;
+  /// Ends every request line (a trailing CR is the device's to strip) / every reply.
+  virtual std::string request_terminator() const = 0;
+  virtual std::string reply_terminator() const = 0;
+  /// The reply to one request (terminator removed); nullopt: the device stays silent.
+  virtual std::optional<std::string> handle(std::string_view request) = 0;
+  /// The reply the device gives when it fails a request (an injected exception `code`).
+  virtual std::string error_reply(std::string_view request, int code) const = 0;
+};
+
+/// Serves one LineDevice. start_*() spawns the thread; the destructor stops and joins it.
+class LineServer final : public SimServer {
+ public:
+  /// Stores the device (not owned; must outlive the server); no I/O.
+  explicit LineServer(LineDevice& device) : device_(device) {}
+  ~LineServer() override;
+  LineServer(const LineServer&) = delete;
+  LineServer& operator=(const LineServer&) = delete;
+
+  /// Listens on 127.0.0.1:port (0 = ephemeral) and serves; throws std::runtime_error.
+  void start_tcp(int port = 0);
+  /// Opens a pty pair and serves on its master; clients open pty_path(). Throws on failure.
+  void start_pty(int baud = 9600);
+  void stop() override;
+
+  int port() const { return port_; }
+  const std::string& pty_path() const { return pty_path_; }
+  /// tcp://127.0.0.1:PORT or serial:/dev/pts/N?baud=B.
+  std::string endpoint() const override;
+  std::uint64_t requests() const override { return requests_.load(); }
+
+  void inject_timeouts(int n) override;
+  void inject_exception(int code, int n = 1) override;
+  void inject_drop(int n = 1) override;
+  void stall_for(double seconds) override;
+  void disconnect_for(double seconds) override;
+  void clear_faults() override;
+
+  /// Longest request line kept; a longer one is discarded unanswered (as a device's buffer).
+  static constexpr std::size_t kMaxLine = 1024;
+
+ private:
+  enum class Fault { none, timeout, exception, drop };
+  using SteadyTime = std::chrono::steady_clock::time_point;
+
+  void run();
+  bool link_up();
+  void serve_bytes(int fd, std::string& buffer, bool& close_it);
+  Fault take_fault(int& code);
+
+  LineDevice& device_;
+  int listen_fd_ = -1, pty_master_ = -1, pty_slave_ = -1, port_ = 0, baud_ = 9600;
+  std::string pty_path_;
+  std::atomic<bool> stop_{false};
+  std::atomic<std::uint64_t> requests_{0};
+  std::thread thread_;
+  std::mutex fault_mutex_;
+  int timeouts_ = 0, exceptions_ = 0, exception_code_ = 0, drops_ = 0;
+  SteadyTime stall_until_{}, down_until_{};
+  bool kick_clients_ = false;
+  std::map<int, std::string> clients_;  // fd -> bytes of a partial line
+};
+
+}  // namespace station::sim
