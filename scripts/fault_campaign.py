@@ -46,6 +46,9 @@ def free_port():
 class Rig:
     """A simrig process with fixed ports (so it can be restarted under a running daemon)."""
 
+    # The dialects every simrig of the campaign speaks (--chamber/--turntable).
+    models = ("generic_plc", "generic_plc")
+
     def __init__(self, build, work, name, seed):
         self.build, self.work, self.name, self.seed = build, work, name, seed
         self.ports = (free_port(), free_port())
@@ -60,7 +63,8 @@ class Rig:
         self.proc = subprocess.Popen(
             [os.path.join(self.build, "sim_devices", "simrig"), "--gyros", "2", "--seed",
              str(self.seed), "--chamber-port", str(self.ports[0]), "--turntable-port",
-             str(self.ports[1]), "--can-socket", self.can, "--control", self.control],
+             str(self.ports[1]), "--can-socket", self.can, "--control", self.control,
+             "--chamber", Rig.models[0], "--turntable", Rig.models[1]],
             stdout=out, stderr=err)
         deadline = time.time() + 10
         text = ""
@@ -322,9 +326,12 @@ def main():
     p.add_argument("--duration-s", type=int, default=150)
     p.add_argument("--seed", type=int, default=1)
     p.add_argument("--faults", type=int, default=9)
+    p.add_argument("--chamber", default="generic_plc", help="chamber dialect (docs/DEVICES.md)")
+    p.add_argument("--turntable", default="generic_plc", help="turntable dialect")
     p.add_argument("--json")
     p.add_argument("--keep")
     args = p.parse_args()
+    Rig.models = (args.chamber, args.turntable)
     if args.duration_s < 60 or args.faults < 1 or args.faults * 8 > args.duration_s:
         print("fault_campaign: need --duration-s >= 60 and about 8 s per fault", file=sys.stderr)
         return 2

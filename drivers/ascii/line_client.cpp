@@ -51,8 +51,9 @@ Result<void> LineClient::connect() {
     const int err = errno;
     auto e = translate_line_error(err, device_ + " connect " + to_string(endpoint_));
     if (e.kind != ErrorKind::timeout) e.kind = ErrorKind::disconnected;
-    tap(TapDirection::event, "error",
-        std::string_view(reinterpret_cast<const char*>(errno_bytes(err).data()), 4), e.message);
+    const auto eb = errno_bytes(err);
+    tap(TapDirection::event, "ascii-error",
+        std::string_view(reinterpret_cast<const char*>(eb.data()), 4), e.message);
     backoff_.failed();
     last_connect_error_ = e.message;
     return e;
@@ -61,12 +62,12 @@ Result<void> LineClient::connect() {
   connected_ = true;
   ++connects_;
   consecutive_timeouts_ = 0;
-  tap(TapDirection::event, "connect", {}, to_string(endpoint_));
+  tap(TapDirection::event, "ascii-connect", {}, to_string(endpoint_));
   return {};
 }
 
 void LineClient::disconnect() {
-  if (connected_) tap(TapDirection::event, "disconnect", {}, to_string(endpoint_));
+  if (connected_) tap(TapDirection::event, "ascii-disconnect", {}, to_string(endpoint_));
   wire_->close();
   connected_ = false;
 }
@@ -89,8 +90,8 @@ Error LineClient::fail(int err, const std::string& what) {
   if (stale_tcp)
     e.message += fmt::format(" ({} timeouts in a row: reconnecting)", consecutive_timeouts_);
   const auto eb = errno_bytes(err);
-  tap(TapDirection::event, "error", std::string_view(reinterpret_cast<const char*>(eb.data()), 4),
-      e.message);
+  tap(TapDirection::event, "ascii-error",
+      std::string_view(reinterpret_cast<const char*>(eb.data()), 4), e.message);
   if (e.kind == ErrorKind::disconnected || stale_tcp) {
     consecutive_timeouts_ = 0;
     disconnect();
@@ -103,9 +104,9 @@ Error LineClient::fail(int err, const std::string& what) {
 Result<void> LineClient::transmit(std::string_view command) {
   if (auto c = ensure_connected(); !c) return c.error();
   wire_->flush();
-  tap(TapDirection::tx, "ascii", command, {});
   std::string bytes(command);
   bytes += framing_.command_terminator;
+  tap(TapDirection::tx, "ascii", bytes, {});  // as sent, terminator included
   if (wire_->send(bytes, timeout_s_) == -1)
     return fail(errno, fmt::format("send '{}'", command));
   return {};

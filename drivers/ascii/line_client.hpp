@@ -1,7 +1,9 @@
 // A small client for line-oriented ASCII devices (ESPEC P300, ACUTROL3000): one command, at most
 // one reply line, each exchange bounded by its timeout. Errors become ErrorKind in one place; a
 // lost link (or kTimeoutsBeforeReconnect timeouts in a row on TCP) is reopened on the next call
-// after the same bounded back-off as ModbusClient. Every exchange passes the tap ("ascii").
+// after the same bounded back-off as ModbusClient. Every exchange passes the tap: kind "ascii"
+// (tx: the bytes sent, terminator included; rx: the reply line without it) and the events
+// "ascii-connect", "ascii-disconnect", "ascii-error" (errno as 4 bytes, the message as detail).
 #pragma once
 
 #include <cstdint>

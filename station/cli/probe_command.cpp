@@ -45,22 +45,39 @@ std::string alarm_text(const dr::AlarmBits& a) {
   add(a.sensor_break, "sensor_break");
   add(a.door_open, "door_open");
   add(a.high_limit_trip, "high_limit_trip");
+  add(a.other, "controller_alarm");
   return s;
 }
 
+json finite_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+// What the controller says it is (dialect, identity, units, decimals, limits) before its values:
+// a unit the dialect cannot read correctly fails here with the dialect's one line.
 DeviceReport probe_chamber(dr::Chamber& chamber, const StationConfig& c) {
+  const std::string where = c.chamber.model + " at " + c.chamber.endpoint;
+  auto id = chamber.identify();
+  if (!id) return failed("chamber", where, id.error());
   auto r = chamber.read();
-  if (!r) return failed("chamber", c.chamber.endpoint, r.error());
+  if (!r) return failed("chamber", where, r.error());
   const dr::ChamberState& s = r.value();
-  DeviceReport d{"chamber", c.chamber.endpoint, {}, {}, json::object()};
+  const dr::ChamberIdentity& i = id.value();
+  DeviceReport d{"chamber", where, {}, {}, json::object()};
   d.summary = fmt::format(
-      "air {:.1f} C, product {:.1f} C, setpoint {:.1f} C, ramp {:.2f} C/min, mode {}, "
+      "{}; units {}{}; setpoint limits {:.1f}..{:.1f} C; {}\n"
+      "    air {:.1f} C, product {:.1f} C, setpoint {:.1f} C, ramp {:.2f} C/min, mode {}, "
       "alarms {}, run {}",
-      s.air_c, s.product_c, s.setpoint_c, s.ramp_c_per_min, dr::to_string(s.mode),
-      alarm_text(s.alarms), s.run_enabled ? "on" : "off");
-  // NaN (sensor break) is not JSON: it becomes null.
-  d.fields = {{"air_c", std::isfinite(s.air_c) ? json(s.air_c) : json(nullptr)},
-              {"product_c", s.product_c},
+      i.identity, i.units, i.decimals >= 0 ? fmt::format(", {} decimals", i.decimals) : "",
+      i.setpoint_low_c, i.setpoint_high_c, i.notes, s.air_c, s.product_c, s.setpoint_c,
+      s.ramp_c_per_min, dr::to_string(s.mode), alarm_text(s.alarms), s.run_enabled ? "on" : "off");
+  // NaN (sensor break, no product sensor) is not JSON: it becomes null.
+  d.fields = {{"model", c.chamber.model},
+              {"identity", i.identity},
+              {"units", i.units},
+              {"decimals", i.decimals >= 0 ? json(i.decimals) : json(nullptr)},
+              {"setpoint_limits_c", {i.setpoint_low_c, i.setpoint_high_c}},
+              {"notes", i.notes},
+              {"air_c", finite_or_null(s.air_c)},
+              {"product_c", finite_or_null(s.product_c)},
               {"setpoint_c", s.setpoint_c},
               {"ramp_c_per_min", s.ramp_c_per_min},
               {"mode", dr::to_string(s.mode)},
@@ -70,16 +87,20 @@ DeviceReport probe_chamber(dr::Chamber& chamber, const StationConfig& c) {
 }
 
 DeviceReport probe_turntable(dr::Turntable& table, const StationConfig& c) {
+  const std::string where = c.turntable->model + " at " + c.turntable->endpoint;
+  auto id = table.identify();
+  if (!id) return failed("turntable", where, id.error());
   auto r = table.read();
-  if (!r) return failed("turntable", c.turntable->endpoint, r.error());
+  if (!r) return failed("turntable", where, r.error());
   const dr::TurntableState& s = r.value();
-  DeviceReport d{"turntable", c.turntable->endpoint, {}, {}, json::object()};
+  DeviceReport d{"turntable", where, {}, {}, json::object()};
   d.summary = fmt::format(
-      "mode {}, angle {:.4f} deg, rate {:.4f} deg/s, in_position {}, at_rate {}, fault {}, "
+      "{}mode {}, angle {:.4f} deg, rate {:.4f} deg/s, in_position {}, at_rate {}, fault {}, "
       "interlock_open {}",
-      dr::to_string(s.mode), s.angle_deg, s.rate_dps, yes_no(s.in_position), yes_no(s.at_rate),
-      yes_no(s.fault), yes_no(s.interlock_open));
+      id.value().empty() ? "" : id.value() + "; ", dr::to_string(s.mode), s.angle_deg, s.rate_dps,
+      yes_no(s.in_position), yes_no(s.at_rate), yes_no(s.fault), yes_no(s.interlock_open));
   d.fields = {
+      {"model", c.turntable->model},       {"identity", id.value()},
       {"mode", dr::to_string(s.mode)},     {"angle_deg", s.angle_deg}, {"rate_dps", s.rate_dps},
       {"in_position", s.in_position},      {"at_rate", s.at_rate},     {"fault", s.fault},
       {"interlock_open", s.interlock_open}};

@@ -127,8 +127,10 @@ std::string digest_text(const std::vector<FileDigest>& files) {
 }  // namespace
 
 const std::vector<std::string>& digested_files() {
-  static const std::vector<std::string> files{"session.toml", "can.log", "gpio.log", "modbus.log",
-                                              "result.json"};
+  // ascii.log: sessions since issue 20 (line devices); an older session has none and its digest
+  // no entry for it.
+  static const std::vector<std::string> files{"session.toml", "can.log",     "gpio.log",
+                                              "modbus.log",   "ascii.log",   "result.json"};
   return files;
 }
 
@@ -138,7 +140,11 @@ FileDigest digest_file(const std::string& dir, const std::string& name, std::str
 
 void write_session_digest(const std::string& dir) {
   std::vector<FileDigest> files;
-  for (const auto& name : digested_files()) files.push_back(digest_file(dir, name));
+  for (const auto& name : digested_files()) {
+    const auto plain = fs::path(dir) / name;
+    if (name == "ascii.log" && !fs::exists(plain) && !fs::exists(plain.string() + ".gz")) continue;
+    files.push_back(digest_file(dir, name));
+  }
   const auto path = fs::path(dir) / "digest.txt";
   const auto tmp = fs::path(dir) / "digest.txt.tmp";
   {

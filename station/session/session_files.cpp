@@ -199,6 +199,7 @@ void append_session_resume(const std::string& dir, double after_tick_s, double n
                 {"next_tick_s", next_tick_s},
                 {"can_lines", complete_lines(d / "can.log")},
                 {"modbus_lines", complete_lines(d / "modbus.log")},
+                {"ascii_lines", complete_lines(d / "ascii.log")},
                 {"gpio_lines", complete_lines(d / "gpio.log")}};
   std::ofstream out(d / "session.toml", std::ios::app);
   out << "\n[[resume]]  # a killed run resumed here (schemas/session.md)\n" << r << '\n';
@@ -221,9 +222,14 @@ std::vector<SessionResume> read_session_resumes(const std::string& path) {
       return *v;
     };
     const auto next = r != nullptr ? (*r)["next_tick_s"].value<double>() : std::nullopt;
+    // ascii_lines: absent in sessions from before issue 20 (no line devices then).
+    const auto ascii = r != nullptr ? (*r)["ascii_lines"].value<double>() : std::nullopt;
+    if (ascii && *ascii < 0)
+      throw InputError(fmt::format("{}: resume {}: key 'ascii_lines': negative", path, i + 1));
     out.push_back({number("after_tick_s"), next, static_cast<std::int64_t>(number("can_lines")),
                    static_cast<std::int64_t>(number("modbus_lines")),
-                   static_cast<std::int64_t>(number("gpio_lines"))});
+                   static_cast<std::int64_t>(number("gpio_lines")),
+                   static_cast<std::int64_t>(ascii.value_or(0))});
   }
   return out;
 }

@@ -37,7 +37,7 @@ void write_session_header(const std::string& dir, const SessionHeader& header);
 struct SessionResume {
   double after_tick_s = 0;
   std::optional<double> next_tick_s;  ///< the resumed daemon's first tick (rig: wall clock)
-  std::int64_t can_lines = 0, modbus_lines = 0, gpio_lines = 0;
+  std::int64_t can_lines = 0, modbus_lines = 0, gpio_lines = 0, ascii_lines = 0;
 };
 
 /// Marks a resume in `dir`: cuts a line the killed daemon left half-written from each log, counts

@@ -57,6 +57,7 @@ SessionRecorder::SessionRecorder(const std::string& dir, Stamp stamp) : stamp_(s
   const std::filesystem::path d(dir);
   can_ = open_log(d / "can.log");
   modbus_ = open_log(d / "modbus.log");
+  ascii_ = open_log(d / "ascii.log");
   gpio_ = open_log(d / "gpio.log");
 }
 
@@ -67,6 +68,8 @@ void SessionRecorder::on_exchange(const dr::TapRecord& record) noexcept {
     const std::lock_guard lock(mutex_);
     if (record.kind == "can") {
       write_can(record, t_s);
+    } else if (record.kind.starts_with("ascii")) {
+      write_line(ascii_, record, t_s);  // line devices: exchanges and their link's events
     } else if (record.kind.starts_with("gpio")) {
       write_line(gpio_, record, t_s);
     } else if (record.kind.starts_with("modbus") || record.device != "can") {
@@ -98,6 +101,7 @@ void SessionRecorder::flush() {
   const std::lock_guard lock(mutex_);
   can_.flush();
   modbus_.flush();
+  ascii_.flush();
   gpio_.flush();
 }
 

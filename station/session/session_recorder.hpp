@@ -1,5 +1,6 @@
 // Records a session (schemas/session.md): every exchange of every device, stamped on the run's
-// clock, as line-oriented text in one directory: can.log (candump -l), modbus.log, gpio.log.
+// clock, as line-oriented text in one directory: can.log (candump -l), modbus.log,
+// ascii.log, gpio.log.
 #pragma once
 
 #include <atomic>
@@ -20,7 +21,7 @@ class SessionRecorder final : public drivers::Tap {
   /// simulated clock under --sim); default: the record's own wall time.
   using Stamp = std::function<double(const drivers::TapRecord&)>;
 
-  /// Opens can.log, modbus.log and gpio.log in `dir` (created if missing) for appending: a
+  /// Opens can.log, modbus.log, ascii.log and gpio.log in `dir` (created if missing) for appending: a
   /// resumed run goes on in the same files. Throws InputError naming a path it cannot write.
   explicit SessionRecorder(const std::string& dir, Stamp stamp = {});
   void on_exchange(const drivers::TapRecord& record) noexcept override;
@@ -35,7 +36,7 @@ class SessionRecorder final : public drivers::Tap {
   void write_line(std::ofstream& out, const drivers::TapRecord& record, double t_s);
 
   std::mutex mutex_;
-  std::ofstream can_, modbus_, gpio_;
+  std::ofstream can_, modbus_, ascii_, gpio_;
   Stamp stamp_;
   std::atomic<bool> paused_{false};
 };

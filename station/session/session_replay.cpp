@@ -24,6 +24,7 @@
 #include "station/daemon/sequencer.hpp"
 #include "station/session/replay_clock.hpp"
 #include "station/session/replay_gpio.hpp"
+#include "station/session/replay_ascii.hpp"
 #include "station/session/replay_modbus.hpp"
 #include "station/session/session_digest.hpp"
 #include "station/session/session_files.hpp"
@@ -98,7 +99,7 @@ std::string fresh_db_path(const ReplayOptions& o) {
 
 /// Everything the session's three logs hold, in order.
 struct SessionLogs {
-  std::vector<SessionLogLine> modbus, gpio;
+  std::vector<SessionLogLine> modbus, ascii, gpio;
   std::vector<dr::can::CandumpRecord> can;
 
   explicit SessionLogs(const std::string& dir) {
@@ -108,6 +109,9 @@ struct SessionLogs {
       return read_session_can_log(path);
     });
     modbus = read_session_log((fs::path(dir) / "modbus.log").string());
+    const auto ascii_log = fs::path(dir) / "ascii.log";  // absent before issue 20
+    if (fs::exists(ascii_log) || fs::exists(ascii_log.string() + ".gz"))
+      ascii = read_session_log(ascii_log.string());
     gpio = read_session_log((fs::path(dir) / "gpio.log").string());
     can = can_log.get();  // rethrows the reader's InputError
   }
@@ -131,20 +135,25 @@ void take_lines(std::vector<SessionLogLine>& lines, std::int64_t from, std::int6
 /// whole run, or the part before a kill, or after a resume).
 struct ReplayRig {
   std::map<std::string, std::vector<SessionLogLine>> modbus;  ///< by device
+  std::map<std::string, std::vector<SessionLogLine>> ascii;   ///< by device
   std::vector<SessionLogLine> gpio;
   std::vector<dr::can::CandumpRecord> can;
   std::vector<double> sync_times_s;
   std::map<std::string, const RecordedModbusWire*> wires;
+  std::map<std::string, const RecordedLineWire*> line_wires;
   const dr::can::ReplayCanTransport* can_transport = nullptr;
   const ReplayGpioBank* gpio_bank = nullptr;
 
-  ReplayRig(std::vector<SessionLogLine> modbus_lines, std::vector<SessionLogLine> gpio_lines,
-            std::vector<dr::can::CandumpRecord> can_records)
+  ReplayRig(std::vector<SessionLogLine> modbus_lines, std::vector<SessionLogLine> ascii_lines,
+            std::vector<SessionLogLine> gpio_lines, std::vector<dr::can::CandumpRecord> can_records)
       : gpio(std::move(gpio_lines)), can(std::move(can_records)) {
-    std::vector<SessionLogLine>* to = nullptr;  // the last line's device's (lines come in runs)
-    for (auto& l : modbus_lines) {
-      if (to == nullptr || to->back().device != l.device) to = &modbus[l.device];
-      to->push_back(std::move(l));
+    for (const auto& [lines, by_device] :
+         {std::pair{&modbus_lines, &modbus}, std::pair{&ascii_lines, &ascii}}) {
+      std::vector<SessionLogLine>* to = nullptr;  // the last line's device's (lines come in runs)
+      for (auto& l : *lines) {
+        if (to == nullptr || to->back().device != l.device) to = &(*by_device)[l.device];
+        to->push_back(std::move(l));
+      }
     }
     for (const auto& r : can)
       if ((r.frame.can_id & CAN_EFF_MASK) == 0x080)  // SYNC (schemas/can_frames.md)
@@ -157,6 +166,11 @@ struct ReplayRig {
       // Each factory runs once per device: the recording moves into its transport.
       auto w = std::make_unique<RecordedModbusWire>(device, std::move(modbus[device]));
       wires[device] = w.get();
+      return w;
+    };
+    o.line_wire_factory = [this](const std::string& device, const dr::ascii::LineEndpoint&) {
+      auto w = std::make_unique<RecordedLineWire>(device, std::move(ascii[device]));
+      line_wires[device] = w.get();
       return w;
     };
     o.can_transport_factory = [this] {
@@ -175,12 +189,16 @@ struct ReplayRig {
     return o;
   }
   /// What this daemon's life replayed so far, in log order: a resumed simulation asks it again.
-  void consumed(std::vector<SessionLogLine>& modbus_out, std::vector<SessionLogLine>& gpio_out,
+  void consumed(std::vector<SessionLogLine>& modbus_out, std::vector<SessionLogLine>& ascii_out,
+                std::vector<SessionLogLine>& gpio_out,
                 std::vector<dr::can::CandumpRecord>& can_out) const {
     for (const auto& [device, wire] : wires)
       for (auto& l : wire->consumed()) modbus_out.push_back(std::move(l));
-    std::sort(modbus_out.begin(), modbus_out.end(),
-              [](const auto& a, const auto& b) { return a.line_no < b.line_no; });
+    for (const auto& [device, wire] : line_wires)
+      for (auto& l : wire->consumed()) ascii_out.push_back(std::move(l));
+    for (auto* out : {&modbus_out, &ascii_out})
+      std::sort(out->begin(), out->end(),
+                [](const auto& a, const auto& b) { return a.line_no < b.line_no; });
     if (gpio_bank != nullptr) gpio_out = gpio_bank->consumed();
     if (can_transport != nullptr) can_out = can_transport->consumed();
   }
@@ -201,7 +219,7 @@ std::vector<SessionResume> replayable_resumes(const std::string& dir, const Sess
                       "daemon chose its first tick from the wall clock",
                       path, i + 1));
   const auto& first = resumes.front();
-  if (first.can_lines + first.modbus_lines + first.gpio_lines == 0)
+  if (first.can_lines + first.modbus_lines + first.ascii_lines + first.gpio_lines == 0)
     throw InputError(
         fmt::format("{}: the recording starts with a resumed run (after t = {:.0f} "
                     "s); its first part was not recorded",
@@ -217,9 +235,9 @@ std::int64_t replay_daemons(const ReplayOptions& o, const Session& session, Stor
   SessionLogs logs(o.dir);
   // The part of the recording a segment's daemon asks first: a resumed simulation recomputes
   // its stored ticks through the devices, with the recorder paused.
-  std::vector<SessionLogLine> modbus_prefix, gpio_prefix;
+  std::vector<SessionLogLine> modbus_prefix, ascii_prefix, gpio_prefix;
   std::vector<dr::can::CandumpRecord> can_prefix;
-  std::int64_t modbus_from = 1, gpio_from = 1, can_from = 0;
+  std::int64_t modbus_from = 1, ascii_from = 1, gpio_from = 1, can_from = 0;
   double last_tick_s = -1;
   for (std::size_t k = 0; k <= resumes.size(); ++k) {
     const bool killed = k < resumes.size();
@@ -228,6 +246,8 @@ std::int64_t replay_daemons(const ReplayOptions& o, const Session& session, Stor
     };
     std::vector<SessionLogLine> modbus = std::move(modbus_prefix), gpio = std::move(gpio_prefix);
     take_lines(logs.modbus, modbus_from, end(killed ? resumes[k].modbus_lines : 0), modbus);
+    std::vector<SessionLogLine> ascii = std::move(ascii_prefix);
+    take_lines(logs.ascii, ascii_from, end(killed ? resumes[k].ascii_lines : 0), ascii);
     take_lines(logs.gpio, gpio_from, end(killed ? resumes[k].gpio_lines : 0), gpio);
     std::vector<dr::can::CandumpRecord> can = std::move(can_prefix);
     const auto can_to =
@@ -244,10 +264,11 @@ std::int64_t replay_daemons(const ReplayOptions& o, const Session& session, Stor
     }
     if (killed) {
       modbus_from = resumes[k].modbus_lines + 1;
+      ascii_from = resumes[k].ascii_lines + 1;
       gpio_from = resumes[k].gpio_lines + 1;
       can_from = static_cast<std::int64_t>(can_to);
     }
-    ReplayRig devices(std::move(modbus), std::move(gpio), std::move(can));
+    ReplayRig devices(std::move(modbus), std::move(ascii), std::move(gpio), std::move(can));
     ReplayClock clock;
     Rig rig = build_rig(session.config, devices.options(clock));
     SequencerOptions so;
@@ -273,7 +294,7 @@ std::int64_t replay_daemons(const ReplayOptions& o, const Session& session, Stor
       }
       if (!killed || r.t_s < resumes[k].after_tick_s) return;
       store.flush();  // what the killed daemon had committed
-      if (session.sim_seed) devices.consumed(modbus_prefix, gpio_prefix, can_prefix);
+      if (session.sim_seed) devices.consumed(modbus_prefix, ascii_prefix, gpio_prefix, can_prefix);
       throw KilledHere{};
     };
     try {

@@ -1,5 +1,5 @@
 // Modbus TCP read transactions per second on loopback against ChamberSim (one register per
-// transaction, and one full ModbusChamber::read() of 7 points: 4 block reads on watlow_f4).
+// transaction, and one full ModbusChamber::read() of 7 points: 4 block reads on generic_plc).
 #include <benchmark/benchmark.h>
 
 #include "drivers/chamber/generic_plc/generic_plc_map.hpp"
@@ -14,7 +14,7 @@ namespace mb = station::drivers::modbus;
 namespace cm = station::drivers::chamber_map;
 
 void BM_ModbusTcpReadRegister(benchmark::State& state) {
-  auto map = cm::watlow_f4();
+  auto map = cm::generic_plc();
   station::sim::ChamberSim sim(map);
   station::sim::ModbusServer server(sim);
   server.start_tcp();
@@ -39,7 +39,7 @@ void BM_ModbusTcpReadRegister(benchmark::State& state) {
 BENCHMARK(BM_ModbusTcpReadRegister)->UseRealTime();
 
 void BM_ModbusChamberRead(benchmark::State& state) {
-  auto map = cm::watlow_f4();
+  auto map = cm::generic_plc();
   station::sim::ChamberSim sim(map);
   station::sim::ModbusServer server(sim);
   server.start_tcp();

@@ -37,7 +37,7 @@ struct Rig {
 }  // namespace
 
 TEST(ModbusChamber, ReadsInitialStateFromWatlowF4Map) {
-  Rig rig(cm::watlow_f4());
+  Rig rig(cm::generic_plc());
   ASSERT_TRUE(rig.chamber->connect());
   auto s = rig.chamber->read();
   ASSERT_TRUE(s) << s.error().message;
@@ -53,7 +53,7 @@ TEST(ModbusChamber, ReadsInitialStateFromWatlowF4Map) {
 // air(t) = 25 - r t + r tau (1 - e^{-t/tau}), i.e. -5 + 2.0 (1 - e^{-15}) = -3.0 C for tau = 120 s.
 // Tolerance: register resolution 0.05 C plus the discretisation error r*dt/2 < 0.001 C.
 TEST(ModbusChamber, RampFollowsFirstOrderModelOverSimulatedTime) {
-  Rig rig(cm::watlow_f4());
+  Rig rig(cm::generic_plc());
   rig.chamber->set_readback_every(1);  // mode and ramp on every read (they are what is checked)
   ASSERT_TRUE(rig.chamber->command({.setpoint_c = -40.0, .ramp_c_per_min = 1.0}));
   rig.sim.step_to(1800.0);
@@ -79,7 +79,7 @@ TEST(ModbusChamber, RampFollowsFirstOrderModelOverSimulatedTime) {
 // A step (ramp 0) is limited by the cooling capacity: 2 C/min, so 10 min after a step from 25 to
 // -40 the air is at most 20 C lower, and the deviation alarm is set (|air - sp| > 5 C).
 TEST(ModbusChamber, StepIsRateLimitedByCoolingCapacity) {
-  Rig rig(cm::watlow_f4());
+  Rig rig(cm::generic_plc());
   ASSERT_TRUE(rig.chamber->command({.setpoint_c = -40.0, .ramp_c_per_min = 0.0}));
   rig.sim.step_to(600.0);
   auto s = rig.chamber->read();
@@ -93,7 +93,7 @@ TEST(ModbusChamber, SetpointOutsideLimitRegistersIsRangeAndNotWritten) {
   station::sim::ChamberSimConfig cfg;
   cfg.setpoint_low_c = -45.0;
   cfg.setpoint_high_c = 85.0;
-  Rig rig(cm::watlow_f4(), cfg);
+  Rig rig(cm::generic_plc(), cfg);
   auto r = rig.chamber->command({.setpoint_c = -50.0, .ramp_c_per_min = 2.0});
   ASSERT_FALSE(r);
   EXPECT_EQ(r.error().kind, ErrorKind::range);
@@ -107,7 +107,7 @@ TEST(ModbusChamber, SetpointOutsideLimitRegistersIsRangeAndNotWritten) {
 }
 
 TEST(ModbusChamber, HoldFreezesRampAndRunDisableTurnsOff) {
-  Rig rig(cm::watlow_f4());
+  Rig rig(cm::generic_plc());
   ASSERT_TRUE(rig.chamber->command({.setpoint_c = 70.0, .ramp_c_per_min = 1.0}));
   rig.sim.step_to(600.0);
   rig.sim.set_hold(true);
@@ -128,7 +128,7 @@ TEST(ModbusChamber, HoldFreezesRampAndRunDisableTurnsOff) {
 }
 
 TEST(ModbusChamber, F4tFloat32CdabRoundTripsOverTheWire) {
-  Rig rig(cm::f4t());
+  Rig rig(cm::generic_plc_float());
   ASSERT_TRUE(rig.chamber->command({.setpoint_c = -39.875, .ramp_c_per_min = 0.75}));
   auto s = rig.chamber->read();
   ASSERT_TRUE(s) << s.error().message;
@@ -141,7 +141,7 @@ TEST(ModbusChamber, F4tFloat32CdabRoundTripsOverTheWire) {
 }
 
 TEST(ModbusChamber, OverriddenMapIsSharedByDriverAndSimulator) {
-  auto map = cm::watlow_f4();
+  auto map = cm::generic_plc();
   mb::apply_overrides(map, {{.name = cm::kAir, .address = 1001, .one_based = true},
                             {.name = cm::kSetpoint, .scale = 0.01}});
   Rig rig(map);
@@ -153,7 +153,7 @@ TEST(ModbusChamber, OverriddenMapIsSharedByDriverAndSimulator) {
 }
 
 TEST(ModbusChamber, SensorBreakDoorAndHighLimitAlarms) {
-  Rig rig(cm::watlow_f4());
+  Rig rig(cm::generic_plc());
   rig.chamber->set_readback_every(1);  // the mode (read back periodically) is checked too
   rig.sim.set_air_sensor_failed(true);
   rig.sim.set_door_open(true);
@@ -174,7 +174,7 @@ TEST(ModbusChamber, SensorBreakDoorAndHighLimitAlarms) {
 }
 
 TEST(ModbusChamber, InjectedFaultsGiveTypedErrorsThenRecover) {
-  Rig rig(cm::watlow_f4());
+  Rig rig(cm::generic_plc());
   rig.server.inject_timeouts(1);
   auto t = rig.chamber->read();
   ASSERT_FALSE(t);
@@ -194,7 +194,7 @@ TEST(ModbusChamber, InjectedFaultsGiveTypedErrorsThenRecover) {
 }
 
 TEST(ModbusChamber, WorksOverRtuOnAPty) {
-  auto map = cm::watlow_f4(7);
+  auto map = cm::generic_plc(7);
   ChamberSim sim(map);
   ModbusServer server(sim, 7);
   server.start_rtu_pty(19200);
@@ -215,10 +215,10 @@ TEST(ModbusChamber, WorksOverRtuOnAPty) {
 }
 
 TEST(ModbusChamber, RtuRequestForAnotherUnitTimesOut) {
-  ChamberSim sim(cm::watlow_f4(2));
+  ChamberSim sim(cm::generic_plc(2));
   ModbusServer server(sim, 2);
   server.start_rtu_pty();
-  ModbusChamber chamber("chamber-rtu", mb::parse_endpoint(server.endpoint()), cm::watlow_f4(3),
+  ModbusChamber chamber("chamber-rtu", mb::parse_endpoint(server.endpoint()), cm::generic_plc(3),
                         0.2);
   auto s = chamber.read();
   ASSERT_FALSE(s);

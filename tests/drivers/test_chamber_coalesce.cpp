@@ -87,7 +87,7 @@ TEST(ReadPlan, NeverAsksForMoreThan125Registers) {
 // The simulated F4 is strict like the real one (a block over the unimplemented 101..103 is
 // exception 02), so the default plan merges only adjacent points: 7 requests, none refused.
 TEST(ModbusChamber, DefaultReadNeverSpansUnmappedRegistersOfAStrictF4) {
-  const auto map = cm::watlow_f4();
+  const auto map = cm::generic_plc();
   const Counted block = count_one_read(map, ModbusChamber::kDefaultMaxReadGap);
   const Counted single = count_one_read(map, -1);
   EXPECT_EQ(block.requests, 7u);
@@ -101,7 +101,7 @@ TEST(ModbusChamber, DefaultReadNeverSpansUnmappedRegistersOfAStrictF4) {
 
 // The old default (gap 16) asked for 100..110 in one read: a strict F4 refuses it with 02.
 TEST(ModbusChamber, GapBridgingBlockReadIsRefusedByAStrictChamber) {
-  const auto map = cm::watlow_f4();
+  const auto map = cm::generic_plc();
   ChamberSim sim(map);
   ModbusServer server(sim);
   server.start_tcp();
@@ -115,14 +115,14 @@ TEST(ModbusChamber, GapBridgingBlockReadIsRefusedByAStrictChamber) {
 
 // F4T: no two read points are adjacent (floats at 2800, 2880, 2160, 2168; words elsewhere).
 TEST(ModbusChamber, ReadOfF4tFloatPointsSucceedsAgainstAStrictChamber) {
-  const auto map = cm::f4t();
+  const auto map = cm::generic_plc_float();
   const Counted block = count_one_read(map, ModbusChamber::kDefaultMaxReadGap);
   EXPECT_EQ(block.requests, 7u);
   EXPECT_DOUBLE_EQ(block.state.air_c, count_one_read(map, -1).state.air_c);
 }
 
 TEST(ModbusChamber, FailedBlockReadIsOneTypedErrorAndTheNextReadRecovers) {
-  const auto map = cm::watlow_f4();
+  const auto map = cm::generic_plc();
   ChamberSim sim(map);
   ModbusServer server(sim);
   server.start_tcp();
@@ -140,7 +140,7 @@ TEST(ModbusChamber, FailedBlockReadIsOneTypedErrorAndTheNextReadRecovers) {
 // Ramp, run, status and product are read back every N reads (drivers/modbus/readback.hpp), and
 // on the read after a write or a reconnect; alarms, air and the setpoint on every read.
 TEST(ModbusChamber, CommandRegistersAreReadBackEveryNReadsAndAfterAWriteOrReconnect) {
-  const auto map = cm::watlow_f4();
+  const auto map = cm::generic_plc();
   ChamberSim sim(map);
   ModbusServer server(sim);
   server.start_tcp();

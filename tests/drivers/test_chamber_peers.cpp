@@ -98,7 +98,7 @@ bool has_pymodbus() {
 
 TEST(ModbusPeers, MbpollReadsAndWritesTheSimulatedChamber) {
   if (access(kMbpoll, X_OK) != 0) GTEST_SKIP() << kMbpoll << " not installed";
-  auto map = cm::watlow_f4();
+  auto map = cm::generic_plc();
   station::sim::ChamberSimConfig cfg;
   cfg.initial_c = 31.7;
   station::sim::ChamberSim sim(map, cfg);
@@ -126,7 +126,7 @@ TEST(ModbusPeers, ChamberDriverReadsAPymodbusServer) {
   int port = free_port();
   PythonPeer peer(port);
   station::drivers::ModbusChamber chamber("chamber-pymodbus", mb::TcpEndpoint{"127.0.0.1", port},
-                                          cm::watlow_f4(), 0.5);
+                                          cm::generic_plc(), 0.5);
   // Bounded wait for the interpreter to come up: 100 tries x 100 ms.
   bool up = false;
   for (int i = 0; i < 100 && !up; ++i) {

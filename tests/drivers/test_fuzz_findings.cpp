@@ -22,7 +22,7 @@ namespace cm = station::drivers::chamber_map;
 // fuzz_register_maps: an override put a float32 at PDU address 65535, and plan_reads then asked
 // for registers 65535..65536, past the Modbus address space (tests/fuzz/findings/...).
 TEST(FuzzFindings, APointPastRegister65535IsAConfigError) {
-  auto map = cm::f4t();
+  auto map = cm::generic_plc_float();
   mb::PointOverride last{.name = cm::kAir, .address = 65535};
   EXPECT_THROW(mb::apply_overrides(map, {last}), std::invalid_argument);
   mb::PointOverride one_based{.name = cm::kAir, .address = 65535, .one_based = true};

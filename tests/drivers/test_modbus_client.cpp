@@ -28,7 +28,7 @@ class ModbusClientTest : public ::testing::Test {
     client =
         std::make_unique<mb::ModbusClient>("chamber", mb::parse_endpoint(server.endpoint()), 0.3);
   }
-  mb::RegisterMap map = cm::watlow_f4();
+  mb::RegisterMap map = cm::generic_plc();
   station::sim::ChamberSim sim{map};
   station::sim::ModbusServer server{sim};
   std::unique_ptr<mb::ModbusClient> client;
@@ -198,7 +198,7 @@ TEST_F(ModbusClientTest, AnAnswerResetsTheTimeoutRun) {
 
 // RTU has no connection to renew: repeated timeouts keep the line open and it recovers.
 TEST(ModbusClientRtu, RepeatedTimeoutsKeepTheLineOpen) {
-  auto map = cm::watlow_f4();
+  auto map = cm::generic_plc();
   station::sim::ChamberSim sim{map};
   station::sim::ModbusServer server{sim};
   server.start_rtu_pty();

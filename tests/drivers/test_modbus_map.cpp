@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "drivers/chamber/generic_plc/generic_plc_map.hpp"
+#include "drivers/registry/dialects.hpp"
 #include "drivers/modbus/endpoint.hpp"
 #include "drivers/modbus/map_overrides.hpp"
 #include "drivers/modbus/register_map.hpp"
@@ -96,21 +97,24 @@ TEST(ModbusEndpoint, ErrorsNameWhatIsWrong) {
             std::string::npos);
 }
 
-TEST(ChamberMap, PresetsByNameAndUnknownNameIsNamed) {
-  auto f4 = cm::preset("watlow_f4");
-  EXPECT_EQ(f4.at(cm::kAir).address, 100);
-  EXPECT_EQ(f4.at(cm::kSetpointHigh).address, 603);
-  EXPECT_EQ(f4.at(cm::kRun).address, 2000);
-  auto f4t = cm::preset("f4t");
-  EXPECT_EQ(f4t.at(cm::kAir).type, mb::PointType::float32);
-  EXPECT_EQ(f4t.at(cm::kAir).order, mb::WordOrder::cdab);
-  EXPECT_NE(error_of([] { cm::preset("espec"); }).find("'espec'"), std::string::npos);
-  EXPECT_NE(error_of([&] { (void)f4.at("nope"); }).find("'nope'"), std::string::npos);
+TEST(ChamberMap, DialectMapsByModelAndUnknownModelIsNamed) {
+  station::drivers::DeviceSpec spec;
+  spec.endpoint = "tcp://127.0.0.1:502";
+  auto plc = station::drivers::chamber_dialect("generic_plc").map(spec);
+  EXPECT_EQ(plc.at(cm::kAir).address, 100);
+  EXPECT_EQ(plc.at(cm::kRun).address, 2000);
+  auto f4t = station::drivers::chamber_dialect("f4t").map(spec);  // the old preset's name
+  EXPECT_EQ(f4t.at("loop1_pv").type, mb::PointType::float32);
+  EXPECT_EQ(f4t.at("loop1_pv").order, mb::WordOrder::cdab);
+  EXPECT_NE(error_of([] { station::drivers::chamber_dialect("espec"); }).find("'espec'"),
+            std::string::npos);
+  EXPECT_NE(error_of([&] { (void)plc.at("nope"); }).find("'nope'"), std::string::npos);
   EXPECT_EQ(station::drivers::turntable_map::generic_plc().points().size(), 9u);
+  EXPECT_FALSE(station::drivers::chamber_dialect("espec_p300").map);  // ASCII: no map
 }
 
 TEST(ChamberMap, OverridesChangeOnlyNamedFieldsAndAreChecked) {
-  auto map = cm::watlow_f4();
+  auto map = cm::generic_plc();
   mb::PointOverride o{.name = cm::kAir, .address = 4001, .one_based = true};
   mb::apply_overrides(map, {o});
   EXPECT_EQ(map.at(cm::kAir).pdu_address(), 4000);

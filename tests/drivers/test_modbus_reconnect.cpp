@@ -38,7 +38,7 @@ TEST(Backoff, DoublesFromHalfASecondToEightAndResetsOnSuccess) {
 namespace {
 
 struct Server {
-  mb::RegisterMap map = cm::watlow_f4();
+  mb::RegisterMap map = cm::generic_plc();
   station::sim::ChamberSim sim{map};
   station::sim::ModbusServer server{sim};
 };

@@ -162,7 +162,8 @@ TEST(SimFaults, InjectedChamberAlarmsStayUntilCleared) {
   Rig rig;
   rig.ok("chamber alarm high-limit on");
   rig.ok("chamber alarm sensor on");
-  modbus_t* raw = modbus_new_tcp("127.0.0.1", rig.world.chamber_server().port());
+  modbus_t* raw = modbus_new_tcp(
+      "127.0.0.1", dynamic_cast<station::sim::ModbusServer&>(rig.world.chamber_server()).port());
   ASSERT_EQ(modbus_connect(raw), 0);
   for (int minute = 1; minute <= 10; ++minute) {
     rig.world.advance_to(60.0 * minute);

@@ -42,13 +42,13 @@ int failure(int rc) {
 }
 
 struct ChamberRig {
-  sim::ChamberSim model{cm::watlow_f4()};
+  sim::ChamberSim model{cm::generic_plc()};
   sim::ModbusServer server{model};
   ChamberRig() { server.start_tcp(); }
 };
 
 struct TableRig {
-  sim::TurntableSim model{ttm::default_map()};
+  sim::TurntableSim model{ttm::generic_plc()};
   sim::ModbusServer server{model};
   TableRig() { server.start_tcp(); }
 };
@@ -120,7 +120,7 @@ TEST(StrictModbus, TurntableInputBlockIsServedWholeButNotPastItsEnd) {
 
 // On a multidrop RTU line a device ignores frames for other units: the master times out.
 TEST(StrictModbus, RtuRequestForAForeignUnitGetsNoAnswerAtAll) {
-  sim::ChamberSim model{cm::watlow_f4()};
+  sim::ChamberSim model{cm::generic_plc()};
   sim::ModbusServer server{model, 1};
   server.start_rtu_pty();
   Ctx c(modbus_new_rtu(server.pty_path().c_str(), 19200, 'N', 8, 1));
@@ -144,7 +144,7 @@ TEST(StrictModbus, RtuRequestForAForeignUnitGetsNoAnswerAtAll) {
 
 // The decision itself, without transport: a PDU and a map in, an exception code out.
 TEST(StrictModbus, RequestExceptionChecksQuantityAndByteCount) {
-  const auto map = cm::watlow_f4();
+  const auto map = cm::generic_plc();
   using Pdu = std::vector<std::uint8_t>;
   EXPECT_EQ(sim::request_exception(map, Pdu{0x03, 0x00, 0x64, 0x00, 0x01}), 0);
   EXPECT_EQ(sim::request_exception(map, Pdu{0x03, 0x00, 0x64, 0x00, 0x00}), sim::kIllegalDataValue);

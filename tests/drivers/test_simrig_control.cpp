@@ -159,7 +159,7 @@ TEST(SimrigControl, SendDeliversFaultCommandsToARunningSimrig) {
   ASSERT_GT(pid, 0);
   std::smatch m;
   std::string text;
-  const std::regex endpoint(R"(# chamber +(tcp://\S+))");
+  const std::regex endpoint(R"(# chamber +\S+ (tcp://\S+))");
   for (int i = 0; i < 250 && !std::regex_search(text, m, endpoint); ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
     text = slurp(out);

@@ -179,7 +179,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   static FakeDevice device;
   const auto endpoint = mb::parse_endpoint("tcp://127.0.0.1:" + std::to_string(device.port()));
   static dr::ModbusChamber f4("f4", endpoint, dr::chamber_map::generic_plc(), kTimeoutS);
-  static dr::ModbusChamber f4t("f4t", endpoint, dr::chamber_map::f4t(), kTimeoutS);
+  static dr::ModbusChamber f4t("f4t", endpoint, dr::chamber_map::generic_plc_float(), kTimeoutS);
   static dr::ModbusTurntable table("table", endpoint, dr::turntable_map::generic_plc(), {},
                                    kTimeoutS);
   if (size < 1) return 0;

@@ -39,7 +39,7 @@ mb::RegisterMap preset(std::uint8_t which) {
     case 0:
       return station::drivers::chamber_map::generic_plc();
     case 1:
-      return station::drivers::chamber_map::f4t();
+      return station::drivers::chamber_map::generic_plc_float();
     default:
       return station::drivers::turntable_map::generic_plc();
   }

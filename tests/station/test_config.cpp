@@ -48,9 +48,10 @@ TEST(Config, ExamplesLoad) {
   EXPECT_DOUBLE_EQ(sim.latitude_deg, 39.9);
   EXPECT_TRUE(sim.turntable.has_value());
   const auto rtu = station::load_station_config(kSrc + "/examples/station_rtu.toml");
-  EXPECT_EQ(rtu.chamber.preset, "f4t");
+  EXPECT_EQ(rtu.chamber.model, "watlow_f4t");
+  EXPECT_EQ(rtu.chamber.run_event, 2);
   ASSERT_EQ(rtu.chamber.overrides.size(), 1u);
-  EXPECT_EQ(*rtu.chamber.overrides[0].address, 2890);
+  EXPECT_EQ(*rtu.chamber.overrides[0].address, 4180);
   EXPECT_NEAR(rtu.slots[1].enu.east, 1.0, 1e-12);  // heading 90 = east
   ASSERT_TRUE(rtu.gpio.has_value());
   ASSERT_NE(station::drivers::gpio::find_role(*rtu.gpio, "interlock"), nullptr);
@@ -86,7 +87,7 @@ TEST(Config, ASyntaxErrorQuotingANewlineIsStillOneLine) {
 
 TEST(Config, MinimalFileGetsDefaults) {
   const auto c = station::parse_station_config(kMinimal, "rig.toml");
-  EXPECT_EQ(c.chamber.preset, "watlow_f4");
+  EXPECT_EQ(c.chamber.model, "generic_plc");
   EXPECT_DOUBLE_EQ(c.slots[0].pulse_weight_arcsec, 1.5);
   EXPECT_DOUBLE_EQ(c.limits.max_ramp_c_per_min, 3.0);
   EXPECT_DOUBLE_EQ(c.limits.air_margin_c, 5.0);
@@ -135,14 +136,23 @@ TEST(Config, BadEndpointPresetAndTransport) {
   EXPECT_NE(error_of(kMinimal + "[chamber]\n").find("rig.toml"), std::string::npos);
   std::string p = kMinimal;
   p.insert(p.find("[can]"), "preset = \"acme\"\n");
-  EXPECT_NE(error_of(p).find("key 'chamber.preset': unknown chamber register-map preset 'acme'"),
+  EXPECT_NE(error_of(p).find("key 'chamber.preset': unknown chamber model 'acme' (known: "
+                             "generic_plc, watlow_f4, watlow_f4t"),
             std::string::npos)
       << error_of(p);
+  // An ASCII dialect takes an ASCII endpoint, and has no register points to override.
+  std::string a = kMinimal;
+  a.insert(a.find("[can]"), "model = \"espec_p300\"\n");
+  EXPECT_NO_THROW(station::parse_station_config(a, "rig.toml"));
+  std::string rtu_p300 = a;
+  rtu_p300.replace(rtu_p300.find("tcp://127.0.0.1:502"), 19, "rtu:/dev/ttyS0");
+  EXPECT_NE(error_of(rtu_p300).find("key 'chamber.endpoint'"), std::string::npos)
+      << error_of(rtu_p300);
   // Issue 7, house: the turntable's preset was accepted and then ignored.
   const std::string table = kMinimal + "[turntable]\nendpoint = \"tcp://127.0.0.1:503\"\n";
   EXPECT_NO_THROW(station::parse_station_config(table + "preset = \"default\"\n", "rig.toml"));
   EXPECT_NE(error_of(table + "preset = \"acme\"\n")
-                .find("key 'turntable.preset': unknown turntable register-map preset 'acme'"),
+                .find("key 'turntable.preset': unknown turntable model 'acme'"),
             std::string::npos)
       << error_of(table + "preset = \"acme\"\n");
   std::string c = kMinimal;

@@ -172,7 +172,7 @@ RunResult run_rig(Cut cut, const std::string& name) {
   BoardServer boards(sock, wc, world.gyros());
   std::string text = fmt::format(
       "[station]\nlatitude_deg = 39.9\nbin_s = 60\nmax_lost_share = 0.005\n"
-      "[chamber]\nendpoint = \"{}\"\npreset = \"watlow_f4\"\n"
+      "[chamber]\nendpoint = \"{}\"\nmodel = \"generic_plc\"\n"
       "[can]\ntransport = \"unix:{}\"\ntick_timeout_ms = 900\n",
       world.chamber_endpoint(), sock);
   for (const auto& g : world.gyros())

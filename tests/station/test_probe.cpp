@@ -32,7 +32,7 @@ name = "probe-test"
 latitude_deg = 39.9
 [chamber]
 endpoint = "{}"
-preset = "watlow_f4"
+model = "generic_plc"
 timeout_s = 0.2
 [turntable]
 endpoint = "{}"

@@ -53,7 +53,7 @@ fs::path temp_dir(const std::string& name) {
 
 TEST(ReplayModbus, AClientOverTheRecordingGetsWhatTheDeviceAnswered) {
   const auto dir = temp_dir("replay_modbus");
-  const mb::RegisterMap map = cm::watlow_f4();
+  const mb::RegisterMap map = cm::generic_plc();
   station::sim::ChamberSim sim{map};
   station::sim::ModbusServer server{sim};
   server.start_tcp();

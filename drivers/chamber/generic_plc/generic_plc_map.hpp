@@ -62,4 +62,26 @@ inline RegisterMap generic_plc(int unit_id = 1) {
                                    t(kSetpointHigh, 603, Access::ro), u(kRun, 2000, Access::rw)});
 }
 
+/// The same points as 32-bit floats, low word first (CDAB), for a PLC that serves floats
+/// (driver tests and fuzzers exercise the float codec through it): 2800 air, 2880 product,
+/// 2920 status, 1500 alarm bits, 2160 setpoint, 2168 ramp, 2172/2174 limits, 2040 run.
+inline RegisterMap generic_plc_float(int unit_id = 1) {
+  auto f = [unit_id](const char* n, std::uint16_t a, Access acc) {
+    return Point{
+        n,     a,  PointType::float32, 1.0, WordOrder::cdab, modbus::FunctionCode::holding, unit_id,
+        false, acc};
+  };
+  auto u = [unit_id](const char* n, std::uint16_t a, Access acc) {
+    return Point{
+        n,     a,  PointType::uint16, 1.0, WordOrder::abcd, modbus::FunctionCode::holding, unit_id,
+        false, acc};
+  };
+  return RegisterMap("generic_plc_float",
+                     {f(kAir, 2800, Access::ro), f(kProduct, 2880, Access::ro),
+                      u(kStatus, 2920, Access::ro), u(kAlarms, 1500, Access::ro),
+                      f(kSetpoint, 2160, Access::rw), f(kRamp, 2168, Access::rw),
+                      f(kSetpointLow, 2172, Access::ro), f(kSetpointHigh, 2174, Access::ro),
+                      u(kRun, 2040, Access::rw)});
+}
+
 }  // namespace station::drivers::chamber_map

@@ -109,6 +109,21 @@ Result<void> ModbusChamber::check_setpoint(double setpoint_c) {
   return {};
 }
 
+Result<ChamberIdentity> ModbusChamber::identify() {
+  auto lo = get(cm::kSetpointLow);
+  if (!lo) return lo.error();
+  auto hi = get(cm::kSetpointHigh);
+  if (!hi) return hi.error();
+  ChamberIdentity id;
+  id.model = "generic_plc";
+  id.identity = "station map '" + map_.device() + "' (no identity register)";
+  id.units = "C";
+  id.setpoint_low_c = lo.value();
+  id.setpoint_high_c = hi.value();
+  id.notes = "scaling from the map";
+  return id;
+}
+
 Result<void> ModbusChamber::command(const ChamberCommand& c) {
   readback_.invalidate();  // the next read confirms what the controller took
   if (c.ramp_c_per_min && !(*c.ramp_c_per_min >= 0 && std::isfinite(*c.ramp_c_per_min)))

@@ -36,6 +36,8 @@ class ModbusChamber final : public Chamber {
   /// gives ErrorKind::range and nothing is written.
   Result<void> command(const ChamberCommand& c) override;
   std::string name() const override { return name_; }
+  /// The map's name and its setpoint limits (the generic map has no identity register).
+  Result<ChamberIdentity> identify() override;
 
   /// Sets the tap every Modbus exchange passes (nullptr: none).
   void set_tap(Tap* tap) { client_.set_tap(tap); }

@@ -2,7 +2,7 @@
 """A Watlow-F4-like chamber played by pymodbus 3.0 (a Modbus peer we did not write).
 
 usage: chamber_peer.py PORT   -- serves holding registers on 127.0.0.1:PORT, unit 1, 0-based
-(zero_mode) at the watlow_f4 preset addresses: air 23.4 C, product 21.0 C, status constant,
+(zero_mode) at the generic_plc map addresses: air 23.4 C, product 21.0 C, status constant,
 setpoint 23.5 C, ramp 1.5 C/min, limits -45.0 / 85.0 C, run 1, no alarms.
 """
 import sys

@@ -1,0 +1,42 @@
+// A recorded session's ascii.log as a LineWire: the daemon's LineClient sends, the recording
+// checks the bytes and answers with the recorded line, exchange by exchange. Sending anything
+// else is a divergence (ReplayDivergence), as for Modbus (replay_modbus.hpp).
+#pragma once
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "drivers/ascii/line_wire.hpp"
+#include "station/session/replay_modbus.hpp"
+#include "station/session/session_log.hpp"
+
+namespace station {
+
+/// One line device's recorded exchanges (lines of ascii.log whose DEVICE is this device).
+class RecordedLineWire final : public drivers::ascii::LineWire {
+ public:
+  RecordedLineWire(std::string device, std::vector<SessionLogLine> lines);
+  int open(double timeout_s) override;
+  void close() override;
+  int send(std::string_view bytes, double timeout_s) override;
+  int receive(std::string& line, std::string_view terminator, double timeout_s,
+              std::size_t max_bytes) override;
+  void flush() override {}
+  std::size_t remaining() const { return lines_.size() - next_; }
+  std::vector<SessionLogLine> consumed() const {
+    return {lines_.begin(), lines_.begin() + static_cast<std::ptrdiff_t>(next_)};
+  }
+
+ private:
+  const SessionLogLine* peek() const { return next_ < lines_.size() ? &lines_[next_] : nullptr; }
+  /// The next line is a recorded failure whose message contains `what` (" send '", " reply to
+  /// '", " connect "): consumed, errno set, true.
+  bool recorded_error(std::string_view what);
+
+  std::string device_;
+  std::vector<SessionLogLine> lines_;
+  std::size_t next_ = 0;
+};
+
+}  // namespace station
