@@ -70,6 +70,7 @@ int FdLineWire::open(double timeout_s) {
 int FdLineWire::open_tcp(const LineTcp& ep, double timeout_s) {
   addrinfo hints{};
   hints.ai_socktype = SOCK_STREAM;
+  hints.ai_flags = AI_NUMERICHOST;  // literals only (parse_line_endpoint): never a DNS wait
   addrinfo* found = nullptr;
   if (::getaddrinfo(ep.host.c_str(), std::to_string(ep.port).c_str(), &hints, &found) != 0) {
     errno = EHOSTUNREACH;
@@ -141,9 +142,11 @@ int FdLineWire::send(std::string_view bytes, double timeout_s) {
         done += static_cast<std::size_t>(w);
         continue;
       }
-    } else if (n >= 0) {
+    } else if (n > 0) {
       done += static_cast<std::size_t>(n);
       continue;
+    } else if (n == 0) {
+      errno = EAGAIN;  // nothing taken: wait for room, under the deadline
     }
     if (errno == EINTR) continue;
     if (errno != EAGAIN && errno != EWOULDBLOCK && errno != ENOTSOCK) return -1;
@@ -161,6 +164,11 @@ int FdLineWire::receive(std::string& line, std::string_view terminator, double t
   const auto deadline = deadline_after(timeout_s);
   for (;;) {
     if (const auto end = pending_.find(terminator); end != std::string::npos) {
+      if (end > max_bytes) {
+        pending_.clear();
+        errno = EMSGSIZE;
+        return -1;
+      }
       line = pending_.substr(0, end);
       pending_.erase(0, end + terminator.size());
       return static_cast<int>(line.size());
@@ -188,8 +196,9 @@ int FdLineWire::receive(std::string& line, std::string_view terminator, double t
 void FdLineWire::flush() {
   pending_.clear();
   if (!fd_.valid()) return;
+  // Bounded: a peer that streams without end cannot hold the caller here.
   char buf[512];
-  while (::read(fd_.get(), buf, sizeof buf) > 0) {
+  for (int i = 0; i < 128 && ::read(fd_.get(), buf, sizeof buf) > 0; ++i) {
   }
 }
 

@@ -107,16 +107,20 @@ Result<void> LineClient::transmit(std::string_view command) {
   std::string bytes(command);
   bytes += framing_.command_terminator;
   tap(TapDirection::tx, "ascii", bytes, {});  // as sent, terminator included
-  if (wire_->send(bytes, timeout_s_) == -1)
-    return fail(errno, fmt::format("send '{}'", command));
+  if (wire_->send(bytes, timeout_s_) == -1) {
+    const int err = errno;  // before anything allocates
+    return fail(err, fmt::format("send '{}'", command));
+  }
   return {};
 }
 
 Result<std::string> LineClient::query(std::string_view command) {
   if (auto t = transmit(command); !t) return t.error();
   std::string line;
-  if (wire_->receive(line, framing_.reply_terminator, timeout_s_, framing_.max_reply_bytes) == -1)
-    return fail(errno, fmt::format("reply to '{}'", command));
+  if (wire_->receive(line, framing_.reply_terminator, timeout_s_, framing_.max_reply_bytes) == -1) {
+    const int err = errno;
+    return fail(err, fmt::format("reply to '{}'", command));
+  }
   consecutive_timeouts_ = 0;
   tap(TapDirection::rx, "ascii", line, {});
   return line;

@@ -1,6 +1,8 @@
 // Line endpoint parsing with errors that name the offending part.
 #include "drivers/ascii/line_endpoint.hpp"
 
+#include <arpa/inet.h>
+
 #include <array>
 #include <charconv>
 #include <stdexcept>
@@ -57,7 +59,16 @@ LineEndpoint parse_line_endpoint(std::string_view text) {
     const auto colon = rest.rfind(':');
     if (colon == std::string_view::npos) fail(text, "missing ':PORT' after host");
     LineTcp ep{std::string(rest.substr(0, colon)), 0};
+    if (ep.host.size() > 2 && ep.host.front() == '[' && ep.host.back() == ']')
+      ep.host = ep.host.substr(1, ep.host.size() - 2);  // [::1]
     if (ep.host.empty()) fail(text, "empty host");
+    if (ep.host == "localhost") ep.host = "127.0.0.1";
+    // An address literal: a host name would be resolved without a deadline (getaddrinfo).
+    in6_addr a6{};
+    in_addr a4{};
+    if (::inet_pton(AF_INET, ep.host.c_str(), &a4) != 1 &&
+        ::inet_pton(AF_INET6, ep.host.c_str(), &a6) != 1)
+      fail(text, "host must be an IPv4 or IPv6 address (a name would need DNS without a deadline)");
     ep.port = parse_int(text, "port", rest.substr(colon + 1), 1, 65535);
     return ep;
   }

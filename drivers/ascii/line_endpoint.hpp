@@ -11,7 +11,7 @@ namespace station::drivers::ascii {
 
 /// A TCP socket carrying lines.
 struct LineTcp {
-  std::string host;  ///< IPv4/IPv6 literal or host name
+  std::string host;  ///< IPv4/IPv6 literal ("localhost" reads as 127.0.0.1; no DNS: no deadline)
   int port = 0;      ///< 1..65535
 };
 

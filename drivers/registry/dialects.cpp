@@ -175,6 +175,13 @@ std::string turntable_models() { return names(turntable_dialects()); }
 
 template <typename Device>
 void validate(const Dialect<Device>& dialect, const DeviceSpec& spec) {
+  const bool has_events = dialect.model == "watlow_f4" || dialect.model == "watlow_f4t" ||
+                          dialect.model == "watlow_f4t_map2";
+  if (spec.run_event != 1 && !has_events)
+    throw std::invalid_argument(fmt::format(
+        "run_event: model '{}' has no event outputs (only watlow_f4, watlow_f4t, "
+        "watlow_f4t_map2 do)",
+        dialect.model));
   if (dialect.transport == Transport::modbus) {
     (void)modbus::parse_endpoint(spec.endpoint);
     if (spec.run_event < 1 || spec.run_event > 8)

@@ -84,9 +84,10 @@ std::string P300Face::answer(std::string_view c) {
   if (c == p3::kTempQuery)
     return fmt::format("{:.1f},{:.1f},{:.1f},{:.1f}", pv, chamber_.setpoint_c(),
                        cfg.setpoint_high_c, cfg.setpoint_low_c);
-  if (c == p3::kMonitorQuery)
-    return fmt::format("{:.1f},,{},{}", pv, mode(), std::count(alarm_codes().begin(),
-                                                               alarm_codes().end(), ','));
+  if (c == p3::kMonitorQuery) {
+    const std::string codes = alarm_codes();
+    return fmt::format("{:.1f},,{},{}", pv, mode(), std::count(codes.begin(), codes.end(), ','));
+  }
   if (c == p3::kModeQuery) return mode();
   if (c == p3::kAlarmQuery) return alarm_codes();
   if (c == p3::kProductQuery)

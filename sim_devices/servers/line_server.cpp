@@ -45,7 +45,9 @@ int listen_on(int port) {
 void write_all(int fd, const std::string& bytes) {
   std::size_t done = 0;
   while (done < bytes.size()) {
-    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    // A socket never raises SIGPIPE at a client that went away (MSG_NOSIGNAL); a pty is written.
+    ssize_t n = ::send(fd, bytes.data() + done, bytes.size() - done, MSG_NOSIGNAL);
+    if (n < 0 && errno == ENOTSOCK) n = ::write(fd, bytes.data() + done, bytes.size() - done);
     if (n > 0) {
       done += static_cast<std::size_t>(n);
     } else if (n < 0 && (errno == EINTR || errno == EAGAIN)) {
@@ -128,6 +130,7 @@ void LineServer::clear_faults() {
   std::lock_guard lock(fault_mutex_);
   timeouts_ = exceptions_ = drops_ = 0;
   stall_until_ = down_until_ = {};
+  kick_clients_ = false;
 }
 
 LineServer::Fault LineServer::take_fault(int& code) {
@@ -176,7 +179,10 @@ bool LineServer::link_up() {
 void LineServer::serve_bytes(int fd, std::string& buffer, bool& close_it) {
   char chunk[512];
   const ssize_t n = ::read(fd, chunk, sizeof chunk);
-  if (n == 0 || (n < 0 && errno != EAGAIN && errno != EINTR && errno != EIO)) {
+  // EIO on the pty master is a slave side with no reader between clients: wait. Anything else
+  // that is not "try again" ends a socket client.
+  const bool pty_idle = n < 0 && errno == EIO && fd == pty_master_;
+  if (n == 0 || (n < 0 && errno != EAGAIN && errno != EINTR && !pty_idle)) {
     close_it = fd != pty_master_;
     return;
   }
@@ -218,7 +224,11 @@ void LineServer::run() {
       if (p.revents == 0) continue;
       if (p.fd == listen_fd_) {
         const int c = ::accept4(listen_fd_, nullptr, nullptr, SOCK_CLOEXEC | SOCK_NONBLOCK);
-        if (c != -1) clients_[c] = {};
+        if (c != -1) {
+          clients_[c] = {};
+        } else if (errno == EMFILE || errno == ENFILE || errno == ENOMEM) {
+          std::this_thread::sleep_for(std::chrono::milliseconds(50));  // no spin on a full table
+        }
         continue;
       }
       auto it = clients_.find(p.fd);

@@ -85,7 +85,8 @@ DeviceConfig read_device(const TomlView& v, bool is_chamber) {
         (void)drivers::ascii::parse_line_endpoint(d.endpoint);
       return 0;
     });
-    at_key(v, "point", [&] {
+    // The dialect checks run_event and the point overrides; the message names the key given.
+    at_key(v, d.run_event != 1 ? "run_event" : "point", [&] {
       drivers::validate(*dialect, d);
       return 0;
     });

@@ -29,8 +29,8 @@ drivers::ChamberCommand Safety::clamp(drivers::ChamberCommand cmd,
     if (asked > 0 && v != asked) {
       notes.push_back(fmt::format("ramp {:.3f} C/min clamped to {:.3f} C/min (limit {:.3f})", asked,
                                   v, limits_.max_ramp_c_per_min));
-      cmd.ramp_c_per_min = v;
     }
+    cmd.ramp_c_per_min = v;  // a step too (found by the issue-20 review: it stayed 0)
   }
   return cmd;
 }
@@ -52,9 +52,10 @@ Protocol Safety::clamp_protocol(const Protocol& p, std::vector<std::string>& not
       }
     }
     if (!controller_ramp && s.kind == StepKind::set_temperature && s.ramp_c_per_h <= 0) {
-      notes.push_back(fmt::format("{}: step ramped by the station at {:.1f} C/h (the chamber has "
-                                  "no ramp of its own)",
-                                  where, max_ramp_c_per_h));
+      // Named by protocol line, not file: a replay reads the protocol from another path.
+      notes.push_back(fmt::format("step {} '{}' (line {}): ramped by the station at {:.1f} C/h "
+                                  "(the chamber has no ramp of its own)",
+                                  i, s.label, s.line, max_ramp_c_per_h));
       s.ramp_c_per_h = max_ramp_c_per_h;
     }
     if (s.ramp_c_per_h > max_ramp_c_per_h) {

@@ -223,9 +223,10 @@ std::vector<SessionResume> read_session_resumes(const std::string& path) {
     };
     const auto next = r != nullptr ? (*r)["next_tick_s"].value<double>() : std::nullopt;
     // ascii_lines: absent in sessions from before issue 20 (no line devices then).
-    const auto ascii = r != nullptr ? (*r)["ascii_lines"].value<double>() : std::nullopt;
-    if (ascii && *ascii < 0)
-      throw InputError(fmt::format("{}: resume {}: key 'ascii_lines': negative", path, i + 1));
+    const auto* ascii_node = r != nullptr ? r->get("ascii_lines") : nullptr;
+    const auto ascii = ascii_node != nullptr ? ascii_node->value<double>() : std::nullopt;
+    if (ascii_node != nullptr && (!ascii || *ascii < 0))
+      throw InputError(fmt::format("{}: resume {}: key 'ascii_lines': not a count", path, i + 1));
     out.push_back({number("after_tick_s"), next, static_cast<std::int64_t>(number("can_lines")),
                    static_cast<std::int64_t>(number("modbus_lines")),
                    static_cast<std::int64_t>(number("gpio_lines")),

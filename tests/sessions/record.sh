@@ -38,7 +38,7 @@ record link_faults --fault "1500:chamber stall 2" --fault "2000:can drop 3" \
 # error replies.
 record dialect_f4 --chamber watlow_f4
 record dialect_f4t_acutrol --chamber watlow_f4t --turntable acutrol3000 \
-  --fault "1500:chamber stall 2" --fault "2000:table disconnect 1"
+  --fault "400:table disconnect 0.02" --fault "1500:chamber stall 2"
 record dialect_f4t_map2 --chamber watlow_f4t_map2
 record dialect_f4p --chamber watlow_f4p
 record dialect_p300_acutrol --chamber espec_p300 --turntable acutrol3000 \

@@ -44,11 +44,10 @@ Result<void> EspecP300Chamber::read_slow(ChamberState& s, int alarm_count) {
       has_product_ = false;  // no PTCON: the library's feature test (CCL espec.py :666-681)
     } else if (!r) {
       return r.error();
-    } else if (auto v = p3::parse_product(r.value())) {
-      product_c_ = *v;
     } else {
-      return make_error(ErrorKind::protocol,
-                        fmt::format("{}: TEMP PTC? reply '{}' is not 7 fields", name_, r.value()));
+      // A non-numeric product field (CCL read_temp_ptc parses with tryfloat) is no reading:
+      // the informational product temperature is NaN, the chamber's read goes on.
+      product_c_ = p3::parse_product(r.value()).value_or(std::numeric_limits<double>::quiet_NaN());
     }
   }
   other_alarm_ = false;

@@ -92,16 +92,18 @@ Result<ChamberState> WatlowF4Chamber::read() {
   if (full) {
     auto status = client_.read(map_.at(f4::kStatus));
     auto run = status ? client_.read(map_.at(f4::kRunEvent)) : status;
-    auto product = run ? temperature_c(f4::kProduct, *product_scale_) : run;
-    if (!product) {
+    auto perr = run ? client_.read(map_.at(f4::kProductError)) : run;
+    auto product = perr ? temperature_c(f4::kProduct, *product_scale_) : perr;
+    auto mode = product ? mode_of_status(static_cast<int>(status.value()),
+                                         run.value() == f4::kEventOn, name_)
+                        : Result<ChamberMode>(product.error());
+    if (!mode) {
       readback_.read_done(false, full, client_.connects());
-      return product.error();
+      return mode.error();
     }
     run_enabled_ = run.value() == f4::kEventOn;
-    auto mode = mode_of_status(static_cast<int>(status.value()), run_enabled_, name_);
-    if (!mode) return mode.error();
     mode_ = mode.value();
-    product_c_ = product.value();
+    product_c_ = perr.value() != 0 ? std::numeric_limits<double>::quiet_NaN() : product.value();
   }
   readback_.read_done(true, full, client_.connects());
   s.product_c = product_c_;

@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -36,6 +37,10 @@ Result<TemperatureScale> WatlowF4pChamber::scale() {
     return make_error(ErrorKind::protocol,
                       fmt::format("{}: register 0 reads {}, not 5280 ('4P'): not an F4P", name_,
                                   model.value()));
+  if (units.value() != f4p::kUnitsFahrenheit && units.value() != f4p::kUnitsCelsius)
+    return make_error(ErrorKind::protocol,
+                      fmt::format("{}: units register 901 = {} (F4P: 0 deg F, 1 deg C)", name_,
+                                  units.value()));
   if (dec.value() < 0 || dec.value() > 3)
     return make_error(ErrorKind::protocol,
                       fmt::format("{}: decimal places {} (register 606) not 0..3", name_, dec.value()));
@@ -94,19 +99,18 @@ Result<ChamberState> WatlowF4pChamber::read() {
 // Ramp to set point on every change at `ramp` deg/min (F4P p. 6.7-6.8), or off for a step.
 Result<void> WatlowF4pChamber::write_ramp(double ramp_c_per_min, const TemperatureScale& s) {
   if (ramp_c_per_min == 0) return client_.write(map_.at(f4p::kRampMode), f4p::kRampOff);
-  // The rate register holds 1..999 in the input's decimals (p. 6.8): a slower rate goes per hour.
+  // The rate register holds 1..999 in the input's decimals (p. 6.8). Per hour keeps more digits
+  // of a slow rate; a rate beyond 999 per minute is written as the largest the unit takes (the
+  // station's ramps are bounds, and the chamber's own capacity is lower still).
   const double per_min = s.delta_from_c(ramp_c_per_min);
-  const bool per_hour = s.to_raw(per_min).value_or(0) < 1;
-  const auto raw = s.to_raw(per_hour ? per_min * 60.0 : per_min);
-  if (!raw || *raw < 1 || *raw > 999)
-    return make_error(ErrorKind::range,
-                      fmt::format("{}: ramp {} C/min not representable in register 1101 (1..999 "
-                                  "with {} decimals)",
-                                  name_, ramp_c_per_min, s.decimals));
+  const double scale = std::pow(10.0, s.decimals);
+  const bool per_hour = per_min * 60.0 * scale <= 999.0;
+  const double raw_d = std::nearbyint((per_hour ? per_min * 60.0 : per_min) * scale);
+  const auto raw = static_cast<std::int16_t>(std::clamp(raw_d, 1.0, 999.0));
   if (auto ok = client_.write(map_.at(f4p::kRampScale), per_hour ? f4p::kPerHour : f4p::kPerMinute);
       !ok)
     return ok;
-  if (auto ok = client_.write(map_.at(f4p::kRampRate), *raw); !ok) return ok;
+  if (auto ok = client_.write(map_.at(f4p::kRampRate), raw); !ok) return ok;
   return client_.write(map_.at(f4p::kRampMode), f4p::kRampStartupOrChange);
 }
 

@@ -134,6 +134,11 @@ Result<void> WatlowF4tChamber::command(const ChamberCommand& c) {
     auto lo = temperature_c(f4t::kSetpointLow, sc.value());
     auto hi = lo ? temperature_c(f4t::kSetpointHigh, sc.value()) : lo;
     if (!hi) return hi.error();
+    if (!std::isfinite(lo.value()) || !std::isfinite(hi.value()) || lo.value() > hi.value())
+      return make_error(ErrorKind::protocol,
+                        fmt::format("{}: setpoint limits read [{}, {}] C: not a range; nothing "
+                                    "written",
+                                    name_, lo.value(), hi.value()));
     if (!std::isfinite(*c.setpoint_c) || *c.setpoint_c < lo.value() - 1e-6 ||
         *c.setpoint_c > hi.value() + 1e-6)
       return make_error(ErrorKind::range,

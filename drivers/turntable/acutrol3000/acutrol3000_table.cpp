@@ -47,8 +47,18 @@ Result<double> Acutrol3000Table::number(std::string_view query) {
 
 Result<void> Acutrol3000Table::connect() {
   if (auto c = client_.connect(); !c) return c;
+  return read_rate_limit();
+}
+
+// The unit's rate limit, read on every new connection (the unit may have been reconfigured or
+// restarted); until it is known no rate demand is sent.
+Result<void> Acutrol3000Table::read_rate_limit() {
+  limit_connects_ = client_.connects();
   auto limit = number(ac::kRateLimitQuery);
-  if (!limit) return limit.error();
+  if (!limit) {
+    rate_limit_dps_.reset();
+    return limit.error();
+  }
   rate_limit_dps_ = std::abs(limit.value());
   return {};
 }
@@ -61,12 +71,16 @@ Result<TurntableState> Acutrol3000Table::read() {
   Result<double> pd = il ? (full ? number(ac::kPositionDemandQuery) : Result<double>(0.0))
                          : Result<double>(il.error());
   Result<double> rd = pd ? (full ? number(ac::kRateDemandQuery) : Result<double>(0.0)) : pd;
-  readback_.read_done(rd.ok(), full, client_.connects());
-  if (!rd) return rd.error();
+  if (!rd) {
+    readback_.read_done(false, full, client_.connects());
+    return rd.error();
+  }
   const auto p = ac::parse_position_rate(pr.value());
   const auto m = ac::parse_mode(mode.value());
   const auto i = ac::parse_interlock(il.value());
-  if (!p || m == ac::Mode::unknown || i == ac::Interlock::unknown)
+  const bool parsed = p && m != ac::Mode::unknown && i != ac::Interlock::unknown;
+  readback_.read_done(parsed, full, client_.connects());
+  if (!parsed)
     return make_error(ErrorKind::protocol,
                       fmt::format("{}: replies '{}' / '{}' / '{}' do not parse", name_, pr.value(),
                                   mode.value(), il.value()));
@@ -93,8 +107,10 @@ Result<TurntableState> Acutrol3000Table::read() {
 
 Result<void> Acutrol3000Table::command(const TurntableCommand& c) {
   readback_.invalidate();
-  if (c.rate_dps && (!std::isfinite(*c.rate_dps) ||
-                     (rate_limit_dps_ && std::abs(*c.rate_dps) > *rate_limit_dps_)))
+  if (c.rate_dps && (!rate_limit_dps_ || limit_connects_ != client_.connects())) {
+    if (auto ok = read_rate_limit(); !ok) return ok;
+  }
+  if (c.rate_dps && (!std::isfinite(*c.rate_dps) || std::abs(*c.rate_dps) > *rate_limit_dps_))
     return make_error(ErrorKind::range,
                       fmt::format("{}: rate {} deg/s beyond the unit's rate limit {} deg/s", name_,
                                   *c.rate_dps, rate_limit_dps_.value_or(0)));

@@ -42,11 +42,13 @@ class Acutrol3000Table final : public Turntable {
   Result<std::string> ask(std::string_view command);
   Result<void> set(std::string_view command);
   Result<double> number(std::string_view query);
+  Result<void> read_rate_limit();
 
   std::string name_;
   ascii::LineClient client_;
   modbus::ReadbackSchedule readback_;
   std::optional<double> rate_limit_dps_;
+  std::uint64_t limit_connects_ = 0;  // the connection the limit was read on
   double position_demand_deg_ = 0, rate_demand_dps_ = 0;
 };
 
