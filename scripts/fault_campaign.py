@@ -231,7 +231,12 @@ def campaign(args, work):
     ref.start()
     victim.start()
     begin = time.time()
-    kinds = (FAULTS * (args.faults // len(FAULTS) + 1))[:args.faults]
+    # Only the generic map carries a door-open alarm: on a maker's dialect the door reaches the
+    # station through [gpio] (docs/DEVICES.md), which a simrig config has not, so its door
+    # fault is replaced by a second e-stop (the table's interlock, which every dialect reports).
+    faults = FAULTS if args.chamber == "generic_plc" else [
+        "estop" if f == "door" else f for f in FAULTS]
+    kinds = (faults * (args.faults // len(faults) + 1))[:args.faults]
     rng.shuffle(kinds)
     slots = sorted(rng.uniform(8, args.duration_s - 15) for _ in kinds)
     log, rows, snaps = [], [], []

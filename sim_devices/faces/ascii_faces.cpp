@@ -176,7 +176,11 @@ std::optional<std::string> AcutrolFace::one(const std::string& path, std::string
   }
   const int mode = path == ":MODE:OFF" ? 0 : path == ":MODE:POSITION" ? 1 : path == ":MODE:RATE" ? 2 : -1;
   if (mode >= 0 && axis1) {
-    if (mode > 0 && !interlock_closed_) return std::string("Error: interlock open");
+    if (mode == 0) {  // off is always taken: with the interlock open the axis is off already
+      (void)table_.set_mode(0);
+      return std::string{};
+    }
+    if (!interlock_closed_) return std::string("Error: interlock open");
     return table_.set_mode(mode) ? std::string{} : std::string("Error: interlock open");
   }
   (void)ac::kAxis;

@@ -49,26 +49,32 @@ std::string alarm_text(const dr::AlarmBits& a) {
   return s;
 }
 
+// A failure names the dialect the station spoke ("model watlow_f4p: ...").
+dr::Error with_model(const std::string& model, dr::Error e) {
+  e.message = "model " + model + ": " + e.message;
+  return e;
+}
+
 json finite_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
 // What the controller says it is (dialect, identity, units, decimals, limits) before its values:
 // a unit the dialect cannot read correctly fails here with the dialect's one line.
 DeviceReport probe_chamber(dr::Chamber& chamber, const StationConfig& c) {
-  const std::string where = c.chamber.model + " at " + c.chamber.endpoint;
+  const std::string& where = c.chamber.endpoint;
   auto id = chamber.identify();
-  if (!id) return failed("chamber", where, id.error());
+  if (!id) return failed("chamber", where, with_model(c.chamber.model, id.error()));
   auto r = chamber.read();
   if (!r) return failed("chamber", where, r.error());
   const dr::ChamberState& s = r.value();
   const dr::ChamberIdentity& i = id.value();
   DeviceReport d{"chamber", where, {}, {}, json::object()};
   d.summary = fmt::format(
-      "{}; units {}{}; setpoint limits {:.1f}..{:.1f} C; {}\n"
-      "    air {:.1f} C, product {:.1f} C, setpoint {:.1f} C, ramp {:.2f} C/min, mode {}, "
-      "alarms {}, run {}",
-      i.identity, i.units, i.decimals >= 0 ? fmt::format(", {} decimals", i.decimals) : "",
-      i.setpoint_low_c, i.setpoint_high_c, i.notes, s.air_c, s.product_c, s.setpoint_c,
-      s.ramp_c_per_min, dr::to_string(s.mode), alarm_text(s.alarms), s.run_enabled ? "on" : "off");
+      "air {:.1f} C, product {:.1f} C, setpoint {:.1f} C, ramp {:.2f} C/min, mode {}, "
+      "alarms {}, run {}; model {}: {}, units {}{}, setpoint limits {:.1f}..{:.1f} C; {}",
+      s.air_c, s.product_c, s.setpoint_c, s.ramp_c_per_min, dr::to_string(s.mode),
+      alarm_text(s.alarms), s.run_enabled ? "on" : "off", c.chamber.model, i.identity, i.units,
+      i.decimals >= 0 ? fmt::format(", {} decimals", i.decimals) : "", i.setpoint_low_c,
+      i.setpoint_high_c, i.notes);
   // NaN (sensor break, no product sensor) is not JSON: it becomes null.
   d.fields = {{"model", c.chamber.model},
               {"identity", i.identity},
@@ -87,18 +93,19 @@ DeviceReport probe_chamber(dr::Chamber& chamber, const StationConfig& c) {
 }
 
 DeviceReport probe_turntable(dr::Turntable& table, const StationConfig& c) {
-  const std::string where = c.turntable->model + " at " + c.turntable->endpoint;
+  const std::string& where = c.turntable->endpoint;
   auto id = table.identify();
-  if (!id) return failed("turntable", where, id.error());
+  if (!id) return failed("turntable", where, with_model(c.turntable->model, id.error()));
   auto r = table.read();
   if (!r) return failed("turntable", where, r.error());
   const dr::TurntableState& s = r.value();
   DeviceReport d{"turntable", where, {}, {}, json::object()};
   d.summary = fmt::format(
-      "{}mode {}, angle {:.4f} deg, rate {:.4f} deg/s, in_position {}, at_rate {}, fault {}, "
-      "interlock_open {}",
-      id.value().empty() ? "" : id.value() + "; ", dr::to_string(s.mode), s.angle_deg, s.rate_dps,
-      yes_no(s.in_position), yes_no(s.at_rate), yes_no(s.fault), yes_no(s.interlock_open));
+      "mode {}, angle {:.4f} deg, rate {:.4f} deg/s, in_position {}, at_rate {}, fault {}, "
+      "interlock_open {}; model {}{}",
+      dr::to_string(s.mode), s.angle_deg, s.rate_dps, yes_no(s.in_position), yes_no(s.at_rate),
+      yes_no(s.fault), yes_no(s.interlock_open), c.turntable->model,
+      id.value().empty() ? "" : ": " + id.value());
   d.fields = {
       {"model", c.turntable->model},       {"identity", id.value()},
       {"mode", dr::to_string(s.mode)},     {"angle_deg", s.angle_deg}, {"rate_dps", s.rate_dps},
