@@ -9,22 +9,14 @@
 #include <cmath>
 #include <vector>
 
+#include "drivers/ascii/number_field.hpp"
 #include "drivers/chamber/espec_p300/p300_wire.hpp"
 #include "drivers/turntable/acutrol3000/acutrol_wire.hpp"
 
 namespace station::sim {
 namespace {
 
-std::optional<double> num(std::string_view s) {
-  while (!s.empty() && s.front() == ' ') s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\r')) s.remove_suffix(1);
-  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
-  double v = 0;
-  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-  if (s.empty() || ec != std::errc{} || end != s.data() + s.size() || !std::isfinite(v))
-    return std::nullopt;
-  return v;
-}
+std::optional<double> num(std::string_view s) { return drivers::ascii::number_field(s); }
 
 std::string upper(std::string_view s) {
   std::string out(s);

@@ -20,12 +20,6 @@ namespace {
   throw std::runtime_error("line server: " + what + ": " + std::strerror(errno));
 }
 
-std::chrono::steady_clock::time_point wall_after(double seconds) {
-  const std::chrono::duration<double> d(std::max(0.0, seconds));
-  return std::chrono::steady_clock::now() +
-         std::chrono::duration_cast<std::chrono::steady_clock::duration>(d);
-}
-
 int listen_on(int port) {
   const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0);
   if (fd == -1) sys_fail("socket");
@@ -104,61 +98,19 @@ std::string LineServer::endpoint() const {
   return "tcp://127.0.0.1:" + std::to_string(port_);
 }
 
-void LineServer::inject_timeouts(int n) {
-  std::lock_guard lock(fault_mutex_);
-  timeouts_ = n;
-}
-void LineServer::inject_exception(int code, int n) {
-  std::lock_guard lock(fault_mutex_);
-  exception_code_ = code;
-  exceptions_ = n;
-}
-void LineServer::inject_drop(int n) {
-  std::lock_guard lock(fault_mutex_);
-  drops_ = n;
-}
-void LineServer::stall_for(double seconds) {
-  std::lock_guard lock(fault_mutex_);
-  stall_until_ = wall_after(seconds);
-}
-void LineServer::disconnect_for(double seconds) {
-  std::lock_guard lock(fault_mutex_);
-  down_until_ = wall_after(seconds);
-  kick_clients_ = true;
-}
-void LineServer::clear_faults() {
-  std::lock_guard lock(fault_mutex_);
-  timeouts_ = exceptions_ = drops_ = 0;
-  stall_until_ = down_until_ = {};
-  kick_clients_ = false;
-}
-
-LineServer::Fault LineServer::take_fault(int& code) {
-  std::lock_guard lock(fault_mutex_);
-  const auto now = std::chrono::steady_clock::now();
-  if (now < stall_until_ || now < down_until_) return Fault::timeout;  // a pty: a silent line
-  if (timeouts_ > 0) return --timeouts_, Fault::timeout;
-  if (drops_ > 0) return --drops_, Fault::drop;
-  if (exceptions_ != 0) {
-    code = exception_code_;
-    if (exceptions_ > 0) --exceptions_;
-    return Fault::exception;
-  }
-  return Fault::none;
-}
+void LineServer::inject_timeouts(int n) { faults_.inject_timeouts(n); }
+void LineServer::inject_exception(int code, int n) { faults_.inject_exception(code, n); }
+void LineServer::inject_drop(int n) { faults_.inject_drop(n); }
+void LineServer::stall_for(double seconds) { faults_.stall_for(seconds); }
+void LineServer::disconnect_for(double seconds) { faults_.disconnect_for(seconds); }
+void LineServer::clear_faults() { faults_.clear(); }
 
 // Applies an injected disconnect (TCP): drops clients and listener, listens again on the same
 // port when the down time is over. False while down.
 bool LineServer::link_up() {
   if (pty_master_ != -1) return true;
-  SteadyTime down_until;
-  bool kick = false;
-  {
-    std::lock_guard lock(fault_mutex_);
-    kick = std::exchange(kick_clients_, false);
-    down_until = down_until_;
-  }
-  if (kick) {
+  FaultSchedule::SteadyTime down_until;
+  if (faults_.take_kick(down_until)) {
     for (auto& [fd, buf] : clients_) ::close(fd);
     clients_.clear();
     if (listen_fd_ != -1) ::close(listen_fd_);
@@ -195,17 +147,17 @@ void LineServer::serve_bytes(int fd, std::string& buffer, bool& close_it) {
     buffer.erase(0, end + term.size());
     ++requests_;
     int code = 0;
-    switch (take_fault(code)) {
-      case Fault::timeout:
+    switch (faults_.take(code)) {
+      case FaultSchedule::Fault::timeout:
         continue;
-      case Fault::drop:
+      case FaultSchedule::Fault::drop:
         close_it = fd != pty_master_;
         if (close_it) return;
         continue;
-      case Fault::exception:
+      case FaultSchedule::Fault::exception:
         write_all(fd, device_.error_reply(request, code) + reply_end);
         continue;
-      case Fault::none:
+      case FaultSchedule::Fault::none:
         break;
     }
     if (auto reply = device_.handle(request)) write_all(fd, *reply + reply_end);

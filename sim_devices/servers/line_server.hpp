@@ -13,6 +13,7 @@
 #include <thread>
 #include <vector>
 
+#include "sim_devices/servers/fault_schedule.hpp"
 #include "sim_devices/servers/sim_server.hpp"
 
 namespace station::sim {
@@ -62,13 +63,9 @@ class LineServer final : public SimServer {
   static constexpr std::size_t kMaxLine = 1024;
 
  private:
-  enum class Fault { none, timeout, exception, drop };
-  using SteadyTime = std::chrono::steady_clock::time_point;
-
   void run();
   bool link_up();
   void serve_bytes(int fd, std::string& buffer, bool& close_it);
-  Fault take_fault(int& code);
 
   LineDevice& device_;
   int listen_fd_ = -1, pty_master_ = -1, pty_slave_ = -1, port_ = 0, baud_ = 9600;
@@ -76,10 +73,7 @@ class LineServer final : public SimServer {
   std::atomic<bool> stop_{false};
   std::atomic<std::uint64_t> requests_{0};
   std::thread thread_;
-  std::mutex fault_mutex_;
-  int timeouts_ = 0, exceptions_ = 0, exception_code_ = 0, drops_ = 0;
-  SteadyTime stall_until_{}, down_until_{};
-  bool kick_clients_ = false;
+  FaultSchedule faults_;
   std::map<int, std::string> clients_;  // fd -> bytes of a partial line
 };
 

@@ -135,60 +135,12 @@ std::string ModbusServer::endpoint() const {
   return "tcp://127.0.0.1:" + std::to_string(port_);
 }
 
-void ModbusServer::inject_timeouts(int n) {
-  std::lock_guard lock(fault_mutex_);
-  timeouts_ = n;
-}
-
-void ModbusServer::inject_exception(int code, int n) {
-  std::lock_guard lock(fault_mutex_);
-  exception_code_ = code;
-  exceptions_ = n;
-}
-
-void ModbusServer::inject_drop(int n) {
-  std::lock_guard lock(fault_mutex_);
-  drops_ = n;
-}
-
-namespace {
-std::chrono::steady_clock::time_point wall_after(double seconds) {
-  const std::chrono::duration<double> d(std::max(0.0, seconds));
-  return std::chrono::steady_clock::now() +
-         std::chrono::duration_cast<std::chrono::steady_clock::duration>(d);
-}
-}  // namespace
-
-void ModbusServer::stall_for(double seconds) {
-  std::lock_guard lock(fault_mutex_);
-  stall_until_ = wall_after(seconds);
-}
-
-void ModbusServer::disconnect_for(double seconds) {
-  std::lock_guard lock(fault_mutex_);
-  down_until_ = wall_after(seconds);
-  kick_clients_ = true;
-}
-
-void ModbusServer::clear_faults() {
-  std::lock_guard lock(fault_mutex_);
-  timeouts_ = exceptions_ = drops_ = 0;
-  stall_until_ = down_until_ = {};
-}
-
-ModbusServer::Fault ModbusServer::take_fault(int& code) {
-  std::lock_guard lock(fault_mutex_);
-  const auto now = std::chrono::steady_clock::now();
-  if (now < stall_until_ || now < down_until_) return Fault::timeout;  // RTU down: a silent line
-  if (timeouts_ > 0) return --timeouts_, Fault::timeout;
-  if (drops_ > 0) return --drops_, Fault::drop;
-  if (exceptions_ != 0) {
-    code = exception_code_;
-    if (exceptions_ > 0) --exceptions_;
-    return Fault::exception;
-  }
-  return Fault::none;
-}
+void ModbusServer::inject_timeouts(int n) { faults_.inject_timeouts(n); }
+void ModbusServer::inject_exception(int code, int n) { faults_.inject_exception(code, n); }
+void ModbusServer::inject_drop(int n) { faults_.inject_drop(n); }
+void ModbusServer::stall_for(double seconds) { faults_.stall_for(seconds); }
+void ModbusServer::disconnect_for(double seconds) { faults_.disconnect_for(seconds); }
+void ModbusServer::clear_faults() { faults_.clear(); }
 
 void ModbusServer::accept_client(std::vector<int>& clients) {
   int fd = accept4(listen_fd_, nullptr, nullptr, SOCK_CLOEXEC);
@@ -198,13 +150,8 @@ void ModbusServer::accept_client(std::vector<int>& clients) {
 // Applies an injected disconnect: drops the clients and the listener, and listens again on the
 // same port once the down time is over. False while the link is down.
 bool ModbusServer::tcp_link_up(std::vector<int>& clients) {
-  SteadyTime down_until;
-  bool kick = false;
-  {
-    std::lock_guard lock(fault_mutex_);
-    kick = std::exchange(kick_clients_, false);
-    down_until = down_until_;
-  }
+  FaultSchedule::SteadyTime down_until;
+  const bool kick = faults_.take_kick(down_until);
   if (kick) {
     for (int c : clients) close(c);
     clients.clear();
@@ -288,14 +235,14 @@ bool ModbusServer::forget(int fd) {
 bool ModbusServer::handle(const std::uint8_t* query, int len) {
   ++requests_;
   int code = 0;
-  switch (take_fault(code)) {
-    case Fault::timeout:
+  switch (faults_.take(code)) {
+    case FaultSchedule::Fault::timeout:
       return true;
-    case Fault::drop:
+    case FaultSchedule::Fault::drop:
       return pty_master_ != -1;  // TCP: close; RTU: just stay silent
-    case Fault::exception:
+    case FaultSchedule::Fault::exception:
       return modbus_reply_exception(ctx_.get(), query, static_cast<unsigned>(code)) != -1;
-    case Fault::none:
+    case FaultSchedule::Fault::none:
       break;
   }
   const int header = modbus_get_header_length(ctx_.get());

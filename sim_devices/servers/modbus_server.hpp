@@ -17,6 +17,7 @@
 
 #include "drivers/modbus/register_map.hpp"
 #include "sim_devices/servers/modbus_strict.hpp"
+#include "sim_devices/servers/fault_schedule.hpp"
 #include "sim_devices/servers/sim_server.hpp"
 
 namespace station::sim {
@@ -91,8 +92,6 @@ class ModbusServer final : public SimServer {
   void clear_faults() override;
 
  private:
-  enum class Fault { none, timeout, exception, drop };
-  using SteadyTime = std::chrono::steady_clock::time_point;
   struct FreeServerCtx {
     void operator()(modbus_t* c) const noexcept;
   };
@@ -110,7 +109,6 @@ class ModbusServer final : public SimServer {
   bool handle(const std::uint8_t* query, int len);
   std::uint8_t strict_exception(std::span<const std::uint8_t> pdu) const;
   void apply_writes(std::span<const std::uint8_t> pdu);
-  Fault take_fault(int& code);
 
   ModbusDeviceModel& model_;
   int unit_id_;
@@ -125,10 +123,7 @@ class ModbusServer final : public SimServer {
   std::atomic<bool> stop_{false};
   std::atomic<std::uint64_t> requests_{0};
   std::thread thread_;
-  std::mutex fault_mutex_;
-  int timeouts_ = 0, exceptions_ = 0, exception_code_ = 0, drops_ = 0;
-  SteadyTime stall_until_{}, down_until_{};
-  bool kick_clients_ = false;
+  FaultSchedule faults_;
   std::map<int, std::vector<std::uint8_t>> pending_;  // per TCP client: bytes of a partial frame
 };
 

@@ -1,6 +1,8 @@
 // P300 command spellings and strict reply parsers.
 #include "drivers/chamber/espec_p300/p300_wire.hpp"
 
+#include "drivers/ascii/number_field.hpp"
+
 #include <fmt/format.h>
 
 #include <charconv>
@@ -25,16 +27,7 @@ std::string_view trim(std::string_view s) {
   return s;
 }
 
-// A finite decimal number filling the whole field.
-std::optional<double> number(std::string_view s) {
-  s = trim(s);
-  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
-  double v = 0;
-  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-  if (s.empty() || ec != std::errc{} || end != s.data() + s.size() || !std::isfinite(v))
-    return std::nullopt;
-  return v;
-}
+std::optional<double> number(std::string_view s) { return ascii::number_field(s); }
 
 std::optional<int> integer(std::string_view s) {
   s = trim(s);

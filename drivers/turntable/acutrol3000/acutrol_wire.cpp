@@ -1,6 +1,8 @@
 // ACUTROL3000 command spellings and strict reply parsers.
 #include "drivers/turntable/acutrol3000/acutrol_wire.hpp"
 
+#include "drivers/ascii/number_field.hpp"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -43,16 +45,7 @@ Interlock parse_interlock(std::string_view reply) {
   return Interlock::unknown;
 }
 
-std::optional<double> parse_number(std::string_view s) {
-  while (!s.empty() && (s.back() == '\r' || s.back() == ' ')) s.remove_suffix(1);
-  while (!s.empty() && s.front() == ' ') s.remove_prefix(1);
-  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
-  double v = 0;
-  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-  if (s.empty() || ec != std::errc{} || end != s.data() + s.size() || !std::isfinite(v))
-    return std::nullopt;
-  return v;
-}
+std::optional<double> parse_number(std::string_view s) { return ascii::number_field(s); }
 
 std::optional<std::pair<double, double>> parse_position_rate(std::string_view reply) {
   const auto i = reply.find(';');
