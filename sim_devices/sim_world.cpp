@@ -82,9 +82,11 @@ std::vector<GpioSimChipSpec> gpio_lines(int gyros) {
 SimWorld::SimWorld(const SimWorldConfig& config) : config_(config) {
   if (config_.gyros < 1 || config_.gyros > 16) throw std::invalid_argument("simworld: 1..16 gyros");
   config_.chamber.initial_c = config_.initial_c;
-  chamber_sim_ = std::make_unique<ChamberSim>(drivers::chamber_map::generic_plc(1), config_.chamber);
+  chamber_sim_ =
+      std::make_unique<ChamberSim>(drivers::chamber_map::generic_plc(1), config_.chamber);
   table_sim_ = std::make_unique<TurntableSim>(drivers::turntable_map::generic_plc(1));
-  chamber_ = serve_chamber(config_.chamber_model, *chamber_sim_, config_.panel, config_.chamber_port);
+  chamber_ =
+      serve_chamber(config_.chamber_model, *chamber_sim_, config_.panel, config_.chamber_port);
   table_ = serve_turntable(config_.turntable_model, *table_sim_, config_.turntable_port);
   gpio_ = std::make_shared<GpioSimChips>(gpio_lines(config_.gyros));
   gpio_->set_input("DOOR_SW", true);  // door closed

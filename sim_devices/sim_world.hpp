@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "sim_devices/chamber_sim.hpp"
-#include "sim_devices/faces/sim_dialects.hpp"
 #include "sim_devices/counter_board_sim.hpp"
+#include "sim_devices/faces/sim_dialects.hpp"
 #include "sim_devices/gpio_sim.hpp"
 #include "sim_devices/servers/modbus_server.hpp"
 #include "sim_devices/turntable_sim.hpp"

@@ -25,7 +25,8 @@ Steady::time_point deadline_after(double s) {
 // Waits for `events` on fd until `deadline`: 1 ready, 0 timed out (errno ETIMEDOUT), -1 error.
 int wait_for(int fd, short events, Steady::time_point deadline) {
   for (;;) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Steady::now());
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Steady::now());
     if (left.count() < 0) {
       errno = ETIMEDOUT;
       return 0;
@@ -45,17 +46,28 @@ int wait_for(int fd, short events, Steady::time_point deadline) {
 
 speed_t speed_of(int baud) {
   switch (baud) {
-    case 300: return B300;
-    case 600: return B600;
-    case 1200: return B1200;
-    case 2400: return B2400;
-    case 4800: return B4800;
-    case 9600: return B9600;
-    case 19200: return B19200;
-    case 38400: return B38400;
-    case 57600: return B57600;
-    case 115200: return B115200;
-    default: return B230400;
+    case 300:
+      return B300;
+    case 600:
+      return B600;
+    case 1200:
+      return B1200;
+    case 2400:
+      return B2400;
+    case 4800:
+      return B4800;
+    case 9600:
+      return B9600;
+    case 19200:
+      return B19200;
+    case 38400:
+      return B38400;
+    case 57600:
+      return B57600;
+    case 115200:
+      return B115200;
+    default:
+      return B230400;
   }
 }
 

@@ -9,10 +9,10 @@
 #include <string_view>
 #include <vector>
 
-#include "drivers/common/unique_fd.hpp"
 #include "drivers/common/clock.hpp"
 #include "drivers/common/result.hpp"
 #include "drivers/common/tap.hpp"
+#include "drivers/common/unique_fd.hpp"
 
 namespace station::drivers::can {
 

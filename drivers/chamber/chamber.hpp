@@ -49,12 +49,12 @@ struct ChamberCommand {
 /// What a chamber says about itself at probe (identify()): model, units and scaling as read
 /// from the controller, so a unit in deg F or with other decimals is read correctly or refused.
 struct ChamberIdentity {
-  std::string model;        ///< dialect name, e.g. "watlow_f4t"
-  std::string identity;     ///< what the controller reports (part number, ROM, model code)
-  std::string units;        ///< "C" or "F" as the controller displays temperatures
-  int decimals = -1;        ///< decimal places of its integers (-1: floats / text)
+  std::string model;     ///< dialect name, e.g. "watlow_f4t"
+  std::string identity;  ///< what the controller reports (part number, ROM, model code)
+  std::string units;     ///< "C" or "F" as the controller displays temperatures
+  int decimals = -1;     ///< decimal places of its integers (-1: floats / text)
   double setpoint_low_c = 0, setpoint_high_c = 0;  ///< the controller's setpoint limits, C
-  std::string notes;        ///< anything the station adapts to (units converted, no product)
+  std::string notes;  ///< anything the station adapts to (units converted, no product)
 };
 
 /// A thermal chamber. Every call is one bounded transaction; none blocks past its timeout.

@@ -4,11 +4,11 @@
 // does not expose its raw frames, so both sides rebuild them with these. No I/O.
 #pragma once
 
-#include "drivers/common/tap.hpp"
-
 #include <cstdint>
 #include <span>
 #include <vector>
+
+#include "drivers/common/tap.hpp"
 
 namespace station::drivers::modbus {
 

@@ -22,8 +22,12 @@
 namespace station::drivers {
 namespace {
 
-modbus::Endpoint modbus_ep(const DeviceSpec& s) { return modbus::parse_endpoint(s.endpoint); }
-ascii::LineEndpoint line_ep(const DeviceSpec& s) { return ascii::parse_line_endpoint(s.endpoint); }
+modbus::Endpoint modbus_ep(const DeviceSpec& s) {
+  return modbus::parse_endpoint(s.endpoint);
+}
+ascii::LineEndpoint line_ep(const DeviceSpec& s) {
+  return ascii::parse_line_endpoint(s.endpoint);
+}
 
 // The map of a Modbus dialect with the spec's overrides applied.
 template <typename MapFn>
@@ -58,17 +62,16 @@ std::unique_ptr<D> hooked_line(std::unique_ptr<D> d, const DeviceSpec& s, const 
   return d;
 }
 
-bool rtu(const DeviceSpec& s) { return std::holds_alternative<modbus::RtuEndpoint>(modbus_ep(s)); }
+bool rtu(const DeviceSpec& s) {
+  return std::holds_alternative<modbus::RtuEndpoint>(modbus_ep(s));
+}
 
-const auto kF4Map = with_overrides([](const DeviceSpec& s) {
-  return watlow_f4::map(s.unit_id, s.run_event, "watlow_f4");
-});
-const auto kF4tMap2Map = with_overrides([](const DeviceSpec& s) {
-  return watlow_f4::map(s.unit_id, s.run_event, "watlow_f4t_map2");
-});
-const auto kF4tMap = with_overrides([](const DeviceSpec& s) {
-  return watlow_f4t::map(s.unit_id, s.run_event, rtu(s));
-});
+const auto kF4Map = with_overrides(
+    [](const DeviceSpec& s) { return watlow_f4::map(s.unit_id, s.run_event, "watlow_f4"); });
+const auto kF4tMap2Map = with_overrides(
+    [](const DeviceSpec& s) { return watlow_f4::map(s.unit_id, s.run_event, "watlow_f4t_map2"); });
+const auto kF4tMap = with_overrides(
+    [](const DeviceSpec& s) { return watlow_f4t::map(s.unit_id, s.run_event, rtu(s)); });
 const auto kF4pMap = with_overrides([](const DeviceSpec& s) { return watlow_f4p::map(s.unit_id); });
 const auto kPlcChamberMap =
     with_overrides([](const DeviceSpec& s) { return chamber_map::generic_plc(s.unit_id); });
@@ -86,8 +89,8 @@ const std::vector<ChamberDialect> kChambers{
     {"watlow_f4", Transport::modbus, "Watlow Series F4, Modbus RTU/TCP, int16 with decimals",
      kF4Map,
      [](const DeviceSpec& s, const LinkOptions& o) -> std::unique_ptr<Chamber> {
-       return hooked(std::make_unique<WatlowF4Chamber>(s.name, "watlow_f4", modbus_ep(s),
-                                                       kF4Map(s), s.timeout_s, modbus_wire(s, o)),
+       return hooked(std::make_unique<WatlowF4Chamber>(s.name, "watlow_f4", modbus_ep(s), kF4Map(s),
+                                                       s.timeout_s, modbus_wire(s, o)),
                      s, o);
      }},
     {"watlow_f4t", Transport::modbus, "Watlow F4T, Modbus Data Map 1, float CDAB", kF4tMap,
@@ -99,13 +102,12 @@ const std::vector<ChamberDialect> kChambers{
     {"watlow_f4t_map2", Transport::modbus, "Watlow F4T in F4-compatibility map (the F4 registers)",
      kF4tMap2Map,
      [](const DeviceSpec& s, const LinkOptions& o) -> std::unique_ptr<Chamber> {
-       return hooked(std::make_unique<WatlowF4Chamber>(s.name, "watlow_f4t_map2", modbus_ep(s),
-                                                       kF4tMap2Map(s), s.timeout_s,
-                                                       modbus_wire(s, o)),
-                     s, o);
+       return hooked(
+           std::make_unique<WatlowF4Chamber>(s.name, "watlow_f4t_map2", modbus_ep(s),
+                                             kF4tMap2Map(s), s.timeout_s, modbus_wire(s, o)),
+           s, o);
      }},
-    {"watlow_f4p", Transport::modbus, "Watlow Series F4P, Modbus RTU, int16 with decimals",
-     kF4pMap,
+    {"watlow_f4p", Transport::modbus, "Watlow Series F4P, Modbus RTU, int16 with decimals", kF4pMap,
      [](const DeviceSpec& s, const LinkOptions& o) -> std::unique_ptr<Chamber> {
        return hooked(std::make_unique<WatlowF4pChamber>(s.name, modbus_ep(s), kF4pMap(s),
                                                         s.timeout_s, modbus_wire(s, o)),
@@ -124,17 +126,17 @@ const std::vector<TurntableDialect> kTables{
     {"generic_plc", Transport::modbus,
      "the station's own Modbus map for a PLC-fronted table (docs/DEVICES.md)", kPlcTableMap,
      [](const DeviceSpec& s, const LinkOptions& o) -> std::unique_ptr<Turntable> {
-       return hooked(std::make_unique<ModbusTurntable>(s.name, modbus_ep(s), kPlcTableMap(s),
-                                                       TurntableLimits{}, s.timeout_s,
-                                                       modbus_wire(s, o)),
-                     s, o);
+       return hooked(
+           std::make_unique<ModbusTurntable>(s.name, modbus_ep(s), kPlcTableMap(s),
+                                             TurntableLimits{}, s.timeout_s, modbus_wire(s, o)),
+           s, o);
      }},
     {"acutrol3000", Transport::ascii, "Acutronic ACUTROL3000, ASCII over TCP 9878 or serial",
      nullptr,
      [](const DeviceSpec& s, const LinkOptions& o) -> std::unique_ptr<Turntable> {
        return hooked_line(
-           std::make_unique<Acutrol3000Table>(s.name, line_ep(s), s.timeout_s, line_wire(s, o)),
-           s, o);
+           std::make_unique<Acutrol3000Table>(s.name, line_ep(s), s.timeout_s, line_wire(s, o)), s,
+           o);
      }},
 };
 
@@ -162,26 +164,34 @@ const Dialect<D>& find(std::span<const Dialect<D>> all, std::string_view model, 
 
 }  // namespace
 
-std::span<const ChamberDialect> chamber_dialects() { return kChambers; }
-std::span<const TurntableDialect> turntable_dialects() { return kTables; }
+std::span<const ChamberDialect> chamber_dialects() {
+  return kChambers;
+}
+std::span<const TurntableDialect> turntable_dialects() {
+  return kTables;
+}
 const ChamberDialect& chamber_dialect(std::string_view model) {
   return find(chamber_dialects(), model, "chamber");
 }
 const TurntableDialect& turntable_dialect(std::string_view model) {
   return find(turntable_dialects(), model, "turntable");
 }
-std::string chamber_models() { return names(chamber_dialects()); }
-std::string turntable_models() { return names(turntable_dialects()); }
+std::string chamber_models() {
+  return names(chamber_dialects());
+}
+std::string turntable_models() {
+  return names(turntable_dialects());
+}
 
 template <typename Device>
 void validate(const Dialect<Device>& dialect, const DeviceSpec& spec) {
   const bool has_events = dialect.model == "watlow_f4" || dialect.model == "watlow_f4t" ||
                           dialect.model == "watlow_f4t_map2";
   if (spec.run_event != 1 && !has_events)
-    throw std::invalid_argument(fmt::format(
-        "run_event: model '{}' has no event outputs (only watlow_f4, watlow_f4t, "
-        "watlow_f4t_map2 do)",
-        dialect.model));
+    throw std::invalid_argument(
+        fmt::format("run_event: model '{}' has no event outputs (only watlow_f4, watlow_f4t, "
+                    "watlow_f4t_map2 do)",
+                    dialect.model));
   if (dialect.transport == Transport::modbus) {
     (void)modbus::parse_endpoint(spec.endpoint);
     if (spec.run_event < 1 || spec.run_event > 8)
@@ -190,8 +200,8 @@ void validate(const Dialect<Device>& dialect, const DeviceSpec& spec) {
     return;
   }
   if (!spec.overrides.empty())
-    throw std::invalid_argument(
-        fmt::format("model '{}' speaks ASCII: it has no register points to override", dialect.model));
+    throw std::invalid_argument(fmt::format(
+        "model '{}' speaks ASCII: it has no register points to override", dialect.model));
   (void)ascii::parse_line_endpoint(spec.endpoint);
 }
 

@@ -37,7 +37,7 @@ struct DeviceSpec {
   double timeout_s = 0.5;
   int readback_every = modbus::ReadbackSchedule::kDefaultEvery;
   std::vector<modbus::PointOverride> overrides;  ///< Modbus dialects: point overrides
-  int run_event = 1;     ///< Watlow F4/F4T: event output that runs the chamber (builder's wiring)
+  int run_event = 1;  ///< Watlow F4/F4T: event output that runs the chamber (builder's wiring)
 };
 
 /// Makes the link under a device's client (replay passes recorded ones); empty: the real link.
@@ -48,16 +48,16 @@ using LineWireFactory = std::function<std::unique_ptr<ascii::LineWire>(
 
 /// What every driver is built with besides its spec.
 struct LinkOptions {
-  Tap* tap = nullptr;              ///< every exchange passes here when set
-  const Clock* clock = nullptr;    ///< reconnect back-off time (nullptr: steady clock)
-  ModbusWireFactory modbus_wire;   ///< empty: libmodbus
-  LineWireFactory line_wire;       ///< empty: FdLineWire
+  Tap* tap = nullptr;             ///< every exchange passes here when set
+  const Clock* clock = nullptr;   ///< reconnect back-off time (nullptr: steady clock)
+  ModbusWireFactory modbus_wire;  ///< empty: libmodbus
+  LineWireFactory line_wire;      ///< empty: FdLineWire
 };
 
 /// One dialect of a device class.
 template <typename Device>
 struct Dialect {
-  std::string_view model;    ///< config name, e.g. "watlow_f4t"
+  std::string_view model;  ///< config name, e.g. "watlow_f4t"
   Transport transport;
   std::string_view summary;  ///< one line for `--help` and errors
   /// The wire map a Modbus dialect's overrides apply to (empty for ASCII dialects).

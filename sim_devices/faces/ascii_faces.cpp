@@ -16,7 +16,9 @@
 namespace station::sim {
 namespace {
 
-std::optional<double> num(std::string_view s) { return drivers::ascii::number_field(s); }
+std::optional<double> num(std::string_view s) {
+  return drivers::ascii::number_field(s);
+}
 
 std::string upper(std::string_view s) {
   std::string out(s);
@@ -42,7 +44,9 @@ std::optional<std::string> P300Face::handle(std::string_view request) {
   return answer(request);
 }
 
-std::string P300Face::error_reply(std::string_view, int) const { return "NA:CHB NOT READY"; }
+std::string P300Face::error_reply(std::string_view, int) const {
+  return "NA:CHB NOT READY";
+}
 
 std::string P300Face::alarm_codes() const {
   // Simulator's codes (the P300 manual's list is not among the sources): 1 high-limit trip,
@@ -103,9 +107,9 @@ namespace {
 
 // A header path like ":dem:pos" matched by unique prefixes against the long forms ([ACL] p. 2).
 std::string canonical_path(std::string_view header) {
-  static const std::vector<std::string> kWords{
-      "MODE", "OFF",  "POSITION", "RATE",  "DEMAND",   "READ", "INTERLOCK",
-      "CLOSE", "OPEN", "RESET",   "LIMIT", "IDN"};
+  static const std::vector<std::string> kWords{"MODE",   "OFF",   "POSITION",  "RATE",
+                                               "DEMAND", "READ",  "INTERLOCK", "CLOSE",
+                                               "OPEN",   "RESET", "LIMIT",     "IDN"};
   std::string out;
   std::size_t i = 0;
   while (i < header.size()) {
@@ -154,7 +158,8 @@ std::optional<std::string> AcutrolFace::one(const std::string& path, std::string
     return std::string{};
   }
   if (path == ":INTERLOCK:RESET") return std::string{};  // clears nothing the model latches
-  if (path == ":LIMIT:RATE?" && (args == "R,1" || upper(args) == "RATE,1")) return fmt5(rate_limit_dps_);
+  if (path == ":LIMIT:RATE?" && (args == "R,1" || upper(args) == "RATE,1"))
+    return fmt5(rate_limit_dps_);
   if (path == ":DEMAND:POSITION?" && axis1) return fmt5(table_.position_demand_deg());
   if (path == ":DEMAND:RATE?" && axis1) return fmt5(table_.rate_demand_dps());
   if (path == ":DEMAND:POSITION" && axis1 && value()) {
@@ -166,7 +171,10 @@ std::optional<std::string> AcutrolFace::one(const std::string& path, std::string
     table_.set_rate_demand_dps(*value());
     return std::string{};
   }
-  const int mode = path == ":MODE:OFF" ? 0 : path == ":MODE:POSITION" ? 1 : path == ":MODE:RATE" ? 2 : -1;
+  const int mode = path == ":MODE:OFF"        ? 0
+                   : path == ":MODE:POSITION" ? 1
+                   : path == ":MODE:RATE"     ? 2
+                                              : -1;
   if (mode >= 0 && axis1) {
     if (mode == 0) {  // off is always taken: with the interlock open the axis is off already
       (void)table_.set_mode(0);
@@ -194,7 +202,8 @@ std::optional<std::string> AcutrolFace::handle(std::string_view request) {
     std::string header(part.substr(0, sp));
     const std::string_view args = sp == std::string_view::npos ? "" : part.substr(sp + 1);
     // Chained without ':' stays in the previous subsystem ([ACL] p. 3).
-    if (!header.empty() && header.front() != ':' && !subsystem.empty()) header = subsystem + ":" + header;
+    if (!header.empty() && header.front() != ':' && !subsystem.empty())
+      header = subsystem + ":" + header;
     std::string path = canonical_path(header);
     const bool query = !header.empty() && header.back() == '?';
     if (query && path.back() != '?') path += "?";

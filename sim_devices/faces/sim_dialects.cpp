@@ -70,7 +70,8 @@ ServedDevice serve_turntable(std::string_view model, TurntableSim& table, int po
 
 std::string device_toml(const char* section, std::string_view model, const std::string& endpoint,
                         const WatlowPanel* panel) {
-  std::string out = fmt::format("[{}]\nmodel = \"{}\"\nendpoint = \"{}\"\n", section, model, endpoint);
+  std::string out =
+      fmt::format("[{}]\nmodel = \"{}\"\nendpoint = \"{}\"\n", section, model, endpoint);
   if (panel != nullptr && panel->run_event != 1 &&
       (model == "watlow_f4" || model == "watlow_f4t" || model == "watlow_f4t_map2"))
     out += fmt::format("run_event = {}\n", panel->run_event);

@@ -55,7 +55,9 @@ void write_all(int fd, const std::string& bytes) {
 
 }  // namespace
 
-LineServer::~LineServer() { stop(); }
+LineServer::~LineServer() {
+  stop();
+}
 
 void LineServer::start_tcp(int port) {
   listen_fd_ = listen_on(port);
@@ -98,12 +100,24 @@ std::string LineServer::endpoint() const {
   return "tcp://127.0.0.1:" + std::to_string(port_);
 }
 
-void LineServer::inject_timeouts(int n) { faults_.inject_timeouts(n); }
-void LineServer::inject_exception(int code, int n) { faults_.inject_exception(code, n); }
-void LineServer::inject_drop(int n) { faults_.inject_drop(n); }
-void LineServer::stall_for(double seconds) { faults_.stall_for(seconds); }
-void LineServer::disconnect_for(double seconds) { faults_.disconnect_for(seconds); }
-void LineServer::clear_faults() { faults_.clear(); }
+void LineServer::inject_timeouts(int n) {
+  faults_.inject_timeouts(n);
+}
+void LineServer::inject_exception(int code, int n) {
+  faults_.inject_exception(code, n);
+}
+void LineServer::inject_drop(int n) {
+  faults_.inject_drop(n);
+}
+void LineServer::stall_for(double seconds) {
+  faults_.stall_for(seconds);
+}
+void LineServer::disconnect_for(double seconds) {
+  faults_.disconnect_for(seconds);
+}
+void LineServer::clear_faults() {
+  faults_.clear();
+}
 
 // Applies an injected disconnect (TCP): drops clients and listener, listens again on the same
 // port when the down time is over. False while down.

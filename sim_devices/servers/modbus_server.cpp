@@ -135,12 +135,24 @@ std::string ModbusServer::endpoint() const {
   return "tcp://127.0.0.1:" + std::to_string(port_);
 }
 
-void ModbusServer::inject_timeouts(int n) { faults_.inject_timeouts(n); }
-void ModbusServer::inject_exception(int code, int n) { faults_.inject_exception(code, n); }
-void ModbusServer::inject_drop(int n) { faults_.inject_drop(n); }
-void ModbusServer::stall_for(double seconds) { faults_.stall_for(seconds); }
-void ModbusServer::disconnect_for(double seconds) { faults_.disconnect_for(seconds); }
-void ModbusServer::clear_faults() { faults_.clear(); }
+void ModbusServer::inject_timeouts(int n) {
+  faults_.inject_timeouts(n);
+}
+void ModbusServer::inject_exception(int code, int n) {
+  faults_.inject_exception(code, n);
+}
+void ModbusServer::inject_drop(int n) {
+  faults_.inject_drop(n);
+}
+void ModbusServer::stall_for(double seconds) {
+  faults_.stall_for(seconds);
+}
+void ModbusServer::disconnect_for(double seconds) {
+  faults_.disconnect_for(seconds);
+}
+void ModbusServer::clear_faults() {
+  faults_.clear();
+}
 
 void ModbusServer::accept_client(std::vector<int>& clients) {
   int fd = accept4(listen_fd_, nullptr, nullptr, SOCK_CLOEXEC);

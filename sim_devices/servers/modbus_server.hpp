@@ -16,8 +16,8 @@
 #include <vector>
 
 #include "drivers/modbus/register_map.hpp"
-#include "sim_devices/servers/modbus_strict.hpp"
 #include "sim_devices/servers/fault_schedule.hpp"
+#include "sim_devices/servers/modbus_strict.hpp"
 #include "sim_devices/servers/sim_server.hpp"
 
 namespace station::sim {

@@ -55,7 +55,9 @@ dr::Error with_model(const std::string& model, dr::Error e) {
   return e;
 }
 
-json finite_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+json finite_or_null(double v) {
+  return std::isfinite(v) ? json(v) : json(nullptr);
+}
 
 // What the controller says it is (dialect, identity, units, decimals, limits) before its values:
 // a unit the dialect cannot read correctly fails here with the dialect's one line.
@@ -106,11 +108,15 @@ DeviceReport probe_turntable(dr::Turntable& table, const StationConfig& c) {
       dr::to_string(s.mode), s.angle_deg, s.rate_dps, yes_no(s.in_position), yes_no(s.at_rate),
       yes_no(s.fault), yes_no(s.interlock_open), c.turntable->model,
       id.value().empty() ? "" : ": " + id.value());
-  d.fields = {
-      {"model", c.turntable->model},       {"identity", id.value()},
-      {"mode", dr::to_string(s.mode)},     {"angle_deg", s.angle_deg}, {"rate_dps", s.rate_dps},
-      {"in_position", s.in_position},      {"at_rate", s.at_rate},     {"fault", s.fault},
-      {"interlock_open", s.interlock_open}};
+  d.fields = {{"model", c.turntable->model},
+              {"identity", id.value()},
+              {"mode", dr::to_string(s.mode)},
+              {"angle_deg", s.angle_deg},
+              {"rate_dps", s.rate_dps},
+              {"in_position", s.in_position},
+              {"at_rate", s.at_rate},
+              {"fault", s.fault},
+              {"interlock_open", s.interlock_open}};
   return d;
 }
 

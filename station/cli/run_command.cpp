@@ -1,8 +1,6 @@
 // `station run`: the daemon. --sim runs the embedded simulated rig; otherwise a real rig from
 // --config. SIGTERM/SIGINT end the run cleanly; under systemd it notifies READY and the watchdog.
 #include <fmt/format.h>
-
-#include "drivers/registry/dialects.hpp"
 #include <fmt/ranges.h>
 #include <systemd/sd-daemon.h>
 
@@ -17,6 +15,7 @@
 
 #include "drivers/can/candump_log.hpp"
 #include "drivers/common/clock.hpp"
+#include "drivers/registry/dialects.hpp"
 #include "station/cli/commands.hpp"
 #include "station/cli/daemon_setup.hpp"
 #include "station/cli/live_service.hpp"
@@ -228,13 +227,13 @@ void add_run_command(CLI::App& app, CommandStatus& status) {
   cmd->add_option("--seed", o->seed, "simulation seed")
       ->check(unsigned_integer())
       ->capture_default_str();
-  cmd->add_option("--chamber", o->chamber_model,
-                  "--sim: the dialect the simulated chamber speaks (" +
-                      drivers::chamber_models() + ")")
+  cmd->add_option(
+         "--chamber", o->chamber_model,
+         "--sim: the dialect the simulated chamber speaks (" + drivers::chamber_models() + ")")
       ->capture_default_str();
-  cmd->add_option("--turntable", o->turntable_model,
-                  "--sim: the dialect the simulated table speaks (" +
-                      drivers::turntable_models() + ")")
+  cmd->add_option(
+         "--turntable", o->turntable_model,
+         "--sim: the dialect the simulated table speaks (" + drivers::turntable_models() + ")")
       ->capture_default_str();
   cmd->add_option("--gyro-preset", o->gyro_preset,
                   "simulated gyros: station (strong thermal effect) or paper (the paper's "
@@ -251,11 +250,12 @@ void add_run_command(CLI::App& app, CommandStatus& status) {
   cmd->add_option("--record-can", o->record_can,
                   "write only the CAN frames, in can-utils' candump format, to this file")
       ->excludes(record);
-  cmd->add_option("--fault", o->faults,
-                  "--sim: at tick T (s) inject a simrig fault command, T:COMMAND "
-                  "(docs/SIMRIG.md), e.g. '3000:door open', or T:kill (the daemon SIGKILLs "
-                  "itself before tick T, to record a killed and resumed run) or T:sigint (it raises SIGINT "
-                  "after tick T: the operator's stop); repeatable");
+  cmd->add_option(
+      "--fault", o->faults,
+      "--sim: at tick T (s) inject a simrig fault command, T:COMMAND "
+      "(docs/SIMRIG.md), e.g. '3000:door open', or T:kill (the daemon SIGKILLs "
+      "itself before tick T, to record a killed and resumed run) or T:sigint (it raises SIGINT "
+      "after tick T: the operator's stop); repeatable");
   cmd->add_option("--parts", o->parts,
                   "part file (TOML, schemas/parts.schema.json): each fit gets a verdict against "
                   "its slot's part (overrides [station] parts; with --sim: applied to every "

@@ -41,7 +41,8 @@ Rig build_rig(const StationConfig& c, const RigOptions& o) {
   Rig rig;
   const dr::LinkOptions links{o.tap, o.clock, o.modbus_wire_factory, o.line_wire_factory};
   rig.chamber = dr::chamber_dialect(c.chamber.model).make(c.chamber, links);
-  if (c.turntable) rig.turntable = dr::turntable_dialect(c.turntable->model).make(*c.turntable, links);
+  if (c.turntable)
+    rig.turntable = dr::turntable_dialect(c.turntable->model).make(*c.turntable, links);
   rig.counters = open_counters(c, o);
   if (c.gpio) {
     rig.gpio = o.gpio_factory ? o.gpio_factory(*c.gpio)

@@ -53,9 +53,10 @@ Protocol Safety::clamp_protocol(const Protocol& p, std::vector<std::string>& not
     }
     if (!controller_ramp && s.kind == StepKind::set_temperature && s.ramp_c_per_h <= 0) {
       // Named by protocol line, not file: a replay reads the protocol from another path.
-      notes.push_back(fmt::format("step {} '{}' (line {}): ramped by the station at {:.1f} C/h "
-                                  "(the chamber has no ramp of its own)",
-                                  i, s.label, s.line, max_ramp_c_per_h));
+      notes.push_back(
+          fmt::format("step {} '{}' (line {}): ramped by the station at {:.1f} C/h "
+                      "(the chamber has no ramp of its own)",
+                      i, s.label, s.line, max_ramp_c_per_h));
       s.ramp_c_per_h = max_ramp_c_per_h;
     }
     if (s.ramp_c_per_h > max_ramp_c_per_h) {

@@ -15,7 +15,9 @@ std::string describe(const SessionLogLine& l) {
   return fmt::format("line {}: {} {} {}", l.line_no, l.direction, l.kind, hex_field(l.bytes));
 }
 
-std::vector<std::uint8_t> bytes_of(std::string_view s) { return {s.begin(), s.end()}; }
+std::vector<std::uint8_t> bytes_of(std::string_view s) {
+  return {s.begin(), s.end()};
+}
 
 }  // namespace
 

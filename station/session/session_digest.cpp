@@ -129,8 +129,8 @@ std::string digest_text(const std::vector<FileDigest>& files) {
 const std::vector<std::string>& digested_files() {
   // ascii.log: sessions since issue 20 (line devices); an older session has none and its digest
   // no entry for it.
-  static const std::vector<std::string> files{"session.toml", "can.log",     "gpio.log",
-                                              "modbus.log",   "ascii.log",   "result.json"};
+  static const std::vector<std::string> files{"session.toml", "can.log",   "gpio.log",
+                                              "modbus.log",   "ascii.log", "result.json"};
   return files;
 }
 

@@ -21,8 +21,8 @@ class SessionRecorder final : public drivers::Tap {
   /// simulated clock under --sim); default: the record's own wall time.
   using Stamp = std::function<double(const drivers::TapRecord&)>;
 
-  /// Opens can.log, modbus.log, ascii.log and gpio.log in `dir` (created if missing) for appending: a
-  /// resumed run goes on in the same files. Throws InputError naming a path it cannot write.
+  /// Opens can.log, modbus.log, ascii.log and gpio.log in `dir` (created if missing) for appending:
+  /// a resumed run goes on in the same files. Throws InputError naming a path it cannot write.
   explicit SessionRecorder(const std::string& dir, Stamp stamp = {});
   void on_exchange(const drivers::TapRecord& record) noexcept override;
   /// Flushes the three logs (after each tick, so a kill loses at most one tick of log).

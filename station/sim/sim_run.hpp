@@ -26,7 +26,7 @@ struct SimRunOptions {
   std::uint64_t seed = 1;
   std::string chamber_model = "generic_plc";    ///< dialect the simulated chamber speaks
   std::string turntable_model = "generic_plc";  ///< dialect the simulated table speaks
-  std::string gyro_preset = "station";  ///< sim::GyroPreset by name: "station" or "paper"
+  std::string gyro_preset = "station";          ///< sim::GyroPreset by name: "station" or "paper"
   double latitude_deg = 39.9;
   std::string protocol = "paper";  ///< shipped name or file
   std::string db_path;             ///< empty: station-sim.db in the current directory

@@ -64,7 +64,7 @@ TEST(Conformance, WatlowF4MatchesChamberConnectLibrary) {
          {"decimals2", 616, U16, ABCD, false, "CCL __get_scalar:100"},
          {"units", 901, U16, ABCD, false, "CCL get_loop_units:396"},
          {"event", 2020, U16, ABCD, true, "CCL get_event:533 (2000 + 10(n-1), n = 3)"}});
-  EXPECT_EQ(station::drivers::watlow_f4::kEventOn, 1);   // CCL set_event:539-543
+  EXPECT_EQ(station::drivers::watlow_f4::kEventOn, 1);  // CCL set_event:539-543
   EXPECT_EQ(station::drivers::watlow_f4::kEventOff, 0);
   EXPECT_EQ(station::drivers::watlow_f4::kProfileRunning, 2);  // CCL get_status:545-554
   EXPECT_EQ(station::drivers::watlow_f4::kProfilePaused, 3);
@@ -109,37 +109,36 @@ TEST(Conformance, WatlowF4tMatchesDataMap1) {
 
 // Watlow Series F4P User's Manual 0600-0032-0013 Rev E, pages as printed.
 TEST(Conformance, WatlowF4pMatchesItsManual) {
-  check(station::drivers::watlow_f4p::map(1),
-        {{"model", 0, U16, ABCD, false, "p. 6.27"},
-         {"input1_pv", 100, I16, ABCD, false, "p. 9.6"},
-         {"input1_err", 101, U16, ABCD, false, "p. 9.6"},
-         {"alarm1_status", 102, U16, ABCD, false, "p. 9.2"},
-         {"auto_manual", 200, U16, ABCD, true, "p. 9.2"},
-         {"control_sp", 298, I16, ABCD, false, "p. 9.4"},
-         {"setpoint1", 300, I16, ABCD, true, "p. 9.9"},
-         {"sp_low1", 602, I16, ABCD, false, "p. 6.13"},
-         {"sp_high1", 603, I16, ABCD, false, "p. 6.13"},
-         {"decimals1", 606, U16, ABCD, false, "p. 6.13"},
-         {"units", 901, U16, ABCD, false, "p. 6.11"},
-         {"ramp_mode", 1100, U16, ABCD, true, "p. 6.7"},
-         {"ramp_rate", 1101, I16, ABCD, true, "p. 6.8"},
-         {"ramp_scale", 1102, U16, ABCD, true, "p. 6.8"}});
+  check(station::drivers::watlow_f4p::map(1), {{"model", 0, U16, ABCD, false, "p. 6.27"},
+                                               {"input1_pv", 100, I16, ABCD, false, "p. 9.6"},
+                                               {"input1_err", 101, U16, ABCD, false, "p. 9.6"},
+                                               {"alarm1_status", 102, U16, ABCD, false, "p. 9.2"},
+                                               {"auto_manual", 200, U16, ABCD, true, "p. 9.2"},
+                                               {"control_sp", 298, I16, ABCD, false, "p. 9.4"},
+                                               {"setpoint1", 300, I16, ABCD, true, "p. 9.9"},
+                                               {"sp_low1", 602, I16, ABCD, false, "p. 6.13"},
+                                               {"sp_high1", 603, I16, ABCD, false, "p. 6.13"},
+                                               {"decimals1", 606, U16, ABCD, false, "p. 6.13"},
+                                               {"units", 901, U16, ABCD, false, "p. 6.11"},
+                                               {"ramp_mode", 1100, U16, ABCD, true, "p. 6.7"},
+                                               {"ramp_rate", 1101, I16, ABCD, true, "p. 6.8"},
+                                               {"ramp_scale", 1102, U16, ABCD, true, "p. 6.8"}});
   EXPECT_EQ(station::drivers::watlow_f4p::kModelF4p, 5280);  // "P4 (4P) ASCII 5280 Dec"
 }
 
 // CCL p300.py / especinteract.py: spellings and the replies as the library parses them.
 TEST(Conformance, EspecP300MatchesChamberConnectLibrary) {
   namespace p = station::drivers::espec_p300;
-  EXPECT_EQ(p::kTcpPort, 10001);                          // EspecTCP.__init__:117
-  EXPECT_EQ(p::kTerminator, "\r\n");                      // EspecSerial.__init__:55
+  EXPECT_EQ(p::kTcpPort, 10001);                           // EspecTCP.__init__:117
+  EXPECT_EQ(p::kTerminator, "\r\n");                       // EspecSerial.__init__:55
   EXPECT_EQ(p::temp_setpoint_command(25), "TEMP, S25.0");  // write_temp:1037 ("TEMP, S%0.1f")
   EXPECT_EQ(p::temp_setpoint_command(-40.04), "TEMP, S-40.0");
   EXPECT_EQ(p::addressed("TEMP?", 1), "1,TEMP?");  // EspecSerial.interact:93 ("%d,%s")
   EXPECT_EQ(p::addressed("TEMP?", 0), "TEMP?");
-  EXPECT_EQ(p::kModeConstant, "MODE,CONSTANT");  // write_mode_constant:1148
-  EXPECT_EQ(p::kModeStandby, "MODE,STANDBY");    // write_mode_standby:1142
-  EXPECT_EQ(p::kPowerOn, "POWER,ON");            // write_power:1014
-  EXPECT_EQ(p::kProductQuery, "TEMP PTC?");      // read_temp_ptc:689
+  EXPECT_EQ(p::kModeConstant, "MODE,CONSTANT");           // write_mode_constant:1148
+  EXPECT_EQ(p::kModeStandby, "MODE,STANDBY");             // write_mode_standby:1142
+  EXPECT_EQ(p::kPowerOn, "POWER,ON");                     // write_power:1014
+  EXPECT_EQ(p::kProductQuery, "TEMP PTC?");               // read_temp_ptc:689
   const auto t = p::parse_temp("23.5,25.0,100.0,-40.0");  // read_temp: pv, sp, high, low
   ASSERT_TRUE(t);
   EXPECT_DOUBLE_EQ(t->pv_c, 23.5);
@@ -160,16 +159,16 @@ TEST(Conformance, EspecP300MatchesChamberConnectLibrary) {
 // Acutronic TM-8004 command language (ACL), TM-9384C (TCP), acutrol3000.py (py).
 TEST(Conformance, Acutrol3000MatchesItsCommandLanguage) {
   namespace a = station::drivers::acutrol3000;
-  EXPECT_EQ(a::kTcpPort, 9878);                        // TCP p. 1
-  EXPECT_EQ(a::kModeOff, ":Mode:Off 1");               // ACL p. 150; py `:mode:off 1`
-  EXPECT_EQ(a::kModePosition, ":Mode:Position 1");     // ACL p. 151
-  EXPECT_EQ(a::kModeRate, ":Mode:Rate 1");             // ACL p. 152
+  EXPECT_EQ(a::kTcpPort, 9878);                         // TCP p. 1
+  EXPECT_EQ(a::kModeOff, ":Mode:Off 1");                // ACL p. 150; py `:mode:off 1`
+  EXPECT_EQ(a::kModePosition, ":Mode:Position 1");      // ACL p. 151
+  EXPECT_EQ(a::kModeRate, ":Mode:Rate 1");              // ACL p. 152
   EXPECT_EQ(a::kInterlockClose, ":Interlock:Close 1");  // ACL p. 131; py `:int:close 1`
-  EXPECT_EQ(a::kInterlockReset, ":Interlock:Reset");   // ACL p. 136 (no axis)
-  EXPECT_EQ(a::kRateLimitQuery, ":Limit:Rate? R,1");   // ACL p. 145 (mode, axis)
+  EXPECT_EQ(a::kInterlockReset, ":Interlock:Reset");    // ACL p. 136 (no axis)
+  EXPECT_EQ(a::kRateLimitQuery, ":Limit:Rate? R,1");    // ACL p. 145 (mode, axis)
   EXPECT_EQ(a::position_demand(135.223), ":Demand:Position 1,135.22300");  // ACL p. 112
-  EXPECT_EQ(a::rate_demand(-1.11111), ":Demand:Rate 1,-1.11111");           // ACL p. 113
-  EXPECT_EQ(a::parse_number("170.00000").value(), 170.0);  // NR2, ACL p. 112
+  EXPECT_EQ(a::rate_demand(-1.11111), ":Demand:Rate 1,-1.11111");          // ACL p. 113
+  EXPECT_EQ(a::parse_number("170.00000").value(), 170.0);                  // NR2, ACL p. 112
   EXPECT_EQ(a::parse_number("-32.19877").value(), -32.19877);
   EXPECT_FALSE(a::parse_number("1.0e3x"));
   const auto pr = a::parse_position_rate("10.0001;44.1250");  // ACL p. 168: ';'-separated

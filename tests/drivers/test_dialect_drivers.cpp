@@ -31,9 +31,9 @@ namespace sim = station::sim;
 struct F4Rig {
   explicit F4Rig(sim::WatlowPanel panel) : face(chamber, panel), server(face, 1) {
     server.start_tcp(0);
-    driver = std::make_unique<dr::WatlowF4Chamber>(
-        "chamber", "watlow_f4", dr::modbus::parse_endpoint(server.endpoint()),
-        dr::watlow_f4::map(1, panel.run_event), 0.5);
+    driver = std::make_unique<dr::WatlowF4Chamber>("chamber", "watlow_f4",
+                                                   dr::modbus::parse_endpoint(server.endpoint()),
+                                                   dr::watlow_f4::map(1, panel.run_event), 0.5);
   }
   sim::ChamberSim chamber{dr::chamber_map::generic_plc(1)};
   sim::F4Face face;
@@ -104,8 +104,7 @@ TEST(Acutrol3000Dialect, RateLimitAndInterlockFault) {
   sim::AcutrolFace face(table, 50.0);
   sim::LineServer server(face);
   server.start_tcp(0);
-  dr::Acutrol3000Table acutrol("turntable", dr::ascii::parse_line_endpoint(server.endpoint()),
-                               0.5);
+  dr::Acutrol3000Table acutrol("turntable", dr::ascii::parse_line_endpoint(server.endpoint()), 0.5);
   ASSERT_TRUE(acutrol.connect());
   const auto requests = server.requests();
   auto fast = acutrol.command({.mode = dr::TurntableMode::rate, .rate_dps = 60.0});

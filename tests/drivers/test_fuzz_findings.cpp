@@ -1,6 +1,5 @@
 // Regression tests for what fuzzing (tests/fuzz, docs/RELIABILITY.md) found in the drivers.
 #include <gtest/gtest.h>
-
 #include <netinet/in.h>
 #include <poll.h>
 #include <sys/socket.h>

@@ -4,10 +4,10 @@
 #include <cmath>
 
 #include "drivers/chamber/generic_plc/generic_plc_map.hpp"
-#include "drivers/registry/dialects.hpp"
 #include "drivers/modbus/endpoint.hpp"
 #include "drivers/modbus/map_overrides.hpp"
 #include "drivers/modbus/register_map.hpp"
+#include "drivers/registry/dialects.hpp"
 #include "drivers/turntable/generic_plc/generic_plc_map.hpp"
 
 namespace mb = station::drivers::modbus;

@@ -20,8 +20,8 @@
 #include "drivers/chamber/generic_plc/generic_plc_map.hpp"
 #include "drivers/chamber/generic_plc/modbus_chamber.hpp"
 #include "drivers/counters/counter_frames.hpp"
-#include "drivers/turntable/generic_plc/modbus_turntable.hpp"
 #include "drivers/turntable/generic_plc/generic_plc_map.hpp"
+#include "drivers/turntable/generic_plc/modbus_turntable.hpp"
 #include "sim_devices/fault_commands.hpp"
 #include "sim_devices/sim_world.hpp"
 

@@ -3,8 +3,8 @@
 
 #include <cmath>
 
-#include "drivers/turntable/generic_plc/modbus_turntable.hpp"
 #include "drivers/turntable/generic_plc/generic_plc_map.hpp"
+#include "drivers/turntable/generic_plc/modbus_turntable.hpp"
 #include "sim_devices/servers/modbus_server.hpp"
 #include "sim_devices/turntable_sim.hpp"
 

@@ -24,8 +24,8 @@
 
 #include "drivers/chamber/generic_plc/generic_plc_map.hpp"
 #include "drivers/chamber/generic_plc/modbus_chamber.hpp"
-#include "drivers/turntable/generic_plc/modbus_turntable.hpp"
 #include "drivers/turntable/generic_plc/generic_plc_map.hpp"
+#include "drivers/turntable/generic_plc/modbus_turntable.hpp"
 #include "fuzz_check.hpp"
 
 namespace dr = station::drivers;

@@ -84,13 +84,13 @@ TEST(RunProbe, MissingSerialLineClosedPortAndBadFdAreRefusedBeforeTheDatabase) {
 TEST(RunProbe, UnresolvableHostAndMissingBusSocketAreRefused) {
   const std::string sock = ::testing::TempDir() + "no-bus-" + std::to_string(getpid()) + ".sock";
   const auto cfg =
-      config_file("unresolvable", "tcp://no-such-host.invalid:502", "", "unix:" + sock);
+      config_file("unresolvable", "tcp://no-such-probe-host.invalid:502", "", "unix:" + sock);
   const std::string db = ::testing::TempDir() + "never2-" + std::to_string(getpid()) + ".db";
   std::remove(db.c_str());
   const auto o = run_station("run --config " + cfg + " --protocol paper --db " + db);
   EXPECT_EQ(o.status, 2) << o.err;
   EXPECT_EQ(lines(o.err), 2) << o.err;
-  EXPECT_NE(o.err.find("chamber tcp://no-such-host.invalid:502"), std::string::npos) << o.err;
+  EXPECT_NE(o.err.find("chamber tcp://no-such-probe-host.invalid:502"), std::string::npos) << o.err;
   EXPECT_NE(o.err.find("can unix:" + sock), std::string::npos) << o.err;
   EXPECT_NE(access(db.c_str(), F_OK), 0) << "the database was created";
 }

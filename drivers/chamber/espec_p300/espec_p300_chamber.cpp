@@ -56,8 +56,9 @@ Result<void> EspecP300Chamber::read_slow(ChamberState& s, int alarm_count) {
     if (!r) return r.error();
     auto codes = p3::parse_alarm(r.value());
     if (!codes)
-      return make_error(ErrorKind::protocol,
-                        fmt::format("{}: ALARM? reply '{}' is not a list of codes", name_, r.value()));
+      return make_error(
+          ErrorKind::protocol,
+          fmt::format("{}: ALARM? reply '{}' is not a list of codes", name_, r.value()));
     other_alarm_ = !codes->empty();
   }
   s.product_c = has_product_ ? product_c_ : std::numeric_limits<double>::quiet_NaN();
@@ -140,8 +141,8 @@ Result<ChamberIdentity> EspecP300Chamber::identify() {
   ChamberIdentity id;
   id.model = "espec_p300";
   // CCL espec.py process_controller:666: a ROM starting "P3" is a P300, else an SCP-220.
-  id.identity = fmt::format("ROM {} ({})", rom.value(),
-                            rom.value().rfind("P3", 0) == 0 ? "P300" : "SCP-220");
+  id.identity =
+      fmt::format("ROM {} ({})", rom.value(), rom.value().rfind("P3", 0) == 0 ? "P300" : "SCP-220");
   id.units = "C";  // the P300 protocol is in deg C (CCL espec.py get_loop_units:299-305)
   id.setpoint_low_c = t->low_c;
   id.setpoint_high_c = t->high_c;

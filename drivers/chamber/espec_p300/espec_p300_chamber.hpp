@@ -15,8 +15,8 @@ namespace station::drivers {
 class EspecP300Chamber final : public Chamber {
  public:
   /// `address`: the unit's RS-485 address, sent as "N," on a serial line (0: none).
-  EspecP300Chamber(std::string name, ascii::LineEndpoint endpoint, int address,
-                   double timeout_s, std::unique_ptr<ascii::LineWire> wire = nullptr);
+  EspecP300Chamber(std::string name, ascii::LineEndpoint endpoint, int address, double timeout_s,
+                   std::unique_ptr<ascii::LineWire> wire = nullptr);
 
   Result<void> connect() override { return client_.connect(); }
   Result<ChamberState> read() override;

@@ -1,12 +1,12 @@
 // P300 command spellings and strict reply parsers.
 #include "drivers/chamber/espec_p300/p300_wire.hpp"
 
-#include "drivers/ascii/number_field.hpp"
-
 #include <fmt/format.h>
 
 #include <charconv>
 #include <cmath>
+
+#include "drivers/ascii/number_field.hpp"
 
 namespace station::drivers::espec_p300 {
 namespace {
@@ -27,7 +27,9 @@ std::string_view trim(std::string_view s) {
   return s;
 }
 
-std::optional<double> number(std::string_view s) { return ascii::number_field(s); }
+std::optional<double> number(std::string_view s) {
+  return ascii::number_field(s);
+}
 
 std::optional<int> integer(std::string_view s) {
   s = trim(s);

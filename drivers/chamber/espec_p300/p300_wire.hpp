@@ -21,12 +21,12 @@ inline constexpr std::string_view kTerminator = "\r\n";
 /// An error reply starts with "NA:" followed by the message (CCL EspecSerial.interact:103-108).
 inline constexpr std::string_view kErrorPrefix = "NA:";
 
-inline constexpr std::string_view kTempQuery = "TEMP?";      // CCL p300.py read_temp:358-376
-inline constexpr std::string_view kMonitorQuery = "MON?";    // CCL read_mon:341-356
-inline constexpr std::string_view kModeQuery = "MODE?";      // CCL read_mode:327-339
-inline constexpr std::string_view kAlarmQuery = "ALARM?";    // CCL read_alarm:285-293
-inline constexpr std::string_view kProductQuery = "TEMP PTC?";  // CCL read_temp_ptc:689-709
-inline constexpr std::string_view kRomQuery = "ROM?";        // CCL read_rom:83-92
+inline constexpr std::string_view kTempQuery = "TEMP?";             // CCL p300.py read_temp:358-376
+inline constexpr std::string_view kMonitorQuery = "MON?";           // CCL read_mon:341-356
+inline constexpr std::string_view kModeQuery = "MODE?";             // CCL read_mode:327-339
+inline constexpr std::string_view kAlarmQuery = "ALARM?";           // CCL read_alarm:285-293
+inline constexpr std::string_view kProductQuery = "TEMP PTC?";      // CCL read_temp_ptc:689-709
+inline constexpr std::string_view kRomQuery = "ROM?";               // CCL read_rom:83-92
 inline constexpr std::string_view kModeConstant = "MODE,CONSTANT";  // CCL write_mode_constant:1148
 inline constexpr std::string_view kModeStandby = "MODE,STANDBY";    // CCL write_mode_standby:1142
 inline constexpr std::string_view kModeOff = "MODE,OFF";            // CCL write_mode_off:1136

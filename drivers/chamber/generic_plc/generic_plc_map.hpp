@@ -56,10 +56,10 @@ inline RegisterMap generic_plc(int unit_id = 1) {
         false, acc};
   };
   return RegisterMap("generic_plc", {t(kAir, 100, Access::ro), t(kProduct, 104, Access::ro),
-                                   u(kAlarms, 110, Access::ro), u(kStatus, 200, Access::ro),
-                                   t(kSetpoint, 300, Access::rw), t(kRamp, 310, Access::rw),
-                                   t(kSetpointLow, 602, Access::ro),
-                                   t(kSetpointHigh, 603, Access::ro), u(kRun, 2000, Access::rw)});
+                                     u(kAlarms, 110, Access::ro), u(kStatus, 200, Access::ro),
+                                     t(kSetpoint, 300, Access::rw), t(kRamp, 310, Access::rw),
+                                     t(kSetpointLow, 602, Access::ro),
+                                     t(kSetpointHigh, 603, Access::ro), u(kRun, 2000, Access::rw)});
 }
 
 /// The same points as 32-bit floats, low word first (CDAB), for a PLC that serves floats
@@ -76,12 +76,12 @@ inline RegisterMap generic_plc_float(int unit_id = 1) {
         n,     a,  PointType::uint16, 1.0, WordOrder::abcd, modbus::FunctionCode::holding, unit_id,
         false, acc};
   };
-  return RegisterMap("generic_plc_float",
-                     {f(kAir, 2800, Access::ro), f(kProduct, 2880, Access::ro),
-                      u(kStatus, 2920, Access::ro), u(kAlarms, 1500, Access::ro),
-                      f(kSetpoint, 2160, Access::rw), f(kRamp, 2168, Access::rw),
-                      f(kSetpointLow, 2172, Access::ro), f(kSetpointHigh, 2174, Access::ro),
-                      u(kRun, 2040, Access::rw)});
+  return RegisterMap(
+      "generic_plc_float",
+      {f(kAir, 2800, Access::ro), f(kProduct, 2880, Access::ro), u(kStatus, 2920, Access::ro),
+       u(kAlarms, 1500, Access::ro), f(kSetpoint, 2160, Access::rw), f(kRamp, 2168, Access::rw),
+       f(kSetpointLow, 2172, Access::ro), f(kSetpointHigh, 2174, Access::ro),
+       u(kRun, 2040, Access::rw)});
 }
 
 }  // namespace station::drivers::chamber_map

@@ -26,15 +26,16 @@ using modbus::RegisterMap;
 inline constexpr const char* kAir = "input1_pv";        // 100, CCL get_loop_pv:349-352
 inline constexpr const char* kAirError = "input1_err";  // 101, F4P p. 9.6 (0 none, 1..6 error)
 inline constexpr const char* kProduct = "input2_pv";    // 104, CCL get_loop_pv:349-352 (loop 2)
-inline constexpr const char* kProductError = "input2_err";  // 105, F4 map (assumption, F4P p. 9.6 pattern)
-inline constexpr const char* kStatus = "status";            // 200, CCL get_status:545-554
-inline constexpr const char* kSetpoint = "setpoint1";       // 300, CCL get_loop_sp:329, set_loop_sp:342
-inline constexpr const char* kSetpointLow = "sp_low1";      // 602, CCL get_loop_range:354-360
-inline constexpr const char* kSetpointHigh = "sp_high1";    // 603, CCL get_loop_range:354-360
-inline constexpr const char* kDecimals = "decimals1";       // 606, CCL __get_scalar:100-115; F4P p. 6.13
-inline constexpr const char* kDecimals2 = "decimals2";      // 616, CCL __get_scalar:100-115
-inline constexpr const char* kUnits = "units";              // 901, CCL get_loop_units:396; F4P p. 6.11
-inline constexpr const char* kRunEvent = "event";           // 2000 + 10(n-1), CCL get_event:533-543
+inline constexpr const char* kProductError =
+    "input2_err";                                 // 105, F4 map (assumption, F4P p. 9.6 pattern)
+inline constexpr const char* kStatus = "status";  // 200, CCL get_status:545-554
+inline constexpr const char* kSetpoint = "setpoint1";   // 300, CCL get_loop_sp:329, set_loop_sp:342
+inline constexpr const char* kSetpointLow = "sp_low1";  // 602, CCL get_loop_range:354-360
+inline constexpr const char* kSetpointHigh = "sp_high1";  // 603, CCL get_loop_range:354-360
+inline constexpr const char* kDecimals = "decimals1";  // 606, CCL __get_scalar:100-115; F4P p. 6.13
+inline constexpr const char* kDecimals2 = "decimals2";  // 616, CCL __get_scalar:100-115
+inline constexpr const char* kUnits = "units";          // 901, CCL get_loop_units:396; F4P p. 6.11
+inline constexpr const char* kRunEvent = "event";       // 2000 + 10(n-1), CCL get_event:533-543
 
 /// Status register 200 values (CCL get_status:545-554): 0 and 1 constant, 2 profile running,
 /// 3 profile paused. No "off", no "ramping": an F4 ramps only inside a profile.
@@ -45,23 +46,25 @@ inline constexpr int kUnitsFahrenheit = 0;
 inline constexpr int kEventOff = 0, kEventOn = 1;
 
 /// Register of event output n (1..8): 2000 + 10 (n - 1) (CCL get_event:533-537).
-constexpr std::uint16_t event_register(int n) { return static_cast<std::uint16_t>(2000 + 10 * (n - 1)); }
+constexpr std::uint16_t event_register(int n) {
+  return static_cast<std::uint16_t>(2000 + 10 * (n - 1));
+}
 
 /// The map for unit `unit_id` with the chamber-run event output `run_event` (1..8; which event
 /// runs the chamber is the chamber builder's wiring, so it is configuration).
 inline RegisterMap map(int unit_id = 1, int run_event = 1, const char* name = "watlow_f4") {
   auto p = [unit_id](const char* n, std::uint16_t a, PointType t, Access acc) {
-    return Point{n, a, t, 1.0, modbus::WordOrder::abcd, modbus::FunctionCode::holding, unit_id,
-                 false, acc};
+    return Point{n,       a,     t,  1.0, modbus::WordOrder::abcd, modbus::FunctionCode::holding,
+                 unit_id, false, acc};
   };
   constexpr auto I = PointType::int16;
   constexpr auto U = PointType::uint16;
   return RegisterMap(name, {p(kAir, 100, I, Access::ro), p(kAirError, 101, U, Access::ro),
                             p(kProduct, 104, I, Access::ro), p(kProductError, 105, U, Access::ro),
                             p(kStatus, 200, U, Access::ro), p(kSetpoint, 300, I, Access::rw),
-                            p(kSetpointLow, 602, I, Access::ro), p(kSetpointHigh, 603, I, Access::ro),
-                            p(kDecimals, 606, U, Access::ro), p(kDecimals2, 616, U, Access::ro),
-                            p(kUnits, 901, U, Access::ro),
+                            p(kSetpointLow, 602, I, Access::ro),
+                            p(kSetpointHigh, 603, I, Access::ro), p(kDecimals, 606, U, Access::ro),
+                            p(kDecimals2, 616, U, Access::ro), p(kUnits, 901, U, Access::ro),
                             p(kRunEvent, event_register(run_event), U, Access::rw)});
 }
 

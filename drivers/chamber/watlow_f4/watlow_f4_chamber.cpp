@@ -39,9 +39,9 @@ WatlowF4Chamber::WatlowF4Chamber(std::string name, std::string model, modbus::En
       client_(name_, endpoint,
               wire ? std::move(wire) : std::make_unique<modbus::LibmodbusWire>(endpoint),
               response_timeout_s) {
-  for (const char* p : {f4::kAir, f4::kAirError, f4::kProduct, f4::kStatus, f4::kSetpoint,
-                        f4::kSetpointLow, f4::kSetpointHigh, f4::kDecimals, f4::kDecimals2,
-                        f4::kUnits, f4::kRunEvent})
+  for (const char* p :
+       {f4::kAir, f4::kAirError, f4::kProduct, f4::kStatus, f4::kSetpoint, f4::kSetpointLow,
+        f4::kSetpointHigh, f4::kDecimals, f4::kDecimals2, f4::kUnits, f4::kRunEvent})
     (void)map_.at(p);  // throws naming the missing point
 }
 
@@ -151,10 +151,10 @@ Result<ChamberIdentity> WatlowF4Chamber::identify() {
   id.decimals = sc.value().decimals;
   id.setpoint_low_c = lo.value();
   id.setpoint_high_c = hi.value();
-  id.notes = fmt::format("{}run = event output at register {}; no constant-mode ramp: the station "
-                         "ramps the setpoint",
-                         sc.value().fahrenheit ? "deg F converted to deg C; " : "",
-                         map_.at(f4::kRunEvent).address);
+  id.notes = fmt::format(
+      "{}run = event output at register {}; no constant-mode ramp: the station "
+      "ramps the setpoint",
+      sc.value().fahrenheit ? "deg F converted to deg C; " : "", map_.at(f4::kRunEvent).address);
   return id;
 }
 

@@ -20,10 +20,10 @@ WatlowF4pChamber::WatlowF4pChamber(std::string name, modbus::Endpoint endpoint,
       client_(name_, endpoint,
               wire ? std::move(wire) : std::make_unique<modbus::LibmodbusWire>(endpoint),
               response_timeout_s) {
-  for (const char* p : {f4p::kModel, f4p::kAir, f4p::kAirError, f4p::kAlarm1, f4p::kOperation,
-                        f4p::kControlSetpoint, f4p::kSetpoint, f4p::kSetpointLow,
-                        f4p::kSetpointHigh, f4p::kDecimals, f4p::kUnits, f4p::kRampMode,
-                        f4p::kRampRate, f4p::kRampScale})
+  for (const char* p :
+       {f4p::kModel, f4p::kAir, f4p::kAirError, f4p::kAlarm1, f4p::kOperation,
+        f4p::kControlSetpoint, f4p::kSetpoint, f4p::kSetpointLow, f4p::kSetpointHigh,
+        f4p::kDecimals, f4p::kUnits, f4p::kRampMode, f4p::kRampRate, f4p::kRampScale})
     (void)map_.at(p);
 }
 
@@ -34,16 +34,17 @@ Result<TemperatureScale> WatlowF4pChamber::scale() {
   auto units = dec ? raw(f4p::kUnits) : dec;
   if (!units) return units.error();
   if (static_cast<int>(model.value()) != f4p::kModelF4p)
-    return make_error(ErrorKind::protocol,
-                      fmt::format("{}: register 0 reads {}, not 5280 ('4P'): not an F4P", name_,
-                                  model.value()));
+    return make_error(
+        ErrorKind::protocol,
+        fmt::format("{}: register 0 reads {}, not 5280 ('4P'): not an F4P", name_, model.value()));
   if (units.value() != f4p::kUnitsFahrenheit && units.value() != f4p::kUnitsCelsius)
-    return make_error(ErrorKind::protocol,
-                      fmt::format("{}: units register 901 = {} (F4P: 0 deg F, 1 deg C)", name_,
-                                  units.value()));
+    return make_error(
+        ErrorKind::protocol,
+        fmt::format("{}: units register 901 = {} (F4P: 0 deg F, 1 deg C)", name_, units.value()));
   if (dec.value() < 0 || dec.value() > 3)
-    return make_error(ErrorKind::protocol,
-                      fmt::format("{}: decimal places {} (register 606) not 0..3", name_, dec.value()));
+    return make_error(
+        ErrorKind::protocol,
+        fmt::format("{}: decimal places {} (register 606) not 0..3", name_, dec.value()));
   scale_ = TemperatureScale{static_cast<int>(dec.value()),
                             static_cast<int>(units.value()) == f4p::kUnitsFahrenheit};
   scale_connects_ = client_.connects();
@@ -73,9 +74,9 @@ Result<ChamberState> WatlowF4pChamber::read() {
     if (!per) csp = per.error();
     if (per) {
       auto_ = static_cast<int>(op.value()) == f4p::kAuto;
-      const double r = sc.value().delta_to_c(
-          sc.value().from_raw(static_cast<std::int16_t>(rate.value())));
-      ramp_c_per_min_ = static_cast<int>(mode.value()) == f4p::kRampOff ? 0.0
+      const double r =
+          sc.value().delta_to_c(sc.value().from_raw(static_cast<std::int16_t>(rate.value())));
+      ramp_c_per_min_ = static_cast<int>(mode.value()) == f4p::kRampOff  ? 0.0
                         : static_cast<int>(per.value()) == f4p::kPerHour ? r / 60.0
                                                                          : r;
     }
@@ -90,7 +91,7 @@ Result<ChamberState> WatlowF4pChamber::read() {
   s.setpoint_c = sp.value();
   s.ramp_c_per_min = ramp_c_per_min_;
   s.run_enabled = auto_;
-  s.mode = !auto_ ? ChamberMode::manual
+  s.mode = !auto_                                      ? ChamberMode::manual
            : std::abs(csp.value() - sp.value()) > 0.05 ? ChamberMode::ramping
                                                        : ChamberMode::constant;
   return s;

@@ -23,20 +23,21 @@ using modbus::Point;
 using modbus::PointType;
 using modbus::RegisterMap;
 
-inline constexpr const char* kAir = "loop1_pv";              // 2820, CCL get_loop_pv:243-247
-inline constexpr const char* kProduct = "loop2_pv";          // 2980 = 2820 + 160, same
-inline constexpr const char* kSetpoint = "loop1_sp";         // 2782, CCL get_loop_sp:234, set:241
-inline constexpr const char* kWorkingSetpoint = "loop1_wsp"; // 2810, CCL get_loop_sp:235
-inline constexpr const char* kSetpointLow = "loop1_sp_min";  // 2774, CCL get_loop_range:256-259
-inline constexpr const char* kSetpointHigh = "loop1_sp_max"; // 2776, same
-inline constexpr const char* kLoopMode = "loop1_mode";       // 2814 current mode, CCL get_loop_en:264
+inline constexpr const char* kAir = "loop1_pv";               // 2820, CCL get_loop_pv:243-247
+inline constexpr const char* kProduct = "loop2_pv";           // 2980 = 2820 + 160, same
+inline constexpr const char* kSetpoint = "loop1_sp";          // 2782, CCL get_loop_sp:234, set:241
+inline constexpr const char* kWorkingSetpoint = "loop1_wsp";  // 2810, CCL get_loop_sp:235
+inline constexpr const char* kSetpointLow = "loop1_sp_min";   // 2774, CCL get_loop_range:256-259
+inline constexpr const char* kSetpointHigh = "loop1_sp_max";  // 2776, same
+inline constexpr const char* kLoopMode = "loop1_mode";  // 2814 current mode, CCL get_loop_en:264
 inline constexpr const char* kRampAction = "loop1_ramp_action";  // 2794 [TE]
 inline constexpr const char* kRampScale = "loop1_ramp_scale";    // 2796 [TE]
 inline constexpr const char* kRampRate = "loop1_ramp_rate";      // 2798 [TE], float
-inline constexpr const char* kProfileState = "profile_state";   // 16568, CCL get_status:528-546
-inline constexpr const char* kAlarm1 = "alarm1_state";           // 1356, CCL get_alarm_status:552-556
-inline constexpr const char* kRunEvent = "event";                // see kEventRegisters
-inline constexpr const char* kUnits = "units";                   // 6730 TCP / 14080 RTU, CCL __profile_units:990-1007
+inline constexpr const char* kProfileState = "profile_state";    // 16568, CCL get_status:528-546
+inline constexpr const char* kAlarm1 = "alarm1_state";  // 1356, CCL get_alarm_status:552-556
+inline constexpr const char* kRunEvent = "event";       // see kEventRegisters
+inline constexpr const char* kUnits =
+    "units";  // 6730 TCP / 14080 RTU, CCL __profile_units:990-1007
 
 /// Loop stride: loop n's registers are loop 1's + 160 (n - 1) (CCL get_loop_pv:243-247).
 inline constexpr int kLoopStride = 160;
@@ -51,31 +52,33 @@ inline constexpr std::uint16_t kUnitsTcp = 6730, kUnitsRtu = 14080;
 
 /// Watlow enumeration codes (CCL watlowf4t.py __init__:78-121 dictionary and the functions named).
 enum Enum : int {
-  kAuto = 10,        // loop mode, CCL set_loop_mode:294-309
-  kManual = 54,      //
-  kOff = 62,         // loop mode off; event off (CCL set_event:508-520); ramp action off
-  kOn = 63,          // event on
-  kCelsius = 15,     // units (CCL __profile_units)
-  kFahrenheit = 30,  //
-  kHours = 39,       // ramp scale (dictionary; [TE] names the register)
-  kMinutes = 57,     //
-  kRampSetpoint = 85,      // ramp action "setpoint" (dictionary)
-  kProfilePaused = 146,    // profile state (CCL get_status:528-546)
-  kProfileRunning = 149,   //
+  kAuto = 10,             // loop mode, CCL set_loop_mode:294-309
+  kManual = 54,           //
+  kOff = 62,              // loop mode off; event off (CCL set_event:508-520); ramp action off
+  kOn = 63,               // event on
+  kCelsius = 15,          // units (CCL __profile_units)
+  kFahrenheit = 30,       //
+  kHours = 39,            // ramp scale (dictionary; [TE] names the register)
+  kMinutes = 57,          //
+  kRampSetpoint = 85,     // ramp action "setpoint" (dictionary)
+  kProfilePaused = 146,   // profile state (CCL get_status:528-546)
+  kProfileRunning = 149,  //
   kProfileTimedStart = 1783,
 };
 /// Alarm state codes that mean "not active" (CCL get_alarm_status:552-556: startup, none, 12).
 inline constexpr std::array<int, 3> kAlarmInactive{88, 61, 12};
 
 /// Name of the i-th part-number register (0..14).
-inline std::string part_number_point(int i) { return "part_number_" + std::to_string(i); }
+inline std::string part_number_point(int i) {
+  return "part_number_" + std::to_string(i);
+}
 
 /// The map for loop `loop` (1..4), chamber-run event output `run_event` (1..8) and the units
 /// register of the transport (`rtu` true: 14080).
 inline RegisterMap map(int unit_id = 1, int run_event = 1, bool rtu = false, int loop = 1) {
   const auto off = static_cast<std::uint16_t>(kLoopStride * (loop - 1));
   auto p = [unit_id](const char* n, std::uint16_t a, PointType t, Access acc) {
-    return Point{n,       a,   t, 1.0, modbus::WordOrder::cdab, modbus::FunctionCode::holding,
+    return Point{n,       a,     t,  1.0, modbus::WordOrder::cdab, modbus::FunctionCode::holding,
                  unit_id, false, acc};
   };
   constexpr auto F = PointType::float32;

@@ -37,14 +37,16 @@ WatlowF4tChamber::WatlowF4tChamber(std::string name, modbus::Endpoint endpoint,
       client_(name_, endpoint,
               wire ? std::move(wire) : std::make_unique<modbus::LibmodbusWire>(endpoint),
               response_timeout_s) {
-  for (const char* p : {f4t::kAir, f4t::kProduct, f4t::kSetpoint, f4t::kWorkingSetpoint,
-                        f4t::kSetpointLow, f4t::kSetpointHigh, f4t::kLoopMode, f4t::kRampAction,
-                        f4t::kRampScale, f4t::kRampRate, f4t::kProfileState, f4t::kAlarm1,
-                        f4t::kRunEvent, f4t::kUnits})
+  for (const char* p :
+       {f4t::kAir, f4t::kProduct, f4t::kSetpoint, f4t::kWorkingSetpoint, f4t::kSetpointLow,
+        f4t::kSetpointHigh, f4t::kLoopMode, f4t::kRampAction, f4t::kRampScale, f4t::kRampRate,
+        f4t::kProfileState, f4t::kAlarm1, f4t::kRunEvent, f4t::kUnits})
     (void)map_.at(p);
 }
 
-Result<double> WatlowF4tChamber::value(const char* point) { return client_.read(map_.at(point)); }
+Result<double> WatlowF4tChamber::value(const char* point) {
+  return client_.read(map_.at(point));
+}
 
 // The display unit (CCL __profile_units: 15 deg C, 30 deg F), read once per connection; any
 // other value is refused rather than guessed.

@@ -10,8 +10,8 @@
 namespace station::drivers {
 namespace ac = acutrol3000;
 
-Acutrol3000Table::Acutrol3000Table(std::string name, ascii::LineEndpoint endpoint,
-                                   double timeout_s, std::unique_ptr<ascii::LineWire> wire)
+Acutrol3000Table::Acutrol3000Table(std::string name, ascii::LineEndpoint endpoint, double timeout_s,
+                                   std::unique_ptr<ascii::LineWire> wire)
     : name_(std::move(name)),
       client_(name_, std::move(endpoint),
               ascii::LineFraming{std::string(ac::kCommandTerminator),
@@ -39,9 +39,8 @@ Result<double> Acutrol3000Table::number(std::string_view query) {
   if (!reply) return reply.error();
   auto v = ac::parse_number(reply.value());
   if (!v)
-    return make_error(ErrorKind::protocol,
-                      fmt::format("{}: reply '{}' to '{}' is not a number", name_, reply.value(),
-                                  query));
+    return make_error(ErrorKind::protocol, fmt::format("{}: reply '{}' to '{}' is not a number",
+                                                       name_, reply.value(), query));
   return *v;
 }
 

@@ -1,7 +1,7 @@
 // A single-axis rate table on an Acutronic ACUTROL3000 (dialect "acutrol3000"), ASCII command
-// language over TCP (port 9878) or a serial line (through the MOXA server the maker ships, TM-9411).
-// The ACUTROL has no axis-lock register: the station's "lock" is a position-mode servo hold,
-// reported locked once the axis is in position. Constructor does no I/O.
+// language over TCP (port 9878) or a serial line (through the MOXA server the maker ships,
+// TM-9411). The ACUTROL has no axis-lock register: the station's "lock" is a position-mode servo
+// hold, reported locked once the axis is in position. Constructor does no I/O.
 #pragma once
 
 #include <memory>

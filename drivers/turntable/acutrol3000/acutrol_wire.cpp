@@ -1,14 +1,14 @@
 // ACUTROL3000 command spellings and strict reply parsers.
 #include "drivers/turntable/acutrol3000/acutrol_wire.hpp"
 
-#include "drivers/ascii/number_field.hpp"
-
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cmath>
+
+#include "drivers/ascii/number_field.hpp"
 
 namespace station::drivers::acutrol3000 {
 namespace {
@@ -24,8 +24,12 @@ std::string lower(std::string_view s) {
 
 }  // namespace
 
-std::string position_demand(double deg) { return fmt::format(":Demand:Position 1,{:.5f}", deg); }
-std::string rate_demand(double dps) { return fmt::format(":Demand:Rate 1,{:.5f}", dps); }
+std::string position_demand(double deg) {
+  return fmt::format(":Demand:Position 1,{:.5f}", deg);
+}
+std::string rate_demand(double dps) {
+  return fmt::format(":Demand:Rate 1,{:.5f}", dps);
+}
 
 Mode parse_mode(std::string_view reply) {
   const auto w = lower(reply);
@@ -45,7 +49,9 @@ Interlock parse_interlock(std::string_view reply) {
   return Interlock::unknown;
 }
 
-std::optional<double> parse_number(std::string_view s) { return ascii::number_field(s); }
+std::optional<double> parse_number(std::string_view s) {
+  return ascii::number_field(s);
+}
 
 std::optional<std::pair<double, double>> parse_position_rate(std::string_view reply) {
   const auto i = reply.find(';');
@@ -56,7 +62,9 @@ std::optional<std::pair<double, double>> parse_position_rate(std::string_view re
   return std::pair{*p, *r};
 }
 
-bool is_error(std::string_view reply) { return lower(reply).rfind("error", 0) == 0; }
+bool is_error(std::string_view reply) {
+  return lower(reply).rfind("error", 0) == 0;
+}
 
 double wrap_deg(double deg) {
   double w = std::fmod(deg, 360.0);

@@ -28,16 +28,17 @@ inline constexpr std::string_view kReplyTerminator = "\n";
 inline constexpr int kAxis = 1;
 
 // Long forms as [ACL] spells them; the unit matches any unique prefix, case-insensitive (p. 2).
-inline constexpr std::string_view kIdentify = "*IDN?";                  // [ACL] p. 15
-inline constexpr std::string_view kModeOff = ":Mode:Off 1";             // [ACL] p. 150
-inline constexpr std::string_view kModePosition = ":Mode:Position 1";   // [ACL] p. 151
-inline constexpr std::string_view kModeRate = ":Mode:Rate 1";           // [ACL] p. 152
-inline constexpr std::string_view kModeQuery = ":Mode? 1";              // [ACL] p. 147
-inline constexpr std::string_view kReadPositionRate = ":Read:Position? 1;Rate? 1";  // [ACL] p. 168-169, [py] 14-18
-inline constexpr std::string_view kInterlockQuery = ":Interlock? 1";    // [ACL] p. 24, 133
+inline constexpr std::string_view kIdentify = "*IDN?";                 // [ACL] p. 15
+inline constexpr std::string_view kModeOff = ":Mode:Off 1";            // [ACL] p. 150
+inline constexpr std::string_view kModePosition = ":Mode:Position 1";  // [ACL] p. 151
+inline constexpr std::string_view kModeRate = ":Mode:Rate 1";          // [ACL] p. 152
+inline constexpr std::string_view kModeQuery = ":Mode? 1";             // [ACL] p. 147
+inline constexpr std::string_view kReadPositionRate =
+    ":Read:Position? 1;Rate? 1";  // [ACL] p. 168-169, [py] 14-18
+inline constexpr std::string_view kInterlockQuery = ":Interlock? 1";       // [ACL] p. 24, 133
 inline constexpr std::string_view kInterlockClose = ":Interlock:Close 1";  // [ACL] p. 131
-inline constexpr std::string_view kInterlockReset = ":Interlock:Reset";    // [ACL] p. 136 (all axes)
-inline constexpr std::string_view kRateLimitQuery = ":Limit:Rate? R,1";    // [ACL] p. 145
+inline constexpr std::string_view kInterlockReset = ":Interlock:Reset";  // [ACL] p. 136 (all axes)
+inline constexpr std::string_view kRateLimitQuery = ":Limit:Rate? R,1";  // [ACL] p. 145
 inline constexpr std::string_view kPositionDemandQuery = ":Demand:Position? 1";  // [ACL] p. 112
 inline constexpr std::string_view kRateDemandQuery = ":Demand:Rate? 1";          // [ACL] p. 113
 
@@ -58,7 +59,8 @@ std::optional<double> parse_number(std::string_view reply);
 std::optional<std::pair<double, double>> parse_position_rate(std::string_view reply);
 /// True for an error reply.
 bool is_error(std::string_view reply);
-/// Position wrapped into [0, 360) (the unit reports +-180 or 0..360 by configuration, [ACL] p. 101).
+/// Position wrapped into [0, 360) (the unit reports +-180 or 0..360 by configuration, [ACL] p.
+/// 101).
 double wrap_deg(double deg);
 
 }  // namespace station::drivers::acutrol3000
