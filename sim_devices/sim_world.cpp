@@ -128,7 +128,7 @@ void SimWorld::add_boards() {
     b.gyro.thermal.initial_c = config_.initial_c;
     b.gyro.earth_rate_dph = config_.earth_rate_dph;
     b.gyro.pulse_weight_arcsec = gyros_[i].pulse_weight_arcsec;
-    b.gyro.seed = config_.seed * 7919u + i + 1;
+    b.gyro.seed = config_.seed * 7919u + i + 1 + config_.noise_run * 0x9E3779B97F4A7C15u;
     b.board_time_offset_us = static_cast<std::uint32_t>(i * 123457u);
     bus_->add_board(b);
   }

@@ -34,6 +34,9 @@ std::optional<GyroPreset> gyro_preset_from_name(std::string_view name);
 struct SimWorldConfig {
   int gyros = 4;                            ///< simulated RLGs, nodes 1..gyros (at most 16)
   std::uint64_t seed = 1;                   ///< drives coefficients and every noise source
+  /// 0: the seed's own noise. N > 0: the same gyros (coefficients) with independent gyro noise,
+  /// as a second run of the same gyros on another day (run --sim --verify).
+  std::uint64_t noise_run = 0;
   GyroPreset preset = GyroPreset::station;  ///< coefficients of the simulated gyros
   double earth_rate_dph = 0;                ///< Earth rate along each gyro's input axis, deg/h
   double initial_c = 25.0;                  ///< chamber and gyros at t = 0, deg C

@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
   station::add_run_command(app, status);
   station::add_serve_command(app, status);
   station::add_fit_commands(app, status);
+  station::add_release_commands(app, status);
   station::add_history_command(app, status);
   station::add_replay_command(app, status);
   station::add_report_command(app, status);

@@ -21,8 +21,10 @@ void add_probe_command(CLI::App& app, CommandStatus& status);
 void add_run_command(CLI::App& app, CommandStatus& status);
 /// `station serve --config FILE --db DB [--http ADDR]`: the long-running service.
 void add_serve_command(CLI::App& app, CommandStatus& status);
-/// `station fit` and `station export`: per-serial fits from the database and their export.
+/// `station fit`: per-serial fits from the database (--cv: leave-one-run-out).
 void add_fit_commands(CLI::App& app, CommandStatus& status);
+/// `station release`, `station export`, `station verify`: delivering a calibration.
+void add_release_commands(CLI::App& app, CommandStatus& status);
 /// `station history --db DB --serial SN [--json]`: one gyro's runs, fits, scatter and drift.
 void add_history_command(CLI::App& app, CommandStatus& status);
 /// `station replay LOG --db PATH --run ID`: a recorded session through the driver again.

@@ -1,10 +1,11 @@
-// `station fit` (per serial, or every serial of a run) and `station export` (coefficients for
-// the navigation computer).
+// `station fit`: per serial, or every serial of a run; --cv adds leave-one-run-out prediction
+// errors beside the in-sample std.
 #include <fmt/format.h>
 
 #include <iostream>
 #include <nlohmann/json.hpp>
 
+#include "compensation/cross_validation.hpp"
 #include "station/cli/commands.hpp"
 #include "station/common/input_error.hpp"
 #include "station/parts/judged_fit.hpp"
@@ -21,8 +22,43 @@ struct FitOptions {
   std::vector<std::int64_t> runs;
   std::optional<std::int64_t> run;
   double ref_temp_c = 25.0;
-  bool all = false, json = false;
+  bool all = false, json = false, cv = false;
 };
+
+/// Leave-one-run-out cross-validation of one fit's model over its runs; empty with one run.
+std::optional<sc::CrossValidation> cross_validate(Store& store, const SerialFit& f) {
+  if (f.runs.size() < 2) return std::nullopt;
+  const sc::ModelData data = store.model_data(f.serial, f.runs);
+  return sc::leave_one_run_out(data.view(), f.fit.spec);
+}
+
+nlohmann::json cv_json(const std::optional<sc::CrossValidation>& cv,
+                       const std::vector<std::int64_t>& runs) {
+  if (!cv) return nullptr;
+  nlohmann::json held = nlohmann::json::array();
+  for (const auto& h : cv->runs)
+    held.push_back({{"run_id", runs.at(static_cast<std::size_t>(h.segment))},
+                    {"bins", h.bins},
+                    {"rms_dph", h.rms_dph},
+                    {"std_dph", h.std_dph}});
+  return {{"method", "leave-one-run-out"},
+          {"held_out", held},
+          {"pooled_rms_dph", cv->pooled_rms_dph},
+          {"in_sample_rms_dph", cv->in_sample_rms_dph}};
+}
+
+void print_cv(const std::optional<sc::CrossValidation>& cv, const std::vector<std::int64_t>& runs) {
+  if (!cv) {
+    fmt::print("  cross-validation: needs two or more runs\n");
+    return;
+  }
+  fmt::print("  leave-one-run-out: prediction RMS {:.5f} deg/h on held-out runs, in-sample {:.5f} "
+             "deg/h ({:.2f}x)\n",
+             cv->pooled_rms_dph, cv->in_sample_rms_dph, cv->pooled_rms_dph / cv->in_sample_rms_dph);
+  for (const auto& h : cv->runs)
+    fmt::print("    run {} held out: RMS {:.5f} deg/h, std {:.5f} deg/h over {} bins\n",
+               runs.at(static_cast<std::size_t>(h.segment)), h.rms_dph, h.std_dph, h.bins);
+}
 
 /// Unit of each coefficient, for people and for the navigation computer.
 std::string unit_of(const std::string& name) {
@@ -84,62 +120,18 @@ int run_fit(const FitOptions& o) {
   const int status = result.skipped.empty() ? 0 : 1;
   if (o.json) {
     nlohmann::json arr = nlohmann::json::array();
-    for (const auto& f : fits) arr.push_back(fit_json(f));
+    for (const auto& f : fits) {
+      arr.push_back(fit_json(f));
+      if (o.cv) arr.back()["cross_validation"] = cv_json(cross_validate(store, f.fit), f.fit.runs);
+    }
     std::cout << (o.all ? arr : arr[0]).dump(2) << '\n';
     return status;
   }
-  for (const auto& f : fits) print_fit(f);
+  for (const auto& f : fits) {
+    print_fit(f);
+    if (o.cv) print_cv(cross_validate(store, f.fit), f.fit.runs);
+  }
   return status;
-}
-
-void run_export(const FitOptions& o) {
-  Store store(o.db, OpenMode::read_only);
-  const auto rec = store.latest_fit(o.serial);
-  if (!rec)
-    throw InputError(
-        fmt::format("{}: no fit stored for serial '{}' (run `station fit` first)", o.db, o.serial));
-  const auto& f = rec->fit;
-  const auto verdict = stored_verdict(store, rec->id);
-  if (o.format == "csv") {
-    // The verdict on every row (a CSV has no header block): pass, fail, or empty for no part;
-    // failed limits joined by ';'.
-    std::string failed;
-    if (verdict)
-      for (const auto& x : verdict->failed) failed += (failed.empty() ? "" : ";") + x.limit;
-    const std::string v = !verdict ? "" : verdict->pass ? "pass" : "fail";
-    fmt::print(
-        "serial,fit_id,term,value,std_error,std_error_ols,unit,ref_temp_c,part_number,verdict,"
-        "failed_limits\n");
-    for (std::size_t i = 0; i < f.names.size(); ++i) {
-      const double ols = i < f.std_errors_ols.size() ? f.std_errors_ols[i] : NAN;
-      fmt::print("{},{},{},{:.9e},{:.3e},{:.3e},{},{},{},{},{}\n", o.serial, rec->id, f.names[i],
-                 f.coefficients[i], f.std_errors[i], ols, unit_of(f.names[i]), f.spec.ref_temp_c,
-                 verdict ? verdict->part_number : "", v, failed);
-    }
-    return;
-  }
-  nlohmann::json coef = nlohmann::json::object(), units = nlohmann::json::object();
-  for (std::size_t i = 0; i < f.names.size(); ++i) {
-    coef[f.names[i]] = f.coefficients[i];
-    units[f.names[i]] = unit_of(f.names[i]);
-  }
-  const nlohmann::json j{
-      {"serial", o.serial},
-      {"fit_id", rec->id},
-      {"created_utc", rec->created_utc},
-      {"runs", rec->runs},
-      {"terms", rec->terms},
-      {"ref_temp_c", f.spec.ref_temp_c},
-      {"model", "B = B0 + k1*dT + k2*dT^2 + ... + k0*gradT (dT = T - ref_temp_c, gradT = T2 - T1)"},
-      {"coefficients", coef},
-      {"std_errors", std_errors_json(f)},
-      {"std_errors_ols", std_errors_ols_json(f)},
-      {"error_model", error_model_json(f.error_model)},
-      {"units", units},
-      {"std_ratio", std_ratio_json(rec->eval)},
-      {"part_number", verdict ? nlohmann::json(verdict->part_number) : nlohmann::json()},
-      {"verdict", verdict ? verdict_json(*verdict) : nlohmann::json()}};
-  std::cout << j.dump(2) << '\n';
 }
 
 }  // namespace
@@ -162,19 +154,10 @@ void add_fit_commands(CLI::App& app, CommandStatus& status) {
       ->capture_default_str();
   fit->add_option("--ref-temp-c", o->ref_temp_c, "T_ref, C")->capture_default_str();
   fit->add_flag("--json", o->json, "print JSON");
+  fit->add_flag("--cv", o->cv,
+                "leave-one-run-out cross-validation: prediction error on each held-out run "
+                "beside the in-sample residual (two or more runs)");
   fit->callback([o, &status] { status.exit_code = run_fit(*o); });
-  auto e = std::make_shared<FitOptions>();
-  auto* exp = app.add_subcommand(
-      "export", "Write a serial's latest coefficients for the navigation computer");
-  exp->add_option("--db", e->db, "SQLite database")->required();
-  exp->add_option("--serial", e->serial, "gyro serial number")->required();
-  exp->add_option("--format", e->format, "json|csv")
-      ->check(CLI::IsMember({"json", "csv"}))
-      ->capture_default_str();
-  exp->callback([e, &status] {
-    run_export(*e);
-    status.exit_code = 0;
-  });
 }
 
 }  // namespace station

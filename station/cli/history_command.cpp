@@ -10,6 +10,7 @@
 #include "station/common/input_error.hpp"
 #include "station/parts/history.hpp"
 #include "station/parts/verdict.hpp"
+#include "station/release/releases.hpp"
 
 namespace station {
 namespace {
@@ -48,8 +49,22 @@ json fit_row_json(const SerialFitRow& f) {
           {"verdict", v ? verdict_json(*v) : json()}};
 }
 
+json releases_json(const std::vector<ReleaseRow>& releases) {
+  json out = json::array();
+  for (const auto& r : releases)
+    out.push_back({{"release_id", r.id},
+                   {"fit_id", r.fit_id},
+                   {"released_utc", r.released_utc},
+                   {"by", r.released_by},
+                   {"note", r.note},
+                   {"override", r.override_reason ? json(*r.override_reason) : json()},
+                   {"current", &r == &releases.back()}});
+  return out;
+}
+
 json history_json(const std::string& serial, const std::vector<SerialRun>& runs,
-                  const std::vector<SerialFitRow>& fits, const SerialHistoryStats& h) {
+                  const std::vector<SerialFitRow>& fits, const SerialHistoryStats& h,
+                  const std::vector<ReleaseRow>& releases) {
   json jr = json::array(), jf = json::array(), jc = json::array(), js = json::array(),
        jflags = json::array();
   for (const auto& r : runs) {
@@ -88,7 +103,9 @@ json history_json(const std::string& serial, const std::vector<SerialRun>& runs,
           {"terms", h.terms},
           {"scatter", js},
           {"drift_limit_zeta", kDriftZetaLimit},
-          {"drift", jflags}};
+          {"drift", jflags},
+          {"released_fit_id", releases.empty() ? json() : json(releases.back().fit_id)},
+          {"releases", releases_json(releases)}};
 }
 
 std::string pm(const SerialFitRow& f, const std::string& name) {
@@ -97,22 +114,36 @@ std::string pm(const SerialFitRow& f, const std::string& name) {
   return u ? fmt::format("{:.4e} +- {:.1e}", *v, *u) : fmt::format("{:.4e}", *v);
 }
 
+void print_releases(const std::vector<ReleaseRow>& releases) {
+  if (releases.empty()) {
+    fmt::print("  no fit released (`station release --fit ID --by NAME`)\n");
+    return;
+  }
+  for (const auto& r : releases)
+    fmt::print("  {} fit {}: {}\n", &r == &releases.back() ? "RELEASED  " : "superseded", r.fit_id,
+               release_text(r));
+}
+
 void print_history(const std::string& serial, const std::vector<SerialRun>& runs,
-                   const std::vector<SerialFitRow>& fits, const SerialHistoryStats& h) {
+                   const std::vector<SerialFitRow>& fits, const SerialHistoryStats& h,
+                   const std::vector<ReleaseRow>& releases) {
+  const std::int64_t released = releases.empty() ? 0 : releases.back().fit_id;
   fmt::print("{}: {} runs, {} fits, {} calibrations\n", serial, runs.size(), fits.size(),
              h.calibrations.size());
   for (const auto& r : runs) {
     fmt::print("  run {:>4} {} {:<10} {:<12} slot {:>2} part {}\n", r.run_id, r.started_utc,
                r.state, r.protocol_name, r.slot, r.part_number.value_or("-"));
   }
-  fmt::print("  {:>5} {:<24} {:<10} {:>24} {:>24} {:>7}  verdict\n", "fit", "created", "runs",
+  fmt::print("  {:>6} {:<24} {:<10} {:>24} {:>24} {:>7}  verdict\n", "fit", "created", "runs",
              "k1 deg/h/C", "k0 deg/h/C", "ratio");
   for (const auto& f : fits) {
-    fmt::print("  {:>5} {:<24} {:<10} {:>24} {:>24} {:>7}  {}\n", f.fit_id, f.created_utc,
+    fmt::print("  {:>5}{} {:<24} {:<10} {:>24} {:>24} {:>7}  {}\n", f.fit_id,
+               f.fit_id == released ? "*" : " ", f.created_utc,
                fmt::format("{}", fmt::join(f.runs, ",")), pm(f, "k1"), pm(f, "k0"),
                f.std_ratio ? fmt::format("{:.3f}", *f.std_ratio) : "undef",
                verdict_text(verdict_of(f)));
   }
+  print_releases(releases);
   for (const auto& s : h.scatter) {
     if (s.n < 2) {
       fmt::print("  {} scatter: {} calibration(s) with terms {}: nothing to compare\n",
@@ -141,11 +172,12 @@ void run_history(const HistoryOptions& o) {
   if (runs.empty() && fits.empty())
     throw InputError(fmt::format("{}: no run or fit of serial '{}'", o.db, o.serial));
   const auto h = serial_history_stats(fits);
+  const auto releases = releases_of(store, o.serial);
   if (o.json) {
-    std::cout << history_json(o.serial, runs, fits, h).dump(2) << '\n';
+    std::cout << history_json(o.serial, runs, fits, h, releases).dump(2) << '\n';
     return;
   }
-  print_history(o.serial, runs, fits, h);
+  print_history(o.serial, runs, fits, h, releases);
 }
 
 }  // namespace

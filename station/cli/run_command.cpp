@@ -41,7 +41,7 @@ void on_stop_signal(int) {
 }
 
 struct RunOptions {
-  bool sim = false, json = false, fresh = false;
+  bool sim = false, json = false, fresh = false, verify = false;
   std::string config, protocol = "paper", db, operator_name, log_file, record_can, record;
   std::string parts, part;          ///< --parts FILE, --part PN (--sim)
   std::vector<std::string> faults;  ///< --sim: "T:COMMAND"
@@ -191,7 +191,7 @@ int run_sim(const RunOptions& o) {
   so.extend = [&live](SequencerOptions& s) { attach_live(live, s); };
   nlohmann::json report;
   try {
-    report = run_simulated(so);
+    report = o.verify ? run_simulated_with_verification(so) : run_simulated(so);
   } catch (const std::exception& e) {
     live.hub().run_ended(live.hub().current_run().value_or(0), fmt::format("failed: {}", e.what()));
     live.shutdown();
@@ -264,6 +264,10 @@ void add_run_command(CLI::App& app, CommandStatus& status) {
                   "--sim: the simulated gyros' part number (default: the part file's first, in "
                   "sort order)");
   cmd->add_flag("--json", o->json, "print one JSON object at the end (--sim)");
+  cmd->add_flag("--verify", o->verify,
+                "--sim: release each passing fit, then run the same gyros again (independent "
+                "noise) and verify the released calibrations on that run")
+      ->needs(sim);
   cmd->add_option("--speed", o->speed,
                   "--sim: simulated seconds per wall second, to watch a run live (600: the 13 h "
                   "cycle in ~80 s; default: as fast as possible)")

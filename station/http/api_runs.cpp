@@ -1,6 +1,8 @@
 // Run queries for the API: plain SQL on a read-only connection (WAL: never blocks the writer).
 #include "station/http/api_runs.hpp"
 
+#include "station/release/releases.hpp"
+#include "station/release/verification.hpp"
 #include "station/store/fit_json.hpp"
 
 namespace station::http {
@@ -72,9 +74,22 @@ std::optional<nlohmann::json> run_json(Store& store, std::int64_t run_id) {
                      {"std_after_dph", f->eval.std_after_dph},
                      {"std_ratio", std_ratio_json(f->eval)}};
     }
+    // The serial's released calibration (it may come from another run) and its release.
+    slot["released"] = nullptr;
+    if (const auto r = current_release(store, s.serial))
+      slot["released"] = {{"fit_id", r->fit_id},
+                          {"released_utc", r->released_utc},
+                          {"by", r->released_by},
+                          {"note", r->note},
+                          {"override", r->override_reason ? nlohmann::json(*r->override_reason)
+                                                          : nlohmann::json(nullptr)}};
     slots.push_back(std::move(slot));
   }
   j["slots"] = std::move(slots);
+  nlohmann::json verifications = nlohmann::json::array();
+  for (const auto& v : verifications_of_run(store, run_id))
+    verifications.push_back(verification_json(v));
+  j["verifications"] = std::move(verifications);
   return j;
 }
 

@@ -9,6 +9,7 @@
 #include "station/http/api_runs.hpp"
 #include "station/http/http_server.hpp"
 #include "station/http/json_reply.hpp"
+#include "station/release/releases.hpp"
 #include "station/store/sqlite.hpp"
 
 // Last: httplib.h pulls in <resolv.h>, whose `_res` macro breaks Eigen headers included after it.
@@ -184,6 +185,56 @@ void HttpServer::control_routes() {
   };
   s.Post(R"(/api/runs/([^/]+)/stop)", end_run(false));
   s.Post(R"(/api/runs/([^/]+)/abort)", end_run(true));
+  s.Post(R"(/api/fits/([^/]+)/release)",
+         [this](const httplib::Request& req, httplib::Response& res) { release_fit_route(req, res); });
+}
+
+// POST /api/fits/{id}/release {"by", "note", "override"}: the same rules as `station release`,
+// on a short-lived writing connection (the API's own connection is read-only).
+void HttpServer::release_fit_route(const httplib::Request& req, httplib::Response& res) {
+  if (!may_write(req, res)) return;
+  const auto id = positive_int(req.matches[1].str());
+  if (!id) {
+    send_json(res, 400, {{"error", fmt::format("fit id '{}': expected a positive integer",
+                                               req.matches[1].str())}});
+    return;
+  }
+  const auto body = nlohmann::json::parse(req.body, nullptr, false);
+  std::string error;
+  std::optional<std::string> by, note, override_reason;
+  if (body.is_discarded() || !body.is_object()) {
+    error = "body: expected a JSON object {\"by\": NAME, \"note\": TEXT, \"override\": REASON}";
+  } else {
+    by = string_field(body, "by", 200, error);
+    note = string_field(body, "note", 4096, error);
+    override_reason = string_field(body, "override", 4096, error);
+    if (error.empty() && (!by || by->empty())) error = "field 'by' is required";
+  }
+  if (!error.empty()) {
+    send_json(res, 400, {{"error", error}});
+    return;
+  }
+  try {
+    Store store(options_.db_path, OpenMode::existing);
+    const ReleaseRow r = release_fit(store, {*id, *by, note.value_or(""), override_reason});
+    log("http")->info("fit {} of {} released by {} from {}", r.fit_id, r.serial, r.released_by,
+                      req.remote_addr);
+    send_json(res, 201,
+              {{"release_id", r.id},
+               {"fit_id", r.fit_id},
+               {"serial", r.serial},
+               {"released_utc", r.released_utc},
+               {"by", r.released_by},
+               {"override", r.override_reason ? nlohmann::json(*r.override_reason) : nullptr}});
+  } catch (const FitNotFound& e) {
+    send_json(res, 404, {{"error", e.what()}});
+  } catch (const ReleaseRefused& e) {
+    send_json(res, 409, {{"error", e.what()}});
+  } catch (const InputError& e) {
+    send_json(res, 400, {{"error", e.what()}});
+  } catch (const SqliteError& e) {
+    send_json(res, 503, {{"error", e.what()}});
+  }
 }
 
 void HttpServer::stream_route() {

@@ -60,6 +60,8 @@ class HttpServer {
   void routes();
   void api_routes();
   void control_routes();
+  /// POST /api/fits/{id}/release.
+  void release_fit_route(const httplib::Request& req, httplib::Response& res);
   void stream_route();
   void static_routes();
   /// Whether the request may read (loopback, or the token); answers 401/403 when not.

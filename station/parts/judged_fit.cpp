@@ -44,17 +44,7 @@ std::vector<double> compensated_record_dph(Store& store, std::int64_t run_id,
                                            const std::string& serial, const sc::FitResult& fit) {
   for (const auto t : fit.spec.terms)
     if (t == sc::Term::dTdt || t == sc::Term::channel) return {};
-  double earth_rate_dph = 0;
-  for (const auto& s : store.run_slots(run_id))
-    if (s.serial == serial) earth_rate_dph = s.earth_rate_dph;
-  sc::ModelData d;
-  for (const auto& s : store.samples(run_id, serial, true)) {
-    // The samples bin_samples (calibration.cpp) puts into bins, and no others.
-    if (!s.rate_dph || !s.temp_c || !s.temp2_c || (s.flags & kUnfitFlags) != 0) continue;
-    d.bias_dph.push_back(*s.rate_dph - earth_rate_dph);
-    d.temp_c.push_back(*s.temp_c);
-    d.grad_c.push_back(*s.temp2_c - *s.temp_c);
-  }
+  const sc::ModelData d = record_model_data(store, run_id, serial);
   if (d.bias_dph.empty()) return {};
   return sc::compensate(fit, d.view());
 }

@@ -36,7 +36,7 @@ LimitRange read_range(const TomlView& part, std::string_view key) {
 PartLimits read_part(const TomlView& v, const std::string& number) {
   v.allow_only({"description", "B0_dph", "k1_dph_per_c", "k0_dph_per_c", "max_std_after_dph",
                 "max_std_ratio", "max_adev_floor_dph", "min_complete_bins", "max_k1_se_dph_per_c",
-                "max_k0_se_dph_per_c"});
+                "max_k0_se_dph_per_c", "max_verify_std_dph", "max_verify_ratio"});
   PartLimits p;
   p.number = number;
   p.description = v.opt_string("description").value_or("");
@@ -50,6 +50,8 @@ PartLimits read_part(const TomlView& v, const std::string& number) {
   p.min_complete_bins = v.opt_integer_in("min_complete_bins", 3, 52560);
   p.max_k1_se_dph_per_c = positive(v, "max_k1_se_dph_per_c");
   p.max_k0_se_dph_per_c = positive(v, "max_k0_se_dph_per_c");
+  p.max_verify_std_dph = positive(v, "max_verify_std_dph");
+  p.max_verify_ratio = positive(v, "max_verify_ratio");
   return p;
 }
 
@@ -144,6 +146,8 @@ json part_limits_json(const PartLimits& p) {
   put("min_complete_bins", p.min_complete_bins);
   put("max_k1_se_dph_per_c", p.max_k1_se_dph_per_c);
   put("max_k0_se_dph_per_c", p.max_k0_se_dph_per_c);
+  put("max_verify_std_dph", p.max_verify_std_dph);
+  put("max_verify_ratio", p.max_verify_ratio);
   return j;
 }
 
@@ -161,6 +165,8 @@ PartLimits part_limits_from_json(const json& j) {
     p.min_complete_bins = opt_from_json<long long>(j, "min_complete_bins");
     p.max_k1_se_dph_per_c = opt_from_json<double>(j, "max_k1_se_dph_per_c");
     p.max_k0_se_dph_per_c = opt_from_json<double>(j, "max_k0_se_dph_per_c");
+    p.max_verify_std_dph = opt_from_json<double>(j, "max_verify_std_dph");
+    p.max_verify_ratio = opt_from_json<double>(j, "max_verify_ratio");
     return p;
   } catch (const json::exception& e) {
     throw std::invalid_argument(fmt::format("stored part limits: {}", e.what()));

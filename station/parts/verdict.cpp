@@ -78,6 +78,16 @@ Verdict judge_fit(const PartLimits& p, const VerdictInputs& in) {
   return v;
 }
 
+std::optional<Verdict> judge_verification(const PartLimits& p, const VerificationFigures& in) {
+  Verdict v;
+  v.part_number = p.number;
+  Checker c(v);
+  c.at_most("max_verify_std_dph", in.std_after_dph, p.max_verify_std_dph);
+  c.at_most("max_verify_ratio", in.std_ratio, p.max_verify_ratio);
+  if (v.checked == 0) return std::nullopt;
+  return v;
+}
+
 json verdict_json(const Verdict& v) {
   json failed = json::array();
   for (const auto& f : v.failed) {

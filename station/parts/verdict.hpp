@@ -39,6 +39,16 @@ struct VerdictInputs {
 /// Checks every limit `limits` sets. Pure.
 Verdict judge_fit(const PartLimits& limits, const VerdictInputs& in);
 
+/// What a verification on an independent run shows (station/release/verification.hpp).
+struct VerificationFigures {
+  double std_after_dph = 0;
+  std::optional<double> std_ratio;  ///< empty when undefined
+};
+
+/// Checks the verification limits (max_verify_std_dph, max_verify_ratio) only; empty when the
+/// part sets neither. Pure.
+std::optional<Verdict> judge_verification(const PartLimits& limits, const VerificationFigures& in);
+
 /// {"pass": bool, "failed": [{"limit", "value", "bound"}], "part": number, "checked": n}.
 nlohmann::json verdict_json(const Verdict& v);
 /// The inverse of verdict_json; throws std::invalid_argument on a malformed object.

@@ -1,6 +1,8 @@
 // The report's figures from a run's stored record (Zhou et al. 2013, Figs. 2-5).
 #include "station/report/report_data.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -189,6 +191,18 @@ Figure figure_5a(const sc::FitResult& fit, const sc::ModelData& data) {
   f.series = {points("before", data.temp_c, data.bias_dph),
               points("after \u0394T only", data.temp_c, after_dt),
               points("after \u0394T + \u2207T", data.temp_c, sc::compensate(fit, data.view()))};
+  return f;
+}
+
+Figure figure_6(std::int64_t fit_id, const std::vector<double>& temp_c,
+                const std::vector<double>& before_dph, const std::vector<double>& after_dph) {
+  Figure f = make_figure("6",
+                         fmt::format("Verification: bias before and after fit {} (fitted on other "
+                                     "runs) against temperature",
+                                     fit_id),
+                         "gyro temperature, \u00b0C", "bias, deg/h");
+  f.series = {points("before", temp_c, before_dph),
+              points(fmt::format("after fit {} (gyro_tc_correct)", fit_id), temp_c, after_dph)};
   return f;
 }
 

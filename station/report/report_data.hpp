@@ -86,5 +86,9 @@ Figure figure_4(const compensation::FitResult& fit, const compensation::ModelDat
 /// Fig. 5a: bias before compensation, after the temperature terms only (bias - B0 - sum k_i
 /// dT^i) and after the whole model (bias - B(x), paper eq. (4)), against temperature.
 Figure figure_5a(const compensation::FitResult& fit, const compensation::ModelData& data);
+/// Fig. 6 (Fig. 5a's form, for a verification): the bias of a run before and after a
+/// calibration fitted on other runs, against temperature, per complete bin.
+Figure figure_6(std::int64_t fit_id, const std::vector<double>& temp_c,
+                const std::vector<double>& before_dph, const std::vector<double>& after_dph);
 
 }  // namespace station::report

@@ -43,12 +43,35 @@ std::vector<RampRun> ramp_runs(Store& store, const std::string& serial) {
   return out;
 }
 
+/// The verifications stored on run `run_id` for the serial, each recomputed for its series (the
+/// stored figures and verdict are kept: they are what was reported when it ran).
+void load_verifications(Store& store, std::int64_t run_id, SerialReport& s) {
+  for (auto& stored : verifications_of_run(store, run_id)) {
+    if (stored.serial != s.slot.serial) continue;
+    if (const auto fit = store.find_fit(stored.fit_id)) {
+      const VerificationResult again = verify_fit(store, *fit, run_id, std::nullopt);
+      stored.t_s = again.t_s;
+      stored.temp_c = again.temp_c;
+      stored.before_dph = again.before_dph;
+      stored.after_dph = again.after_dph;
+    }
+    s.verification_figures.push_back(
+        figure_6(stored.fit_id, stored.temp_c, stored.before_dph, stored.after_dph));
+    if (!s.verifications.empty())
+      s.verification_figures.back().id = fmt::format("6.{}", s.verifications.size() + 1);
+    s.verifications.push_back(std::move(stored));
+  }
+}
+
 SerialReport load_serial(Store& store, const RunReport& rr, const RunSlot& slot) {
   SerialReport s;
   s.slot = slot;
+  s.current_release = current_release(store, slot.serial);
+  load_verifications(store, rr.run.id, s);
   s.fit = store.latest_fit_of_run(slot.serial, rr.run.id);
   if (!s.fit) return s;
   s.extras = fit_extras(store, *s.fit);
+  s.fit_release = release_of_fit(store, s.fit->id);
   const auto samples = store.samples(rr.run.id, slot.serial, false);
   const auto bins = whole_run_bins(samples, rr.bin_s, slot.earth_rate_dph);
   const auto data = store.model_data(slot.serial, s.fit->runs);

@@ -9,6 +9,8 @@
 #include <vector>
 
 #include "station/report/report_allan.hpp"
+#include "station/release/releases.hpp"
+#include "station/release/verification.hpp"
 #include "station/report/report_data.hpp"
 #include "station/store/store.hpp"
 
@@ -32,6 +34,12 @@ struct SerialReport {
   FitExtras extras;
   AllanCurves allan;            ///< for the noise terms
   std::vector<Figure> figures;  ///< 2a, 2b, 3, 4, 5a, 5b (empty without a fit)
+  std::optional<ReleaseRow> fit_release;      ///< the newest release of this run's fit
+  std::optional<ReleaseRow> current_release;  ///< the serial's released calibration (any fit)
+  /// Verifications stored on this run for this serial, with their per-bin series, and Fig. 6
+  /// of each (same order).
+  std::vector<VerificationResult> verifications;
+  std::vector<Figure> verification_figures;
 };
 
 /// One run and its serials.

@@ -119,12 +119,16 @@ std::string noise_table(const AllanCurves& a) {
   return t + "</table>\n";
 }
 
+std::string release_cell(const SerialReport& s);
+
 std::string serial_summary_row(const RunReport& r, std::size_t i, const std::string& page) {
   const auto& s = r.serials[i];
   const std::string name = page.empty() ? html_escape(s.slot.serial)
                                         : fmt::format("<a href=\"{}\">{}</a>", html_escape(page),
                                                       html_escape(s.slot.serial));
-  if (!s.fit) return row({name, std::to_string(s.slot.slot), "no fit stored for this run"});
+  if (!s.fit)
+    return row({name, std::to_string(s.slot.slot), "no fit stored for this run", "", "", "", "",
+                "", release_cell(s)});
   const auto& f = s.fit->fit;
   std::string coef;
   for (std::size_t k = 0; k < f.names.size(); ++k)
@@ -133,7 +137,95 @@ std::string serial_summary_row(const RunReport& r, std::size_t i, const std::str
                         num(k < f.std_errors.size() ? f.std_errors[k] : NAN, "{:.2e}"));
   return row({name, std::to_string(s.slot.slot), verdict_html(s.extras), coef,
               num(s.fit->eval.std_before_dph), num(s.fit->eval.std_after_dph),
-              html_escape(std_ratio_text(s.fit->eval)), std::to_string(f.n_points)});
+              html_escape(std_ratio_text(s.fit->eval)), std::to_string(f.n_points),
+              release_cell(s)});
+}
+
+std::string release_line(const ReleaseRow& r) {
+  std::string t = fmt::format("fit {} released {} by {}", r.fit_id, html_escape(r.released_utc),
+                              html_escape(r.released_by));
+  if (!r.note.empty()) t += " (" + html_escape(r.note) + ")";
+  if (r.override_reason)
+    t += " <span class=\"fail\">over its verdict: " + html_escape(*r.override_reason) + "</span>";
+  return t;
+}
+
+/// Whether this run's fit is the gyro's calibration, was superseded, or was never released.
+std::string release_html(const SerialReport& s) {
+  std::string t = "<p class=\"release\">";
+  const bool current = s.fit && s.current_release && s.current_release->fit_id == s.fit->id;
+  if (current)
+    t += "<span class=\"pass\">RELEASED</span>: " + release_line(*s.current_release) +
+         ". This fit is the gyro's calibration (`station export`).";
+  else if (s.fit_release)
+    t += "Superseded: " + release_line(*s.fit_release) + "; the released calibration is now " +
+         (s.current_release ? release_line(*s.current_release) : std::string("none")) + ".";
+  else if (s.current_release)
+    t += "This run's fit is not released; the gyro's calibration is " +
+         release_line(*s.current_release) + ".";
+  else
+    t += "Not released: no fit of this gyro is released (`station release --fit ID --by NAME`).";
+  return t + "</p>\n";
+}
+
+std::string release_cell(const SerialReport& s) {
+  if (s.fit && s.current_release && s.current_release->fit_id == s.fit->id)
+    return fmt::format("<span class=\"pass\">released</span> (fit {})", s.fit->id);
+  if (s.current_release) return fmt::format("fit {} is released", s.current_release->fit_id);
+  return "not released";
+}
+
+std::string verification_rows(const VerificationResult& v) {
+  std::string t;
+  t += row({"calibration applied", fmt::format("fit {} (fitted on other runs; the navigation "
+                                               "computer's gyro_tc_correct, clamped to its span)",
+                                               v.fit_id)});
+  t += row({"bins", fmt::format("{} ({} outside the fit's span, clamped)", v.bins,
+                                v.clamped_bins)});
+  t += row({"std before", num(v.eval.std_before_dph) + " deg/h"});
+  t += row({"std after", num(v.eval.std_after_dph) + " deg/h"});
+  t += row({"std ratio", v.eval.std_ratio ? num(*v.eval.std_ratio, "{:.3f}") : "undefined"});
+  t += row({"mean residual", num(v.mean_residual_dph) + " deg/h"});
+  if (v.drift_dph_per_c)
+    t += row({"residual drift against T", num(*v.drift_dph_per_c, "{:.3e}") + " &plusmn; " +
+                                              num(v.drift_se_dph_per_c, "{:.1e}") + " deg/h/C"});
+  t += row({"ADEV floor (compensated 1 Hz)", num(v.adev_floor_dph) + " deg/h"});
+  const std::string cls = !v.verdict ? "" : (v.verdict->pass ? "pass" : "fail");
+  t += row({"verdict", fmt::format("<span class=\"verdict {}\">{}</span>", cls,
+                                   html_escape(station::verdict_text(v.verdict)))});
+  return t;
+}
+
+/// The serial page's verification section: each verification's figures and its Fig. 6.
+std::string verification_html(const SerialReport& s, json& figures) {
+  if (s.verifications.empty()) return "";
+  std::string t = "<section class=\"verification\">\n<h2>Verification on this run</h2>\n";
+  for (std::size_t i = 0; i < s.verifications.size(); ++i) {
+    t += "<table class=\"verification-figures\">\n" + verification_rows(s.verifications[i]) +
+         "</table>\n";
+    if (i < s.verification_figures.size()) {
+      t += "<div class=\"figures\">\n" + figure_box(s.verification_figures[i]) + "</div>\n";
+      figures.push_back(figure_json(s.verification_figures[i]));
+    }
+  }
+  return t + "</section>\n";
+}
+
+/// The index's verification table: every verification stored on this run.
+std::string verification_index(const RunReport& r) {
+  std::string t;
+  for (const auto& s : r.serials)
+    for (const auto& v : s.verifications)
+      t += row({html_escape(v.serial), std::to_string(v.fit_id), num(v.eval.std_before_dph),
+                num(v.eval.std_after_dph),
+                v.eval.std_ratio ? num(*v.eval.std_ratio, "{:.3f}") : "undefined",
+                num(v.mean_residual_dph), html_escape(station::verdict_text(v.verdict))});
+  if (t.empty()) return "";
+  return "<section class=\"verification\">\n<h2>Verification on this run</h2>\n<table>\n"
+         "<tr><th>serial</th><th>fit applied</th><th>std before, deg/h</th>"
+         "<th>std after, deg/h</th><th>ratio</th><th>mean residual, deg/h</th><th>verdict</th>"
+         "</tr>\n" +
+         t + "</table>\n</section>\n";
 }
 
 }  // namespace
@@ -186,10 +278,10 @@ std::string index_html(const RunReport& r, const Assets& a, const std::vector<st
                      "</h1>\n<section class=\"serials\">\n"
                      "<h2>Serials</h2>\n<table>\n<tr><th>serial</th><th>slot</th><th>verdict</th>"
                      "<th>coefficients &plusmn; 1&sigma;</th><th>std before, deg/h</th>"
-                     "<th>std after, deg/h</th><th>ratio</th><th>bins</th></tr>\n";
+                     "<th>std after, deg/h</th><th>ratio</th><th>bins</th><th>release</th></tr>\n";
   for (std::size_t i = 0; i < r.serials.size(); ++i)
     body += serial_summary_row(r, i, i < pages.size() ? pages[i] : "");
-  body += "</table>\n</section>\n" + run_record_html(r) + events_html(r);
+  body += "</table>\n</section>\n" + verification_index(r) + run_record_html(r) + events_html(r);
   return page_html(title, body, json::array(), a);
 }
 
@@ -197,7 +289,8 @@ std::string serial_html(const RunReport& r, const SerialReport& s, const Assets&
   const std::string title =
       fmt::format("Serial {}, run {}: calibration report", s.slot.serial, r.run.id);
   std::string body =
-      "<h1>" + html_escape(title) + "</h1>\n<p>Verdict: " + verdict_html(s.extras) + "</p>\n";
+      "<h1>" + html_escape(title) + "</h1>\n<p>Verdict: " + verdict_html(s.extras) + "</p>\n" +
+      release_html(s);
   json figures = json::array();
   if (s.fit) {
     body +=
@@ -212,6 +305,7 @@ std::string serial_html(const RunReport& r, const SerialReport& s, const Assets&
     }
     body += "</div>\n";
   }
+  body += verification_html(s, figures);
   body += run_record_html(r) + events_html(r);
   return page_html(title, body, figures, a);
 }

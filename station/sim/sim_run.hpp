@@ -24,6 +24,7 @@ struct SequencerOptions;
 struct SimRunOptions {
   int gyros = 4;
   std::uint64_t seed = 1;
+  std::uint64_t noise_run = 0;  ///< sim::SimWorldConfig::noise_run (same gyros, new noise)
   std::string chamber_model = "generic_plc";    ///< dialect the simulated chamber speaks
   std::string turntable_model = "generic_plc";  ///< dialect the simulated table speaks
   std::string gyro_preset = "station";          ///< sim::GyroPreset by name: "station" or "paper"
@@ -55,6 +56,13 @@ std::optional<std::string> sim_part_number(const SimRunOptions& options);
 /// Runs the simulated rig to the end of the protocol (or a resumed one to its end) and returns
 /// the report: {"run_id","sim_s","wall_s","gyros":[{serial,true,fitted,std_errors,std_*}]}.
 nlohmann::json run_simulated(const SimRunOptions& options);
+
+/// `run --sim --verify`: the run above, then each gyro's fit released when its verdict allows
+/// (by "station run --sim --verify"), then a second run of the same gyros with independent
+/// noise, on which each released calibration is verified (station/release/verification.hpp).
+/// Returns the second run's report with "calibration_run" (the first's), "releases" and
+/// "verifications".
+nlohmann::json run_simulated_with_verification(const SimRunOptions& options);
 
 /// Prints the report as a readable table.
 void print_sim_report(const nlohmann::json& report);

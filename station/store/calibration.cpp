@@ -12,12 +12,29 @@ namespace station {
 
 namespace sc = station::compensation;
 
+bool sample_goes_into_bins(const SampleRow& s) {
+  return s.recording && s.rate_dph && s.temp_c && s.temp2_c && (s.flags & kUnfitFlags) == 0;
+}
+
+sc::ModelData record_model_data(Store& store, std::int64_t run_id, const std::string& serial) {
+  double earth_rate_dph = 0;
+  for (const auto& s : store.run_slots(run_id))
+    if (s.serial == serial) earth_rate_dph = s.earth_rate_dph;
+  sc::ModelData d;
+  for (const auto& s : store.samples(run_id, serial, true)) {
+    if (!sample_goes_into_bins(s)) continue;
+    d.bias_dph.push_back(*s.rate_dph - earth_rate_dph);
+    d.temp_c.push_back(*s.temp_c);
+    d.grad_c.push_back(*s.temp2_c - *s.temp_c);  // gradient = second sensor - first
+    d.t_mid_s.push_back(s.t_s);
+  }
+  return d;
+}
+
 std::vector<sc::Bin> bin_samples(const std::vector<SampleRow>& rows, double bin_s) {
   std::vector<double> t, rate, temp, grad;
   for (const auto& s : rows) {
-    if (!s.recording || !s.rate_dph || !s.temp_c || !s.temp2_c || (s.flags & kUnfitFlags) != 0) {
-      continue;
-    }
+    if (!sample_goes_into_bins(s)) continue;
     t.push_back(s.t_s);
     rate.push_back(*s.rate_dph);
     temp.push_back(*s.temp_c);

@@ -359,6 +359,13 @@ std::optional<FitRecord> Store::latest_fit(const std::string& serial) {
   return read_fit(st);
 }
 
+std::optional<FitRecord> Store::find_fit(std::int64_t fit_id) {
+  auto st = db_.prepare(std::string(kFitColumns) + "WHERE id = ?");
+  st.bind(1, fit_id);
+  if (!st.step()) return std::nullopt;
+  return read_fit(st);
+}
+
 std::optional<FitRecord> Store::latest_fit_of_run(const std::string& serial, std::int64_t run_id) {
   auto st = db_.prepare(std::string(kFitColumns) +
                         "WHERE serial = ? AND EXISTS (SELECT 1 FROM json_each(fits.runs_json) "

@@ -137,6 +137,8 @@ class Store {
   std::int64_t save_fit(const std::string& serial, const std::vector<std::int64_t>& runs,
                         const compensation::FitResult& fit, const compensation::Evaluation& eval);
   std::optional<FitRecord> latest_fit(const std::string& serial);
+  /// Fit `fit_id`; empty when there is none.
+  std::optional<FitRecord> find_fit(std::int64_t fit_id);
   /// The newest fit of `serial` whose runs include `run_id` (the report of that run).
   std::optional<FitRecord> latest_fit_of_run(const std::string& serial, std::int64_t run_id);
 

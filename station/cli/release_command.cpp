@@ -1,0 +1,201 @@
+// `station release` (a fit becomes the gyro's calibration), `station export` (the released
+// calibration as a coefficient block for the navigation computer) and `station verify` (a fit
+// applied to a run it was not fitted on).
+#include <fmt/format.h>
+
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "station/cli/commands.hpp"
+#include "station/common/input_error.hpp"
+#include "station/parts/judged_fit.hpp"
+#include "station/release/block_formats.hpp"
+#include "station/release/releases.hpp"
+#include "station/release/verification.hpp"
+
+namespace station {
+namespace {
+
+struct ReleaseOptions {
+  std::string db, by, note, override_reason;
+  std::int64_t fit_id = 0;
+};
+
+struct ExportOptions {
+  std::string db, format = "json";
+  std::vector<std::string> serials;
+  std::optional<std::int64_t> fit_id;
+  Px4Slot px4;
+};
+
+struct VerifyOptions {
+  std::string db, serial, parts, part;
+  std::int64_t run_id = 0;
+  std::optional<std::int64_t> fit_id;
+  bool json = false;
+};
+
+void run_release(const ReleaseOptions& o) {
+  Store store(o.db, OpenMode::existing);
+  ReleaseRequest req{o.fit_id, o.by, o.note, std::nullopt};
+  if (!o.override_reason.empty()) req.override_reason = o.override_reason;
+  const ReleaseRow r = release_fit(store, req);
+  fmt::print("{}: fit {} is the released calibration ({}, release {})\n", r.serial, r.fit_id,
+             release_text(r), r.id);
+  if (r.override_reason)
+    fmt::print(stderr, "station: warning: fit {} released over its verdict: {}\n", r.fit_id,
+               *r.override_reason);
+}
+
+/// The block `station export` writes for one serial: its released fit, or --fit ID.
+CoefficientBlock export_block(Store& store, const ExportOptions& o, const std::string& serial) {
+  if (!o.fit_id) {
+    const auto released = current_release(store, serial);
+    if (!released)
+      throw InputError(fmt::format(
+          "{}: serial '{}' has no released calibration (`station release --fit ID --by NAME`; "
+          "`station export --fit ID` exports a fit that is not released)",
+          o.db, serial));
+    const auto fit = store.find_fit(released->fit_id);
+    if (!fit) throw InputError(fmt::format("{}: released fit {} is missing", o.db, released->fit_id));
+    return make_block(store, *fit, released);
+  }
+  const auto fit = store.find_fit(*o.fit_id);
+  if (!fit) throw InputError(fmt::format("{}: no fit {}", o.db, *o.fit_id));
+  if (!serial.empty() && fit->serial != serial)
+    throw InputError(fmt::format("{}: fit {} is of serial '{}', not '{}'", o.db, *o.fit_id,
+                                 fit->serial, serial));
+  const auto released = current_release(store, fit->serial);
+  const bool is_released = released && released->fit_id == fit->id;
+  if (!is_released)
+    fmt::print(stderr,
+               "station: warning: fit {} is NOT the released calibration of {} ({}); its block "
+               "says so (\"release\": null)\n",
+               fit->id, fit->serial,
+               released ? fmt::format("fit {} is", released->fit_id) : std::string("none is"));
+  return make_block(store, *fit, is_released ? released : std::nullopt);
+}
+
+void run_export(const ExportOptions& o) {
+  if (o.serials.empty() && !o.fit_id) throw InputError("export: give --serial SN or --fit ID");
+  if (o.fit_id && o.serials.size() > 1)
+    throw InputError("export: --fit ID names one fit: give at most one --serial");
+  if (o.format == "px4" && o.serials.size() > 1)
+    throw InputError("export --format px4: one gyro axis per file: give one --serial");
+  Store store(o.db, OpenMode::read_only);
+  std::vector<CoefficientBlock> blocks;
+  if (o.serials.empty()) blocks.push_back(export_block(store, o, ""));
+  for (const auto& s : o.serials) blocks.push_back(export_block(store, o, s));
+  if (o.format == "csv") {
+    std::cout << blocks_csv(blocks);
+  } else if (o.format == "c") {
+    std::cout << blocks_c_header(blocks);
+  } else if (o.format == "px4") {
+    std::cout << block_px4(blocks.front(), o.px4);
+  } else {
+    nlohmann::json arr = nlohmann::json::array();
+    for (const auto& b : blocks) arr.push_back(block_json(b));
+    std::cout << (arr.size() == 1 ? arr[0] : arr).dump(2) << '\n';
+  }
+}
+
+void print_verification(const VerificationResult& v) {
+  fmt::print("{}: fit {} applied to run {} ({} bins, {} outside the fit's span, clamped)\n",
+             v.serial, v.fit_id, v.run_id, v.bins, v.clamped_bins);
+  fmt::print("  std before {:.5f} deg/h, after {:.5f} deg/h, ratio {}\n", v.eval.std_before_dph,
+             v.eval.std_after_dph,
+             v.eval.std_ratio ? fmt::format("{:.3f}", *v.eval.std_ratio) : "undefined");
+  fmt::print("  mean residual {:+.5f} deg/h\n", v.mean_residual_dph);
+  if (v.drift_dph_per_c)
+    fmt::print("  residual drift {:+.3e} +- {:.1e} deg/h/C (against T)\n", *v.drift_dph_per_c,
+               *v.drift_se_dph_per_c);
+  if (v.adev_floor_dph) fmt::print("  ADEV floor {:.5f} deg/h (compensated 1 Hz record)\n", *v.adev_floor_dph);
+  fmt::print("  verdict: {} (verification {})\n", verdict_text(v.verdict), v.id);
+}
+
+int run_verify(const VerifyOptions& o) {
+  std::optional<PartFile> parts;
+  if (!o.parts.empty()) parts = load_part_file(o.parts);
+  Store store(o.db, OpenMode::existing);
+  std::optional<FitRecord> fit;
+  if (o.fit_id) {
+    fit = store.find_fit(*o.fit_id);
+    if (!fit) throw InputError(fmt::format("{}: no fit {}", o.db, *o.fit_id));
+    if (fit->serial != o.serial)
+      throw InputError(fmt::format("{}: fit {} is of serial '{}', not '{}'", o.db, *o.fit_id,
+                                   fit->serial, o.serial));
+  } else {
+    const auto rel = current_release(store, o.serial);
+    if (!rel)
+      throw InputError(fmt::format(
+          "{}: serial '{}' has no released calibration (give --fit ID to verify another fit)",
+          o.db, o.serial));
+    fit = store.find_fit(rel->fit_id);
+  }
+  const auto limits = limits_for(store, o.serial, {o.run_id}, {parts ? &*parts : nullptr, o.part});
+  VerificationResult v = verify_fit(store, *fit, o.run_id, limits);
+  save_verification(store, v);
+  if (o.json)
+    std::cout << verification_json(v).dump(2) << '\n';
+  else
+    print_verification(v);
+  return v.verdict && !v.verdict->pass ? 1 : 0;
+}
+
+void add_release(CLI::App& app, CommandStatus& status) {
+  auto o = std::make_shared<ReleaseOptions>();
+  auto* c = app.add_subcommand("release", "Make a fit the gyro's released calibration");
+  c->add_option("--db", o->db, "SQLite database")->required();
+  c->add_option("--fit", o->fit_id, "fit id (station fit / history)")->required();
+  c->add_option("--by", o->by, "who releases")->required();
+  c->add_option("--note", o->note, "free text stored with the release");
+  c->add_option("--override", o->override_reason,
+                "release a fit whose verdict failed (or is missing) anyway, for this reason");
+  c->callback([o, &status] {
+    run_release(*o);
+    status.exit_code = 0;
+  });
+}
+
+void add_export(CLI::App& app, CommandStatus& status) {
+  auto o = std::make_shared<ExportOptions>();
+  auto* c = app.add_subcommand(
+      "export", "Write the released calibration of gyros for the navigation computer");
+  c->add_option("--db", o->db, "SQLite database")->required();
+  c->add_option("--serial", o->serials, "gyro serial number(s)")->delimiter(',');
+  c->add_option("--fit", o->fit_id, "export this fit (warns when it is not the released one)");
+  c->add_option("--format", o->format, "json|csv|c|px4")
+      ->check(CLI::IsMember({"json", "csv", "c", "px4"}))
+      ->capture_default_str();
+  c->add_option("--px4-instance", o->px4.instance, "px4: gyro instance (TC_G<N>), 0..3")
+      ->capture_default_str();
+  c->add_option("--px4-axis", o->px4.axis, "px4: board axis of this gyro, 0 x, 1 y, 2 z")
+      ->capture_default_str();
+  c->callback([o, &status] {
+    run_export(*o);
+    status.exit_code = 0;
+  });
+}
+
+void add_verify(CLI::App& app, CommandStatus& status) {
+  auto o = std::make_shared<VerifyOptions>();
+  auto* c = app.add_subcommand("verify", "Apply a calibration to a run it was not fitted on");
+  c->add_option("--db", o->db, "SQLite database")->required();
+  c->add_option("--serial", o->serial, "gyro serial number")->required();
+  c->add_option("--run", o->run_id, "the independent run")->required();
+  c->add_option("--fit", o->fit_id, "fit id (default: the released calibration)");
+  c->add_option("--parts", o->parts, "part file (default: the limits stored with the run)");
+  c->add_option("--part", o->part, "part number (default: the one the run's slot named)");
+  c->add_flag("--json", o->json, "print JSON");
+  c->callback([o, &status] { status.exit_code = run_verify(*o); });
+}
+
+}  // namespace
+
+void add_release_commands(CLI::App& app, CommandStatus& status) {
+  add_release(app, status);
+  add_export(app, status);
+  add_verify(app, status);
+}
+
+}  // namespace station

@@ -1,0 +1,198 @@
+// Writers of the coefficient block. Numbers are written with 17 significant digits (%.17g):
+// every double reads back to itself, so a consumer's compensation equals the station's.
+#include "station/release/block_formats.hpp"
+
+#include <fmt/format.h>
+
+#include <cctype>
+#include <cmath>
+#include <numbers>
+
+#include "station/common/input_error.hpp"
+
+namespace station {
+namespace {
+
+using nlohmann::json;
+namespace sc = station::compensation;
+
+constexpr const char* kModel =
+    "B = B0 + k1*dT + k2*dT^2 + k3*dT^3 + k4*dT^4 + k0*gradT, dT = clamp(T, t_min_c, t_max_c) - "
+    "t_ref_c, gradT = clamp(T2 - T1, grad_min_c, grad_max_c); compensated = bias - B";
+
+json release_json(const CoefficientBlock& b) {
+  if (!b.release) return nullptr;
+  const auto& r = *b.release;
+  return {{"release_id", r.id},
+          {"released_utc", r.released_utc},
+          {"by", r.released_by},
+          {"note", r.note},
+          {"override", r.override_reason ? json(*r.override_reason) : json(nullptr)}};
+}
+
+std::string c_identifier(const std::string& serial) {
+  std::string id = "gyro_tc_";
+  for (const char c : serial)
+    id += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+  return id;
+}
+
+/// A C string literal: printable ASCII kept, everything else as an octal escape.
+std::string c_string(const std::string& s) {
+  std::string out = "\"";
+  for (const char ch : s) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (c == '"' || c == '\\')
+      out += std::string("\\") + ch;
+    else if (c >= 0x20 && c < 0x7f && c != '?')  // '?' escaped: no trigraphs
+      out += ch;
+    else
+      out += fmt::format("\\{:03o}", c);
+  }
+  return out + "\"";
+}
+
+std::string csv_field(const std::string& s) {
+  if (s.find_first_of(",\"\r\n") == std::string::npos) return s;
+  std::string out = "\"";
+  for (const char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return out + "\"";
+}
+
+std::string release_summary(const CoefficientBlock& b) {
+  return b.release ? release_text(*b.release) : "NOT RELEASED";
+}
+
+}  // namespace
+
+double dph_to_rad_per_s(double dph) { return dph * std::numbers::pi / (180.0 * 3600.0); }
+
+json block_json(const CoefficientBlock& b) {
+  json coef = json::object(), se = json::object(), units = json::object();
+  for (std::size_t i = 0; i < b.names.size(); ++i) {
+    coef[b.names[i]] = b.coefficients[i];
+    se[b.names[i]] = b.std_errors[i];
+    units[b.names[i]] = std::string(sc::coefficient_unit(b.names[i]));
+  }
+  return {{"serial", b.serial},
+          {"part_number", b.part_number.empty() ? json(nullptr) : json(b.part_number)},
+          {"model", kModel},
+          {"terms", b.names},
+          {"coefficients", coef},
+          {"std_errors", se},
+          {"units", units},
+          {"t_ref_c", b.t_ref_c},
+          {"span",
+           {{"t_min_c", b.t_min_c},
+            {"t_max_c", b.t_max_c},
+            {"grad_min_c", b.grad_min_c},
+            {"grad_max_c", b.grad_max_c}}},
+          {"outside_span", "clamp"},
+          {"bin_s", b.bin_s ? json(*b.bin_s) : json(nullptr)},
+          {"runs", b.runs},
+          {"fit_id", b.fit_id},
+          {"fit_created_utc", b.fit_created_utc},
+          {"std_after_dph", b.std_after_dph},
+          {"std_ratio", b.std_ratio ? json(*b.std_ratio) : json(nullptr)},
+          {"verdict", b.verdict_json ? json::parse(*b.verdict_json) : json(nullptr)},
+          {"released", b.release.has_value()},
+          {"release", release_json(b)},
+          {"software_version", b.software_version},
+          {"checksum",
+           {{"algorithm", "CRC-32/ISO-HDLC of canonical (gyro_tc.h, gyro_tc_canonical)"},
+            {"canonical", b.canonical},
+            {"crc32", fmt::format("0x{:08x}", b.crc32)}}}};
+}
+
+std::string blocks_csv(const std::vector<CoefficientBlock>& blocks) {
+  std::string out =
+      "serial,part_number,fit_id,term,value,std_error,unit,t_ref_c,t_min_c,t_max_c,grad_min_c,"
+      "grad_max_c,outside_span,bin_s,runs,verdict,released,released_by,override,"
+      "software_version,crc32\n";
+  for (const auto& b : blocks) {
+    const std::string verdict =
+        !b.verdict_json ? "" : (json::parse(*b.verdict_json).value("pass", false) ? "pass" : "fail");
+    for (std::size_t i = 0; i < b.names.size(); ++i) {
+      out += fmt::format(
+          "{},{},{},{},{:.17g},{:.17g},{},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},clamp,{},{},{},{},"
+          "{},{},{},0x{:08x}\n",
+          csv_field(b.serial), csv_field(b.part_number), b.fit_id, b.names[i], b.coefficients[i],
+          b.std_errors[i], sc::coefficient_unit(b.names[i]), b.t_ref_c, b.t_min_c, b.t_max_c,
+          b.grad_min_c, b.grad_max_c, b.bin_s ? fmt::format("{:g}", *b.bin_s) : "",
+          fmt::join(b.runs, ";"), verdict, b.release ? b.release->released_utc : "",
+          csv_field(b.release ? b.release->released_by : ""),
+          csv_field(b.release && b.release->override_reason ? *b.release->override_reason : ""),
+          b.software_version, b.crc32);
+    }
+  }
+  return out;
+}
+
+std::string blocks_c_header(const std::vector<CoefficientBlock>& blocks) {
+  std::string out = fmt::format(
+      "/* Gyro thermal-bias calibrations, written by `station export --format c` (station {}).\n"
+      " * Apply with gyro_tc_correct() from gyro_tc.h; check each with gyro_tc_verify() first.\n"
+      " * Model: {} */\n"
+      "#ifndef GYRO_TC_CALIBRATIONS_H\n#define GYRO_TC_CALIBRATIONS_H\n\n#include \"gyro_tc.h\"\n",
+      blocks.empty() ? "" : blocks.front().software_version, kModel);
+  std::string table;
+  for (const auto& b : blocks) {
+    const gyro_tc_block c = b.c_block();
+    out += fmt::format(
+        "\n/* {}: fit {} over runs {}, terms {}; {}; verdict {} */\n"
+        "static const gyro_tc_block {} = {{\n"
+        "    {}, {}, {}LL,\n"
+        "    {:.17g}, /* t_ref_c */\n"
+        "    {:.17g}, {:.17g}, /* t_min_c, t_max_c */\n"
+        "    {:.17g}, {:.17g}, /* grad_min_c, grad_max_c */\n"
+        "    {:.17g}, /* b0_dph */\n"
+        "    {{{:.17g}, {:.17g}, {:.17g}, {:.17g}}}, /* k1..k4 */\n"
+        "    {:.17g}, /* k0_dph_per_c */\n"
+        "    0x{:08x}u}};\n",
+        b.serial, b.fit_id, fmt::join(b.runs, ","), b.terms, release_summary(b),
+        !b.verdict_json ? "none" : (json::parse(*b.verdict_json).value("pass", false) ? "pass" : "FAIL"),
+        c_identifier(b.serial), c_string(b.serial), c_string(b.part_number), b.fit_id, c.t_ref_c,
+        c.t_min_c, c.t_max_c, c.grad_min_c, c.grad_max_c, c.b0_dph, c.k_dph[0], c.k_dph[1],
+        c.k_dph[2], c.k_dph[3], c.k0_dph_per_c, c.crc32);
+    table += fmt::format("    &{},\n", c_identifier(b.serial));
+  }
+  out += fmt::format(
+      "\nstatic const gyro_tc_block *const gyro_tc_blocks[] = {{\n{}}};\n"
+      "#define GYRO_TC_BLOCK_COUNT {}\n\n#endif /* GYRO_TC_CALIBRATIONS_H */\n",
+      table, blocks.size());
+  return out;
+}
+
+std::string block_px4(const CoefficientBlock& b, Px4Slot slot) {
+  for (const auto* name : {"k0", "k4"}) {
+    if (b.coefficient_or_zero(name) != 0.0)
+      throw InputError(fmt::format(
+          "export --format px4: fit {} of {} has {} ({}): PX4's TC_G model is a cubic in dT "
+          "alone; export json, csv or c, or fit --terms dT,dT2,dT3",
+          b.fit_id, b.serial, name, name == std::string("k0") ? "the gradient term" : "dT^4"));
+  }
+  if (slot.instance < 0 || slot.instance > 3 || slot.axis < 0 || slot.axis > 2)
+    throw InputError("export --format px4: --px4-instance must be 0..3 and --px4-axis 0..2");
+  const std::string g = fmt::format("TC_G{}_", slot.instance);
+  std::string out = fmt::format(
+      "# Gyro thermal compensation for PX4 (TC_G* layout, one axis), `station export --format "
+      "px4`\n# serial {}, fit {} over runs {}, {}, crc32 0x{:08x}\n"
+      "# Units: rad/s (converted from deg/h). PX4 subtracts X0 + X1 dT + X2 dT^2 + X3 dT^3, "
+      "dT = clamp(T, TMIN, TMAX) - TREF;\n# TC_G{}_ID is 0: set it to the sensor's device id. "
+      "Enable with TC_G_ENABLE = 1.\n# Vehicle-Id Component-Id Name Value Type\n",
+      b.serial, b.fit_id, fmt::join(b.runs, ","), release_summary(b), b.crc32, slot.instance);
+  const auto row = [&out](const std::string& name, double v) {
+    out += fmt::format("1\t1\t{}\t{:.17g}\t9\n", name, v);
+  };
+  out += fmt::format("1\t1\t{}ID\t0\t6\n", g);
+  row(g + "TMAX", b.t_max_c);
+  row(g + "TMIN", b.t_min_c);
+  row(g + "TREF", b.t_ref_c);
+  row(fmt::format("{}X0_{}", g, slot.axis), dph_to_rad_per_s(b.coefficient_or_zero("B0")));
+  for (int i = 1; i <= 3; ++i)
+    row(fmt::format("{}X{}_{}", g, i, slot.axis),
+        dph_to_rad_per_s(b.coefficient_or_zero(fmt::format("k{}", i))));
+  return out;
+}
+
+}  // namespace station

@@ -1,0 +1,39 @@
+// The coefficient block written for its consumers: JSON (one object per serial), CSV (one row
+// per coefficient, the block's fields on every row), a C header (one `const gyro_tc_block` per
+// serial, for gyro_tc.h) and a PX4 parameter file (the TC_G* layout for one gyro axis).
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "station/release/coefficient_block.hpp"
+
+namespace station {
+
+/// The block as JSON: serial, part_number, model, terms, coefficients, std_errors, units,
+/// t_ref_c, span {t_min_c, t_max_c, grad_min_c, grad_max_c}, outside_span "clamp", bin_s,
+/// runs, fit_id, verdict, release, software_version, checksum {algorithm, canonical, crc32}.
+nlohmann::json block_json(const CoefficientBlock& b);
+
+/// CSV: a header line, then one row per coefficient of each block.
+std::string blocks_csv(const std::vector<CoefficientBlock>& blocks);
+
+/// A C header: `#include "gyro_tc.h"`, then one `static const gyro_tc_block gyro_tc_<SERIAL>`
+/// per block (serial mangled to an identifier), and a table of them.
+std::string blocks_c_header(const std::vector<CoefficientBlock>& blocks);
+
+/// Where a PX4 block goes: gyro instance (TC_G<instance>) and board axis (0 x, 1 y, 2 z).
+struct Px4Slot {
+  int instance = 0, axis = 0;
+};
+/// A QGroundControl parameter file (PX4 Tools/process_sensor_caldata.py's .params layout:
+/// "vehicle\tcomponent\tname\tvalue\ttype", type 6 int32, 9 float) with TC_G<i>_TMIN, TMAX,
+/// TREF and X0..X3 of one axis in rad/s. PX4's model is a cubic in dT alone: a block with a
+/// gradient or a dT^4 term is refused (InputError), never silently truncated.
+std::string block_px4(const CoefficientBlock& b, Px4Slot slot);
+
+/// deg/h -> rad/s (PX4 gyro units): pi / (180 * 3600).
+double dph_to_rad_per_s(double dph);
+
+}  // namespace station

@@ -1,0 +1,127 @@
+// Building a coefficient block from a stored fit, its runs' 1 Hz record and its release.
+#include "station/release/coefficient_block.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <limits>
+#include <nlohmann/json.hpp>
+
+#include "station/store/calibration.hpp"
+#include "station/store/fit_verdicts.hpp"
+
+namespace station {
+namespace {
+
+namespace sc = station::compensation;
+
+/// The bin length every run of the fit used; empty when they differ or none says.
+std::optional<double> runs_bin_s(Store& store, const std::vector<std::int64_t>& runs) {
+  std::optional<double> bin_s;
+  for (const auto id : runs) {
+    const auto run = store.find_run(id);
+    if (!run) return std::nullopt;
+    const auto j = nlohmann::json::parse(run->resolved_json, nullptr, false);
+    if (!j.is_object() || !j.contains("bin_s") || !j["bin_s"].is_number()) return std::nullopt;
+    const double b = j["bin_s"].get<double>();
+    if (bin_s && *bin_s != b) return std::nullopt;
+    bin_s = b;
+  }
+  return bin_s;
+}
+
+void set_spans(Store& store, const FitRecord& fit, CoefficientBlock& b) {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  double t_lo = inf, t_hi = -inf, g_lo = inf, g_hi = -inf;
+  for (const auto run : fit.runs) {
+    const sc::ModelData d = record_model_data(store, run, fit.serial);
+    for (std::size_t i = 0; i < d.temp_c.size(); ++i) {
+      t_lo = std::min(t_lo, d.temp_c[i]);
+      t_hi = std::max(t_hi, d.temp_c[i]);
+      g_lo = std::min(g_lo, d.grad_c[i]);
+      g_hi = std::max(g_hi, d.grad_c[i]);
+    }
+  }
+  if (t_lo > t_hi)
+    throw InputError(fmt::format("{}: fit {}: its runs {} hold no binned 1 Hz sample of {}",
+                                 store.db().path(), fit.id, fmt::join(fit.runs, ","),
+                                 fit.serial));
+  b.t_min_c = t_lo;
+  b.t_max_c = t_hi;
+  b.grad_min_c = g_lo;
+  b.grad_max_c = g_hi;
+}
+
+}  // namespace
+
+std::optional<std::string> undeliverable_term(const sc::FitResult& fit) {
+  for (const auto t : fit.spec.terms) {
+    if (t == sc::Term::dTdt || t == sc::Term::channel)
+      return fmt::format(
+          "term {} cannot be delivered: gyro_tc_correct() takes the bias, T and gradT only",
+          sc::term_option_name(t));
+  }
+  return std::nullopt;
+}
+
+double CoefficientBlock::coefficient_or_zero(const std::string& name) const {
+  for (std::size_t i = 0; i < names.size(); ++i)
+    if (names[i] == name) return coefficients[i];
+  return 0.0;
+}
+
+gyro_tc_block CoefficientBlock::c_block() const {
+  gyro_tc_block c{};
+  c.serial = serial.c_str();
+  c.part_number = part_number.c_str();
+  c.fit_id = fit_id;
+  c.t_ref_c = t_ref_c;
+  c.t_min_c = t_min_c;
+  c.t_max_c = t_max_c;
+  c.grad_min_c = grad_min_c;
+  c.grad_max_c = grad_max_c;
+  c.b0_dph = coefficient_or_zero("B0");
+  for (int i = 0; i < 4; ++i) c.k_dph[i] = coefficient_or_zero(fmt::format("k{}", i + 1));
+  c.k0_dph_per_c = coefficient_or_zero("k0");
+  c.crc32 = crc32;
+  return c;
+}
+
+void seal_block(CoefficientBlock& b) {
+  const gyro_tc_block c = b.c_block();
+  const int n = gyro_tc_canonical(&c, nullptr, 0);
+  std::string text(static_cast<std::size_t>(n) + 1, '\0');
+  gyro_tc_canonical(&c, text.data(), text.size());
+  text.resize(static_cast<std::size_t>(n));
+  b.canonical = text;
+  b.crc32 = gyro_tc_crc32(text.data(), text.size());
+}
+
+CoefficientBlock make_block(Store& store, const FitRecord& fit,
+                            const std::optional<ReleaseRow>& release) {
+  if (const auto bad = undeliverable_term(fit.fit))
+    throw ReleaseRefused(fmt::format("fit {} of {}: {}", fit.id, fit.serial, *bad));
+  CoefficientBlock b;
+  b.serial = fit.serial;
+  const StoredVerdict v = load_fit_verdict(store, fit.id);
+  b.part_number = v.part_number.value_or("");
+  b.verdict_json = v.verdict_json;
+  b.fit_id = fit.id;
+  b.fit_created_utc = fit.created_utc;
+  b.terms = fit.terms;
+  b.runs = fit.runs;
+  b.names = fit.fit.names;
+  b.coefficients = fit.fit.coefficients;
+  b.std_errors = fit.fit.std_errors;
+  b.t_ref_c = fit.fit.spec.ref_temp_c;
+  set_spans(store, fit, b);
+  b.bin_s = runs_bin_s(store, fit.runs);
+  b.std_ratio = fit.eval.std_ratio;
+  b.std_after_dph = fit.eval.std_after_dph;
+  b.release = release;
+  b.software_version = STATION_VERSION;
+  seal_block(b);
+  return b;
+}
+
+}  // namespace station

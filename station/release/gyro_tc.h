@@ -1,0 +1,100 @@
+/* gyro_tc.h: apply a gyro thermal-bias calibration exported by the gyro thermal-calibration
+ * station (`station export --format c|json|csv|px4`). Dependency-free C99 (libc only), for the
+ * navigation computer; installed as /usr/include/gyro-station/gyro_tc.h.
+ *
+ * Model (the paper's eq. (3)/(4), README "Releasing and exporting a calibration"):
+ *   B(T, gradT) = B0 + k1 dT + k2 dT^2 + k3 dT^3 + k4 dT^4 + k0 gradT,   dT = T - t_ref_c
+ * in deg/h; T is the gyro's first temperature sensor, gradT = second sensor - first, deg C.
+ * Outside the span the fit saw, T and gradT are clamped to it (PX4's rule for TC_*_TMIN/TMAX,
+ * PX4 Devguide "Thermal Calibration and Compensation"): the polynomial is never extrapolated.
+ * A term the fit did not have has coefficient 0.
+ *
+ * The checksum is CRC-32 (ISO-HDLC: reflected polynomial 0xEDB88320, init and final XOR
+ * 0xFFFFFFFF; zlib's crc32) over the canonical text gyro_tc_canonical() writes: a consumer
+ * recomputes it with gyro_tc_verify() before use and refuses a block that does not match. */
+#ifndef GYRO_TC_H
+#define GYRO_TC_H
+
+#include <stdint.h>
+#include <stdio.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct gyro_tc_block {
+  const char *serial;      /* gyro serial number */
+  const char *part_number; /* "" when the fit was judged against no part */
+  long long fit_id;        /* the station's fit id */
+  double t_ref_c;          /* T_ref, deg C */
+  double t_min_c, t_max_c; /* temperature span the fit saw, deg C: T is clamped to it */
+  double grad_min_c, grad_max_c; /* gradient span the fit saw, deg C: gradT is clamped to it */
+  double b0_dph;           /* B0, deg/h */
+  double k_dph[4];         /* k1..k4: deg/h/C, deg/h/C^2, deg/h/C^3, deg/h/C^4 */
+  double k0_dph_per_c;     /* k0 (gradient), deg/h/C */
+  uint32_t crc32;          /* CRC-32 of gyro_tc_canonical() */
+} gyro_tc_block;
+
+static inline double gyro_tc_clamp(double x, double lo, double hi) {
+  return x < lo ? lo : (x > hi ? hi : x);
+}
+
+/* Modelled thermal bias at (temp_c, grad_c), deg/h, with both inputs clamped to the span. */
+static inline double gyro_tc_bias_dph(const gyro_tc_block *b, double temp_c, double grad_c) {
+  const double dt = gyro_tc_clamp(temp_c, b->t_min_c, b->t_max_c) - b->t_ref_c;
+  const double g = gyro_tc_clamp(grad_c, b->grad_min_c, b->grad_max_c);
+  double dt_n = dt, model = b->b0_dph;
+  int i;
+  for (i = 0; i < 4; ++i) {
+    model += b->k_dph[i] * dt_n;
+    dt_n *= dt;
+  }
+  return model + b->k0_dph_per_c * g;
+}
+
+/* Compensated bias: the measured bias (rate minus Earth rate along the input axis, deg/h) minus
+ * the modelled thermal bias. */
+static inline double gyro_tc_correct(const gyro_tc_block *b, double bias_dph, double temp_c,
+                                     double grad_c) {
+  return bias_dph - gyro_tc_bias_dph(b, temp_c, grad_c);
+}
+
+/* The canonical text the checksum covers, written into buf (size n); returns the length
+ * snprintf reports (>= n: truncated). Numbers as %.17g: a double prints to the same text on
+ * every IEEE-754 machine with a correctly rounding printf (glibc, musl, newlib). */
+static inline int gyro_tc_canonical(const gyro_tc_block *b, char *buf, size_t n) {
+  return snprintf(buf, n,
+                  "gyro_tc/1;serial=%s;part=%s;fit=%lld;t_ref_c=%.17g;t_min_c=%.17g;"
+                  "t_max_c=%.17g;grad_min_c=%.17g;grad_max_c=%.17g;b0_dph=%.17g;k1=%.17g;"
+                  "k2=%.17g;k3=%.17g;k4=%.17g;k0=%.17g",
+                  b->serial, b->part_number, b->fit_id, b->t_ref_c, b->t_min_c, b->t_max_c,
+                  b->grad_min_c, b->grad_max_c, b->b0_dph, b->k_dph[0], b->k_dph[1],
+                  b->k_dph[2], b->k_dph[3], b->k0_dph_per_c);
+}
+
+/* CRC-32 (ISO-HDLC), bitwise: small rather than fast; a block is checked once at start-up. */
+static inline uint32_t gyro_tc_crc32(const char *s, size_t n) {
+  uint32_t crc = 0xFFFFFFFFu;
+  size_t i;
+  int bit;
+  for (i = 0; i < n; ++i) {
+    crc ^= (uint32_t)(unsigned char)s[i];
+    for (bit = 0; bit < 8; ++bit) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
+  }
+  return crc ^ 0xFFFFFFFFu;
+}
+
+/* 1 when the block's checksum matches its contents and its spans are ordered, else 0. */
+static inline int gyro_tc_verify(const gyro_tc_block *b) {
+  char text[1024];
+  const int len = gyro_tc_canonical(b, text, sizeof text);
+  if (len < 0 || (size_t)len >= sizeof text) return 0;
+  if (!(b->t_min_c <= b->t_max_c) || !(b->grad_min_c <= b->grad_max_c)) return 0;
+  return gyro_tc_crc32(text, (size_t)len) == b->crc32;
+}
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* GYRO_TC_H */

@@ -1,0 +1,283 @@
+// The round trip of issue 21: a released fit exported in every format, read back as a consumer
+// would, applied with the shipped C function gyro_tc_correct() (the C header compiled by a C
+// compiler for --format c) to the run's own 1 Hz record and bins, and compared with the
+// station's compensated values. The checksum is checked against zlib's independent CRC-32.
+#include <gtest/gtest.h>
+#include <zlib.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "station/release/block_formats.hpp"
+#include "station/store/calibration.hpp"
+#include "tests/station/release_fixture.hpp"
+
+namespace {
+
+namespace sc = station::compensation;
+using nlohmann::json;
+using station::testing_support::calibrated_db;
+
+/// Bins and 1 Hz record of one gyro in one run, with the station's compensated values.
+struct Record {
+  sc::ModelData data;
+  std::vector<double> station_dph;
+};
+
+std::vector<Record> records(station::Store& store, const station::FitRecord& fit) {
+  std::vector<Record> out;
+  for (const auto run : fit.runs) {
+    for (auto d : {store.model_data(fit.serial, {run}),
+                   station::record_model_data(store, run, fit.serial)}) {
+      Record r{d, sc::compensate(fit.fit, d.view())};
+      out.push_back(std::move(r));
+    }
+  }
+  return out;
+}
+
+/// Applies `b` to every record; the largest difference from the station, relative to the
+/// largest bias magnitude (the scale of the numbers involved).
+double worst_relative(const gyro_tc_block& b, const std::vector<Record>& recs) {
+  double worst = 0;
+  for (const auto& r : recs) {
+    double scale = 0;
+    for (const double x : r.data.bias_dph) scale = std::max(scale, std::abs(x));
+    for (std::size_t i = 0; i < r.station_dph.size(); ++i) {
+      const double c = gyro_tc_correct(&b, r.data.bias_dph[i], r.data.temp_c[i], r.data.grad_c[i]);
+      worst = std::max(worst, std::abs(c - r.station_dph[i]) / scale);
+    }
+  }
+  return worst;
+}
+
+gyro_tc_block from_json(const json& j, std::string& serial, std::string& part) {
+  serial = j["serial"].get<std::string>();
+  part = j["part_number"].is_null() ? "" : j["part_number"].get<std::string>();
+  gyro_tc_block b{};
+  b.serial = serial.c_str();
+  b.part_number = part.c_str();
+  b.fit_id = j["fit_id"].get<long long>();
+  b.t_ref_c = j["t_ref_c"].get<double>();
+  const auto& s = j["span"];
+  b.t_min_c = s["t_min_c"].get<double>();
+  b.t_max_c = s["t_max_c"].get<double>();
+  b.grad_min_c = s["grad_min_c"].get<double>();
+  b.grad_max_c = s["grad_max_c"].get<double>();
+  const auto& c = j["coefficients"];
+  b.b0_dph = c.value("B0", 0.0);
+  for (int i = 0; i < 4; ++i) b.k_dph[i] = c.value("k" + std::to_string(i + 1), 0.0);
+  b.k0_dph_per_c = c.value("k0", 0.0);
+  b.crc32 = static_cast<uint32_t>(
+      std::stoul(j["checksum"]["crc32"].get<std::string>(), nullptr, 16));
+  return b;
+}
+
+/// The CSV's rows by column name.
+std::vector<std::map<std::string, std::string>> csv_rows(const std::string& text) {
+  std::istringstream in(text);
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> head;
+  std::stringstream hs(line);
+  for (std::string h; std::getline(hs, h, ',');) head.push_back(h);
+  std::vector<std::map<std::string, std::string>> rows;
+  while (std::getline(in, line)) {
+    std::stringstream ls(line);
+    std::map<std::string, std::string> row;
+    std::size_t i = 0;
+    for (std::string f; std::getline(ls, f, ',') && i < head.size(); ++i) row[head[i]] = f;
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+class ExportRoundTrip : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    cal_ = calibrated_db("export-roundtrip", 1);
+    store_.emplace(cal_.path, station::OpenMode::existing);
+    serial_ = cal_.report["gyros"][0]["serial"].get<std::string>();
+    rel_ = station::current_release(*store_, serial_);
+    ASSERT_TRUE(rel_);
+    fit_ = *store_->find_fit(rel_->fit_id);
+    block_ = station::make_block(*store_, fit_, rel_);
+    recs_ = records(*store_, fit_);
+  }
+  station::testing_support::CalibratedDb cal_;
+  std::optional<station::Store> store_;
+  std::string serial_;
+  std::optional<station::ReleaseRow> rel_;
+  station::FitRecord fit_;
+  station::CoefficientBlock block_;
+  std::vector<Record> recs_;
+};
+
+TEST_F(ExportRoundTrip, JsonBlockVerifiesAndReproducesTheStation) {
+  const json j = json::parse(station::block_json(block_).dump(2));
+  EXPECT_EQ(j["release"]["by"], rel_->released_by);
+  EXPECT_EQ(j["outside_span"], "clamp");
+  EXPECT_EQ(j["terms"], json({"B0", "k1", "k0"}));
+  EXPECT_EQ(j["units"]["k1"], "deg/h/C");
+  // The checksum, recomputed with zlib (an independent CRC-32) over the canonical text.
+  const std::string canon = j["checksum"]["canonical"].get<std::string>();
+  const auto z = crc32(0L, reinterpret_cast<const Bytef*>(canon.data()),
+                       static_cast<uInt>(canon.size()));
+  EXPECT_EQ(j["checksum"]["crc32"].get<std::string>(), fmt::format("0x{:08x}", z));
+  std::string sn, pn;
+  gyro_tc_block b = from_json(j, sn, pn);
+  EXPECT_EQ(gyro_tc_verify(&b), 1);
+  EXPECT_LE(worst_relative(b, recs_), 1e-9);
+  // Every bin mean and every binned sample lies inside the span: no clamping on the fit's data.
+  for (const auto& r : recs_)
+    for (std::size_t i = 0; i < r.data.temp_c.size(); ++i) {
+      ASSERT_GE(r.data.temp_c[i], b.t_min_c);
+      ASSERT_LE(r.data.temp_c[i], b.t_max_c);
+    }
+  // One ulp changed in a coefficient: the block no longer verifies.
+  b.k_dph[0] = std::nextafter(b.k_dph[0], 1.0);
+  EXPECT_EQ(gyro_tc_verify(&b), 0);
+}
+
+TEST_F(ExportRoundTrip, CsvRowsReproduceTheStation) {
+  const auto rows = csv_rows(station::blocks_csv({block_}));
+  ASSERT_EQ(rows.size(), 3u);
+  std::string sn = rows[0].at("serial"), pn = rows[0].at("part_number");
+  gyro_tc_block b{};
+  b.serial = sn.c_str();
+  b.part_number = pn.c_str();
+  b.fit_id = std::stoll(rows[0].at("fit_id"));
+  b.t_ref_c = std::stod(rows[0].at("t_ref_c"));
+  b.t_min_c = std::stod(rows[0].at("t_min_c"));
+  b.t_max_c = std::stod(rows[0].at("t_max_c"));
+  b.grad_min_c = std::stod(rows[0].at("grad_min_c"));
+  b.grad_max_c = std::stod(rows[0].at("grad_max_c"));
+  for (const auto& r : rows) {
+    const double v = std::stod(r.at("value"));
+    const std::string t = r.at("term");
+    if (t == "B0") b.b0_dph = v;
+    if (t == "k1") b.k_dph[0] = v;
+    if (t == "k0") b.k0_dph_per_c = v;
+  }
+  b.crc32 = static_cast<uint32_t>(std::stoul(rows[0].at("crc32"), nullptr, 16));
+  EXPECT_EQ(gyro_tc_verify(&b), 1);
+  EXPECT_LE(worst_relative(b, recs_), 1e-9);
+}
+
+// The C header, compiled by the C compiler with -std=c99 -pedantic -Werror next to gyro_tc.h,
+// applied by a C program to the 1 Hz record written as text.
+TEST_F(ExportRoundTrip, CHeaderCompiledAsCReproducesTheStation) {
+  const std::string cc = STATION_C_COMPILER;
+  if (cc.empty() || std::system((cc + " --version >/dev/null 2>&1").c_str()) != 0)
+    GTEST_SKIP() << "no C compiler (" << cc << "): the C header is not compiled";
+  const std::string dir = ::testing::TempDir() + "gyro_tc_c_" + std::to_string(getpid());
+  ASSERT_EQ(std::system(("mkdir -p " + dir).c_str()), 0);
+  std::ofstream(dir + "/calibrations.h") << station::blocks_c_header({block_});
+  std::ofstream(dir + "/apply.c") << R"(#include <stdio.h>
+#include "calibrations.h"
+int main(void) {
+  double bias, t, g;
+  const gyro_tc_block *b = gyro_tc_blocks[0];
+  if (GYRO_TC_BLOCK_COUNT != 1 || !gyro_tc_verify(b)) return 3;
+  while (scanf("%lf %lf %lf", &bias, &t, &g) == 3) printf("%.17g\n", gyro_tc_correct(b, bias, t, g));
+  return 0;
+}
+)";
+  const std::string build = cc + " -std=c99 -pedantic -Wall -Wextra -Werror -I" +
+                            STATION_SOURCE_DIR + "/station/release " + dir + "/apply.c -o " +
+                            dir + "/apply 2>" + dir + "/cc.log";
+  ASSERT_EQ(std::system(build.c_str()), 0) << slurp(dir + "/cc.log");
+  const Record& rec = recs_.back();  // the 1 Hz record
+  {
+    std::ofstream in(dir + "/in.txt");
+    for (std::size_t i = 0; i < rec.station_dph.size(); ++i)
+      in << fmt::format("{:.17g} {:.17g} {:.17g}\n", rec.data.bias_dph[i], rec.data.temp_c[i],
+                        rec.data.grad_c[i]);
+  }
+  ASSERT_EQ(std::system((dir + "/apply <" + dir + "/in.txt >" + dir + "/out.txt").c_str()), 0)
+      << "the C program refused the block (exit 3: checksum)";
+  std::ifstream out(dir + "/out.txt");
+  double scale = 0, worst = 0, v = 0;
+  for (const double x : rec.data.bias_dph) scale = std::max(scale, std::abs(x));
+  std::size_t n = 0;
+  while (out >> v) {
+    worst = std::max(worst, std::abs(v - rec.station_dph[n]) / scale);
+    ++n;
+  }
+  EXPECT_EQ(n, rec.station_dph.size());
+  EXPECT_LE(worst, 1e-9);
+}
+
+// PX4's TC_G layout holds a cubic in dT: a released dT,dT2,dT3 fit round-trips through the
+// parameter file (rad/s there), a gradient model is refused.
+TEST_F(ExportRoundTrip, Px4ParameterFileReproducesACubicFitAndRefusesAGradient) {
+  EXPECT_THROW(station::block_px4(block_, {0, 2}), station::InputError);
+  const auto cubic = station::fit_serial(*store_, serial_, fit_.runs,
+                                         {{sc::Term::dT, sc::Term::dT2, sc::Term::dT3}, 25.0});
+  station::release_fit(*store_, {cubic.fit_id, "Ann", "cubic for PX4", std::nullopt});
+  const auto rec = *store_->find_fit(cubic.fit_id);
+  const auto block = station::make_block(*store_, rec, station::current_release(*store_, serial_));
+  const std::string text = station::block_px4(block, {1, 2});
+  std::map<std::string, double> p;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream ls(line);
+    std::string vehicle, comp, name, type;
+    double value = 0;
+    ls >> vehicle >> comp >> name >> value >> type;
+    EXPECT_EQ(type, name == "TC_G1_ID" ? "6" : "9") << line;
+    p[name] = value;
+  }
+  ASSERT_EQ(p.size(), 8u) << text;
+  const double to_dph = 180.0 * 3600.0 / M_PI;
+  std::string sn = serial_, pn;
+  gyro_tc_block b{};
+  b.serial = sn.c_str();
+  b.part_number = pn.c_str();
+  b.t_ref_c = p.at("TC_G1_TREF");
+  b.t_min_c = p.at("TC_G1_TMIN");
+  b.t_max_c = p.at("TC_G1_TMAX");
+  b.grad_min_c = -1e9;
+  b.grad_max_c = 1e9;
+  b.b0_dph = p.at("TC_G1_X0_2") * to_dph;
+  for (int i = 1; i <= 3; ++i) b.k_dph[i - 1] = p.at(fmt::format("TC_G1_X{}_2", i)) * to_dph;
+  EXPECT_LE(worst_relative(b, records(*store_, rec)), 1e-9);
+}
+
+TEST(GyroTc, ClampsTemperatureAndGradientToTheSpanTheFitSaw) {
+  gyro_tc_block b{};
+  b.serial = "X";
+  b.part_number = "";
+  b.t_ref_c = 25;
+  b.t_min_c = -40;
+  b.t_max_c = 70;
+  b.grad_min_c = -0.5;
+  b.grad_max_c = 1.5;
+  b.b0_dph = 0.1;
+  b.k_dph[0] = 2e-3;
+  b.k_dph[1] = -1e-5;
+  b.k0_dph_per_c = 0.03;
+  // Inside: the polynomial written out by hand.
+  const double dt = 10 - 25.0;
+  EXPECT_NEAR(gyro_tc_bias_dph(&b, 10, 0.4), 0.1 + 2e-3 * dt - 1e-5 * dt * dt + 0.03 * 0.4,
+              1e-15);
+  // Outside: the value at the edge of the span, never an extrapolation.
+  EXPECT_DOUBLE_EQ(gyro_tc_bias_dph(&b, 95, 3), gyro_tc_bias_dph(&b, 70, 1.5));
+  EXPECT_DOUBLE_EQ(gyro_tc_bias_dph(&b, -60, -2), gyro_tc_bias_dph(&b, -40, -0.5));
+  EXPECT_DOUBLE_EQ(gyro_tc_correct(&b, 1.0, 10, 0.4), 1.0 - gyro_tc_bias_dph(&b, 10, 0.4));
+  // A block whose span is reversed never verifies, whatever its checksum.
+  b.t_min_c = 80;
+  EXPECT_EQ(gyro_tc_verify(&b), 0);
+}
+
+}  // namespace
