@@ -3,11 +3,14 @@
 // compiler for --format c) to the run's own 1 Hz record and bins, and compared with the
 // station's compensated values. The checksum is checked against zlib's independent CRC-32.
 #include <gtest/gtest.h>
+#include <fmt/format.h>
+#include <unistd.h>
 #include <zlib.h>
 
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include "station/release/block_formats.hpp"
