@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <fstream>
@@ -165,7 +166,13 @@ nlohmann::json run_simulated(const SimRunOptions& o) {
   Store store(o.db_path.empty() ? "station-sim.db" : o.db_path);
   // One commit per simulated minute: a commit costs more than a simulated tick, and a killed
   // simulation resumes by deterministic replay anyway. Real rigs commit every tick.
-  store.set_ticks_per_commit(o.wall_clock ? 1 : 60);
+  // A paced simulation (--speed, watched live) holds a write transaction at most ~20 ms of wall
+  // time: another writer on the same file (a release over the API) waits in its busy handler
+  // for a gap between batches, and a batch held across the whole pace starves it.
+  store.set_ticks_per_commit(o.wall_clock ? 1
+                             : o.speed > 0
+                                 ? std::max(1, static_cast<int>(o.speed * 0.02))
+                                 : 60);
   // A simulation continues only the same simulation: same slots, seed and protocol text.
   ResumeDecision rd = decide_resume(store, config, o.fresh, true);
   std::optional<RunRecord> resume = rd.run;

@@ -14,6 +14,10 @@ Scenario A: `station run --sim --speed 200 --gyros 2 --http 127.0.0.1:0 --db TMP
   one line naming the address); then the stop over the API (202, exit 0, final table, `stopped`).
 Scenario D: a second run in the same database: the stopped run 1 is 409 for stop, runs newest
   first, its stored bins; SIGTERM ends the daemon with exit 0.
+Scenario R: a completed short run with its fit; a daemon on the same database; POST
+  /api/fits/{id}/release refused without or with a wrong token (401, 403), for bad bodies (400),
+  unknown or malformed ids (404, 400); 201 with the token; 409 the second time; the release in
+  /api/runs/{id} (slot "released") and in the database (releases row, 'release' event).
 Scenario C: a new database, abort over the API once bins are complete: 202, exit 0, state
   `aborted`, no row in `fits` for the run.
 
@@ -1013,6 +1017,49 @@ def scenario_a(binary, tmp):
         st.kill()
 
 
+def check_release(port, token, db, run_id):
+    """POST /api/fits/{id}/release while another run runs: refusals, 201, 409 again, and the
+    release in the run's JSON and the database."""
+    with sqlite3.connect(f"file:{db}?mode=ro", uri=True) as c:
+        fits = c.execute("SELECT id, serial FROM fits WHERE runs_json = ? ORDER BY id",
+                         (f"[{run_id}]",)).fetchall()
+    if not fits:
+        FAILURES.append(f"[R] run {run_id} has no fit to release")
+        return
+    fit_id, serial = fits[0]
+    path = f"/api/fits/{fit_id}/release"
+    js = {"Content-Type": "application/json", **auth(token)}
+    expect_error(request(port, "POST", path, body=b'{"by":"x"}'), 401, f"[R] POST {path} no token")
+    expect_error(request(port, "POST", path, body=b'{"by":"x"}', headers=auth(WRONG_TOKEN)), 403,
+                 f"[R] POST {path} wrong token")
+    for body, what in [(b"{", "bad JSON"), (b'{"note":"n"}', "no 'by'"), (b'{"by":""}', "empty 'by'"),
+                       (b'{"by":7}', "'by' not a string"), (b"[]", "not an object")]:
+        expect_error(request(port, "POST", path, body=body, headers=js), 400, f"[R] POST {path} {what}")
+    for bad, status in [("/api/fits/999999/release", 404), ("/api/fits/abc/release", 400),
+                        ("/api/fits/0/release", 400)]:
+        expect_error(request(port, "POST", bad, body=b'{"by":"x"}', headers=js), status, f"[R] POST {bad}")
+    r = request(port, "POST", path, body=json.dumps({"by": "api-test", "note": "from curl"}).encode(),
+                headers=js)
+    if expect(r, 201, f"[R] POST {path} with the token -> 201"):
+        got = r.json() or {}
+        check(got.get("fit_id") == fit_id and got.get("serial") == serial and got.get("by") == "api-test",
+              f"[R] release reply names fit {fit_id} of {serial}", r.brief())
+    expect_error(request(port, "POST", path, body=b'{"by":"again"}', headers=js), 409,
+                 f"[R] POST {path} again: already the released calibration")
+    r, run = get_json(port, f"/api/runs/{run_id}")
+    rel = [s.get("released") for s in (run or {}).get("slots", []) if s.get("serial") == serial]
+    check(rel and isinstance(rel[0], dict) and rel[0].get("fit_id") == fit_id
+          and rel[0].get("by") == "api-test" and rel[0].get("note") == "from curl",
+          f"[R] /api/runs/{run_id}: slot {serial} shows the release", f"got {rel!r}")
+    with sqlite3.connect(f"file:{db}?mode=ro", uri=True) as c:
+        rows = c.execute("SELECT fit_id, released_by FROM releases").fetchall()
+        ev = c.execute("SELECT kind FROM events WHERE run_id = ? AND kind = 'release'",
+                       (run_id,)).fetchall()
+    check(rows == [(fit_id, "api-test")], "[R] one row in releases", f"got {rows}")
+    check(len(ev) == 1, f"[R] one 'release' event on run {run_id}", f"got {ev}")
+    still_up(port, "release requests")
+
+
 def scenario_d(binary, tmp, db, stopped_id):
     """The same database again: a new run beside the stopped one."""
     st = Station(binary, ["run", "--sim", "--speed", "200", "--gyros", "2",
@@ -1054,6 +1101,30 @@ def scenario_d(binary, tmp, db, stopped_id):
         st.proc.send_signal(signal.SIGTERM)
         rc = st.wait_exit(30)
         check(rc == 0, "[D] SIGTERM: exit 0 within 30 s", f"exit {rc}")
+    finally:
+        st.kill()
+
+
+def scenario_r(binary, tmp):
+    """A completed short run with its fit, then a daemon on the same database: the release over
+    the API while that daemon runs."""
+    db = os.path.join(tmp, "r.db")
+    short = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data", "short_cycle.toml")
+    r = subprocess.run([binary, "run", "--sim", "--gyros", "1", "--protocol", short, "--db", db,
+                        "--json"], capture_output=True, text=True, timeout=120)
+    if r.returncode != 0:
+        fatal(f"[R] the short run: exit {r.returncode}: {r.stderr[-800:]}")
+    run_id = json.loads(r.stdout)["run_id"]
+    st = Station(binary, ["run", "--sim", "--speed", "200", "--gyros", "1", "--new",
+                          "--http", "127.0.0.1:0", "--db", db], tmp, "R")
+    try:
+        port = st.wait_listening(30)
+        if port is None:
+            fatal(f"[R] no listening line; exit {st.proc.poll()}; stderr {st.err_text()[-1500:]}")
+        token = open(db + ".token").read().strip()
+        check_release(port, token, db, run_id)
+        st.proc.send_signal(signal.SIGTERM)
+        check(st.wait_exit(30) == 0, "[R] SIGTERM: exit 0 within 30 s")
     finally:
         st.kill()
 
@@ -1110,6 +1181,7 @@ def main():
         db, run_id = scenario_a(binary, tmp)
         scenario_d(binary, tmp, db, run_id)
         scenario_c(binary, tmp)
+        scenario_r(binary, tmp)
     except Fatal:
         pass
     except Exception as e:  # a bug of the test itself, or an unexpected answer shape
