@@ -56,15 +56,48 @@ def station(bin_path, *args):
     return r.stdout
 
 
-def make_db(bin_path, db, gyros, ramps):
+def make_db(bin_path, db, gyros, ramps, verify=False):
     for ext in ("", "-wal", "-shm", ".lock"):
         if os.path.exists(db + ext):
             os.remove(db + ext)
     for protocol in RAMPS if ramps else []:
         station(bin_path, "run", "--sim", "--gyros", str(gyros), "--protocol", protocol, "--new",
                 "--db", db, "--json")
-    out = station(bin_path, "run", "--sim", "--gyros", str(gyros), "--new", "--db", db, "--json")
-    return json.loads(out)["run_id"]
+    out = station(bin_path, "run", "--sim", "--gyros", str(gyros), "--new", "--db", db, "--json",
+                  *(["--verify"] if verify else []))
+    return json.loads(out)
+
+
+def check_verification(drv, index, page, report):
+    """run --sim --verify: the verification run's index lists each verification, its serial page
+    shows the verification table and Fig. 6 drawn, and says which fit is released."""
+    from selenium.webdriver.common.by import By
+    load(drv, index)
+    rows = drv.find_elements(By.CSS_SELECTOR, "section.verification tr")
+    if len(rows) != 1 + len(report["verifications"]):
+        fail(f"{index}: verification table has {len(rows)} rows, expected "
+             f"{1 + len(report['verifications'])}")
+    cells = [c.text for c in drv.find_elements(By.CSS_SELECTOR, ".serials td")]
+    if not any("is released" in c for c in cells):
+        fail(f"{index}: no serial row names its released fit: {cells}")
+    load(drv, page)
+    rel = drv.find_element(By.CSS_SELECTOR, "p.release").text
+    fit = report["verifications"][0]["fit_id"]
+    if "not released" not in rel or f"fit {fit} released" not in rel:
+        fail(f"{page}: release paragraph {rel!r} does not say this run's fit is not released and "
+             f"fit {fit} is the calibration")
+    el = drv.find_element(By.CSS_SELECTOR, '[data-figure="6"]')
+    deadline = time.time() + 10
+    while el.get_attribute("data-drawn") != "true" and time.time() < deadline:
+        time.sleep(0.1)
+    if el.get_attribute("data-drawn") != "true" or int(el.get_attribute("data-points")) <= 0:
+        fail(f"{page}: Fig. 6 (verification) not drawn")
+    table = drv.find_element(By.CSS_SELECTOR, "table.verification-figures").text
+    for word in ("std before", "std after", "mean residual", "ADEV floor", "verdict"):
+        if word not in table:
+            fail(f"{page}: verification table lacks '{word}': {table!r}")
+    print(f"verification: {len(rows) - 1} rows on the index, Fig. 6 drawn on {page}")
+    return el
 
 
 def load(drv, path):
@@ -141,15 +174,18 @@ def main():
     ap.add_argument("--artifacts", required=True, help="where the screenshot goes")
     ap.add_argument("--gyros", type=int, default=2)
     ap.add_argument("--ramps", action="store_true", help="also ramp_00/10/20 runs (Fig. 3)")
+    ap.add_argument("--verify", action="store_true",
+                    help="run --sim --verify: report the verification run (release, Fig. 6)")
     a = ap.parse_args()
     drv = browser()
     try:
         os.makedirs(a.work, exist_ok=True)
         os.makedirs(a.artifacts, exist_ok=True)
-        name = "report-ramps" if a.ramps else "report"
+        name = "report-ramps" if a.ramps else "report-verify" if a.verify else "report"
         db = os.path.join(a.work, name + ".db")
         t0 = time.time()
-        run_id = make_db(a.station, db, a.gyros, a.ramps)
+        report = make_db(a.station, db, a.gyros, a.ramps, a.verify)
+        run_id = report["run_id"]
         print(f"database {db}: run {run_id} in {time.time() - t0:.1f} s")
         out_dir = os.path.join(a.work, name)
         shutil.rmtree(out_dir, ignore_errors=True)
@@ -173,6 +209,20 @@ def main():
         figures = os.path.join(a.artifacts, name + "-figures.png")
         drv.find_element(By.CSS_SELECTOR, ".figures").screenshot(figures)
         print(f"screenshots {shot} {figures}")
+        if a.verify:
+            fig6 = check_verification(drv, index, pages[0], report)
+            verification = os.path.join(a.artifacts, name + "-verification.png")
+            drv.find_element(By.CSS_SELECTOR, "section.verification").screenshot(verification)
+            print(f"screenshot {verification}")
+            # The calibration run's page: its fit is the released one.
+            cal_dir = out_dir + "-calibration"
+            shutil.rmtree(cal_dir, ignore_errors=True)
+            cal = station(a.station, "report", "--db", db, "--run",
+                          str(report["calibration_run"]["run_id"]), "--out", cal_dir).split()
+            load(drv, cal[1])
+            rel = drv.find_element(By.CSS_SELECTOR, "p.release").text
+            if not rel.startswith("RELEASED"):
+                fail(f"{cal[1]}: the calibration run's fit is not shown released: {rel!r}")
         if not a.ramps:
             check_pdf(a.station, db, run_id, out_dir + "-pdf", a.gyros)
     finally:
