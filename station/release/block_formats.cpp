@@ -107,19 +107,25 @@ json block_json(const CoefficientBlock& b) {
 std::string blocks_csv(const std::vector<CoefficientBlock>& blocks) {
   std::string out =
       "serial,part_number,fit_id,term,value,std_error,unit,t_ref_c,t_min_c,t_max_c,grad_min_c,"
-      "grad_max_c,outside_span,bin_s,runs,verdict,released,released_by,override,"
+      "grad_max_c,outside_span,bin_s,runs,verdict,failed_limits,released,released_by,override,"
       "software_version,crc32\n";
   for (const auto& b : blocks) {
-    const std::string verdict =
-        !b.verdict_json ? "" : (json::parse(*b.verdict_json).value("pass", false) ? "pass" : "fail");
+    // The verdict on every row (a CSV has no header block): pass, fail or empty for no part,
+    // and the failed limits joined by ';'.
+    const json v = b.verdict_json ? json::parse(*b.verdict_json) : json();
+    const std::string verdict = v.is_null() ? "" : (v.value("pass", false) ? "pass" : "fail");
+    std::string failed;
+    if (v.is_object())
+      for (const auto& f : v.value("failed", json::array()))
+        failed += (failed.empty() ? "" : ";") + f.value("limit", std::string("?"));
     for (std::size_t i = 0; i < b.names.size(); ++i) {
       out += fmt::format(
           "{},{},{},{},{:.17g},{:.17g},{},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},clamp,{},{},{},{},"
-          "{},{},{},0x{:08x}\n",
+          "{},{},{},{},0x{:08x}\n",
           csv_field(b.serial), csv_field(b.part_number), b.fit_id, b.names[i], b.coefficients[i],
           b.std_errors[i], sc::coefficient_unit(b.names[i]), b.t_ref_c, b.t_min_c, b.t_max_c,
           b.grad_min_c, b.grad_max_c, b.bin_s ? fmt::format("{:g}", *b.bin_s) : "",
-          fmt::join(b.runs, ";"), verdict, b.release ? b.release->released_utc : "",
+          fmt::join(b.runs, ";"), verdict, failed, b.release ? b.release->released_utc : "",
           csv_field(b.release ? b.release->released_by : ""),
           csv_field(b.release && b.release->override_reason ? *b.release->override_reason : ""),
           b.software_version, b.crc32);

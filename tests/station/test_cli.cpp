@@ -137,19 +137,35 @@ TEST(Cli, SimRunThenFitAllAndExport) {
   ASSERT_EQ(one.status, 0) << one.out;
   EXPECT_EQ(nlohmann::json::parse(one.out)["runs"][0].get<int>(), j["run_id"].get<int>());
 
+  // Nothing released yet: export refuses (issue 21), --fit exports the named fit with a warning.
+  const auto unreleased = run_station("export --db " + db + " --serial SIM-0002");
+  EXPECT_EQ(unreleased.status, 2);
+  EXPECT_NE(unreleased.out.find("serial 'SIM-0002' has no released calibration"),
+            std::string::npos)
+      << unreleased.out;
+  const auto latest = nlohmann::json::parse(one.out)["fit_id"].get<std::int64_t>();
+  const auto named = run_station("export --db " + db + " --fit " + std::to_string(latest));
+  EXPECT_EQ(named.status, 0) << named.out;
+  EXPECT_NE(named.out.find("is NOT the released calibration"), std::string::npos) << named.out;
+  const auto rel = run_station(
+      "release --db " + db + " --fit " + std::to_string(latest) + " --by tester", false);
+  ASSERT_EQ(rel.status, 0) << rel.out;
   const auto csv = run_station("export --db " + db + " --serial SIM-0002 --format csv", false);
   ASSERT_EQ(csv.status, 0) << csv.out;
-  EXPECT_EQ(csv.out.rfind("serial,fit_id,term,value,std_error,std_error_ols,unit,ref_temp_c,"
-                          "part_number,verdict,failed_limits\n",
+  EXPECT_EQ(csv.out.rfind("serial,part_number,fit_id,term,value,std_error,unit,t_ref_c,t_min_c,"
+                          "t_max_c,grad_min_c,grad_max_c,outside_span,bin_s,runs,verdict,"
+                          "failed_limits,released,released_by,override,software_version,crc32\n",
                           0),
             0u)
       << csv.out;
   EXPECT_NE(csv.out.find("SIM-0002,"), std::string::npos);
-  EXPECT_NE(csv.out.find(",k0,"), std::string::npos);  // the latest fit is the dT+gradT one
+  EXPECT_NE(csv.out.find(",k0,"), std::string::npos);  // the released fit is the dT+gradT one
+  EXPECT_NE(csv.out.find(",tester,"), std::string::npos);
 
   const auto missing = run_station("export --db " + db + " --serial NOPE");
   EXPECT_EQ(missing.status, 2);
-  EXPECT_NE(missing.out.find("no fit stored for serial 'NOPE'"), std::string::npos) << missing.out;
+  EXPECT_NE(missing.out.find("serial 'NOPE' has no released calibration"), std::string::npos)
+      << missing.out;
 }
 
 TEST(Cli, SimRunRecordsEveryCanFrameInCandumpFormat) {

@@ -129,18 +129,24 @@ TEST(PartsCli, SimRunFitExportAndHistoryCarryTheVerdict) {
             std::string::npos)
       << text.out;
 
+  // The passing fit released and exported; the failing one refused without an override.
+  const auto pass_fit = std::to_string(lj["fit_id"].get<std::int64_t>());
+  ASSERT_EQ(station_cmd("release --db " + db + " --fit " + pass_fit + " --by qa", false).status, 0);
   const auto csv = station_cmd("export --db " + db + " --serial SIM-0001 --format csv", false);
   ASSERT_EQ(csv.status, 0) << csv.out;
-  EXPECT_EQ(
-      csv.out.rfind("serial,fit_id,term,value,std_error,std_error_ols,unit,ref_temp_c,part_number,"
-                    "verdict,failed_limits\n",
-                    0),
-      0u)
-      << csv.out;
-  EXPECT_NE(csv.out.find(",LOOSE,pass,\n"), std::string::npos) << csv.out;
-  const auto ej =
-      nlohmann::json::parse(station_cmd("export --db " + db + " --serial SIM-0002", false).out);
+  EXPECT_NE(csv.out.find(",pass,,"), std::string::npos) << csv.out;
+  EXPECT_NE(csv.out.find("SIM-0001,LOOSE,"), std::string::npos) << csv.out;
+  const auto failing =
+      nlohmann::json::parse(station_cmd("fit --db " + db + " --serial SIM-0002 --json", false).out);
+  const auto fail_fit = std::to_string(failing["fit_id"].get<std::int64_t>());
+  const auto refused = station_cmd("release --db " + db + " --fit " + fail_fit + " --by qa");
+  EXPECT_EQ(refused.status, 2);
+  EXPECT_NE(refused.out.find("its verdict failed"), std::string::npos) << refused.out;
+  EXPECT_NE(refused.out.find("--override"), std::string::npos) << refused.out;
+  const auto ej = nlohmann::json::parse(
+      station_cmd("export --db " + db + " --fit " + fail_fit, false).out);
   EXPECT_EQ(ej["verdict"]["failed"][0]["limit"], "min_complete_bins");
+  EXPECT_TRUE(ej["release"].is_null());
 
   const auto hist = station_cmd("history --db " + db + " --serial SIM-0001 --json", false);
   ASSERT_EQ(hist.status, 0) << hist.out;
