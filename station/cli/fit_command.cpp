@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <iostream>
+#include <set>
 #include <nlohmann/json.hpp>
 
 #include "compensation/cross_validation.hpp"
@@ -25,16 +26,31 @@ struct FitOptions {
   bool all = false, json = false, cv = false;
 };
 
-/// Leave-one-run-out cross-validation of one fit's model over its runs; empty with one run.
-std::optional<sc::CrossValidation> cross_validate(Store& store, const SerialFit& f) {
-  if (f.runs.size() < 2) return std::nullopt;
+/// Leave-one-run-out cross-validation of one fit's model over its runs, or why there is none
+/// (one run with bins, a fold with too few bins): the fit is stored already, so this never
+/// throws.
+struct CvOutcome {
+  std::optional<sc::CrossValidation> cv;
+  std::string why_not;
+};
+
+CvOutcome cross_validate(Store& store, const SerialFit& f) {
   const sc::ModelData data = store.model_data(f.serial, f.runs);
-  return sc::leave_one_run_out(data.view(), f.fit.spec);
+  const std::set<int> with_bins(data.segment.begin(), data.segment.end());
+  if (with_bins.size() < 2)
+    return {std::nullopt, fmt::format("needs two or more runs with complete bins ({} of runs {} "
+                                      "have any)",
+                                      with_bins.size(), fmt::join(f.runs, ","))};
+  try {
+    return {sc::leave_one_run_out(data.view(), f.fit.spec), {}};
+  } catch (const std::exception& e) {
+    return {std::nullopt, fmt::format("not possible: {}", e.what())};
+  }
 }
 
-nlohmann::json cv_json(const std::optional<sc::CrossValidation>& cv,
-                       const std::vector<std::int64_t>& runs) {
-  if (!cv) return nullptr;
+nlohmann::json cv_json(const CvOutcome& out, const std::vector<std::int64_t>& runs) {
+  if (!out.cv) return {{"method", "leave-one-run-out"}, {"unavailable", out.why_not}};
+  const auto& cv = out.cv;
   nlohmann::json held = nlohmann::json::array();
   for (const auto& h : cv->runs)
     held.push_back({{"run_id", runs.at(static_cast<std::size_t>(h.segment))},
@@ -47,11 +63,12 @@ nlohmann::json cv_json(const std::optional<sc::CrossValidation>& cv,
           {"in_sample_rms_dph", cv->in_sample_rms_dph}};
 }
 
-void print_cv(const std::optional<sc::CrossValidation>& cv, const std::vector<std::int64_t>& runs) {
-  if (!cv) {
-    fmt::print("  cross-validation: needs two or more runs\n");
+void print_cv(const CvOutcome& out, const std::vector<std::int64_t>& runs) {
+  if (!out.cv) {
+    fmt::print("  cross-validation: {}\n", out.why_not);
     return;
   }
+  const auto& cv = out.cv;
   fmt::print("  leave-one-run-out: prediction RMS {:.5f} deg/h on held-out runs, in-sample {:.5f} "
              "deg/h ({:.2f}x)\n",
              cv->pooled_rms_dph, cv->in_sample_rms_dph, cv->pooled_rms_dph / cv->in_sample_rms_dph);

@@ -3,6 +3,7 @@
 // applied to a run it was not fitted on).
 #include <fmt/format.h>
 
+#include <cctype>
 #include <iostream>
 #include <nlohmann/json.hpp>
 
@@ -17,12 +18,13 @@ namespace station {
 namespace {
 
 struct ReleaseOptions {
-  std::string db, by, note, override_reason;
+  std::string db, by, note;
+  std::optional<std::string> override_reason;
   std::int64_t fit_id = 0;
 };
 
 struct ExportOptions {
-  std::string db, format = "json";
+  std::string db, format = "json", c_name = "gyro_tc_calibrations";
   std::vector<std::string> serials;
   std::optional<std::int64_t> fit_id;
   Px4Slot px4;
@@ -37,9 +39,7 @@ struct VerifyOptions {
 
 void run_release(const ReleaseOptions& o) {
   Store store(o.db, OpenMode::existing);
-  ReleaseRequest req{o.fit_id, o.by, o.note, std::nullopt};
-  if (!o.override_reason.empty()) req.override_reason = o.override_reason;
-  const ReleaseRow r = release_fit(store, req);
+  const ReleaseRow r = release_fit(store, {o.fit_id, o.by, o.note, o.override_reason});
   fmt::print("{}: fit {} is the released calibration ({}, release {})\n", r.serial, r.fit_id,
              release_text(r), r.id);
   if (r.override_reason)
@@ -69,10 +69,14 @@ CoefficientBlock export_block(Store& store, const ExportOptions& o, const std::s
   const bool is_released = released && released->fit_id == fit->id;
   if (!is_released)
     fmt::print(stderr,
-               "station: warning: fit {} is NOT the released calibration of {} ({}); its block "
-               "says so (\"release\": null)\n",
+               "station: warning: fit {} is NOT the released calibration of {} ({}); the export "
+               "says so ({})\n",
                fit->id, fit->serial,
-               released ? fmt::format("fit {} is", released->fit_id) : std::string("none is"));
+               released ? fmt::format("fit {} is", released->fit_id) : std::string("none is"),
+               o.format == "json"  ? "\"released\": false"
+               : o.format == "csv" ? "released NO"
+               : o.format == "c"   ? "released = 0, in the checksum"
+                                   : "a comment: PX4 parameters cannot say it");
   return make_block(store, *fit, is_released ? released : std::nullopt);
 }
 
@@ -82,6 +86,14 @@ void run_export(const ExportOptions& o) {
     throw InputError("export: --fit ID names one fit: give at most one --serial");
   if (o.format == "px4" && o.serials.size() > 1)
     throw InputError("export --format px4: one gyro axis per file: give one --serial");
+  for (std::size_t i = 0; i < o.serials.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (o.serials[i] == o.serials[j])
+        throw InputError(fmt::format("export: serial '{}' named twice", o.serials[i]));
+  if (o.c_name.empty() || std::isdigit(static_cast<unsigned char>(o.c_name[0])) ||
+      o.c_name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") !=
+          std::string::npos || o.c_name.size() > 64)
+    throw InputError(fmt::format("export --c-name '{}': expected a C identifier", o.c_name));
   Store store(o.db, OpenMode::read_only);
   std::vector<CoefficientBlock> blocks;
   if (o.serials.empty()) blocks.push_back(export_block(store, o, ""));
@@ -89,7 +101,7 @@ void run_export(const ExportOptions& o) {
   if (o.format == "csv") {
     std::cout << blocks_csv(blocks);
   } else if (o.format == "c") {
-    std::cout << blocks_c_header(blocks);
+    std::cout << blocks_c_header(blocks, o.c_name);
   } else if (o.format == "px4") {
     std::cout << block_px4(blocks.front(), o.px4);
   } else {
@@ -110,6 +122,7 @@ void print_verification(const VerificationResult& v) {
     fmt::print("  residual drift {:+.3e} +- {:.1e} deg/h/C (against T)\n", *v.drift_dph_per_c,
                *v.drift_se_dph_per_c);
   if (v.adev_floor_dph) fmt::print("  ADEV floor {:.5f} deg/h (compensated 1 Hz record)\n", *v.adev_floor_dph);
+  for (const auto& w : v.warnings) fmt::print("  warning: {}\n", w);
   fmt::print("  verdict: {} (verification {})\n", verdict_text(v.verdict), v.id);
 }
 
@@ -133,6 +146,10 @@ int run_verify(const VerifyOptions& o) {
     fit = store.find_fit(rel->fit_id);
   }
   const auto limits = limits_for(store, o.serial, {o.run_id}, {parts ? &*parts : nullptr, o.part});
+  if (parts && !limits)
+    throw InputError(fmt::format("verify: --parts {}: run {}'s slot of '{}' names no part: give "
+                                 "--part PN",
+                                 o.parts, o.run_id, o.serial));
   VerificationResult v = verify_fit(store, *fit, o.run_id, limits);
   save_verification(store, v);
   if (o.json)
@@ -166,6 +183,9 @@ void add_export(CLI::App& app, CommandStatus& status) {
   c->add_option("--fit", o->fit_id, "export this fit (warns when it is not the released one)");
   c->add_option("--format", o->format, "json|csv|c|px4")
       ->check(CLI::IsMember({"json", "csv", "c", "px4"}))
+      ->capture_default_str();
+  c->add_option("--c-name", o->c_name,
+                "c: prefix of the header's names (NAME_blocks, NAME_BLOCK_COUNT, guard NAME_H)")
       ->capture_default_str();
   c->add_option("--px4-instance", o->px4.instance, "px4: gyro instance (TC_G<N>), 0..3")
       ->capture_default_str();

@@ -20,21 +20,14 @@ constexpr const char* kModel =
     "B = B0 + k1*dT + k2*dT^2 + k3*dT^3 + k4*dT^4 + k0*gradT, dT = clamp(T, t_min_c, t_max_c) - "
     "t_ref_c, gradT = clamp(T2 - T1, grad_min_c, grad_max_c); compensated = bias - B";
 
-json release_json(const CoefficientBlock& b) {
-  if (!b.release) return nullptr;
-  const auto& r = *b.release;
-  return {{"release_id", r.id},
-          {"released_utc", r.released_utc},
-          {"by", r.released_by},
-          {"note", r.note},
-          {"override", r.override_reason ? json(*r.override_reason) : json(nullptr)}};
-}
-
-std::string c_identifier(const std::string& serial) {
-  std::string id = "gyro_tc_";
-  for (const char c : serial)
-    id += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
-  return id;
+/// NAME_SERIAL_fitID: the fit id keeps serials that mangle alike ("A-1", "A_1") apart.
+std::string c_identifier(const std::string& name, const CoefficientBlock& b) {
+  std::string id = name + "_";
+  for (const char c : b.serial.substr(0, 64))
+    id += std::isalnum(static_cast<unsigned char>(c)) != 0 && static_cast<unsigned char>(c) < 0x80
+              ? c
+              : '_';
+  return id + "_fit" + std::to_string(b.fit_id);
 }
 
 /// A C string literal: printable ASCII kept, everything else as an octal escape.
@@ -52,6 +45,21 @@ std::string c_string(const std::string& s) {
   return out + "\"";
 }
 
+/// Text for a comment line of a C header or a parameter file: no control character (a newline
+/// would end the comment), no "*/" or "/*", no '?' (a C99 trigraph "??/" is a backslash that
+/// splices the next line into the comment), no backslash; at most 200 characters.
+std::string comment_safe(const std::string& s) {
+  std::string out;
+  for (const char ch : s.substr(0, 200)) {
+    const auto c = static_cast<unsigned char>(ch);
+    out += c < 0x20 || c == 0x7f || c == '?' || c == '\\' ? '.' : ch;
+  }
+  for (const char* pair : {"*/", "/*"})
+    for (auto at = out.find(pair); at != std::string::npos; at = out.find(pair, at))
+      out[at + 1] = ' ';
+  return out;
+}
+
 std::string csv_field(const std::string& s) {
   if (s.find_first_of(",\"\r\n") == std::string::npos) return s;
   std::string out = "\"";
@@ -60,7 +68,8 @@ std::string csv_field(const std::string& s) {
 }
 
 std::string release_summary(const CoefficientBlock& b) {
-  return b.release ? release_text(*b.release) : "NOT RELEASED";
+  return comment_safe(b.release ? release_text(*b.release)
+                                : "NOT RELEASED (exported with --fit; not the gyro's calibration)");
 }
 
 }  // namespace
@@ -96,7 +105,7 @@ json block_json(const CoefficientBlock& b) {
           {"std_ratio", b.std_ratio ? json(*b.std_ratio) : json(nullptr)},
           {"verdict", b.verdict_json ? json::parse(*b.verdict_json) : json(nullptr)},
           {"released", b.release.has_value()},
-          {"release", release_json(b)},
+          {"release", b.release ? release_json(*b.release) : json(nullptr)},
           {"software_version", b.software_version},
           {"checksum",
            {{"algorithm", "CRC-32/ISO-HDLC of canonical (gyro_tc.h, gyro_tc_canonical)"},
@@ -107,7 +116,8 @@ json block_json(const CoefficientBlock& b) {
 std::string blocks_csv(const std::vector<CoefficientBlock>& blocks) {
   std::string out =
       "serial,part_number,fit_id,term,value,std_error,unit,t_ref_c,t_min_c,t_max_c,grad_min_c,"
-      "grad_max_c,outside_span,bin_s,runs,verdict,failed_limits,released,released_by,override,"
+      "grad_max_c,outside_span,bin_s,runs,verdict,failed_limits,released,released_utc,released_by,"
+      "note,override,"
       "software_version,crc32\n";
   for (const auto& b : blocks) {
     // The verdict on every row (a CSV has no header block): pass, fail or empty for no part,
@@ -121,12 +131,13 @@ std::string blocks_csv(const std::vector<CoefficientBlock>& blocks) {
     for (std::size_t i = 0; i < b.names.size(); ++i) {
       out += fmt::format(
           "{},{},{},{},{:.17g},{:.17g},{},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},clamp,{},{},{},{},"
-          "{},{},{},{},0x{:08x}\n",
+          "{},{},{},{},{},{},0x{:08x}\n",
           csv_field(b.serial), csv_field(b.part_number), b.fit_id, b.names[i], b.coefficients[i],
           b.std_errors[i], sc::coefficient_unit(b.names[i]), b.t_ref_c, b.t_min_c, b.t_max_c,
           b.grad_min_c, b.grad_max_c, b.bin_s ? fmt::format("{:g}", *b.bin_s) : "",
-          fmt::join(b.runs, ";"), verdict, failed, b.release ? b.release->released_utc : "",
-          csv_field(b.release ? b.release->released_by : ""),
+          fmt::join(b.runs, ";"), verdict, failed, b.release ? "yes" : "NO",
+          b.release ? b.release->released_utc : "", csv_field(b.release ? b.release->released_by : ""),
+          csv_field(b.release ? b.release->note : ""),
           csv_field(b.release && b.release->override_reason ? *b.release->override_reason : ""),
           b.software_version, b.crc32);
     }
@@ -134,20 +145,22 @@ std::string blocks_csv(const std::vector<CoefficientBlock>& blocks) {
   return out;
 }
 
-std::string blocks_c_header(const std::vector<CoefficientBlock>& blocks) {
+std::string blocks_c_header(const std::vector<CoefficientBlock>& blocks, const std::string& name) {
+  std::string guard;
+  for (const char c : name) guard += static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
   std::string out = fmt::format(
       "/* Gyro thermal-bias calibrations, written by `station export --format c` (station {}).\n"
       " * Apply with gyro_tc_correct() from gyro_tc.h; check each with gyro_tc_verify() first.\n"
       " * Model: {} */\n"
-      "#ifndef GYRO_TC_CALIBRATIONS_H\n#define GYRO_TC_CALIBRATIONS_H\n\n#include \"gyro_tc.h\"\n",
-      blocks.empty() ? "" : blocks.front().software_version, kModel);
+      "#ifndef {}_H\n#define {}_H\n\n#include \"gyro_tc.h\"\n",
+      blocks.empty() ? "" : blocks.front().software_version, kModel, guard, guard);
   std::string table;
   for (const auto& b : blocks) {
     const gyro_tc_block c = b.c_block();
     out += fmt::format(
         "\n/* {}: fit {} over runs {}, terms {}; {}; verdict {} */\n"
         "static const gyro_tc_block {} = {{\n"
-        "    {}, {}, {}LL,\n"
+        "    {}, {}, {}LL, {}, /* serial, part, fit, released */\n"
         "    {:.17g}, /* t_ref_c */\n"
         "    {:.17g}, {:.17g}, /* t_min_c, t_max_c */\n"
         "    {:.17g}, {:.17g}, /* grad_min_c, grad_max_c */\n"
@@ -155,17 +168,18 @@ std::string blocks_c_header(const std::vector<CoefficientBlock>& blocks) {
         "    {{{:.17g}, {:.17g}, {:.17g}, {:.17g}}}, /* k1..k4 */\n"
         "    {:.17g}, /* k0_dph_per_c */\n"
         "    0x{:08x}u}};\n",
-        b.serial, b.fit_id, fmt::join(b.runs, ","), b.terms, release_summary(b),
+        comment_safe(b.serial), b.fit_id, fmt::join(b.runs, ","), b.terms, release_summary(b),
         !b.verdict_json ? "none" : (json::parse(*b.verdict_json).value("pass", false) ? "pass" : "FAIL"),
-        c_identifier(b.serial), c_string(b.serial), c_string(b.part_number), b.fit_id, c.t_ref_c,
+        c_identifier(name, b), c_string(b.serial), c_string(b.part_number), b.fit_id, c.released,
+        c.t_ref_c,
         c.t_min_c, c.t_max_c, c.grad_min_c, c.grad_max_c, c.b0_dph, c.k_dph[0], c.k_dph[1],
         c.k_dph[2], c.k_dph[3], c.k0_dph_per_c, c.crc32);
-    table += fmt::format("    &{},\n", c_identifier(b.serial));
+    table += fmt::format("    &{},\n", c_identifier(name, b));
   }
   out += fmt::format(
-      "\nstatic const gyro_tc_block *const gyro_tc_blocks[] = {{\n{}}};\n"
-      "#define GYRO_TC_BLOCK_COUNT {}\n\n#endif /* GYRO_TC_CALIBRATIONS_H */\n",
-      table, blocks.size());
+      "\nstatic const gyro_tc_block *const {}_blocks[] = {{\n{}}};\n"
+      "#define {}_BLOCK_COUNT {}\n\n#endif /* {}_H */\n",
+      name, table, guard, blocks.size(), guard);
   return out;
 }
 
@@ -186,7 +200,8 @@ std::string block_px4(const CoefficientBlock& b, Px4Slot slot) {
       "# Units: rad/s (converted from deg/h). PX4 subtracts X0 + X1 dT + X2 dT^2 + X3 dT^3, "
       "dT = clamp(T, TMIN, TMAX) - TREF;\n# TC_G{}_ID is 0: set it to the sensor's device id. "
       "Enable with TC_G_ENABLE = 1.\n# Vehicle-Id Component-Id Name Value Type\n",
-      b.serial, b.fit_id, fmt::join(b.runs, ","), release_summary(b), b.crc32, slot.instance);
+      comment_safe(b.serial), b.fit_id, fmt::join(b.runs, ","), release_summary(b), b.crc32,
+      slot.instance);
   const auto row = [&out](const std::string& name, double v) {
     out += fmt::format("1\t1\t{}\t{:.17g}\t9\n", name, v);
   };

@@ -19,9 +19,11 @@ nlohmann::json block_json(const CoefficientBlock& b);
 /// CSV: a header line, then one row per coefficient of each block.
 std::string blocks_csv(const std::vector<CoefficientBlock>& blocks);
 
-/// A C header: `#include "gyro_tc.h"`, then one `static const gyro_tc_block gyro_tc_<SERIAL>`
-/// per block (serial mangled to an identifier), and a table of them.
-std::string blocks_c_header(const std::vector<CoefficientBlock>& blocks);
+/// A C header: `#include "gyro_tc.h"`, then one `static const gyro_tc_block NAME_<SERIAL>_fit<ID>`
+/// per block (serial mangled to an identifier), a table NAME_blocks and NAME_BLOCK_COUNT; the
+/// include guard is NAME_H in capitals. `name` must be a C identifier (export --c-name).
+std::string blocks_c_header(const std::vector<CoefficientBlock>& blocks,
+                            const std::string& name = "gyro_tc_calibrations");
 
 /// Where a PX4 block goes: gyro instance (TC_G<instance>) and board axis (0 x, 1 y, 2 z).
 struct Px4Slot {

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <nlohmann/json.hpp>
 
@@ -34,7 +35,7 @@ void set_spans(Store& store, const FitRecord& fit, CoefficientBlock& b) {
   constexpr double inf = std::numeric_limits<double>::infinity();
   double t_lo = inf, t_hi = -inf, g_lo = inf, g_hi = -inf;
   for (const auto run : fit.runs) {
-    const sc::ModelData d = record_model_data(store, run, fit.serial);
+    const sc::ModelData d = fitted_record_model_data(store, run, fit.serial);
     for (std::size_t i = 0; i < d.temp_c.size(); ++i) {
       t_lo = std::min(t_lo, d.temp_c[i]);
       t_hi = std::max(t_hi, d.temp_c[i]);
@@ -43,22 +44,38 @@ void set_spans(Store& store, const FitRecord& fit, CoefficientBlock& b) {
     }
   }
   if (t_lo > t_hi)
-    throw InputError(fmt::format("{}: fit {}: its runs {} hold no binned 1 Hz sample of {}",
-                                 store.db().path(), fit.id, fmt::join(fit.runs, ","),
-                                 fit.serial));
+    throw InputError(fmt::format("{}: fit {}: its runs {} hold no 1 Hz sample of {} in a complete "
+                                 "bin",
+                                 store.db().path(), fit.id, fmt::join(fit.runs, ","), fit.serial));
   b.t_min_c = t_lo;
   b.t_max_c = t_hi;
   b.grad_min_c = g_lo;
   b.grad_max_c = g_hi;
 }
 
+/// A block with a value that is not finite is refused: "inf" in a C header does not compile, and
+/// JSON would carry null.
+void check_finite(const CoefficientBlock& b) {
+  std::vector<double> v{b.t_ref_c, b.t_min_c, b.t_max_c, b.grad_min_c, b.grad_max_c};
+  v.insert(v.end(), b.coefficients.begin(), b.coefficients.end());
+  v.insert(v.end(), b.std_errors.begin(), b.std_errors.end());
+  for (const double x : v)
+    if (!std::isfinite(x))
+      throw InputError(fmt::format("fit {} of '{}': a coefficient, error or span is not finite: "
+                                   "nothing to deliver",
+                                   b.fit_id, b.serial));
+}
+
 }  // namespace
 
 std::optional<std::string> undeliverable_term(const sc::FitResult& fit) {
   for (const auto t : fit.spec.terms) {
-    if (t == sc::Term::dTdt || t == sc::Term::channel)
+    const bool in_block = t == sc::Term::dT || t == sc::Term::dT2 || t == sc::Term::dT3 ||
+                          t == sc::Term::dT4 || t == sc::Term::gradT;
+    if (!in_block)
       return fmt::format(
-          "term {} cannot be delivered: gyro_tc_correct() takes the bias, T and gradT only",
+          "term {} cannot be delivered: gyro_tc_correct() applies B0, k1..k4 (dT..dT4) and k0 "
+          "(gradT) only",
           sc::term_option_name(t));
   }
   return std::nullopt;
@@ -75,6 +92,7 @@ gyro_tc_block CoefficientBlock::c_block() const {
   c.serial = serial.c_str();
   c.part_number = part_number.c_str();
   c.fit_id = fit_id;
+  c.released = release ? 1 : 0;
   c.t_ref_c = t_ref_c;
   c.t_min_c = t_min_c;
   c.t_max_c = t_max_c;
@@ -89,9 +107,13 @@ gyro_tc_block CoefficientBlock::c_block() const {
 
 void seal_block(CoefficientBlock& b) {
   const gyro_tc_block c = b.c_block();
-  const int n = gyro_tc_canonical(&c, nullptr, 0);
-  std::string text(static_cast<std::size_t>(n) + 1, '\0');
-  gyro_tc_canonical(&c, text.data(), text.size());
+  std::string text(GYRO_TC_CANONICAL_MAX, '\0');
+  const int n = gyro_tc_canonical(&c, text.data(), text.size());
+  if (n < 0)
+    throw InputError(fmt::format(
+        "fit {} of '{}': the block's canonical text would exceed {} bytes (serial or part "
+        "number too long): a consumer could never verify it",
+        b.fit_id, b.serial.substr(0, 40), GYRO_TC_CANONICAL_MAX - 1));
   text.resize(static_cast<std::size_t>(n));
   b.canonical = text;
   b.crc32 = gyro_tc_crc32(text.data(), text.size());
@@ -120,6 +142,7 @@ CoefficientBlock make_block(Store& store, const FitRecord& fit,
   b.std_after_dph = fit.eval.std_after_dph;
   b.release = release;
   b.software_version = STATION_VERSION;
+  check_finite(b);
   seal_block(b);
   return b;
 }

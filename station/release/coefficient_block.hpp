@@ -17,8 +17,8 @@
 
 namespace station {
 
-/// Why a fit's model cannot travel in a block (a term gyro_tc_correct does not take: dTdt,
-/// channel); empty when it can.
+/// Why a fit's model cannot travel in a block (a term gyro_tc_correct does not apply: dTdt,
+/// channel, gradTdT); empty when it can.
 std::optional<std::string> undeliverable_term(const compensation::FitResult& fit);
 
 /// One gyro's calibration as delivered.
@@ -48,9 +48,10 @@ struct CoefficientBlock {
 };
 
 /// Builds the block of a stored fit: the spans are the min and max of T and gradT over the 1 Hz
-/// samples of the fit's runs that went into bins (calibration.hpp's rule), so every bin mean
-/// and every binned sample lies inside them. Throws ReleaseRefused for an undeliverable term and
-/// InputError when the fit's runs hold no binned sample.
+/// samples of the fit's complete bins (fitted_record_model_data), so every bin mean the fit used
+/// and every sample in it lies inside them. Throws ReleaseRefused for an undeliverable term, and
+/// InputError when the fit's runs hold no such sample, a value is not finite, or the canonical
+/// text would not fit GYRO_TC_CANONICAL_MAX.
 CoefficientBlock make_block(Store& store, const FitRecord& fit,
                             const std::optional<ReleaseRow>& release);
 

@@ -15,6 +15,7 @@
 #ifndef GYRO_TC_H
 #define GYRO_TC_H
 
+#include <locale.h>
 #include <stdint.h>
 #include <stdio.h>
 
@@ -22,10 +23,14 @@
 extern "C" {
 #endif
 
+/* The longest canonical text a block may have (the station refuses to export a longer one). */
+#define GYRO_TC_CANONICAL_MAX 1024
+
 typedef struct gyro_tc_block {
   const char *serial;      /* gyro serial number */
   const char *part_number; /* "" when the fit was judged against no part */
   long long fit_id;        /* the station's fit id */
+  int released;            /* 1: the released calibration; 0: exported with --fit, NOT released */
   double t_ref_c;          /* T_ref, deg C */
   double t_min_c, t_max_c; /* temperature span the fit saw, deg C: T is clamped to it */
   double grad_min_c, grad_max_c; /* gradient span the fit saw, deg C: gradT is clamped to it */
@@ -39,7 +44,8 @@ static inline double gyro_tc_clamp(double x, double lo, double hi) {
   return x < lo ? lo : (x > hi ? hi : x);
 }
 
-/* Modelled thermal bias at (temp_c, grad_c), deg/h, with both inputs clamped to the span. */
+/* Modelled thermal bias at (temp_c, grad_c), deg/h, with both inputs clamped to the span. A NaN
+ * input (a failed sensor) gives NaN: the caller decides what a missing temperature means. */
 static inline double gyro_tc_bias_dph(const gyro_tc_block *b, double temp_c, double grad_c) {
   const double dt = gyro_tc_clamp(temp_c, b->t_min_c, b->t_max_c) - b->t_ref_c;
   const double g = gyro_tc_clamp(grad_c, b->grad_min_c, b->grad_max_c);
@@ -59,17 +65,40 @@ static inline double gyro_tc_correct(const gyro_tc_block *b, double bias_dph, do
   return bias_dph - gyro_tc_bias_dph(b, temp_c, grad_c);
 }
 
-/* The canonical text the checksum covers, written into buf (size n); returns the length
- * snprintf reports (>= n: truncated). Numbers as %.17g: a double prints to the same text on
- * every IEEE-754 machine with a correctly rounding printf (glibc, musl, newlib). */
+/* One number as %.17g with '.' as the decimal point whatever the locale (a consumer that set
+ * LC_NUMERIC to a decimal-comma locale still reads the same text). */
+static inline void gyro_tc_number(char *buf, size_t n, double v) {
+  const char *point = localeconv()->decimal_point;
+  char *p;
+  snprintf(buf, n, "%.17g", v);
+  if (point != NULL && point[0] != '\0' && point[0] != '.')
+    for (p = buf; *p != '\0'; ++p)
+      if (*p == point[0]) *p = '.';
+}
+
+/* The canonical text the checksum covers, written into buf (size n); returns its length, or -1
+ * when it does not fit. Numbers as %.17g: a double prints to the same text on every IEEE-754
+ * machine with a correctly rounding printf (glibc, musl, newlib). */
 static inline int gyro_tc_canonical(const gyro_tc_block *b, char *buf, size_t n) {
-  return snprintf(buf, n,
-                  "gyro_tc/1;serial=%s;part=%s;fit=%lld;t_ref_c=%.17g;t_min_c=%.17g;"
-                  "t_max_c=%.17g;grad_min_c=%.17g;grad_max_c=%.17g;b0_dph=%.17g;k1=%.17g;"
-                  "k2=%.17g;k3=%.17g;k4=%.17g;k0=%.17g",
-                  b->serial, b->part_number, b->fit_id, b->t_ref_c, b->t_min_c, b->t_max_c,
-                  b->grad_min_c, b->grad_max_c, b->b0_dph, b->k_dph[0], b->k_dph[1],
-                  b->k_dph[2], b->k_dph[3], b->k0_dph_per_c);
+  const double v[] = {b->t_ref_c,  b->t_min_c,  b->t_max_c,  b->grad_min_c, b->grad_max_c,
+                      b->b0_dph,   b->k_dph[0], b->k_dph[1], b->k_dph[2],   b->k_dph[3],
+                      b->k0_dph_per_c};
+  static const char *const key[] = {"t_ref_c", "t_min_c", "t_max_c", "grad_min_c", "grad_max_c",
+                                    "b0_dph",  "k1",      "k2",      "k3",         "k4",
+                                    "k0"};
+  char num[40];
+  size_t len;
+  int i, w = snprintf(buf, n, "gyro_tc/2;serial=%s;part=%s;fit=%lld;released=%d", b->serial,
+                      b->part_number, b->fit_id, b->released);
+  if (w < 0 || (size_t)w >= n) return -1;
+  len = (size_t)w;
+  for (i = 0; i < 11; ++i) {
+    gyro_tc_number(num, sizeof num, v[i]);
+    w = snprintf(buf + len, n - len, ";%s=%s", key[i], num);
+    if (w < 0 || (size_t)w >= n - len) return -1;
+    len += (size_t)w;
+  }
+  return (int)len;
 }
 
 /* CRC-32 (ISO-HDLC), bitwise: small rather than fast; a block is checked once at start-up. */
@@ -86,9 +115,9 @@ static inline uint32_t gyro_tc_crc32(const char *s, size_t n) {
 
 /* 1 when the block's checksum matches its contents and its spans are ordered, else 0. */
 static inline int gyro_tc_verify(const gyro_tc_block *b) {
-  char text[1024];
+  char text[GYRO_TC_CANONICAL_MAX];
   const int len = gyro_tc_canonical(b, text, sizeof text);
-  if (len < 0 || (size_t)len >= sizeof text) return 0;
+  if (len < 0) return 0;
   if (!(b->t_min_c <= b->t_max_c) || !(b->grad_min_c <= b->grad_max_c)) return 0;
   return gyro_tc_crc32(text, (size_t)len) == b->crc32;
 }

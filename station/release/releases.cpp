@@ -44,12 +44,26 @@ std::optional<std::string> needs_override(Store& store, const FitRecord& fit,
   return std::nullopt;
 }
 
+/// Free text of a release: no control character (it would hide text in a one-line audit trail
+/// or break an export's comment) and a bounded length; `required` refuses a blank one.
+void check_text(const char* what, const std::string& text, std::size_t max_len, bool required) {
+  if (required && text.find_first_not_of(" \t\r\n") == std::string::npos)
+    throw InputError(fmt::format("release: {}: must not be empty", what));
+  if (text.size() > max_len)
+    throw InputError(fmt::format("release: {}: {} characters, at most {}", what, text.size(),
+                                 max_len));
+  for (const char ch : text)
+    if (static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f)
+      throw InputError(fmt::format("release: {}: control character 0x{:02x} not allowed", what,
+                                   static_cast<unsigned char>(ch)));
+}
+
 void check_request(Store& store, const ReleaseRequest& req, const FitRecord& fit,
                    const StoredVerdict& v) {
-  if (req.by.find_first_not_of(" \t") == std::string::npos)
-    throw InputError("release: --by NAME: who releases must be named");
-  if (req.override_reason && req.override_reason->find_first_not_of(" \t") == std::string::npos)
-    throw InputError("release: --override REASON: the reason must not be empty");
+  check_text("--by NAME (who releases)", req.by, kMaxNameChars, true);
+  check_text("--note", req.note, kMaxNoteChars, false);
+  if (req.override_reason)
+    check_text("--override REASON", *req.override_reason, kMaxNoteChars, true);
   if (const auto bad = undeliverable_term(fit.fit))
     throw ReleaseRefused(fmt::format("fit {} of {}: {}", fit.id, fit.serial, *bad));
   if (const auto cur = current_release(store, fit.serial); cur && cur->fit_id == fit.id)
@@ -60,6 +74,13 @@ void check_request(Store& store, const ReleaseRequest& req, const FitRecord& fit
     throw ReleaseRefused(fmt::format("fit {} of {} is not released: {}; give --override REASON "
                                      "to release it anyway",
                                      fit.id, fit.serial, *why));
+  // An override is a statement that a rule was set aside: on a fit no rule holds back, it would
+  // put a false "released over its verdict" into the record.
+  if (!why && req.override_reason)
+    throw ReleaseRefused(fmt::format("fit {} of {} needs no override ({}): release it without "
+                                     "--override",
+                                     fit.id, fit.serial, v.verdict_json ? "its verdict passed"
+                                                                        : "no part applies"));
 }
 
 void add_release_event(Store& store, const FitRecord& fit, const ReleaseRow& r) {
@@ -121,6 +142,16 @@ std::optional<ReleaseRow> release_of_fit(Store& store, std::int64_t fit_id) {
   st->bind(1, fit_id);
   if (!st->step()) return std::nullopt;
   return read_release(*st);
+}
+
+nlohmann::json release_json(const ReleaseRow& r) {
+  return {{"release_id", r.id},
+          {"fit_id", r.fit_id},
+          {"serial", r.serial},
+          {"released_utc", r.released_utc},
+          {"by", r.released_by},
+          {"note", r.note},
+          {"override", r.override_reason ? nlohmann::json(*r.override_reason) : nullptr}};
 }
 
 std::string release_text(const ReleaseRow& r) {

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -22,6 +23,10 @@ struct ReleaseRow {
   std::optional<std::string> override_reason;
   std::optional<std::string> verdict_json;  ///< the fit's verdict at the release (NULL: none)
 };
+
+/// Bounds of a release's free text (CLI and API alike).
+inline constexpr std::size_t kMaxNameChars = 200;
+inline constexpr std::size_t kMaxNoteChars = 4096;
 
 /// What a person asks for.
 struct ReleaseRequest {
@@ -41,8 +46,10 @@ struct ReleaseRefused : InputError {
 };
 
 /// Releases a fit: checks the request, stores the release and an event ('release', on the
-/// newest run of the fit) in one transaction. Throws FitNotFound, ReleaseRefused, or InputError
-/// for an empty name.
+/// newest run of the fit) in one transaction. Throws FitNotFound; ReleaseRefused (failed or
+/// missing verdict without an override, an override where none is needed, an undeliverable
+/// model, already released); InputError for a blank name or reason, text with a control
+/// character or longer than kMaxNameChars / kMaxNoteChars.
 ReleaseRow release_fit(Store& store, const ReleaseRequest& req);
 
 /// The released calibration of `serial` (its newest release); empty when none.
@@ -51,6 +58,10 @@ std::optional<ReleaseRow> current_release(Store& store, const std::string& seria
 std::vector<ReleaseRow> releases_of(Store& store, const std::string& serial);
 /// The newest release of fit `fit_id`; empty when it was never released.
 std::optional<ReleaseRow> release_of_fit(Store& store, std::int64_t fit_id);
+
+/// {"release_id", "fit_id", "serial", "released_utc", "by", "note", "override"} (override null
+/// when none): the one JSON shape of a release (export, history, API).
+nlohmann::json release_json(const ReleaseRow& r);
 
 /// "released 2026-11-25T10:00:00Z by Ann (override: ...)" for people.
 std::string release_text(const ReleaseRow& r);

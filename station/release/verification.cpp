@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 
 #include "compensation/adev_floor.hpp"
@@ -78,9 +79,23 @@ VerificationResult verify_fit(Store& store, const FitRecord& fit, std::int64_t r
   for (std::size_t i = 0; i < record.size(); ++i)
     record[i] = gyro_tc_correct(&c, rec.bias_dph[i], rec.temp_c[i], rec.grad_c[i]);
   if (const auto floor = sc::adev_floor(record, 1.0)) v.adev_floor_dph = floor->adev;
+  const auto run = store.find_run(run_id);
+  if (run && run->state != "completed")
+    v.warnings.push_back(fmt::format("run {} ended '{}', not completed", run_id, run->state));
+  const bool enough = v.bins >= kMinVerifyBins;
+  if (!enough)
+    v.warnings.push_back(fmt::format("only {} complete bins (fewer than {}): the figures say "
+                                     "little and every verification limit fails",
+                                     v.bins, kMinVerifyBins));
   if (limits) {
     v.part_number = limits->number;
-    v.verdict = judge_verification(*limits, {v.eval.std_after_dph, v.eval.std_ratio});
+    VerificationFigures fig{v.eval.std_after_dph, v.eval.std_ratio};
+    if (!enough) fig = {NAN, std::nullopt};  // cannot be shown: fails (verdict.hpp's rule)
+    v.verdict = judge_verification(*limits, fig);
+    if (!v.verdict)
+      v.warnings.push_back(fmt::format("part {} sets no verification limit (max_verify_std_dph, "
+                                       "max_verify_ratio): no verdict",
+                                       limits->number));
   }
   return v;
 }
@@ -100,7 +115,8 @@ json verification_json(const VerificationResult& v) {
           {"adev_floor_dph", opt(v.adev_floor_dph)},
           {"clamped_bins", v.clamped_bins},
           {"part_number", v.part_number ? json(*v.part_number) : json(nullptr)},
-          {"verdict", v.verdict ? verdict_json(*v.verdict) : json(nullptr)}};
+          {"verdict", v.verdict ? verdict_json(*v.verdict) : json(nullptr)},
+          {"warnings", v.warnings}};
 }
 
 std::int64_t save_verification(Store& store, VerificationResult& v) {
@@ -151,6 +167,7 @@ std::vector<VerificationResult> verifications_of_run(Store& store, std::int64_t 
                             {"adev_floor_dph", &v.adev_floor_dph}})
       if (r.contains(key) && r[key].is_number()) *dst = r[key].get<double>();
     v.clamped_bins = r.value("clamped_bins", std::size_t{0});
+    v.warnings = r.value("warnings", std::vector<std::string>{});
     if (!st.column_is_null(5)) v.part_number = st.column_text(5);
     if (!st.column_is_null(6)) v.verdict = verdict_from_json(json::parse(st.column_text(6)));
     out.push_back(std::move(v));

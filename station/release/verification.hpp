@@ -16,6 +16,11 @@
 
 namespace station {
 
+/// Fewer complete bins than this on the verification run: the figures are shown, but no
+/// verification limit can be shown to hold (they fail): a std over a handful of bins says
+/// nothing (one bin has a std of 0).
+inline constexpr std::size_t kMinVerifyBins = 6;
+
 /// What a verification shows.
 struct VerificationResult {
   std::int64_t id = 0;  ///< verifications.id (0 before it is stored)
@@ -31,6 +36,7 @@ struct VerificationResult {
   std::size_t clamped_bins = 0;             ///< bins with T or gradT outside the fit's span
   std::optional<std::string> part_number;
   std::optional<Verdict> verdict;           ///< against max_verify_std_dph / max_verify_ratio
+  std::vector<std::string> warnings;        ///< too few bins, a run that did not complete
   /// Per bin, for the report's figure: mid time (s), T (C), bias before and after (deg/h).
   std::vector<double> t_s, temp_c, before_dph, after_dph;
 };

@@ -57,10 +57,12 @@ void load_verifications(Store& store, std::int64_t run_id, SerialReport& s) {
     }
     s.verification_figures.push_back(
         figure_6(stored.fit_id, stored.temp_c, stored.before_dph, stored.after_dph));
-    if (!s.verifications.empty())
-      s.verification_figures.back().id = fmt::format("6.{}", s.verifications.size() + 1);
     s.verifications.push_back(std::move(stored));
   }
+  // One verification is Fig. 6; several are Figs. 6.1, 6.2, ...
+  if (s.verification_figures.size() > 1)
+    for (std::size_t k = 0; k < s.verification_figures.size(); ++k)
+      s.verification_figures[k].id = fmt::format("6.{}", k + 1);
 }
 
 SerialReport load_serial(Store& store, const RunReport& rr, const RunSlot& slot) {

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <nlohmann/json.hpp>
 
 #include "compensation/binning.hpp"
 #include "station/common/input_error.hpp"
@@ -27,6 +28,30 @@ sc::ModelData record_model_data(Store& store, std::int64_t run_id, const std::st
     d.temp_c.push_back(*s.temp_c);
     d.grad_c.push_back(*s.temp2_c - *s.temp_c);  // gradient = second sensor - first
     d.t_mid_s.push_back(s.t_s);
+  }
+  return d;
+}
+
+sc::ModelData fitted_record_model_data(Store& store, std::int64_t run_id,
+                                       const std::string& serial) {
+  const auto run = store.find_run(run_id);
+  double bin_s = 600.0;  // the paper's, when the run did not record its own (before migration 2)
+  if (run) {
+    const auto j = nlohmann::json::parse(run->resolved_json, nullptr, false);
+    if (j.is_object() && j.contains("bin_s") && j["bin_s"].is_number() && j["bin_s"] > 0)
+      bin_s = j["bin_s"].get<double>();
+  }
+  const std::vector<double> starts = store.model_data(serial, {run_id}).t_mid_s;  // bin starts
+  const sc::ModelData all = record_model_data(store, run_id, serial);
+  sc::ModelData d;
+  for (std::size_t i = 0; i < all.bias_dph.size(); ++i) {
+    const double t = all.t_mid_s[i];
+    auto it = std::upper_bound(starts.begin(), starts.end(), t);  // first start after t
+    if (it == starts.begin() || t >= *std::prev(it) + bin_s) continue;
+    d.bias_dph.push_back(all.bias_dph[i]);
+    d.temp_c.push_back(all.temp_c[i]);
+    d.grad_c.push_back(all.grad_c[i]);
+    d.t_mid_s.push_back(t);
   }
   return d;
 }

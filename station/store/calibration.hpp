@@ -20,6 +20,11 @@ bool sample_goes_into_bins(const SampleRow& s);
 compensation::ModelData record_model_data(Store& store, std::int64_t run_id,
                                           const std::string& serial);
 
+/// The same over the samples of the run's complete stored bins only (what a fit saw): a sample
+/// belongs to the bin [t_start_s, t_start_s + bin_s) of the run's bin width.
+compensation::ModelData fitted_record_model_data(Store& store, std::int64_t run_id,
+                                                 const std::string& serial);
+
 /// Bins one gyro's samples of the record window (recording = true) at bin_s.
 std::vector<compensation::Bin> bin_samples(const std::vector<SampleRow>& rows, double bin_s);
 

@@ -184,8 +184,8 @@ void Database::migrate() {
   }
   if (mode_ == OpenMode::read_only) {
     throw SqliteError(fmt::format(
-        "{}: schema version {} is older than this software ({}); a writing command (station run "
-        "or station fit) migrates it",
+        "{}: schema version {} is older than this software ({}); a writing command (station run, "
+        "fit, release or verify) migrates it",
         path_, have, known));
   }
   backup_before_migrating(have);

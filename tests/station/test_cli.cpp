@@ -154,12 +154,14 @@ TEST(Cli, SimRunThenFitAllAndExport) {
   ASSERT_EQ(csv.status, 0) << csv.out;
   EXPECT_EQ(csv.out.rfind("serial,part_number,fit_id,term,value,std_error,unit,t_ref_c,t_min_c,"
                           "t_max_c,grad_min_c,grad_max_c,outside_span,bin_s,runs,verdict,"
-                          "failed_limits,released,released_by,override,software_version,crc32\n",
+                          "failed_limits,released,released_utc,released_by,note,override,"
+                          "software_version,crc32\n",
                           0),
             0u)
       << csv.out;
   EXPECT_NE(csv.out.find("SIM-0002,"), std::string::npos);
   EXPECT_NE(csv.out.find(",k0,"), std::string::npos);  // the released fit is the dT+gradT one
+  EXPECT_NE(csv.out.find(",yes,"), std::string::npos);
   EXPECT_NE(csv.out.find(",tester,"), std::string::npos);
 
   const auto missing = run_station("export --db " + db + " --serial NOPE");

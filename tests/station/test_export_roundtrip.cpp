@@ -33,7 +33,7 @@ std::vector<Record> records(station::Store& store, const station::FitRecord& fit
   std::vector<Record> out;
   for (const auto run : fit.runs) {
     for (auto d : {store.model_data(fit.serial, {run}),
-                   station::record_model_data(store, run, fit.serial)}) {
+                   station::fitted_record_model_data(store, run, fit.serial)}) {
       Record r{d, sc::compensate(fit.fit, d.view())};
       out.push_back(std::move(r));
     }
@@ -63,6 +63,7 @@ gyro_tc_block from_json(const json& j, std::string& serial, std::string& part) {
   b.serial = serial.c_str();
   b.part_number = part.c_str();
   b.fit_id = j["fit_id"].get<long long>();
+  b.released = j["released"].get<bool>() ? 1 : 0;
   b.t_ref_c = j["t_ref_c"].get<double>();
   const auto& s = j["span"];
   b.t_min_c = s["t_min_c"].get<double>();
@@ -159,6 +160,8 @@ TEST_F(ExportRoundTrip, CsvRowsReproduceTheStation) {
   b.serial = sn.c_str();
   b.part_number = pn.c_str();
   b.fit_id = std::stoll(rows[0].at("fit_id"));
+  b.released = rows[0].at("released") == "yes" ? 1 : 0;
+  EXPECT_EQ(b.released, 1);
   b.t_ref_c = std::stod(rows[0].at("t_ref_c"));
   b.t_min_c = std::stod(rows[0].at("t_min_c"));
   b.t_max_c = std::stod(rows[0].at("t_max_c"));
@@ -185,12 +188,16 @@ TEST_F(ExportRoundTrip, CHeaderCompiledAsCReproducesTheStation) {
   const std::string dir = ::testing::TempDir() + "gyro_tc_c_" + std::to_string(getpid());
   ASSERT_EQ(std::system(("mkdir -p " + dir).c_str()), 0);
   std::ofstream(dir + "/calibrations.h") << station::blocks_c_header({block_});
-  std::ofstream(dir + "/apply.c") << R"(#include <stdio.h>
+  std::ofstream(dir + "/apply.c") << R"(#include <locale.h>
+#include <stdio.h>
 #include "calibrations.h"
 int main(void) {
   double bias, t, g;
-  const gyro_tc_block *b = gyro_tc_blocks[0];
-  if (GYRO_TC_BLOCK_COUNT != 1 || !gyro_tc_verify(b)) return 3;
+  const gyro_tc_block *b = gyro_tc_calibrations_blocks[0];
+  if (GYRO_TC_CALIBRATIONS_BLOCK_COUNT != 1 || !gyro_tc_verify(b) || !b->released) return 3;
+  /* A consumer in a decimal-comma locale still verifies (where the machine has one). */
+  if (setlocale(LC_NUMERIC, "de_DE.UTF-8") != NULL && !gyro_tc_verify(b)) return 4;
+  setlocale(LC_NUMERIC, "C");
   while (scanf("%lf %lf %lf", &bias, &t, &g) == 3) printf("%.17g\n", gyro_tc_correct(b, bias, t, g));
   return 0;
 }
@@ -255,6 +262,24 @@ TEST_F(ExportRoundTrip, Px4ParameterFileReproducesACubicFitAndRefusesAGradient) 
   b.b0_dph = p.at("TC_G1_X0_2") * to_dph;
   for (int i = 1; i <= 3; ++i) b.k_dph[i - 1] = p.at(fmt::format("TC_G1_X{}_2", i)) * to_dph;
   EXPECT_LE(worst_relative(b, records(*store_, rec)), 1e-9);
+}
+
+// Text in a block's comments cannot end the comment: no code or parameter line gets in.
+TEST_F(ExportRoundTrip, CommentTextCannotInjectCodeOrParameters) {
+  auto b = block_;
+  b.release->note = "*/ int evil = 1; /* x";
+  b.release->released_by = "Eve\n1\t1\tTC_G0_TMAX\t999\t9";
+  b.serial = "X\"1,\n*/ bad";
+  const std::string c = station::blocks_c_header({b});
+  EXPECT_EQ(c.find("*/ int evil"), std::string::npos) << c;
+  EXPECT_EQ(c.find("\n*/ bad"), std::string::npos) << c;
+  EXPECT_NE(c.find("\"X\\\"1,\\012*/ bad\""), std::string::npos) << "the literal keeps the serial: " << c;
+  auto cubic = b;
+  cubic.names = {"B0", "k1"};
+  cubic.coefficients = {0.1, 1e-3};
+  cubic.std_errors = {0.01, 1e-4};
+  const std::string px4 = station::block_px4(cubic, {0, 2});
+  EXPECT_EQ(px4.find("\n1\t1\tTC_G0_TMAX\t999"), std::string::npos) << px4;
 }
 
 TEST(GyroTc, ClampsTemperatureAndGradientToTheSpanTheFitSaw) {

@@ -2,6 +2,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <sys/wait.h>
+
+#include <cstdio>
 #include <numeric>
 
 #include "station/parts/part_file.hpp"
@@ -107,6 +110,16 @@ TEST(Release, ANewerReleaseSupersedesTheOlderAndNothingIsDeleted) {
                station::FitNotFound);
   const auto second = fit_of_run(store, sn, c.verification_run);
   EXPECT_THROW(station::release_fit(store, {second, "  ", "", std::nullopt}), station::InputError);
+  // Text that would hide in a one-line audit trail or end an export's comment line.
+  EXPECT_THROW(station::release_fit(store, {second, "Ann\nEve", "", std::nullopt}),
+               station::InputError);
+  EXPECT_THROW(station::release_fit(store, {second, "Ann", std::string("a\0b", 3), std::nullopt}),
+               station::InputError);
+  EXPECT_THROW(station::release_fit(store, {second, std::string(201, 'x'), "", std::nullopt}),
+               station::InputError);
+  // No verdict and no part: nothing to override; an override would record a false exception.
+  EXPECT_THROW(station::release_fit(store, {second, "Ann", "", "because"}), station::ReleaseRefused);
+  EXPECT_THROW(station::release_fit(store, {second, "Ann", "", ""}), station::InputError);
   station::release_fit(store, {second, "Bob", "", std::nullopt});
   EXPECT_EQ(station::current_release(store, sn)->fit_id, second);
   const auto all = station::releases_of(store, sn);
@@ -181,6 +194,51 @@ TEST(Verify, RefusesARunTheFitUsedAndJudgesAgainstTheVerificationLimits) {
   ASSERT_TRUE(back.back().verdict);
   EXPECT_FALSE(back.back().verdict->pass);
   EXPECT_DOUBLE_EQ(back.back().eval.std_after_dph, v.eval.std_after_dph);
+}
+
+}  // namespace
+
+namespace {
+
+/// `station ARGS` (stdout only) and its exit status.
+std::pair<int, std::string> station_cli(const std::string& args) {
+  const std::string cmd = std::string(STATION_BINARY_DIR) + "/station/station " + args + " 2>/dev/null";
+  std::string out;
+  FILE* p = popen(cmd.c_str(), "r");
+  if (p == nullptr) return {-1, out};
+  char buf[4096];
+  std::size_t n = 0;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
+  const int raw = pclose(p);
+  return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, out};
+}
+
+// fit --cv over the two runs: one held-out entry per run, each the RMS of the other run's fit
+// applied to it, recomputed here from the store.
+TEST(FitCv, LeaveOneRunOutOverTwoRunsMatchesAFitOnTheOtherRun) {
+  const auto c = calibrated_db("fit-cv", 1);
+  const std::string sn = c.report["gyros"][0]["serial"].get<std::string>();
+  const auto [rc, out] = station_cli("fit --db " + c.path + " --serial " + sn + " --cv --json");
+  ASSERT_EQ(rc, 0) << out;
+  const auto j = nlohmann::json::parse(out);
+  const auto& cv = j["cross_validation"];
+  ASSERT_EQ(cv["held_out"].size(), 2u) << j.dump();
+  station::Store store(c.path, station::OpenMode::existing);
+  for (const auto& h : cv["held_out"]) {
+    const auto held = h["run_id"].get<std::int64_t>();
+    const auto other = held == c.calibration_run ? c.verification_run : c.calibration_run;
+    const auto train = store.model_data(sn, {other}), test = store.model_data(sn, {held});
+    const auto f = sc::fit_model(train.view(), {{sc::Term::dT, sc::Term::gradT}, 25.0});
+    double ss = 0;
+    for (const double e : sc::compensate(f, test.view())) ss += e * e;
+    EXPECT_NEAR(h["rms_dph"].get<double>(), std::sqrt(ss / test.bias_dph.size()), 1e-12);
+  }
+  EXPECT_GT(cv["pooled_rms_dph"].get<double>(), 0.0);
+  // One run: no cross-validation, said in the output.
+  const auto [rc1, one] = station_cli("fit --db " + c.path + " --serial " + sn + " --runs " +
+                                      std::to_string(c.calibration_run) + " --cv --json");
+  ASSERT_EQ(rc1, 0);
+  EXPECT_TRUE(nlohmann::json::parse(one)["cross_validation"].contains("unavailable")) << one;
 }
 
 }  // namespace
