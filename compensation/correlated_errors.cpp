@@ -14,8 +14,8 @@ namespace {
 constexpr double kMaxShare = 0.99;  // q = 1 with tau -> infinity makes the filter degenerate
 constexpr int kCoarseSteps = 15;    // 15 x 15 grid over log tau and q, then
 constexpr int kRefinements = 4;     // 4 rounds of 5 x 5 around the best point
-// The filter's columns: y and up to 8 regressors (B0 and the seven terms of fit.hpp).
-constexpr int kMaxColumns = 9;
+// The filter's columns: y and up to 9 regressors (B0 and the eight terms of fit.hpp).
+constexpr int kMaxColumns = 10;
 using SmallMatrix =
     Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxColumns, kMaxColumns>;
 using SmallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxColumns, 1>;

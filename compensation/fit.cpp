@@ -8,6 +8,7 @@
 #include <numeric>
 #include <string>
 
+#include "compensation/fit_diagnostics.hpp"
 #include "compensation/limits.hpp"
 
 namespace station::compensation {
@@ -34,12 +35,13 @@ constexpr TermInfo kTerms[] = {
     {Term::gradT, "gradT", "k0", "deg/h/C (gradient)"},
     {Term::dTdt, "dTdt", "kr", "deg/h/(C/h)"},
     {Term::channel, "channel", "kc", "deg/h per channel unit"},
+    {Term::gradTdT, "gradTdT", "kg", "deg/h/C^2 (gradient x dT)"},
 };
 constexpr bool table_in_enum_order() {
   for (std::size_t i = 0; i < std::size(kTerms); ++i) {
     if (static_cast<std::size_t>(kTerms[i].term) != i) return false;
   }
-  return std::size(kTerms) == static_cast<std::size_t>(Term::channel) + 1;
+  return std::size(kTerms) == static_cast<std::size_t>(Term::gradTdT) + 1;
 }
 static_assert(table_in_enum_order(), "kTerms must list every Term in enum order");
 
@@ -55,6 +57,7 @@ std::span<const double> source_of(Term t, const ModelInput& in) {
     case Term::dT4:
       return in.temp_c;
     case Term::gradT:
+    case Term::gradTdT:  // and temp_c, always checked with the bias
       return in.grad_c;
     case Term::dTdt:
       return in.dtdt_c_per_h;
@@ -64,8 +67,10 @@ std::span<const double> source_of(Term t, const ModelInput& in) {
   return in.temp_c;  // not reached: the switch covers every Term
 }
 
-double regressor(Term t, double x, double ref_temp_c) {
+double regressor(Term t, double x, double temp_c, double ref_temp_c) {
   switch (t) {
+    case Term::gradTdT:
+      return x * (temp_c - ref_temp_c);
     case Term::dT:
       return x - ref_temp_c;
     case Term::dT2:
@@ -91,6 +96,7 @@ std::string source_problem(Term t, double v) {
     case Term::dT4:
       return temp_problem(v);
     case Term::gradT:
+    case Term::gradTdT:
       return temp_diff_problem(v);
     case Term::dTdt:
     case Term::channel:
@@ -115,6 +121,14 @@ void check_model_input(const ModelInput& in, const ModelSpec& spec) {
   for (std::size_t i = 0; i < in.bias_dph.size(); ++i) {
     if (auto p = rate_problem(in.bias_dph[i]); !p.empty())
       throw DataError("fit: bin " + std::to_string(i) + " of those used: bias: " + p);
+  }
+  // gradTdT also reads the temperature: checked as dT's source.
+  for (Term t : spec.terms) {
+    if (t != Term::gradTdT) continue;
+    if (in.temp_c.size() != n) throw DataError("fit: term gradTdT has no temperature for every point");
+    for (std::size_t i = 0; i < n; ++i)
+      if (auto p = temp_problem(in.temp_c[i]); !p.empty())
+        throw DataError("fit: bin " + std::to_string(i) + " of those used: temperature: " + p);
   }
   for (Term t : spec.terms) {
     const auto src = source_of(t, in);
@@ -149,7 +163,11 @@ Eigen::MatrixXd design_matrix(const ModelInput& in, const ModelSpec& spec) {
     if (src.size() != in.bias_dph.size()) {
       throw DataError("fit: term " + std::string(info(t).option) + " has no data for every point");
     }
-    for (Eigen::Index i = 0; i < n; ++i) x(i, j + 1) = regressor(t, src[i], spec.ref_temp_c);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      const double temp = t == Term::gradTdT ? in.temp_c[k] : 0.0;
+      x(i, j + 1) = regressor(t, src[k], temp, spec.ref_temp_c);
+    }
   }
   return x;
 }
@@ -171,6 +189,23 @@ Eigen::VectorXd hac_variances(const Eigen::MatrixXd& x, const Eigen::VectorXd& r
   const Eigen::MatrixXd a = r_inv * r_inv.transpose();
   const double dof_correction = static_cast<double>(n) / static_cast<double>(n - x.cols());
   return (a * s * a).diagonal() * dof_correction;
+}
+
+/// Variance inflation factor of each regressor but the constant: the diagonal of the inverse of
+/// the regressors' correlation matrix, VIF_j = 1 / (1 - R_j^2) (Kutner, Nachtsheim, Neter & Li,
+/// Applied Linear Statistical Models, 5th ed., 2005, eq. 10.41).
+std::vector<double> variance_inflation(const Eigen::MatrixXd& x) {
+  const Eigen::Index k = x.cols() - 1;
+  if (k <= 1) return std::vector<double>(static_cast<std::size_t>(std::max<Eigen::Index>(k, 0)), 1.0);
+  Eigen::MatrixXd c = x.rightCols(k).rowwise() - x.rightCols(k).colwise().mean();
+  const Eigen::VectorXd norm = c.colwise().norm().transpose();
+  c = c * norm.cwiseInverse().asDiagonal();
+  const Eigen::MatrixXd corr = c.transpose() * c;
+  const Eigen::MatrixXd inv = corr.ldlt().solve(Eigen::MatrixXd::Identity(k, k));
+  std::vector<double> vif;
+  for (Eigen::Index j = 0; j < k; ++j)
+    vif.push_back(std::isfinite(inv(j, j)) && inv(j, j) > 0 ? std::max(inv(j, j), 1.0) : INFINITY);
+  return vif;
 }
 
 }  // namespace
@@ -205,7 +240,8 @@ std::vector<Term> parse_terms(std::string_view list) {
     const auto t = term_from_option_name(word);
     if (!t) {
       throw std::invalid_argument("unknown term '" + std::string(word) +
-                                  "' (expected dT, dT2, dT3, dT4, gradT, dTdt, channel)");
+                                  "' (expected dT, dT2, dT3, dT4, gradT, dTdt, channel, "
+                                  "gradTdT)");
     }
     for (Term have : terms) {
       if (have == *t) throw std::invalid_argument("term '" + std::string(word) + "' given twice");
@@ -230,7 +266,9 @@ ModelData model_data_from_bins(std::span<const Bin> bins, double earth_rate_dph)
   return d;
 }
 
-FitResult fit_model(const ModelInput& in, const ModelSpec& spec) {
+namespace {
+
+FitResult fit_impl(const ModelInput& in, const ModelSpec& spec, const ErrorModel* fixed) {
   const std::size_t p = spec.terms.size() + 1;
   const std::size_t n = in.bias_dph.size();
   if (n <= p) {
@@ -240,6 +278,7 @@ FitResult fit_model(const ModelInput& in, const ModelSpec& spec) {
   check_model_input(in, spec);
   Eigen::MatrixXd x = design_matrix(in, spec);
   const Eigen::Map<const Eigen::VectorXd> y(in.bias_dph.data(), static_cast<Eigen::Index>(n));
+  std::vector<double> vif = variance_inflation(x);
 
   // Scale each column to unit norm: better conditioned QR and a meaningful condition number.
   Eigen::VectorXd scale = x.colwise().norm().transpose();
@@ -258,6 +297,7 @@ FitResult fit_model(const ModelInput& in, const ModelSpec& spec) {
   const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(r).singularValues();
   FitResult res;
   res.spec = spec;
+  res.vif = std::move(vif);
   res.condition_number = sv(sv.size() - 1) > 0 ? sv(0) / sv(sv.size() - 1) : INFINITY;
   if (!(res.condition_number < kSingularCondition)) {
     throw DataError("fit: the terms are linearly dependent (condition number " +
@@ -278,7 +318,7 @@ FitResult fit_model(const ModelInput& in, const ModelSpec& spec) {
   // The error model sees the orthonormal basis Q of the design (same column space, so the same
   // likelihood) and the sandwich is formed from Q and R^-1: neither squares X's condition.
   const Eigen::MatrixXd q_basis = qr.householderQ() * Eigen::MatrixXd::Identity(x.rows(), pi);
-  res.error_model = estimate_error_model(q_basis, y, in.t_s, in.segment);
+  res.error_model = fixed != nullptr ? *fixed : estimate_error_model(q_basis, y, in.t_s, in.segment);
   // No correlated part: the model's covariance is s^2 I and the errors are the OLS ones exactly.
   const Eigen::VectorXd var_model =
       res.error_model.correlated_share > 0
@@ -314,6 +354,18 @@ FitResult fit_model(const ModelInput& in, const ModelSpec& spec) {
   }
   check_result(res);
   return res;
+}
+
+}  // namespace
+
+FitResult fit_model(const ModelInput& in, const ModelSpec& spec) {
+  FitResult res = fit_impl(in, spec, nullptr);
+  diagnose_fit(in, res);
+  return res;
+}
+
+FitResult fit_model_under(const ModelInput& in, const ModelSpec& spec, const ErrorModel& model) {
+  return fit_impl(in, spec, &model);
 }
 
 std::vector<double> predict(const FitResult& fit, const ModelInput& in) {

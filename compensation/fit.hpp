@@ -15,11 +15,14 @@
 namespace station::compensation {
 
 /// A regressor of the model besides the constant B0.
-enum class Term { dT, dT2, dT3, dT4, gradT, dTdt, channel };
+/// gradTdT is the gradient times dT (a gradient sensitivity that changes with temperature): a
+/// candidate of the lack-of-fit check (fit_diagnostics.hpp) that a user may also fit.
+enum class Term { dT, dT2, dT3, dT4, gradT, dTdt, channel, gradTdT };
 
-/// Option name of a term: "dT", "dT2", "dT3", "dT4", "gradT", "dTdt", "channel".
+/// Option name of a term: "dT", "dT2", "dT3", "dT4", "gradT", "dTdt", "channel", "gradTdT".
 std::string_view term_option_name(Term t);
-/// Coefficient name of a term as the paper writes it: k1..k4, k0 (gradient), kr (rate), kc.
+/// Coefficient name of a term as the paper writes it: k1..k4, k0 (gradient), kr (rate), kc,
+/// kg (gradient x dT).
 std::string_view term_coefficient_name(Term t);
 /// Unit of a coefficient by name ("B0" -> "deg/h", "k1" -> "deg/h/C", ...); empty when unknown.
 std::string_view coefficient_unit(std::string_view coefficient_name);
@@ -82,7 +85,20 @@ struct FitResult {
   double r2 = 0;                      ///< coefficient of determination
   double residual_rms_dph = 0;        ///< sqrt(RSS / n)
   double condition_number = 0;        ///< 2-norm condition of the column-scaled design matrix
-  std::vector<std::string> warnings;  ///< e.g. nearly collinear terms
+  std::vector<std::string> warnings;  ///< e.g. nearly collinear terms, a missing term
+  /// Variance inflation factor of each term (names[1..]), Kutner et al. 2005 §10.5.
+  std::vector<double> vif;
+  /// The lack-of-fit check (fit_diagnostics.hpp): each candidate term not in the model, tried.
+  struct Candidate {
+    std::string option;       ///< "dT2", "dT3", "dTdt", "gradTdT"
+    double value = 0;         ///< its coefficient in the extended model
+    double std_error = 0;     ///< its standard error under this fit's error model
+    double z = 0;             ///< value / std_error
+    bool significant = false; ///< |z| above the Bonferroni bound
+    std::vector<double> coefficients;  ///< the extended model's, names then the candidate's
+  };
+  std::vector<Candidate> candidates;
+  double candidate_z_critical = 0;  ///< the bound |z| must pass (family-wise 1 %)
 };
 
 /// Least squares through Householder QR of the column-scaled design matrix (not normal
@@ -91,6 +107,10 @@ struct FitResult {
 /// +-kMaxAbsRateDph, temperatures and T_ref within kMinTempC..kMaxTempC, gradients within
 /// +-kMaxAbsTempDiffC), linearly dependent terms, or a result that is not finite.
 FitResult fit_model(const ModelInput& in, const ModelSpec& spec);
+
+/// The same fit under a given error model (no REML search) and without diagnostics: how the
+/// lack-of-fit check fits a model's extensions under that model's own error model.
+FitResult fit_model_under(const ModelInput& in, const ModelSpec& spec, const ErrorModel& model);
 
 /// Model value B(x) at each point.
 std::vector<double> predict(const FitResult& fit, const ModelInput& in);

@@ -51,14 +51,10 @@ json fit_row_json(const SerialFitRow& f) {
 
 json releases_json(const std::vector<ReleaseRow>& releases) {
   json out = json::array();
-  for (const auto& r : releases)
-    out.push_back({{"release_id", r.id},
-                   {"fit_id", r.fit_id},
-                   {"released_utc", r.released_utc},
-                   {"by", r.released_by},
-                   {"note", r.note},
-                   {"override", r.override_reason ? json(*r.override_reason) : json()},
-                   {"current", &r == &releases.back()}});
+  for (const auto& r : releases) {
+    out.push_back(release_json(r));
+    out.back()["current"] = &r == &releases.back();
+  }
   return out;
 }
 

@@ -76,13 +76,7 @@ std::optional<nlohmann::json> run_json(Store& store, std::int64_t run_id) {
     }
     // The serial's released calibration (it may come from another run) and its release.
     slot["released"] = nullptr;
-    if (const auto r = current_release(store, s.serial))
-      slot["released"] = {{"fit_id", r->fit_id},
-                          {"released_utc", r->released_utc},
-                          {"by", r->released_by},
-                          {"note", r->note},
-                          {"override", r->override_reason ? nlohmann::json(*r->override_reason)
-                                                          : nlohmann::json(nullptr)}};
+    if (const auto r = current_release(store, s.serial)) slot["released"] = release_json(*r);
     slots.push_back(std::move(slot));
   }
   j["slots"] = std::move(slots);

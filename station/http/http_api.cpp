@@ -219,13 +219,7 @@ void HttpServer::release_fit_route(const httplib::Request& req, httplib::Respons
     const ReleaseRow r = release_fit(store, {*id, *by, note.value_or(""), override_reason});
     log("http")->info("fit {} of {} released by {} from {}", r.fit_id, r.serial, r.released_by,
                       req.remote_addr);
-    send_json(res, 201,
-              {{"release_id", r.id},
-               {"fit_id", r.fit_id},
-               {"serial", r.serial},
-               {"released_utc", r.released_utc},
-               {"by", r.released_by},
-               {"override", r.override_reason ? nlohmann::json(*r.override_reason) : nullptr}});
+    send_json(res, 201, release_json(r));
   } catch (const FitNotFound& e) {
     send_json(res, 404, {{"error", e.what()}});
   } catch (const ReleaseRefused& e) {

@@ -1,6 +1,8 @@
 // Fit coefficients as JSON objects.
 #include "station/store/fit_json.hpp"
 
+#include <cmath>
+
 #include <fmt/format.h>
 
 namespace station {
@@ -82,7 +84,29 @@ nlohmann::json fit_summary_json(const compensation::FitResult& fit,
           {"std_ratio", std_ratio_json(eval)},
           {"improvement_pct",
            eval.improvement_pct ? nlohmann::json(*eval.improvement_pct) : nlohmann::json(nullptr)},
-          {"warnings", fit.warnings}};
+          {"warnings", fit.warnings},
+          {"diagnostics", diagnostics_json(fit)}};
+}
+
+nlohmann::json diagnostics_json(const compensation::FitResult& fit) {
+  nlohmann::json vif = nlohmann::json::object(), cands = nlohmann::json::array();
+  for (std::size_t j = 0; j < fit.vif.size() && j + 1 < fit.names.size(); ++j)
+    vif[fit.names[j + 1]] = std::isfinite(fit.vif[j]) ? nlohmann::json(fit.vif[j]) : nullptr;
+  for (const auto& c : fit.candidates) {
+    nlohmann::json coef = nlohmann::json::object();
+    for (std::size_t i = 0; i < c.coefficients.size(); ++i)
+      coef[i < fit.names.size() ? fit.names[i] : c.option] = c.coefficients[i];
+    cands.push_back({{"term", c.option},
+                     {"value", c.value},
+                     {"std_error", c.std_error},
+                     {"z", c.z},
+                     {"significant", c.significant},
+                     {"coefficients_with_it", coef}});
+  }
+  return {{"vif", vif},
+          {"vif_limit", 10.0},
+          {"missing_term_candidates", cands},
+          {"z_critical", fit.candidate_z_critical}};
 }
 
 nlohmann::json std_ratio_json(const compensation::Evaluation& eval) {

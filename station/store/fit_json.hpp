@@ -29,9 +29,12 @@ nlohmann::json std_errors_hac_json(const compensation::FitResult& fit);
 /// The fit and its evaluation as every command reports them: coefficients, std_errors,
 /// std_errors_hac, hac_lag, bins, r2, residual_rms_dph, condition_number, std_before_dph,
 /// std_after_dph, std_ratio, improvement_pct (both null when the ratio is undefined), warnings
-/// (the fit's).
+/// (the fit's), diagnostics (diagnostics_json).
 nlohmann::json fit_summary_json(const compensation::FitResult& fit,
                                 const compensation::Evaluation& eval);
+/// {"vif": {name: VIF}, "vif_limit", "missing_term_candidates": [{"term", "value", "std_error",
+/// "z", "significant", "coefficients_with_it"}], "z_critical"} (compensation/fit_diagnostics.hpp).
+nlohmann::json diagnostics_json(const compensation::FitResult& fit);
 /// The std ratio as JSON: a number, or null when undefined.
 nlohmann::json std_ratio_json(const compensation::Evaluation& eval);
 /// The std ratio for people: "0.384", or "undefined".

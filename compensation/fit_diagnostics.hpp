@@ -1,0 +1,29 @@
+// Diagnostics every fit carries (issue 22): is a term missing, and can the protocol tell the
+// terms apart?
+//
+// Lack of fit: each candidate extension of the model (dT^2, dT^3, dT/dt, gradT x dT) not already
+// in it is fitted in turn under the model's own error model (fit_model_under: the same honest
+// covariance, no new REML search), and its coefficient is tested against zero with a Wald z test,
+// z = value / standard error, a 1-degree-of-freedom F test under the error model (Greene,
+// Econometric Analysis, 7th ed., §5.4). The m candidates are tested together at a family-wise
+// level of 1 % by Bonferroni: |z| > Phi^-1(1 - 0.005 / m). A significant candidate is named in a
+// warning with what k1 and k0 become with it.
+//
+// Collinearity: the variance inflation factor of each term (fit.cpp, FitResult::vif); above 10 a
+// term is poorly determined (Kutner et al., Applied Linear Statistical Models, 5th ed., §10.5).
+// When that is k1 against k0, the warning says so in words: the protocol's gradient follows its
+// temperature, and runs at two heating rates (ramp_10 with ramp_20) separate them.
+#pragma once
+
+#include "compensation/fit.hpp"
+
+namespace station::compensation {
+
+/// The VIF above which a term is reported as poorly determined.
+inline constexpr double kVifLimit = 10.0;
+
+/// Fills fit.candidates, fit.candidate_z_critical and adds the warnings. Candidates whose data
+/// are missing (dT/dt of a 1 Hz record) or whose extended fit is impossible are skipped.
+void diagnose_fit(const ModelInput& in, FitResult& fit);
+
+}  // namespace station::compensation
