@@ -4,10 +4,13 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
+#include <tuple>
 
 #include "compensation/chi_squared.hpp"
 #include "compensation/limits.hpp"
+#include "compensation/noise_edf.hpp"
 
 namespace station::compensation {
 namespace {
@@ -37,15 +40,15 @@ double second_difference_sum(const double* theta, std::size_t m, std::size_t n_t
   return (s0 + s1) + (s2 + s3);
 }
 
-// Equivalent degrees of freedom of the overlapping AVAR for white FM noise (gyro angle random
-// walk: rate = frequency, angle = phase), the simple approximation of Howe, Allan & Barnes (1981)
-// given in NIST SP 1065 §5.3, Table 5: edf = [3(N-1)/(2m) - 2(N-2)/N] * 4m^2/(4m^2+5), with N
-// the number of phase (angle) points. Floored at 1: for N - 2m close to 1 the formula drops
-// below the single degree of freedom a one-term sum still has.
-double white_fm_edf(double n_angle, double m) {
-  const double edf = (3.0 * (n_angle - 1.0) / (2.0 * m) - 2.0 * (n_angle - 2.0) / n_angle) *
-                     (4.0 * m * m / (4.0 * m * m + 5.0));
-  return std::max(edf, 1.0);
+// Sum over k < n_terms of (theta[k+3m] - 3 theta[k+2m] + 3 theta[k+m] - theta[k])^2: the
+// Hadamard variance's third difference (NIST SP 1065 §5.2.8, eq. 23 with x = tau0 theta).
+double third_difference_sum(const double* theta, std::size_t m, std::size_t n_terms) {
+  double s = 0;
+  for (std::size_t k = 0; k < n_terms; ++k) {
+    const double d = theta[k + 3 * m] - 3.0 * theta[k + 2 * m] + 3.0 * theta[k + m] - theta[k];
+    s += d * d;
+  }
+  return s;
 }
 
 // Reading noise terms off the curve (IEEE Std 952-1997 Annex C, Table C.2). A term whose ADEV
@@ -123,8 +126,15 @@ std::vector<std::size_t> tau_factors(std::size_t n, TauSpacing spacing) {
   return out;
 }
 
+std::pair<double, double> chi_squared_interval(double dev, double edf, double confidence) {
+  const double alpha = 1.0 - confidence;
+  return {dev * std::sqrt(edf / chi_squared_quantile(1.0 - alpha / 2.0, edf)),
+          dev * std::sqrt(edf / chi_squared_quantile(alpha / 2.0, edf))};
+}
+
 std::vector<AdevPoint> overlapping_adev(std::span<const double> rate, double rate_hz,
-                                        std::span<const std::size_t> m_list, double confidence) {
+                                        std::span<const std::size_t> m_list, double confidence,
+                                        DeviationKind kind) {
   if (!(rate_hz > 0.0) || !std::isfinite(rate_hz) || !(confidence > 0.0 && confidence < 1.0)) {
     throw DataError("overlapping_adev: need rate_hz > 0 and 0 < confidence < 1, got " +
                     std::to_string(rate_hz) + ", " + std::to_string(confidence));
@@ -149,29 +159,39 @@ std::vector<AdevPoint> overlapping_adev(std::span<const double> rate, double rat
   theta[0] = 0.0;
   for (std::size_t i = 0; i < rate.size(); ++i) theta[i + 1] = theta[i] + (rate[i] - mean);
 
-  const double alpha = 1.0 - confidence;
   const double tau0_s = 1.0 / rate_hz;
+  const bool hadamard = kind == DeviationKind::hdev;
+  const std::size_t order = hadamard ? 3 : 2;  // the difference the variance takes of the angle
+  std::optional<int> last_alpha;
   for (std::size_t m : m_list) {
-    if (m == 0 || 2 * m >= n_angle) continue;  // fewer than 1 term
-    const std::size_t n_terms = n_angle - 2 * m;
+    if (m == 0 || order * m >= n_angle) continue;  // fewer than 1 term
+    const std::size_t n_terms = n_angle - order * m;
     // NIST SP 1065 §5.2.4, overlapping AVAR from phase data:
     //   AVAR(m tau0) = 1 / (2 tau^2 (N - 2m)) sum_{k} (x_{k+2m} - 2 x_{k+m} + x_k)^2,
-    // with x = tau0 * theta and tau = m tau0, so tau0^2 cancels: 1 / (2 m^2 (N - 2m)).
-    const double sum = second_difference_sum(theta.data(), m, n_terms);
+    // and §5.2.8, overlapping HVAR: 1 / (6 tau^2 (N - 3m)) sum_k (third difference)^2,
+    // with x = tau0 * theta and tau = m tau0, so tau0^2 cancels.
+    const double sum = hadamard ? third_difference_sum(theta.data(), m, n_terms)
+                                : second_difference_sum(theta.data(), m, n_terms);
     const double md = static_cast<double>(m);
     AdevPoint p;
     p.m = m;
     p.tau_s = md * tau0_s;
     p.n = n_terms;
-    p.adev = std::sqrt(sum / (2.0 * md * md * static_cast<double>(n_terms)));
+    p.adev = std::sqrt(sum / ((hadamard ? 6.0 : 2.0) * md * md * static_cast<double>(n_terms)));
     if (!std::isfinite(p.adev)) {
       throw DataError("overlapping_adev: the Allan deviation at m = " + std::to_string(m) +
                       " overflows: the values are too large");
     }
-    p.edf = white_fm_edf(static_cast<double>(n_angle), md);
-    // Chi-squared interval, NIST SP 1065 §5.3: edf * s^2 / sigma^2 ~ chi^2(edf).
-    p.ci_low = p.adev * std::sqrt(p.edf / chi_squared_quantile(1.0 - alpha / 2.0, p.edf));
-    p.ci_high = p.adev * std::sqrt(p.edf / chi_squared_quantile(alpha / 2.0, p.edf));
+    // The noise at this tau decides the interval (Greenhall & Riley 2003): identified where 30
+    // averages remain, else carried from the largest tau where it was; white FM (the gyro's
+    // angle random walk) when the series is too short to identify anything.
+    if (const auto id = identify_noise(rate, m, static_cast<int>(order))) {
+      last_alpha = id->alpha;
+      p.alpha_identified = true;
+    }
+    p.alpha = last_alpha.value_or(0);
+    p.edf = greenhall_edf(p.alpha, static_cast<int>(order), md, static_cast<double>(n_angle), true);
+    std::tie(p.ci_low, p.ci_high) = chi_squared_interval(p.adev, p.edf, confidence);
     out.push_back(p);
   }
   return out;

@@ -6,6 +6,7 @@
 #include <optional>
 #include <span>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace station::compensation {
@@ -30,17 +31,31 @@ struct AdevPoint {
   double ci_high = 0;  ///< upper bound
   std::size_t n = 0;   ///< number of terms in the overlapping sum (N - 2m, N angle points)
   double edf = 0;      ///< equivalent degrees of freedom used for the interval
+  /// Power-law exponent of the noise the interval assumes (noise_edf.hpp: +2 white PM .. -2
+  /// random-walk FM), identified at this tau by the lag-1 method, or carried from the largest
+  /// tau where it could be (fewer than 30 averages left: `alpha_identified` false).
+  int alpha = 0;
+  bool alpha_identified = false;
 };
 
-/// Overlapping ADEV of `rate` (any rate unit, sampled at rate_hz) at each factor in `m_list`,
-/// computed from the integrated angle in O(N) per tau; interval at `confidence` (two-sided).
-/// Factors with fewer than 1 term are skipped. Interval from the white-FM (angle random walk)
-/// edf of NIST SP 1065 Table 5. Throws DataError unless rate_hz > 0 is finite,
-/// 0 < confidence < 1 and every sample is finite, or when the result overflows. Pure; no allocation
-/// beyond the result and one cumulative-sum buffer.
+/// Which deviation: Allan (second difference of the angle) or Hadamard (third difference:
+/// insensitive to a linear drift of the rate; NIST SP 1065 §5.2.8).
+enum class DeviationKind { adev, hdev };
+
+/// Overlapping ADEV (or HDEV) of `rate` (any rate unit, sampled at rate_hz) at each factor in
+/// `m_list` (increasing), computed from the integrated angle in O(N) per tau; interval at
+/// `confidence` (two-sided) from the chi-squared distribution with the equivalent degrees of
+/// freedom of Greenhall & Riley for the noise identified at that tau (noise_edf.hpp). Factors
+/// with fewer than 1 term are skipped. Throws DataError unless rate_hz > 0 is finite,
+/// 0 < confidence < 1 and every sample is finite, or when the result overflows. Pure.
 std::vector<AdevPoint> overlapping_adev(std::span<const double> rate, double rate_hz,
                                         std::span<const std::size_t> m_list,
-                                        double confidence = 0.683);
+                                        double confidence = 0.683,
+                                        DeviationKind kind = DeviationKind::adev);
+
+/// The two-sided interval of a deviation `dev` estimated with `edf` equivalent degrees of
+/// freedom at `confidence`: edf s^2 / sigma^2 ~ chi^2(edf) (NIST SP 1065 §5.3, eq. 47).
+std::pair<double, double> chi_squared_interval(double dev, double edf, double confidence);
 
 /// Noise coefficients read off an ADEV curve of a rate series in deg/h (IEEE 952 Table C.2).
 /// Each is empty when the curve does not reach the region it is read from.

@@ -21,6 +21,7 @@ struct AdevOptions {
   std::string file, col;
   double rate_hz = 1.0;
   std::string taus = "octave";
+  std::string kind = "adev";  ///< adev or hdev
   bool json = false;
 };
 
@@ -70,14 +71,19 @@ nlohmann::json noise_json(const sc::NoiseTerms& nt) {
 
 void print_table(const AdevOptions& o, std::size_t n, const std::vector<sc::AdevPoint>& pts,
                  const sc::NoiseTerms& nt) {
+  const bool h = o.kind == "hdev";
   fmt::print(
-      "{}: column '{}', {} samples at {:g} Hz, overlapping ADEV (IEEE 952 / NIST SP 1065)\n\n",
-      o.file, o.col, n, o.rate_hz);
-  fmt::print("  {:>12} {:>9} {:>13} {:>13} {:>13} {:>9}\n", "tau_s", "m", "adev", "ci_low",
-             "ci_high", "n");
+      "{}: column '{}', {} samples at {:g} Hz, overlapping {} (IEEE 952 / NIST SP 1065); 68.3 % "
+      "intervals with Greenhall's edf for the noise identified at each tau (alpha: +2 white PM, "
+      "0 white FM = ARW, -1 flicker FM = bias instability, -2 random-walk FM = RRW; * carried "
+      "from a shorter tau)\n\n",
+      o.file, o.col, n, o.rate_hz, h ? "Hadamard deviation" : "Allan deviation");
+  fmt::print("  {:>12} {:>9} {:>13} {:>13} {:>13} {:>9} {:>6} {:>8}\n", "tau_s", "m",
+             h ? "hdev" : "adev", "ci_low", "ci_high", "n", "alpha", "edf");
   for (const auto& p : pts) {
-    fmt::print("  {:>12g} {:>9} {:>13.5e} {:>13.5e} {:>13.5e} {:>9}\n", p.tau_s, p.m, p.adev,
-               p.ci_low, p.ci_high, p.n);
+    fmt::print("  {:>12g} {:>9} {:>13.5e} {:>13.5e} {:>13.5e} {:>9} {:>5}{} {:>8.1f}\n", p.tau_s,
+               p.m, p.adev, p.ci_low, p.ci_high, p.n, p.alpha, p.alpha_identified ? " " : "*",
+               p.edf);
   }
   auto line = [](const char* what, const std::optional<double>& v, const char* unit) {
     if (v)
@@ -103,6 +109,10 @@ void add_adev_command(CLI::App& app, CommandStatus& status) {
       ->capture_default_str()
       ->check(finite_positive(1e9, "Hz"));
   cmd->add_option("--taus", o->taus, "octave|decade|all|LIST of tau in s")->capture_default_str();
+  cmd->add_option("--kind", o->kind,
+                  "adev (Allan) or hdev (Hadamard: insensitive to a linear rate drift)")
+      ->check(CLI::IsMember({"adev", "hdev"}))
+      ->capture_default_str();
   cmd->add_flag("--json", o->json, "print one JSON object");
   cmd->callback([o, &status] {
     const CsvColumns csv = read_csv_columns(o->file, {o->col});
@@ -113,7 +123,9 @@ void add_adev_command(CLI::App& app, CommandStatus& status) {
     const auto ms = factors_from(*o, rate.size());
     std::vector<sc::AdevPoint> pts;
     try {
-      pts = sc::overlapping_adev(rate, o->rate_hz, ms);
+      pts = sc::overlapping_adev(rate, o->rate_hz, ms, 0.683,
+                                 o->kind == "hdev" ? sc::DeviationKind::hdev
+                                                   : sc::DeviationKind::adev);
     } catch (const sc::DataError& e) {
       throw InputError(fmt::format("{}: column '{}': {}", o->file, o->col, e.what()));
     }
@@ -126,9 +138,13 @@ void add_adev_command(CLI::App& app, CommandStatus& status) {
                         {"adev", p.adev},
                         {"ci_low", p.ci_low},
                         {"ci_high", p.ci_high},
-                        {"n", p.n}});
+                        {"n", p.n},
+                        {"alpha", p.alpha},
+                        {"alpha_identified", p.alpha_identified},
+                        {"edf", p.edf}});
       }
-      std::cout << nlohmann::json{{"rows", rows}, {"noise", noise_json(nt)}}.dump(2) << '\n';
+      std::cout << nlohmann::json{{"kind", o->kind}, {"rows", rows}, {"noise", noise_json(nt)}}.dump(2)
+                << '\n';
     } else {
       print_table(*o, rate.size(), pts, nt);
     }

@@ -114,7 +114,7 @@ Analysis analyze(const AnalyzeOptions& o) {
 }
 
 nlohmann::json to_json(const Analysis& a) {
-  nlohmann::json j = fit_summary_json(a.fit, a.eval);
+  nlohmann::json j = fit_summary_json_with_diagnostics(a.fit, a.eval);
   j["bins_flagged"] = a.bins_flagged;
   j["samples"] = a.samples;
   j["earth_rate_dph"] = a.earth_rate_dph;
@@ -137,10 +137,13 @@ void print_table(const AnalyzeOptions& o, const Analysis& a) {
         return s;
       }(),
       o.ref_temp_c);
-  fmt::print("  {:<4} {:>14} {:>12} {:>14}\n", "term", "value", "std error", "Newey-West");
+  fmt::print("  {:<4} {:>14} {:>12} {:>14} {:>7}\n", "term", "value", "std error", "Newey-West",
+             "VIF");
   for (std::size_t i = 0; i < a.fit.names.size(); ++i) {
-    fmt::print("  {:<4} {:>14.6e} {:>12.3e} {:>14.3e}\n", a.fit.names[i], a.fit.coefficients[i],
-               a.fit.std_errors[i], a.fit.std_errors_hac[i]);
+    const std::string vif =
+        i == 0 || i > a.fit.vif.size() ? "-" : fmt::format("{:.1f}", a.fit.vif[i - 1]);
+    fmt::print("  {:<4} {:>14.6e} {:>12.3e} {:>14.3e} {:>7}\n", a.fit.names[i],
+               a.fit.coefficients[i], a.fit.std_errors[i], a.fit.std_errors_hac[i], vif);
   }
   fmt::print("\n{}\n", evaluation_text(a.eval));
   fmt::print("R^2 {:.4f}, residual RMS {:.5f} deg/h, condition number {:.1f}\n", a.fit.r2,

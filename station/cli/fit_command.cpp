@@ -84,7 +84,7 @@ std::string unit_of(const std::string& name) {
 
 nlohmann::json fit_json(const JudgedFit& jf) {
   const SerialFit& f = jf.fit;
-  nlohmann::json j = fit_summary_json(f.fit, f.eval);
+  nlohmann::json j = fit_summary_json_with_diagnostics(f.fit, f.eval);
   j["serial"] = f.serial;
   j["fit_id"] = f.fit_id;
   j["runs"] = f.runs;
@@ -99,9 +99,12 @@ void print_fit(const JudgedFit& jf) {
   fmt::print("{}: fit {} over runs {} ({} bins)\n", f.serial, f.fit_id, fmt::join(f.runs, ","),
              f.fit.n_points);
   for (std::size_t i = 0; i < f.fit.names.size(); ++i) {
-    fmt::print("  {:<3} {:>13.5e} +- {:.2e} {:<9} (OLS +- {:.2e})\n", f.fit.names[i],
+    const std::string vif = i == 0 || i > f.fit.vif.size()
+                                ? std::string()
+                                : fmt::format("  VIF {:.1f}", f.fit.vif[i - 1]);
+    fmt::print("  {:<3} {:>13.5e} +- {:.2e} {:<9} (OLS +- {:.2e}){}\n", f.fit.names[i],
                f.fit.coefficients[i], f.fit.std_errors[i], unit_of(f.fit.names[i]),
-               f.fit.std_errors_ols[i]);
+               f.fit.std_errors_ols[i], vif);
   }
   fmt::print("  {}\n", error_model_text(f.fit.error_model));
   fmt::print("  {}\n", evaluation_text(f.eval));

@@ -84,8 +84,14 @@ nlohmann::json fit_summary_json(const compensation::FitResult& fit,
           {"std_ratio", std_ratio_json(eval)},
           {"improvement_pct",
            eval.improvement_pct ? nlohmann::json(*eval.improvement_pct) : nlohmann::json(nullptr)},
-          {"warnings", fit.warnings},
-          {"diagnostics", diagnostics_json(fit)}};
+          {"warnings", fit.warnings}};
+}
+
+nlohmann::json fit_summary_json_with_diagnostics(const compensation::FitResult& fit,
+                                                 const compensation::Evaluation& eval) {
+  nlohmann::json j = fit_summary_json(fit, eval);
+  j["diagnostics"] = diagnostics_json(fit);
+  return j;
 }
 
 nlohmann::json diagnostics_json(const compensation::FitResult& fit) {

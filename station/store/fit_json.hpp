@@ -29,9 +29,13 @@ nlohmann::json std_errors_hac_json(const compensation::FitResult& fit);
 /// The fit and its evaluation as every command reports them: coefficients, std_errors,
 /// std_errors_hac, hac_lag, bins, r2, residual_rms_dph, condition_number, std_before_dph,
 /// std_after_dph, std_ratio, improvement_pct (both null when the ratio is undefined), warnings
-/// (the fit's), diagnostics (diagnostics_json).
+/// (the fit's). The shape of a stored fit (sessions' result.json compare it).
 nlohmann::json fit_summary_json(const compensation::FitResult& fit,
                                 const compensation::Evaluation& eval);
+/// fit_summary_json plus "diagnostics" (diagnostics_json): a fit just computed (analyze, fit);
+/// a fit read back from the store has no diagnostics (only their warnings are stored).
+nlohmann::json fit_summary_json_with_diagnostics(const compensation::FitResult& fit,
+                                                 const compensation::Evaluation& eval);
 /// {"vif": {name: VIF}, "vif_limit", "missing_term_candidates": [{"term", "value", "std_error",
 /// "z", "significant", "coefficients_with_it"}], "z_critical"} (compensation/fit_diagnostics.hpp).
 nlohmann::json diagnostics_json(const compensation::FitResult& fit);
