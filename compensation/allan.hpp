@@ -65,7 +65,26 @@ struct NoiseTerms {
   std::optional<double> bias_instability_dph;       ///< B: flat minimum / 0.664, deg/h
   std::optional<double> bias_instability_tau_s;     ///< tau of that minimum, s
   std::optional<double> rate_random_walk_dph_rth;   ///< K: tau^+1/2 line at tau = 3, deg/h/sqrt(h)
+  /// Standard errors of the four, when they come from the weighted fit (fit_noise_terms).
+  std::optional<double> quantization_se, angle_random_walk_se, bias_instability_se,
+      rate_random_walk_se;
+  /// The fit's chi^2 per degree of freedom (about 1 when the four terms explain the curve).
+  std::optional<double> fit_chi2_per_dof;
 };
+
+/// The IEEE 952 terms from a weighted least-squares fit of the Allan variance over the whole
+/// curve (IEEE Std 952-1997 Annex C, Table C.2: sigma^2 = 3 Q^2/tau^2 + N'^2/tau + (2 ln 2/pi) B^2
+/// + K'^2 tau/3), each point weighted by the inverse variance of its AVAR estimate,
+/// 2 sigma^4 / edf (chi-squared with the point's Greenhall edf), the model's sigma iterated in
+/// place of the noisy estimate; the squared coefficients kept non-negative (the best of the
+/// term subsets whose fit is feasible: the NNLS solution). The terms no longer depend on which
+/// taus the curve has. Standard errors from the fit's covariance, scaled up by chi^2/dof when the
+/// model does not explain the points, and carried to each coefficient by the delta method
+/// (se(c) = se(c^2) / 2c). Rate in deg/h, tau in s. Pure.
+NoiseTerms fit_noise_terms(std::span<const AdevPoint> curve);
+
+/// The Allan deviation the terms predict at tau (deg/h): the fitted model drawn on a figure.
+double noise_model_adev(const NoiseTerms& terms, double tau_s);
 
 /// Reads the noise terms off `curve` (rate in deg/h, tau in s): each coefficient from the tangent
 /// line of its slope touching the curve from below, only where the curve has a stretch of that

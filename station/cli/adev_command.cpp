@@ -62,11 +62,17 @@ nlohmann::json noise_json(const sc::NoiseTerms& nt) {
   auto opt = [](const std::optional<double>& v) {
     return v ? nlohmann::json(*v) : nlohmann::json();
   };
-  return {{"quantization_arcsec", opt(nt.quantization_arcsec)},
+  return {{"method", "weighted fit of the Allan variance (IEEE 952 Table C.2)"},
+          {"quantization_arcsec", opt(nt.quantization_arcsec)},
+          {"quantization_se_arcsec", opt(nt.quantization_se)},
           {"angle_random_walk_deg_rth", opt(nt.angle_random_walk_deg_rth)},
+          {"angle_random_walk_se_deg_rth", opt(nt.angle_random_walk_se)},
           {"bias_instability_dph", opt(nt.bias_instability_dph)},
+          {"bias_instability_se_dph", opt(nt.bias_instability_se)},
           {"bias_instability_tau_s", opt(nt.bias_instability_tau_s)},
-          {"rate_random_walk_dph_rth", opt(nt.rate_random_walk_dph_rth)}};
+          {"rate_random_walk_dph_rth", opt(nt.rate_random_walk_dph_rth)},
+          {"rate_random_walk_se_dph_rth", opt(nt.rate_random_walk_se)},
+          {"chi2_per_dof", opt(nt.fit_chi2_per_dof)}};
 }
 
 void print_table(const AdevOptions& o, std::size_t n, const std::vector<sc::AdevPoint>& pts,
@@ -85,17 +91,21 @@ void print_table(const AdevOptions& o, std::size_t n, const std::vector<sc::Adev
                p.m, p.adev, p.ci_low, p.ci_high, p.n, p.alpha, p.alpha_identified ? " " : "*",
                p.edf);
   }
-  auto line = [](const char* what, const std::optional<double>& v, const char* unit) {
+  auto line = [](const char* what, const std::optional<double>& v,
+                 const std::optional<double>& se, const char* unit) {
     if (v)
-      fmt::print("  {:<26} {:.4e} {}\n", what, *v, unit);
+      fmt::print("  {:<26} {:.4e} +- {:.1e} {}\n", what, *v, se.value_or(NAN), unit);
     else
-      fmt::print("  {:<26} (not reached by the curve)\n", what);
+      fmt::print("  {:<26} (not in the fit: zero)\n", what);
   };
-  fmt::print("\nnoise terms (units assume the column is in deg/h):\n");
-  line("quantization Q", nt.quantization_arcsec, "arcsec");
-  line("angle random walk N", nt.angle_random_walk_deg_rth, "deg/sqrt(h)");
-  line("bias instability B", nt.bias_instability_dph, "deg/h");
-  line("rate random walk K", nt.rate_random_walk_dph_rth, "deg/h/sqrt(h)");
+  fmt::print(
+      "\nnoise terms, weighted fit of the whole Allan-variance curve (IEEE 952 Table C.2; units "
+      "assume the column is in deg/h; chi2/dof {:.2f}):\n",
+      nt.fit_chi2_per_dof.value_or(NAN));
+  line("quantization Q", nt.quantization_arcsec, nt.quantization_se, "arcsec");
+  line("angle random walk N", nt.angle_random_walk_deg_rth, nt.angle_random_walk_se, "deg/sqrt(h)");
+  line("bias instability B", nt.bias_instability_dph, nt.bias_instability_se, "deg/h");
+  line("rate random walk K", nt.rate_random_walk_dph_rth, nt.rate_random_walk_se, "deg/h/sqrt(h)");
 }
 
 }  // namespace
@@ -129,7 +139,7 @@ void add_adev_command(CLI::App& app, CommandStatus& status) {
     } catch (const sc::DataError& e) {
       throw InputError(fmt::format("{}: column '{}': {}", o->file, o->col, e.what()));
     }
-    const auto nt = sc::noise_terms(pts);
+    const auto nt = sc::fit_noise_terms(pts);
     if (o->json) {
       nlohmann::json rows = nlohmann::json::array();
       for (const auto& p : pts) {

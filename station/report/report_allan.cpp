@@ -67,8 +67,8 @@ AllanCurves allan_curves(const OneHzRecord& record) {
   const auto m = sc::tau_factors(record.bias_dph.size(), sc::TauSpacing::octave);
   c.before = sc::overlapping_adev(record.bias_dph, kRateHz, m, kConfidence);
   c.after = sc::overlapping_adev(record.compensated_dph, kRateHz, m, kConfidence);
-  c.noise_before = sc::noise_terms(c.before);
-  c.noise_after = sc::noise_terms(c.after);
+  c.noise_before = sc::fit_noise_terms(c.before);
+  c.noise_after = sc::fit_noise_terms(c.after);
   return c;
 }
 
@@ -85,6 +85,19 @@ Figure figure_5b(const AllanCurves& curves) {
       s.y.push_back(p.adev);
       s.y_low.push_back(p.ci_low);
       s.y_high.push_back(p.ci_high);
+    }
+    f.series.push_back(std::move(s));
+  }
+  // The IEEE 952 terms fitted to each curve, drawn as the curve they predict.
+  for (const auto* curve : {&curves.before, &curves.after}) {
+    const auto& terms = curve == &curves.before ? curves.noise_before : curves.noise_after;
+    if (!terms.fit_chi2_per_dof) continue;
+    Series s;
+    s.label = curve == &curves.before ? "fitted terms (before)" : "fitted terms (after)";
+    s.line = true;
+    for (const auto& p : *curve) {
+      s.x.push_back(p.tau_s);
+      s.y.push_back(sc::noise_model_adev(terms, p.tau_s));
     }
     f.series.push_back(std::move(s));
   }

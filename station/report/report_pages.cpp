@@ -105,17 +105,25 @@ std::string evaluation_table(const FitRecord& rec) {
 
 std::string noise_table(const AllanCurves& a) {
   std::string t =
-      "<table class=\"noise\">\n<tr><th>noise term (IEEE 952 Table C.2)</th><th>before</th>"
+      "<table class=\"noise\">\n<tr><th>noise term (IEEE 952 Table C.2), fitted over the whole Allan "
+      "variance</th><th>before</th>"
       "<th>after</th></tr>\n";
   const auto& b = a.noise_before;
   const auto& c = a.noise_after;
-  t += row({"quantization Q, arcsec", num(b.quantization_arcsec), num(c.quantization_arcsec)});
-  t += row({"angle random walk N, deg/\u221ah", num(b.angle_random_walk_deg_rth),
-            num(c.angle_random_walk_deg_rth)});
-  t += row({"bias instability B, deg/h", num(b.bias_instability_dph), num(c.bias_instability_dph)});
-  t += row({"at \u03c4, s", num(b.bias_instability_tau_s), num(c.bias_instability_tau_s)});
-  t += row({"rate random walk K, deg/h/\u221ah", num(b.rate_random_walk_dph_rth),
-            num(c.rate_random_walk_dph_rth)});
+  // value ± standard error of the weighted fit over the whole curve (compensation/allan.hpp).
+  const auto pm = [](const std::optional<double>& v, const std::optional<double>& se) {
+    return v ? num(v) + (se ? " &plusmn; " + num(se, "{:.2g}") : std::string()) : "0 (not in fit)";
+  };
+  t += row({"quantization Q, arcsec", pm(b.quantization_arcsec, b.quantization_se),
+            pm(c.quantization_arcsec, c.quantization_se)});
+  t += row({"angle random walk N, deg/\u221ah", pm(b.angle_random_walk_deg_rth, b.angle_random_walk_se),
+            pm(c.angle_random_walk_deg_rth, c.angle_random_walk_se)});
+  t += row({"bias instability B, deg/h", pm(b.bias_instability_dph, b.bias_instability_se),
+            pm(c.bias_instability_dph, c.bias_instability_se)});
+  t += row({"flattest at \u03c4, s", num(b.bias_instability_tau_s), num(c.bias_instability_tau_s)});
+  t += row({"rate random walk K, deg/h/\u221ah", pm(b.rate_random_walk_dph_rth, b.rate_random_walk_se),
+            pm(c.rate_random_walk_dph_rth, c.rate_random_walk_se)});
+  t += row({"fit \u03c7\u00b2/dof", num(b.fit_chi2_per_dof, "{:.2f}"), num(c.fit_chi2_per_dof, "{:.2f}")});
   return t + "</table>\n";
 }
 
