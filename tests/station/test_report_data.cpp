@@ -187,8 +187,16 @@ TEST(ReportData, AllanCurvesOfWhiteNoiseAfterCompensationReadTheNoise) {
   EXPECT_GT(c.before.back().adev, 10 * c.after.back().adev);
   const auto f = rp::figure_5b(c);
   EXPECT_TRUE(f.log_axes);
-  EXPECT_EQ(f.points(), 2 * c.before.size());
+  // The two measured curves and the two curves of the fitted IEEE 952 terms.
+  ASSERT_EQ(f.series.size(), 4u);
+  EXPECT_EQ(f.points(), 4 * c.before.size());
   EXPECT_EQ(f.series[1].y_low.size(), c.after.size());
+  EXPECT_EQ(f.series[3].label, "fitted terms (after)");
+  // White noise of sigma per 1 s sample is an angle random walk N = sigma / 60 deg/sqrt(h): the
+  // fitted term finds it within 3 of its standard errors.
+  ASSERT_TRUE(c.noise_after.angle_random_walk_deg_rth && c.noise_after.angle_random_walk_se);
+  EXPECT_NEAR(*c.noise_after.angle_random_walk_deg_rth, kSigmaDph / 60,
+              3 * *c.noise_after.angle_random_walk_se);
   EXPECT_TRUE(f.note.empty());
   EXPECT_EQ(rp::figure_5b(rp::allan_curves({})).points(), 0u);
 }
