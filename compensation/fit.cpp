@@ -327,7 +327,10 @@ FitResult fit_impl(const ModelInput& in, const ModelSpec& spec, const ErrorModel
   // Lag rule of Newey & West (1994): L = floor(4 (n/100)^(2/9)).
   res.hac_lag = static_cast<std::size_t>(
       std::floor(4.0 * std::pow(static_cast<double>(n) / 100.0, 2.0 / 9.0)));
-  const Eigen::VectorXd var_hac = hac_variances(x, resid, r_inv, res.hac_lag);
+  // The lack-of-fit extensions (fixed error model) need only the error model's variances: no
+  // Newey-West pass over the bins for them.
+  const Eigen::VectorXd var_hac = fixed != nullptr ? Eigen::VectorXd::Zero(pi)
+                                                   : hac_variances(x, resid, r_inv, res.hac_lag);
   res.names.emplace_back("B0");
   for (Term t : spec.terms) res.names.emplace_back(info(t).coefficient);
   for (Eigen::Index j = 0; j < pi; ++j) {
