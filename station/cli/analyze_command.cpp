@@ -170,7 +170,7 @@ void add_analyze_command(CLI::App& app, CommandStatus& status) {
   cmd->add_option("--ref-temp-c", o->ref_temp_c, "reference temperature T_ref, C")
       ->capture_default_str()
       ->check(finite_within(sc::kMinTempC, sc::kMaxTempC, "C"));
-  cmd->add_option("--terms", o->terms, "dT,dT2,dT3,dT4,gradT,dTdt (B0 always)")
+  cmd->add_option("--terms", o->terms, "dT,dT2,dT3,dT4,gradT,dTdt,gradTdT (B0 always)")
       ->capture_default_str();
   // A component of the Earth rate cannot exceed the rate itself; 0.1 % slack for a user's
   // rounding of 15.041 deg/h.

@@ -170,7 +170,7 @@ void add_fit_commands(CLI::App& app, CommandStatus& status) {
   fit->add_option("--parts", o->parts,
                   "part file: judge against it (default: the limits stored with the run)");
   fit->add_option("--part", o->part, "part number (default: the one the run's slot named)");
-  fit->add_option("--terms", o->terms, "dT,dT2,dT3,dT4,gradT,dTdt (B0 always)")
+  fit->add_option("--terms", o->terms, "dT,dT2,dT3,dT4,gradT,dTdt,gradTdT (B0 always)")
       ->capture_default_str();
   fit->add_option("--ref-temp-c", o->ref_temp_c, "T_ref, C")->capture_default_str();
   fit->add_flag("--json", o->json, "print JSON");
