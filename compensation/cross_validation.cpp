@@ -29,8 +29,7 @@ CrossValidation leave_one_run_out(const ModelInput& in, const ModelSpec& spec) {
   if (in.segment.size() != in.bias_dph.size())
     throw std::invalid_argument("cross-validation: every bin needs its run (segment)");
   const std::set<int> segments(in.segment.begin(), in.segment.end());
-  if (segments.size() < 2)
-    throw std::invalid_argument("cross-validation needs two or more runs");
+  if (segments.size() < 2) throw std::invalid_argument("cross-validation needs two or more runs");
   CrossValidation cv;
   cv.in_sample_rms_dph = fit_model(in, spec).residual_rms_dph;
   double ss = 0;

@@ -15,10 +15,10 @@ namespace station::compensation {
 
 /// One held-out run.
 struct HeldOutRun {
-  int segment = 0;           ///< the run's segment index in the input
-  std::size_t bins = 0;      ///< its bins
-  double rms_dph = 0;        ///< RMS of bias - prediction over its bins, deg/h
-  double std_dph = 0;        ///< sample std of bias - prediction (the compensated std), deg/h
+  int segment = 0;       ///< the run's segment index in the input
+  std::size_t bins = 0;  ///< its bins
+  double rms_dph = 0;    ///< RMS of bias - prediction over its bins, deg/h
+  double std_dph = 0;    ///< sample std of bias - prediction (the compensated std), deg/h
 };
 
 /// The cross-validation of one model over several runs.

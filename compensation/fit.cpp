@@ -125,7 +125,8 @@ void check_model_input(const ModelInput& in, const ModelSpec& spec) {
   // gradTdT also reads the temperature: checked as dT's source.
   for (Term t : spec.terms) {
     if (t != Term::gradTdT) continue;
-    if (in.temp_c.size() != n) throw DataError("fit: term gradTdT has no temperature for every point");
+    if (in.temp_c.size() != n)
+      throw DataError("fit: term gradTdT has no temperature for every point");
     for (std::size_t i = 0; i < n; ++i)
       if (auto p = temp_problem(in.temp_c[i]); !p.empty())
         throw DataError("fit: bin " + std::to_string(i) + " of those used: temperature: " + p);
@@ -196,7 +197,8 @@ Eigen::VectorXd hac_variances(const Eigen::MatrixXd& x, const Eigen::VectorXd& r
 /// Applied Linear Statistical Models, 5th ed., 2005, eq. 10.41).
 std::vector<double> variance_inflation(const Eigen::MatrixXd& x) {
   const Eigen::Index k = x.cols() - 1;
-  if (k <= 1) return std::vector<double>(static_cast<std::size_t>(std::max<Eigen::Index>(k, 0)), 1.0);
+  if (k <= 1)
+    return std::vector<double>(static_cast<std::size_t>(std::max<Eigen::Index>(k, 0)), 1.0);
   Eigen::MatrixXd c = x.rightCols(k).rowwise() - x.rightCols(k).colwise().mean();
   const Eigen::VectorXd norm = c.colwise().norm().transpose();
   c = c * norm.cwiseInverse().asDiagonal();
@@ -318,7 +320,8 @@ FitResult fit_impl(const ModelInput& in, const ModelSpec& spec, const ErrorModel
   // The error model sees the orthonormal basis Q of the design (same column space, so the same
   // likelihood) and the sandwich is formed from Q and R^-1: neither squares X's condition.
   const Eigen::MatrixXd q_basis = qr.householderQ() * Eigen::MatrixXd::Identity(x.rows(), pi);
-  res.error_model = fixed != nullptr ? *fixed : estimate_error_model(q_basis, y, in.t_s, in.segment);
+  res.error_model =
+      fixed != nullptr ? *fixed : estimate_error_model(q_basis, y, in.t_s, in.segment);
   // No correlated part: the model's covariance is s^2 I and the errors are the OLS ones exactly.
   const Eigen::VectorXd var_model =
       res.error_model.correlated_share > 0
@@ -329,8 +332,8 @@ FitResult fit_impl(const ModelInput& in, const ModelSpec& spec, const ErrorModel
       std::floor(4.0 * std::pow(static_cast<double>(n) / 100.0, 2.0 / 9.0)));
   // The lack-of-fit extensions (fixed error model) need only the error model's variances: no
   // Newey-West pass over the bins for them.
-  const Eigen::VectorXd var_hac = fixed != nullptr ? Eigen::VectorXd::Zero(pi)
-                                                   : hac_variances(x, resid, r_inv, res.hac_lag);
+  const Eigen::VectorXd var_hac =
+      fixed != nullptr ? Eigen::VectorXd::Zero(pi) : hac_variances(x, resid, r_inv, res.hac_lag);
   res.names.emplace_back("B0");
   for (Term t : spec.terms) res.names.emplace_back(info(t).coefficient);
   for (Eigen::Index j = 0; j < pi; ++j) {

@@ -90,11 +90,11 @@ struct FitResult {
   std::vector<double> vif;
   /// The lack-of-fit check (fit_diagnostics.hpp): each candidate term not in the model, tried.
   struct Candidate {
-    std::string option;       ///< "dT2", "dT3", "dTdt", "gradTdT"
-    double value = 0;         ///< its coefficient in the extended model
-    double std_error = 0;     ///< its standard error under this fit's error model
-    double z = 0;             ///< value / std_error
-    bool significant = false; ///< |z| above the Bonferroni bound
+    std::string option;                ///< "dT2", "dT3", "dTdt", "gradTdT"
+    double value = 0;                  ///< its coefficient in the extended model
+    double std_error = 0;              ///< its standard error under this fit's error model
+    double z = 0;                      ///< value / std_error
+    bool significant = false;          ///< |z| above the Bonferroni bound
     std::vector<double> coefficients;  ///< the extended model's, names then the candidate's
   };
   std::vector<Candidate> candidates;

@@ -43,9 +43,10 @@ void warn_missing(FitResult& fit, const FitResult::Candidate& c, const FitResult
       with += std::string(with.empty() ? "" : ", ") + k + " " + num(now, "%.4g") + " -> " +
               num(then, "%.4g");
   }
-  fit.warnings.push_back("the model may be missing term " + c.option + ": adding it explains "
-                         "significantly more (z = " + num(c.z, "%.1f") + ", beyond " +
-                         num(fit.candidate_z_critical, "%.2f") +
+  fit.warnings.push_back("the model may be missing term " + c.option +
+                         ": adding it explains "
+                         "significantly more (z = " +
+                         num(c.z, "%.1f") + ", beyond " + num(fit.candidate_z_critical, "%.2f") +
                          " under the error model, 1 % over the candidates); with it " + with +
                          " (fit --terms " + c.option + " ... to include it)");
 }
@@ -78,7 +79,8 @@ void warn_collinear(const ModelInput& in, FitResult& fit) {
     has_k0 = has_k0 || name == "k0";
     if (fit.vif[j] > kVifLimit)
       fit.warnings.push_back("term " + name + " is poorly determined: variance inflation " +
-                             num(fit.vif[j], "%.0f") + " > 10 (it is nearly a combination of "
+                             num(fit.vif[j], "%.0f") +
+                             " > 10 (it is nearly a combination of "
                              "the other terms)");
   }
   if (!(has_k1 && has_k0)) return;
@@ -86,7 +88,8 @@ void warn_collinear(const ModelInput& in, FitResult& fit) {
   if (vif > kVifLimit)
     fit.warnings.push_back(
         "k1 and k0 cannot be separated on these runs: the gradient follows the temperature "
-        "(dT against gradT alone: variance inflation " + num(vif, "%.0f") +
+        "(dT against gradT alone: variance inflation " +
+        num(vif, "%.0f") +
         " > 10); fit runs at two heating rates together (ramp_10 with ramp_20: station fit "
         "--serial SN --runs A,B), where the gradient differs at the same temperature");
 }

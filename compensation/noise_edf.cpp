@@ -49,14 +49,22 @@ double sw(double t, int alpha) {
   const double a = std::abs(t);
   const auto tlog = [&](int k) { return t == 0 ? 0.0 : std::pow(t, k) * std::log(a); };
   switch (alpha) {
-    case 2: return -a;
-    case 1: return tlog(2);
-    case 0: return a * a * a;
-    case -1: return tlog(4);
-    case -2: return std::pow(a, 5);
-    case -3: return tlog(6);
-    case -4: return std::pow(a, 7);
-    default: throw std::invalid_argument("greenhall_edf: alpha outside +2..-4");
+    case 2:
+      return -a;
+    case 1:
+      return tlog(2);
+    case 0:
+      return a * a * a;
+    case -1:
+      return tlog(4);
+    case -2:
+      return std::pow(a, 5);
+    case -3:
+      return tlog(6);
+    case -4:
+      return std::pow(a, 7);
+    default:
+      throw std::invalid_argument("greenhall_edf: alpha outside +2..-4");
   }
 }
 
@@ -96,14 +104,13 @@ struct A01 {
   double a0, a1;
 };
 A01 table2(int alpha, int d) {
-  static const A01 t[7][3] = {
-      {{1.5, 0.5}, {35.0 / 18, 1.0}, {2.31, 1.5}},                         // alpha +2
-      {{78.6, 25.2}, {790.0, 410.0}, {9950.0, 6520.0}},                    // +1
-      {{2.0 / 3, 1.0 / 6}, {2.0 / 3, 1.0 / 3}, {7.0 / 9, 0.5}},            // 0
-      {{NAN, NAN}, {0.852, 0.375}, {0.997, 0.617}},                        // -1
-      {{NAN, NAN}, {1.079, 0.368}, {1.033, 0.607}},                        // -2
-      {{NAN, NAN}, {NAN, NAN}, {1.053, 0.553}},                            // -3
-      {{NAN, NAN}, {NAN, NAN}, {1.302, 0.535}}};                           // -4
+  static const A01 t[7][3] = {{{1.5, 0.5}, {35.0 / 18, 1.0}, {2.31, 1.5}},               // alpha +2
+                              {{78.6, 25.2}, {790.0, 410.0}, {9950.0, 6520.0}},          // +1
+                              {{2.0 / 3, 1.0 / 6}, {2.0 / 3, 1.0 / 3}, {7.0 / 9, 0.5}},  // 0
+                              {{NAN, NAN}, {0.852, 0.375}, {0.997, 0.617}},              // -1
+                              {{NAN, NAN}, {1.079, 0.368}, {1.033, 0.607}},              // -2
+                              {{NAN, NAN}, {NAN, NAN}, {1.053, 0.553}},                  // -3
+                              {{NAN, NAN}, {NAN, NAN}, {1.302, 0.535}}};                 // -4
   return t[2 - alpha][d - 1];
 }
 
@@ -146,15 +153,15 @@ std::optional<NoiseId> identify_noise(std::span<const double> rate, std::size_t 
 double greenhall_edf(int alpha, int d, double m, double n_phase, bool overlapping) {
   if (alpha + 2 * d <= 1 || alpha > 2)
     throw std::invalid_argument("greenhall_edf: the variance does not converge for this alpha");
-  const double f = m;                         // unmodified variance: filter factor m
-  const double s = overlapping ? m : 1.0;     // stride factor
-  const double l = m / f + m * d;             // filter length in phase samples
+  const double f = m;                      // unmodified variance: filter factor m
+  const double s = overlapping ? m : 1.0;  // stride factor
+  const double l = m / f + m * d;          // filter length in phase samples
   const double m_terms = 1 + std::floor(s * (n_phase - l) / m);
   if (m_terms < 1) return 1.0;
   const double j_terms = std::min(m_terms, (d + 1) * s);
   const double r = m_terms / s;
   double inv = NAN;
-  if (alpha == 2) {  // case 4: a closed form
+  if (alpha == 2) {         // case 4: a closed form
     double c4 = 1, c2 = 1;  // C(4d, 2d), C(2d, d)
     for (int k = 1; k <= 2 * d; ++k) c4 = c4 * (2 * d + k) / k;
     for (int k = 1; k <= d; ++k) c2 = c2 * (d + k) / k;

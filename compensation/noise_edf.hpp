@@ -26,9 +26,9 @@ inline constexpr std::size_t kMinNoiseIdPoints = 30;
 
 /// What the lag-1 method found at one averaging factor.
 struct NoiseId {
-  int alpha = 0;          ///< integer power-law exponent of the rate's PSD, +2 .. -2
-  double alpha_est = 0;   ///< the unrounded estimate -2 (delta + d)
-  int differences = 0;    ///< d
+  int alpha = 0;         ///< integer power-law exponent of the rate's PSD, +2 .. -2
+  double alpha_est = 0;  ///< the unrounded estimate -2 (delta + d)
+  int differences = 0;   ///< d
 };
 
 /// Identifies the dominant power-law noise of `rate` at averaging factor m; empty when fewer than

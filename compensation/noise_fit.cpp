@@ -85,8 +85,7 @@ NoiseTerms fit_noise_terms(std::span<const AdevPoint> curve) {
   // Var(AVAR estimate) = 2 sigma^4 / edf; sigma from the model once there is one (iterated
   // weights: the estimate's own scatter would favour the points that came out low).
   std::vector<double> w(pts.size());
-  for (std::size_t i = 0; i < pts.size(); ++i)
-    w[i] = pts[i].edf / (2.0 * std::pow(pts[i].adev, 4));
+  for (std::size_t i = 0; i < pts.size(); ++i) w[i] = pts[i].edf / (2.0 * std::pow(pts[i].adev, 4));
   SubsetFit fit = best_fit(pts, w);
   for (int iter = 0; iter < 5 && fit.feasible; ++iter) {
     for (std::size_t i = 0; i < pts.size(); ++i) {

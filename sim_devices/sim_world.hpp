@@ -32,8 +32,8 @@ std::optional<GyroPreset> gyro_preset_from_name(std::string_view name);
 
 /// What to simulate.
 struct SimWorldConfig {
-  int gyros = 4;                            ///< simulated RLGs, nodes 1..gyros (at most 16)
-  std::uint64_t seed = 1;                   ///< drives coefficients and every noise source
+  int gyros = 4;           ///< simulated RLGs, nodes 1..gyros (at most 16)
+  std::uint64_t seed = 1;  ///< drives coefficients and every noise source
   /// 0: the seed's own noise. N > 0: the same gyros (coefficients) with independent gyro noise,
   /// as a second run of the same gyros on another day (run --sim --verify).
   std::uint64_t noise_run = 0;

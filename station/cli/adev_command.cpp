@@ -91,8 +91,8 @@ void print_table(const AdevOptions& o, std::size_t n, const std::vector<sc::Adev
                p.m, p.adev, p.ci_low, p.ci_high, p.n, p.alpha, p.alpha_identified ? " " : "*",
                p.edf);
   }
-  auto line = [](const char* what, const std::optional<double>& v,
-                 const std::optional<double>& se, const char* unit) {
+  auto line = [](const char* what, const std::optional<double>& v, const std::optional<double>& se,
+                 const char* unit) {
     if (v)
       fmt::print("  {:<26} {:.4e} +- {:.1e} {}\n", what, *v, se.value_or(NAN), unit);
     else
@@ -133,9 +133,9 @@ void add_adev_command(CLI::App& app, CommandStatus& status) {
     const auto ms = factors_from(*o, rate.size());
     std::vector<sc::AdevPoint> pts;
     try {
-      pts = sc::overlapping_adev(rate, o->rate_hz, ms, 0.683,
-                                 o->kind == "hdev" ? sc::DeviationKind::hdev
-                                                   : sc::DeviationKind::adev);
+      pts = sc::overlapping_adev(
+          rate, o->rate_hz, ms, 0.683,
+          o->kind == "hdev" ? sc::DeviationKind::hdev : sc::DeviationKind::adev);
     } catch (const sc::DataError& e) {
       throw InputError(fmt::format("{}: column '{}': {}", o->file, o->col, e.what()));
     }
@@ -153,8 +153,9 @@ void add_adev_command(CLI::App& app, CommandStatus& status) {
                         {"alpha_identified", p.alpha_identified},
                         {"edf", p.edf}});
       }
-      std::cout << nlohmann::json{{"kind", o->kind}, {"rows", rows}, {"noise", noise_json(nt)}}.dump(2)
-                << '\n';
+      std::cout
+          << nlohmann::json{{"kind", o->kind}, {"rows", rows}, {"noise", noise_json(nt)}}.dump(2)
+          << '\n';
     } else {
       print_table(*o, rate.size(), pts, nt);
     }

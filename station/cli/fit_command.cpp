@@ -3,8 +3,8 @@
 #include <fmt/format.h>
 
 #include <iostream>
-#include <set>
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include "compensation/cross_validation.hpp"
 #include "station/cli/commands.hpp"
@@ -69,9 +69,10 @@ void print_cv(const CvOutcome& out, const std::vector<std::int64_t>& runs) {
     return;
   }
   const auto& cv = out.cv;
-  fmt::print("  leave-one-run-out: prediction RMS {:.5f} deg/h on held-out runs, in-sample {:.5f} "
-             "deg/h ({:.2f}x)\n",
-             cv->pooled_rms_dph, cv->in_sample_rms_dph, cv->pooled_rms_dph / cv->in_sample_rms_dph);
+  fmt::print(
+      "  leave-one-run-out: prediction RMS {:.5f} deg/h on held-out runs, in-sample {:.5f} "
+      "deg/h ({:.2f}x)\n",
+      cv->pooled_rms_dph, cv->in_sample_rms_dph, cv->pooled_rms_dph / cv->in_sample_rms_dph);
   for (const auto& h : cv->runs)
     fmt::print("    run {} held out: RMS {:.5f} deg/h, std {:.5f} deg/h over {} bins\n",
                runs.at(static_cast<std::size_t>(h.segment)), h.rms_dph, h.std_dph, h.bins);

@@ -57,7 +57,8 @@ CoefficientBlock export_block(Store& store, const ExportOptions& o, const std::s
           "`station export --fit ID` exports a fit that is not released)",
           o.db, serial));
     const auto fit = store.find_fit(released->fit_id);
-    if (!fit) throw InputError(fmt::format("{}: released fit {} is missing", o.db, released->fit_id));
+    if (!fit)
+      throw InputError(fmt::format("{}: released fit {} is missing", o.db, released->fit_id));
     return make_block(store, *fit, released);
   }
   const auto fit = store.find_fit(*o.fit_id);
@@ -91,8 +92,9 @@ void run_export(const ExportOptions& o) {
       if (o.serials[i] == o.serials[j])
         throw InputError(fmt::format("export: serial '{}' named twice", o.serials[i]));
   if (o.c_name.empty() || std::isdigit(static_cast<unsigned char>(o.c_name[0])) ||
-      o.c_name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") !=
-          std::string::npos || o.c_name.size() > 64)
+      o.c_name.find_first_not_of(
+          "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") != std::string::npos ||
+      o.c_name.size() > 64)
     throw InputError(fmt::format("export --c-name '{}': expected a C identifier", o.c_name));
   Store store(o.db, OpenMode::read_only);
   std::vector<CoefficientBlock> blocks;
@@ -121,7 +123,8 @@ void print_verification(const VerificationResult& v) {
   if (v.drift_dph_per_c)
     fmt::print("  residual drift {:+.3e} +- {:.1e} deg/h/C (against T)\n", *v.drift_dph_per_c,
                *v.drift_se_dph_per_c);
-  if (v.adev_floor_dph) fmt::print("  ADEV floor {:.5f} deg/h (compensated 1 Hz record)\n", *v.adev_floor_dph);
+  if (v.adev_floor_dph)
+    fmt::print("  ADEV floor {:.5f} deg/h (compensated 1 Hz record)\n", *v.adev_floor_dph);
   for (const auto& w : v.warnings) fmt::print("  warning: {}\n", w);
   fmt::print("  verdict: {} (verification {})\n", verdict_text(v.verdict), v.id);
 }
@@ -141,15 +144,16 @@ int run_verify(const VerifyOptions& o) {
     const auto rel = current_release(store, o.serial);
     if (!rel)
       throw InputError(fmt::format(
-          "{}: serial '{}' has no released calibration (give --fit ID to verify another fit)",
-          o.db, o.serial));
+          "{}: serial '{}' has no released calibration (give --fit ID to verify another fit)", o.db,
+          o.serial));
     fit = store.find_fit(rel->fit_id);
   }
   const auto limits = limits_for(store, o.serial, {o.run_id}, {parts ? &*parts : nullptr, o.part});
   if (parts && !limits)
-    throw InputError(fmt::format("verify: --parts {}: run {}'s slot of '{}' names no part: give "
-                                 "--part PN",
-                                 o.parts, o.run_id, o.serial));
+    throw InputError(
+        fmt::format("verify: --parts {}: run {}'s slot of '{}' names no part: give "
+                    "--part PN",
+                    o.parts, o.run_id, o.serial));
   VerificationResult v = verify_fit(store, *fit, o.run_id, limits);
   save_verification(store, v);
   if (o.json)

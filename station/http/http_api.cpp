@@ -185,8 +185,9 @@ void HttpServer::control_routes() {
   };
   s.Post(R"(/api/runs/([^/]+)/stop)", end_run(false));
   s.Post(R"(/api/runs/([^/]+)/abort)", end_run(true));
-  s.Post(R"(/api/fits/([^/]+)/release)",
-         [this](const httplib::Request& req, httplib::Response& res) { release_fit_route(req, res); });
+  s.Post(
+      R"(/api/fits/([^/]+)/release)",
+      [this](const httplib::Request& req, httplib::Response& res) { release_fit_route(req, res); });
 }
 
 // POST /api/fits/{id}/release {"by", "note", "override"}: the same rules as `station release`,
@@ -195,8 +196,9 @@ void HttpServer::release_fit_route(const httplib::Request& req, httplib::Respons
   if (!may_write(req, res)) return;
   const auto id = positive_int(req.matches[1].str());
   if (!id) {
-    send_json(res, 400, {{"error", fmt::format("fit id '{}': expected a positive integer",
-                                               req.matches[1].str())}});
+    send_json(
+        res, 400,
+        {{"error", fmt::format("fit id '{}': expected a positive integer", req.matches[1].str())}});
     return;
   }
   const auto body = nlohmann::json::parse(req.body, nullptr, false);

@@ -32,8 +32,8 @@ struct PartLimits {
   std::optional<double> max_k1_se_dph_per_c;   ///< standard error of k1, deg/h/C
   std::optional<double> max_k0_se_dph_per_c;   ///< standard error of k0, deg/h/C
   /// Verification on an independent run (`station verify`), not part of a fit's verdict:
-  std::optional<double> max_verify_std_dph;    ///< std of the compensated bins, deg/h
-  std::optional<double> max_verify_ratio;      ///< std after / std before on that run
+  std::optional<double> max_verify_std_dph;  ///< std of the compensated bins, deg/h
+  std::optional<double> max_verify_ratio;    ///< std after / std before on that run
 };
 
 /// A whole part file.

@@ -74,7 +74,9 @@ std::string release_summary(const CoefficientBlock& b) {
 
 }  // namespace
 
-double dph_to_rad_per_s(double dph) { return dph * std::numbers::pi / (180.0 * 3600.0); }
+double dph_to_rad_per_s(double dph) {
+  return dph * std::numbers::pi / (180.0 * 3600.0);
+}
 
 json block_json(const CoefficientBlock& b) {
   json coef = json::object(), se = json::object(), units = json::object();
@@ -130,13 +132,15 @@ std::string blocks_csv(const std::vector<CoefficientBlock>& blocks) {
         failed += (failed.empty() ? "" : ";") + f.value("limit", std::string("?"));
     for (std::size_t i = 0; i < b.names.size(); ++i) {
       out += fmt::format(
-          "{},{},{},{},{:.17g},{:.17g},{},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},clamp,{},{},{},{},"
+          "{},{},{},{},{:.17g},{:.17g},{},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},clamp,{},{},{},{}"
+          ","
           "{},{},{},{},{},{},0x{:08x}\n",
           csv_field(b.serial), csv_field(b.part_number), b.fit_id, b.names[i], b.coefficients[i],
           b.std_errors[i], sc::coefficient_unit(b.names[i]), b.t_ref_c, b.t_min_c, b.t_max_c,
           b.grad_min_c, b.grad_max_c, b.bin_s ? fmt::format("{:g}", *b.bin_s) : "",
           fmt::join(b.runs, ";"), verdict, failed, b.release ? "yes" : "NO",
-          b.release ? b.release->released_utc : "", csv_field(b.release ? b.release->released_by : ""),
+          b.release ? b.release->released_utc : "",
+          csv_field(b.release ? b.release->released_by : ""),
           csv_field(b.release ? b.release->note : ""),
           csv_field(b.release && b.release->override_reason ? *b.release->override_reason : ""),
           b.software_version, b.crc32);
@@ -169,11 +173,11 @@ std::string blocks_c_header(const std::vector<CoefficientBlock>& blocks, const s
         "    {:.17g}, /* k0_dph_per_c */\n"
         "    0x{:08x}u}};\n",
         comment_safe(b.serial), b.fit_id, fmt::join(b.runs, ","), b.terms, release_summary(b),
-        !b.verdict_json ? "none" : (json::parse(*b.verdict_json).value("pass", false) ? "pass" : "FAIL"),
+        !b.verdict_json ? "none"
+                        : (json::parse(*b.verdict_json).value("pass", false) ? "pass" : "FAIL"),
         c_identifier(name, b), c_string(b.serial), c_string(b.part_number), b.fit_id, c.released,
-        c.t_ref_c,
-        c.t_min_c, c.t_max_c, c.grad_min_c, c.grad_max_c, c.b0_dph, c.k_dph[0], c.k_dph[1],
-        c.k_dph[2], c.k_dph[3], c.k0_dph_per_c, c.crc32);
+        c.t_ref_c, c.t_min_c, c.t_max_c, c.grad_min_c, c.grad_max_c, c.b0_dph, c.k_dph[0],
+        c.k_dph[1], c.k_dph[2], c.k_dph[3], c.k0_dph_per_c, c.crc32);
     table += fmt::format("    &{},\n", c_identifier(name, b));
   }
   out += fmt::format(

@@ -44,9 +44,10 @@ void set_spans(Store& store, const FitRecord& fit, CoefficientBlock& b) {
     }
   }
   if (t_lo > t_hi)
-    throw InputError(fmt::format("{}: fit {}: its runs {} hold no 1 Hz sample of {} in a complete "
-                                 "bin",
-                                 store.db().path(), fit.id, fmt::join(fit.runs, ","), fit.serial));
+    throw InputError(
+        fmt::format("{}: fit {}: its runs {} hold no 1 Hz sample of {} in a complete "
+                    "bin",
+                    store.db().path(), fit.id, fmt::join(fit.runs, ","), fit.serial));
   b.t_min_c = t_lo;
   b.t_max_c = t_hi;
   b.grad_min_c = g_lo;
@@ -61,9 +62,10 @@ void check_finite(const CoefficientBlock& b) {
   v.insert(v.end(), b.std_errors.begin(), b.std_errors.end());
   for (const double x : v)
     if (!std::isfinite(x))
-      throw InputError(fmt::format("fit {} of '{}': a coefficient, error or span is not finite: "
-                                   "nothing to deliver",
-                                   b.fit_id, b.serial));
+      throw InputError(
+          fmt::format("fit {} of '{}': a coefficient, error or span is not finite: "
+                      "nothing to deliver",
+                      b.fit_id, b.serial));
 }
 
 }  // namespace

@@ -25,21 +25,21 @@ std::optional<std::string> undeliverable_term(const compensation::FitResult& fit
 struct CoefficientBlock {
   std::string serial, part_number;  ///< part_number empty: judged against no part
   std::int64_t fit_id = 0;
-  std::string fit_created_utc, terms;                ///< terms as fitted ("dT,gradT")
-  std::vector<std::int64_t> runs;                    ///< the runs the fit used
-  std::vector<std::string> names;                    ///< coefficient names in model order
-  std::vector<double> coefficients, std_errors;      ///< by names
-  double t_ref_c = 0;                                ///< T_ref, deg C
-  double t_min_c = 0, t_max_c = 0;                   ///< span of T the fit saw, deg C
-  double grad_min_c = 0, grad_max_c = 0;             ///< span of gradT the fit saw, deg C
-  std::optional<double> bin_s;                       ///< bin length (empty: runs differ)
-  std::optional<double> std_ratio;                   ///< in-sample std after / before
-  double std_after_dph = 0;                          ///< in-sample std after, deg/h
-  std::optional<std::string> verdict_json;           ///< the fit's verdict (empty: none)
-  std::optional<ReleaseRow> release;                 ///< empty: exported without release
-  std::string software_version;                      ///< the station's version
-  std::uint32_t crc32 = 0;                           ///< of canonical
-  std::string canonical;                             ///< gyro_tc_canonical's text
+  std::string fit_created_utc, terms;            ///< terms as fitted ("dT,gradT")
+  std::vector<std::int64_t> runs;                ///< the runs the fit used
+  std::vector<std::string> names;                ///< coefficient names in model order
+  std::vector<double> coefficients, std_errors;  ///< by names
+  double t_ref_c = 0;                            ///< T_ref, deg C
+  double t_min_c = 0, t_max_c = 0;               ///< span of T the fit saw, deg C
+  double grad_min_c = 0, grad_max_c = 0;         ///< span of gradT the fit saw, deg C
+  std::optional<double> bin_s;                   ///< bin length (empty: runs differ)
+  std::optional<double> std_ratio;               ///< in-sample std after / before
+  double std_after_dph = 0;                      ///< in-sample std after, deg/h
+  std::optional<std::string> verdict_json;       ///< the fit's verdict (empty: none)
+  std::optional<ReleaseRow> release;             ///< empty: exported without release
+  std::string software_version;                  ///< the station's version
+  std::uint32_t crc32 = 0;                       ///< of canonical
+  std::string canonical;                         ///< gyro_tc_canonical's text
 
   /// The block as gyro_tc.h holds it; points into this object's strings.
   gyro_tc_block c_block() const;

@@ -50,8 +50,8 @@ void check_text(const char* what, const std::string& text, std::size_t max_len, 
   if (required && text.find_first_not_of(" \t\r\n") == std::string::npos)
     throw InputError(fmt::format("release: {}: must not be empty", what));
   if (text.size() > max_len)
-    throw InputError(fmt::format("release: {}: {} characters, at most {}", what, text.size(),
-                                 max_len));
+    throw InputError(
+        fmt::format("release: {}: {} characters, at most {}", what, text.size(), max_len));
   for (const char ch : text)
     if (static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f)
       throw InputError(fmt::format("release: {}: control character 0x{:02x} not allowed", what,
@@ -71,16 +71,17 @@ void check_request(Store& store, const ReleaseRequest& req, const FitRecord& fit
                                      fit.id, fit.serial, release_text(*cur)));
   const auto why = needs_override(store, fit, v);
   if (why && !req.override_reason)
-    throw ReleaseRefused(fmt::format("fit {} of {} is not released: {}; give --override REASON "
-                                     "to release it anyway",
-                                     fit.id, fit.serial, *why));
+    throw ReleaseRefused(
+        fmt::format("fit {} of {} is not released: {}; give --override REASON "
+                    "to release it anyway",
+                    fit.id, fit.serial, *why));
   // An override is a statement that a rule was set aside: on a fit no rule holds back, it would
   // put a false "released over its verdict" into the record.
   if (!why && req.override_reason)
-    throw ReleaseRefused(fmt::format("fit {} of {} needs no override ({}): release it without "
-                                     "--override",
-                                     fit.id, fit.serial, v.verdict_json ? "its verdict passed"
-                                                                        : "no part applies"));
+    throw ReleaseRefused(
+        fmt::format("fit {} of {} needs no override ({}): release it without "
+                    "--override",
+                    fit.id, fit.serial, v.verdict_json ? "its verdict passed" : "no part applies"));
 }
 
 void add_release_event(Store& store, const FitRecord& fit, const ReleaseRow& r) {
@@ -104,8 +105,8 @@ ReleaseRow release_fit(Store& store, const ReleaseRequest& req) {
   if (!fit) throw FitNotFound(fmt::format("{}: no fit {}", store.db().path(), req.fit_id));
   const StoredVerdict v = load_fit_verdict(store, fit->id);
   check_request(store, req, *fit, v);
-  ReleaseRow r{0,       fit->id, fit->serial, utc_now_iso(), req.by, req.note, req.override_reason,
-               v.verdict_json};
+  ReleaseRow r{0,      fit->id,  fit->serial,         utc_now_iso(),
+               req.by, req.note, req.override_reason, v.verdict_json};
   auto st = store.db().prepare(
       "INSERT INTO releases (fit_id, serial, released_utc, released_by, note, override_reason, "
       "verdict_json) VALUES (?,?,?,?,?,?,?)");
@@ -121,8 +122,8 @@ ReleaseRow release_fit(Store& store, const ReleaseRequest& req) {
 }
 
 std::optional<ReleaseRow> current_release(Store& store, const std::string& serial) {
-  auto st = store.cached(std::string(kReleaseColumns) +
-                         "WHERE serial = ? ORDER BY id DESC LIMIT 1");
+  auto st =
+      store.cached(std::string(kReleaseColumns) + "WHERE serial = ? ORDER BY id DESC LIMIT 1");
   st->bind(1, serial);
   if (!st->step()) return std::nullopt;
   return read_release(*st);
@@ -137,8 +138,8 @@ std::vector<ReleaseRow> releases_of(Store& store, const std::string& serial) {
 }
 
 std::optional<ReleaseRow> release_of_fit(Store& store, std::int64_t fit_id) {
-  auto st = store.cached(std::string(kReleaseColumns) +
-                         "WHERE fit_id = ? ORDER BY id DESC LIMIT 1");
+  auto st =
+      store.cached(std::string(kReleaseColumns) + "WHERE fit_id = ? ORDER BY id DESC LIMIT 1");
   st->bind(1, fit_id);
   if (!st->step()) return std::nullopt;
   return read_release(*st);

@@ -28,8 +28,8 @@ void check_run(Store& store, const FitRecord& fit, std::int64_t run_id) {
   const auto slots = store.run_slots(run_id);
   if (std::none_of(slots.begin(), slots.end(),
                    [&](const RunSlot& s) { return s.serial == fit.serial; }))
-    throw InputError(
-        fmt::format("{}: run {} did not record serial '{}'", store.db().path(), run_id, fit.serial));
+    throw InputError(fmt::format("{}: run {} did not record serial '{}'", store.db().path(), run_id,
+                                 fit.serial));
 }
 
 /// Slope of `after` against T and its honest SE (the station's own fit, terms dT).
@@ -71,8 +71,8 @@ VerificationResult verify_fit(Store& store, const FitRecord& fit, std::int64_t r
   v.temp_c = bins.temp_c;
   v.before_dph = bins.bias_dph;
   v.eval = sc::evaluate(v.before_dph, v.after_dph);
-  v.mean_residual_dph = std::accumulate(v.after_dph.begin(), v.after_dph.end(), 0.0) /
-                        static_cast<double>(v.bins);
+  v.mean_residual_dph =
+      std::accumulate(v.after_dph.begin(), v.after_dph.end(), 0.0) / static_cast<double>(v.bins);
   fit_drift(bins, v.after_dph, block.t_ref_c, v);
   const sc::ModelData rec = record_model_data(store, run_id, fit.serial);
   std::vector<double> record(rec.bias_dph.size());
@@ -84,18 +84,20 @@ VerificationResult verify_fit(Store& store, const FitRecord& fit, std::int64_t r
     v.warnings.push_back(fmt::format("run {} ended '{}', not completed", run_id, run->state));
   const bool enough = v.bins >= kMinVerifyBins;
   if (!enough)
-    v.warnings.push_back(fmt::format("only {} complete bins (fewer than {}): the figures say "
-                                     "little and every verification limit fails",
-                                     v.bins, kMinVerifyBins));
+    v.warnings.push_back(
+        fmt::format("only {} complete bins (fewer than {}): the figures say "
+                    "little and every verification limit fails",
+                    v.bins, kMinVerifyBins));
   if (limits) {
     v.part_number = limits->number;
     VerificationFigures fig{v.eval.std_after_dph, v.eval.std_ratio};
     if (!enough) fig = {NAN, std::nullopt};  // cannot be shown: fails (verdict.hpp's rule)
     v.verdict = judge_verification(*limits, fig);
     if (!v.verdict)
-      v.warnings.push_back(fmt::format("part {} sets no verification limit (max_verify_std_dph, "
-                                       "max_verify_ratio): no verdict",
-                                       limits->number));
+      v.warnings.push_back(
+          fmt::format("part {} sets no verification limit (max_verify_std_dph, "
+                      "max_verify_ratio): no verdict",
+                      limits->number));
   }
   return v;
 }
@@ -133,12 +135,12 @@ std::int64_t save_verification(Store& store, VerificationResult& v) {
   v.id = store.db().last_insert_id();
   const auto run = store.find_run(v.run_id);
   const bool failed = v.verdict && !v.verdict->pass;
-  store.add_event(v.run_id, run && run->last_tick_s ? *run->last_tick_s : 0.0,
-                  failed ? "warn" : "info", "verify", "verification",
-                  fmt::format("{}: fit {} applied to this run: std {:.5f} -> {:.5f} deg/h, {}",
-                              v.serial, v.fit_id, v.eval.std_before_dph, v.eval.std_after_dph,
-                              verdict_text(v.verdict)),
-                  json{{"verification_id", v.id}, {"fit_id", v.fit_id}}.dump());
+  store.add_event(
+      v.run_id, run && run->last_tick_s ? *run->last_tick_s : 0.0, failed ? "warn" : "info",
+      "verify", "verification",
+      fmt::format("{}: fit {} applied to this run: std {:.5f} -> {:.5f} deg/h, {}", v.serial,
+                  v.fit_id, v.eval.std_before_dph, v.eval.std_after_dph, verdict_text(v.verdict)),
+      json{{"verification_id", v.id}, {"fit_id", v.fit_id}}.dump());
   tx.commit();
   return v.id;
 }

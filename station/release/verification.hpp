@@ -26,17 +26,17 @@ struct VerificationResult {
   std::int64_t id = 0;  ///< verifications.id (0 before it is stored)
   std::string serial, created_utc;
   std::int64_t fit_id = 0, run_id = 0;
-  std::size_t bins = 0;                     ///< complete bins of the run
-  compensation::Evaluation eval;            ///< std before / after over those bins, ratio
-  double mean_residual_dph = 0;             ///< mean compensated bias
+  std::size_t bins = 0;           ///< complete bins of the run
+  compensation::Evaluation eval;  ///< std before / after over those bins, ratio
+  double mean_residual_dph = 0;   ///< mean compensated bias
   /// Slope of the compensated bias against T (what the model left, deg/h/C) and its honest
   /// standard error (fit_model, terms dT); empty when too few bins to fit a line.
   std::optional<double> drift_dph_per_c, drift_se_dph_per_c;
-  std::optional<double> adev_floor_dph;     ///< ADEV floor of the compensated 1 Hz record
-  std::size_t clamped_bins = 0;             ///< bins with T or gradT outside the fit's span
+  std::optional<double> adev_floor_dph;  ///< ADEV floor of the compensated 1 Hz record
+  std::size_t clamped_bins = 0;          ///< bins with T or gradT outside the fit's span
   std::optional<std::string> part_number;
-  std::optional<Verdict> verdict;           ///< against max_verify_std_dph / max_verify_ratio
-  std::vector<std::string> warnings;        ///< too few bins, a run that did not complete
+  std::optional<Verdict> verdict;     ///< against max_verify_std_dph / max_verify_ratio
+  std::vector<std::string> warnings;  ///< too few bins, a run that did not complete
   /// Per bin, for the report's figure: mid time (s), T (C), bias before and after (deg/h).
   std::vector<double> t_s, temp_c, before_dph, after_dph;
 };

@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "station/report/report_allan.hpp"
 #include "station/release/releases.hpp"
 #include "station/release/verification.hpp"
+#include "station/report/report_allan.hpp"
 #include "station/report/report_data.hpp"
 #include "station/store/store.hpp"
 
@@ -32,8 +32,8 @@ struct SerialReport {
   RunSlot slot;
   std::optional<FitRecord> fit;  ///< the newest fit that used this run; empty: none stored
   FitExtras extras;
-  AllanCurves allan;            ///< for the noise terms
-  std::vector<Figure> figures;  ///< 2a, 2b, 3, 4, 5a, 5b (empty without a fit)
+  AllanCurves allan;                          ///< for the noise terms
+  std::vector<Figure> figures;                ///< 2a, 2b, 3, 4, 5a, 5b (empty without a fit)
   std::optional<ReleaseRow> fit_release;      ///< the newest release of this run's fit
   std::optional<ReleaseRow> current_release;  ///< the serial's released calibration (any fit)
   /// Verifications stored on this run for this serial, with their per-bin series, and Fig. 6

@@ -105,7 +105,8 @@ std::string evaluation_table(const FitRecord& rec) {
 
 std::string noise_table(const AllanCurves& a) {
   std::string t =
-      "<table class=\"noise\">\n<tr><th>noise term (IEEE 952 Table C.2), fitted over the whole Allan "
+      "<table class=\"noise\">\n<tr><th>noise term (IEEE 952 Table C.2), fitted over the whole "
+      "Allan "
       "variance</th><th>before</th>"
       "<th>after</th></tr>\n";
   const auto& b = a.noise_before;
@@ -116,14 +117,17 @@ std::string noise_table(const AllanCurves& a) {
   };
   t += row({"quantization Q, arcsec", pm(b.quantization_arcsec, b.quantization_se),
             pm(c.quantization_arcsec, c.quantization_se)});
-  t += row({"angle random walk N, deg/\u221ah", pm(b.angle_random_walk_deg_rth, b.angle_random_walk_se),
+  t += row({"angle random walk N, deg/\u221ah",
+            pm(b.angle_random_walk_deg_rth, b.angle_random_walk_se),
             pm(c.angle_random_walk_deg_rth, c.angle_random_walk_se)});
   t += row({"bias instability B, deg/h", pm(b.bias_instability_dph, b.bias_instability_se),
             pm(c.bias_instability_dph, c.bias_instability_se)});
   t += row({"flattest at \u03c4, s", num(b.bias_instability_tau_s), num(c.bias_instability_tau_s)});
-  t += row({"rate random walk K, deg/h/\u221ah", pm(b.rate_random_walk_dph_rth, b.rate_random_walk_se),
+  t += row({"rate random walk K, deg/h/\u221ah",
+            pm(b.rate_random_walk_dph_rth, b.rate_random_walk_se),
             pm(c.rate_random_walk_dph_rth, c.rate_random_walk_se)});
-  t += row({"fit \u03c7\u00b2/dof", num(b.fit_chi2_per_dof, "{:.2f}"), num(c.fit_chi2_per_dof, "{:.2f}")});
+  t += row({"fit \u03c7\u00b2/dof", num(b.fit_chi2_per_dof, "{:.2f}"),
+            num(c.fit_chi2_per_dof, "{:.2f}")});
   return t + "</table>\n";
 }
 
@@ -135,8 +139,8 @@ std::string serial_summary_row(const RunReport& r, std::size_t i, const std::str
                                         : fmt::format("<a href=\"{}\">{}</a>", html_escape(page),
                                                       html_escape(s.slot.serial));
   if (!s.fit)
-    return row({name, std::to_string(s.slot.slot), "no fit stored for this run", "", "", "", "",
-                "", release_cell(s)});
+    return row({name, std::to_string(s.slot.slot), "no fit stored for this run", "", "", "", "", "",
+                release_cell(s)});
   const auto& f = s.fit->fit;
   std::string coef;
   for (std::size_t k = 0; k < f.names.size(); ++k)
@@ -188,8 +192,8 @@ std::string verification_rows(const VerificationResult& v) {
   t += row({"calibration applied", fmt::format("fit {} (fitted on other runs; the navigation "
                                                "computer's gyro_tc_correct, clamped to its span)",
                                                v.fit_id)});
-  t += row({"bins", fmt::format("{} ({} outside the fit's span, clamped)", v.bins,
-                                v.clamped_bins)});
+  t +=
+      row({"bins", fmt::format("{} ({} outside the fit's span, clamped)", v.bins, v.clamped_bins)});
   t += row({"std before", num(v.eval.std_before_dph) + " deg/h"});
   t += row({"std after", num(v.eval.std_after_dph) + " deg/h"});
   t += row({"std ratio", v.eval.std_ratio ? num(*v.eval.std_ratio, "{:.3f}") : "undefined"});
@@ -296,9 +300,8 @@ std::string index_html(const RunReport& r, const Assets& a, const std::vector<st
 std::string serial_html(const RunReport& r, const SerialReport& s, const Assets& a) {
   const std::string title =
       fmt::format("Serial {}, run {}: calibration report", s.slot.serial, r.run.id);
-  std::string body =
-      "<h1>" + html_escape(title) + "</h1>\n<p>Verdict: " + verdict_html(s.extras) + "</p>\n" +
-      release_html(s);
+  std::string body = "<h1>" + html_escape(title) + "</h1>\n<p>Verdict: " + verdict_html(s.extras) +
+                     "</p>\n" + release_html(s);
   json figures = json::array();
   if (s.fit) {
     body +=

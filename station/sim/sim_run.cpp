@@ -169,10 +169,9 @@ nlohmann::json run_simulated(const SimRunOptions& o) {
   // A paced simulation (--speed, watched live) holds a write transaction at most ~20 ms of wall
   // time: another writer on the same file (a release over the API) waits in its busy handler
   // for a gap between batches, and a batch held across the whole pace starves it.
-  store.set_ticks_per_commit(o.wall_clock ? 1
-                             : o.speed > 0
-                                 ? std::max(1, static_cast<int>(o.speed * 0.02))
-                                 : 60);
+  store.set_ticks_per_commit(o.wall_clock  ? 1
+                             : o.speed > 0 ? std::max(1, static_cast<int>(o.speed * 0.02))
+                                           : 60);
   // A simulation continues only the same simulation: same slots, seed and protocol text.
   ResumeDecision rd = decide_resume(store, config, o.fresh, true);
   std::optional<RunRecord> resume = rd.run;
@@ -248,8 +247,8 @@ void print_verifications(const nlohmann::json& r) {
                x["released"].get<bool>() ? "" : ", NOT released: verdict failed");
   fmt::print("\nverification on run {} (the calibration applied to a run it was not fitted on):\n",
              r["run_id"].get<long>());
-  fmt::print("{:<10} {:>5} {:>13} {:>13} {:>6} {:>14}  verdict\n", "serial", "fit",
-             "std bef deg/h", "std aft deg/h", "ratio", "mean res deg/h");
+  fmt::print("{:<10} {:>5} {:>13} {:>13} {:>6} {:>14}  verdict\n", "serial", "fit", "std bef deg/h",
+             "std aft deg/h", "ratio", "mean res deg/h");
   for (const auto& v : r["verifications"]) {
     if (v.contains("error")) {
       fmt::print("{:<10} {:>5} {}\n", v["serial"].get<std::string>(), v["fit_id"].get<long>(),
@@ -258,13 +257,13 @@ void print_verifications(const nlohmann::json& r) {
     }
     const auto& ratio = v["ratio"];
     const auto& verdict = v["verdict"];
-    fmt::print("{:<10} {:>5} {:>13.5f} {:>13.5f} {:>6} {:>+14.5f}  {}\n",
-               v["serial"].get<std::string>(), v["fit_id"].get<long>(),
-               v["std_before_dph"].get<double>(), v["std_after_dph"].get<double>(),
-               ratio.is_number() ? fmt::format("{:.3f}", ratio.get<double>()) : "undef",
-               v["mean_residual_dph"].get<double>(),
-               verdict_text(verdict.is_null() ? std::nullopt
-                                              : std::optional(verdict_from_json(verdict))));
+    fmt::print(
+        "{:<10} {:>5} {:>13.5f} {:>13.5f} {:>6} {:>+14.5f}  {}\n", v["serial"].get<std::string>(),
+        v["fit_id"].get<long>(), v["std_before_dph"].get<double>(),
+        v["std_after_dph"].get<double>(),
+        ratio.is_number() ? fmt::format("{:.3f}", ratio.get<double>()) : "undef",
+        v["mean_residual_dph"].get<double>(),
+        verdict_text(verdict.is_null() ? std::nullopt : std::optional(verdict_from_json(verdict))));
   }
 }
 

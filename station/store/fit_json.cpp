@@ -1,9 +1,9 @@
 // Fit coefficients as JSON objects.
 #include "station/store/fit_json.hpp"
 
-#include <cmath>
-
 #include <fmt/format.h>
+
+#include <cmath>
 
 namespace station {
 namespace {

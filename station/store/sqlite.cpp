@@ -132,8 +132,8 @@ bool Database::identify_empty() {
   const int version = schema_version();
   if (app_id == kStationApplicationId) return false;
   const auto foreign = [&](const std::string& why) {
-    return SqliteError(fmt::format(
-        "{}: not a station database ({}); nothing was written to it", path_, why));
+    return SqliteError(
+        fmt::format("{}: not a station database ({}); nothing was written to it", path_, why));
   };
   if (app_id != 0)
     throw foreign(fmt::format("its application_id is 0x{:08X}, another program's",

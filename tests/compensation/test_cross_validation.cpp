@@ -1,10 +1,10 @@
 // Leave-one-run-out cross-validation (compensation/cross_validation.hpp).
-#include "compensation/cross_validation.hpp"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
+
+#include "compensation/cross_validation.hpp"
 
 namespace sc = station::compensation;
 
@@ -50,8 +50,8 @@ TEST(CrossValidation, AnOverfittedModelShowsAsAHeldOutErrorAboveTheInSampleOne) 
     const auto d = three_runs(0.01, 100 + k);
     const auto right = sc::leave_one_run_out(d.view(), {{sc::Term::dT, sc::Term::gradT}, 25.0});
     const auto over = sc::leave_one_run_out(
-        d.view(), {{sc::Term::dT, sc::Term::dT2, sc::Term::dT3, sc::Term::dT4, sc::Term::gradT},
-                   25.0});
+        d.view(),
+        {{sc::Term::dT, sc::Term::dT2, sc::Term::dT3, sc::Term::dT4, sc::Term::gradT}, 25.0});
     right_gap += right.pooled_rms_dph / right.in_sample_rms_dph / trials;
     over_gap += over.pooled_rms_dph / over.in_sample_rms_dph / trials;
   }

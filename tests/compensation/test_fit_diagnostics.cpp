@@ -1,13 +1,13 @@
 // Lack-of-fit and collinearity diagnostics (compensation/fit_diagnostics.hpp), on a simulated
 // thermal cycle: 78 bins of 600 s over 13 h, T from -40 to +70 C and back, a gradient that
 // follows the heating rate (the paper's hysteresis) plus its own slow variation.
-#include "compensation/fit_diagnostics.hpp"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <numbers>
 #include <random>
+
+#include "compensation/fit_diagnostics.hpp"
 
 namespace sc = station::compensation;
 
@@ -82,8 +82,8 @@ TEST(FitDiagnostics, AMissingQuadraticTermIsNamedWithWhatK0Becomes) {
 TEST(FitDiagnostics, FalseAlarmsUnderWhiteNoiseStayNearOnePercent) {
   int alarms = 0;
   for (unsigned seed = 0; seed < 200; ++seed) {
-    const auto fit = sc::fit_model(cycle(Truth{}, 1000 + seed).view(),
-                                   {{sc::Term::dT, sc::Term::gradT}, 25.0});
+    const auto fit =
+        sc::fit_model(cycle(Truth{}, 1000 + seed).view(), {{sc::Term::dT, sc::Term::gradT}, 25.0});
     alarms += warns_missing(fit) ? 1 : 0;
     ASSERT_EQ(fit.candidates.size(), 4u);  // dT2, dT3, dTdt, gradTdT
     EXPECT_NEAR(fit.candidate_z_critical, 3.0233, 1e-4);
@@ -107,7 +107,8 @@ TEST(FitDiagnostics, AGradientThatFollowsTemperatureIsSaidToBeInseparable) {
                     w.find("ramp_10 with ramp_20") != std::string::npos);
   EXPECT_TRUE(said);
   // The paper-like cycle separates them: no such warning, VIFs near 1.
-  const auto good = sc::fit_model(cycle(Truth{}, 3).view(), {{sc::Term::dT, sc::Term::gradT}, 25.0});
+  const auto good =
+      sc::fit_model(cycle(Truth{}, 3).view(), {{sc::Term::dT, sc::Term::gradT}, 25.0});
   for (const double v : good.vif) EXPECT_LT(v, 10.0);
 }
 

@@ -140,8 +140,7 @@ TEST(Cli, SimRunThenFitAllAndExport) {
   // Nothing released yet: export refuses (issue 21), --fit exports the named fit with a warning.
   const auto unreleased = run_station("export --db " + db + " --serial SIM-0002");
   EXPECT_EQ(unreleased.status, 2);
-  EXPECT_NE(unreleased.out.find("serial 'SIM-0002' has no released calibration"),
-            std::string::npos)
+  EXPECT_NE(unreleased.out.find("serial 'SIM-0002' has no released calibration"), std::string::npos)
       << unreleased.out;
   const auto latest = nlohmann::json::parse(one.out)["fit_id"].get<std::int64_t>();
   const auto named = run_station("export --db " + db + " --fit " + std::to_string(latest));

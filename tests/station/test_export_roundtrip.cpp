@@ -2,8 +2,8 @@
 // would, applied with the shipped C function gyro_tc_correct() (the C header compiled by a C
 // compiler for --format c) to the run's own 1 Hz record and bins, and compared with the
 // station's compensated values. The checksum is checked against zlib's independent CRC-32.
-#include <gtest/gtest.h>
 #include <fmt/format.h>
+#include <gtest/gtest.h>
 #include <unistd.h>
 #include <zlib.h>
 
@@ -74,8 +74,8 @@ gyro_tc_block from_json(const json& j, std::string& serial, std::string& part) {
   b.b0_dph = c.value("B0", 0.0);
   for (int i = 0; i < 4; ++i) b.k_dph[i] = c.value("k" + std::to_string(i + 1), 0.0);
   b.k0_dph_per_c = c.value("k0", 0.0);
-  b.crc32 = static_cast<uint32_t>(
-      std::stoul(j["checksum"]["crc32"].get<std::string>(), nullptr, 16));
+  b.crc32 =
+      static_cast<uint32_t>(std::stoul(j["checksum"]["crc32"].get<std::string>(), nullptr, 16));
   return b;
 }
 
@@ -134,8 +134,8 @@ TEST_F(ExportRoundTrip, JsonBlockVerifiesAndReproducesTheStation) {
   EXPECT_EQ(j["units"]["k1"], "deg/h/C");
   // The checksum, recomputed with zlib (an independent CRC-32) over the canonical text.
   const std::string canon = j["checksum"]["canonical"].get<std::string>();
-  const auto z = crc32(0L, reinterpret_cast<const Bytef*>(canon.data()),
-                       static_cast<uInt>(canon.size()));
+  const auto z =
+      crc32(0L, reinterpret_cast<const Bytef*>(canon.data()), static_cast<uInt>(canon.size()));
   EXPECT_EQ(j["checksum"]["crc32"].get<std::string>(), fmt::format("0x{:08x}", z));
   std::string sn, pn;
   gyro_tc_block b = from_json(j, sn, pn);
@@ -203,8 +203,8 @@ int main(void) {
 }
 )";
   const std::string build = cc + " -std=c99 -pedantic -Wall -Wextra -Werror -I" +
-                            STATION_SOURCE_DIR + "/station/release " + dir + "/apply.c -o " +
-                            dir + "/apply 2>" + dir + "/cc.log";
+                            STATION_SOURCE_DIR + "/station/release " + dir + "/apply.c -o " + dir +
+                            "/apply 2>" + dir + "/cc.log";
   ASSERT_EQ(std::system(build.c_str()), 0) << slurp(dir + "/cc.log");
   const Record& rec = recs_.back();  // the 1 Hz record
   {
@@ -273,7 +273,8 @@ TEST_F(ExportRoundTrip, CommentTextCannotInjectCodeOrParameters) {
   const std::string c = station::blocks_c_header({b});
   EXPECT_EQ(c.find("*/ int evil"), std::string::npos) << c;
   EXPECT_EQ(c.find("\n*/ bad"), std::string::npos) << c;
-  EXPECT_NE(c.find("\"X\\\"1,\\012*/ bad\""), std::string::npos) << "the literal keeps the serial: " << c;
+  EXPECT_NE(c.find("\"X\\\"1,\\012*/ bad\""), std::string::npos)
+      << "the literal keeps the serial: " << c;
   auto cubic = b;
   cubic.names = {"B0", "k1"};
   cubic.coefficients = {0.1, 1e-3};
@@ -297,8 +298,7 @@ TEST(GyroTc, ClampsTemperatureAndGradientToTheSpanTheFitSaw) {
   b.k0_dph_per_c = 0.03;
   // Inside: the polynomial written out by hand.
   const double dt = 10 - 25.0;
-  EXPECT_NEAR(gyro_tc_bias_dph(&b, 10, 0.4), 0.1 + 2e-3 * dt - 1e-5 * dt * dt + 0.03 * 0.4,
-              1e-15);
+  EXPECT_NEAR(gyro_tc_bias_dph(&b, 10, 0.4), 0.1 + 2e-3 * dt - 1e-5 * dt * dt + 0.03 * 0.4, 1e-15);
   // Outside: the value at the edge of the span, never an extrapolation.
   EXPECT_DOUBLE_EQ(gyro_tc_bias_dph(&b, 95, 3), gyro_tc_bias_dph(&b, 70, 1.5));
   EXPECT_DOUBLE_EQ(gyro_tc_bias_dph(&b, -60, -2), gyro_tc_bias_dph(&b, -40, -0.5));

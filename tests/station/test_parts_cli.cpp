@@ -143,8 +143,8 @@ TEST(PartsCli, SimRunFitExportAndHistoryCarryTheVerdict) {
   EXPECT_EQ(refused.status, 2);
   EXPECT_NE(refused.out.find("its verdict failed"), std::string::npos) << refused.out;
   EXPECT_NE(refused.out.find("--override"), std::string::npos) << refused.out;
-  const auto ej = nlohmann::json::parse(
-      station_cmd("export --db " + db + " --fit " + fail_fit, false).out);
+  const auto ej =
+      nlohmann::json::parse(station_cmd("export --db " + db + " --fit " + fail_fit, false).out);
   EXPECT_EQ(ej["verdict"]["failed"][0]["limit"], "min_complete_bins");
   EXPECT_TRUE(ej["release"].is_null());
 

@@ -1,9 +1,8 @@
 // Releasing a fit, verification on an independent run and `run --sim --verify` (issue 21).
 #include <gtest/gtest.h>
-
-#include <cmath>
 #include <sys/wait.h>
 
+#include <cmath>
 #include <cstdio>
 #include <numeric>
 
@@ -63,8 +62,9 @@ TEST(Release, FailedVerdictIsReleasedOnlyWithAnOverrideThatIsStored) {
   const auto fit = fit_of_run(store, sn, c.verification_run);
   station::save_fit_verdict(
       store, fit,
-      {"GX-1", R"({"pass":false,"failed":[{"limit":"max_std_ratio","value":0.9,"bound":0.5}],)"
-               R"("part":"GX-1","checked":1})",
+      {"GX-1",
+       R"({"pass":false,"failed":[{"limit":"max_std_ratio","value":0.9,"bound":0.5}],)"
+       R"("part":"GX-1","checked":1})",
        std::nullopt});
   EXPECT_THROW(station::release_fit(store, {fit, "Ann", "", std::nullopt}),
                station::ReleaseRefused);
@@ -118,7 +118,8 @@ TEST(Release, ANewerReleaseSupersedesTheOlderAndNothingIsDeleted) {
   EXPECT_THROW(station::release_fit(store, {second, std::string(201, 'x'), "", std::nullopt}),
                station::InputError);
   // No verdict and no part: nothing to override; an override would record a false exception.
-  EXPECT_THROW(station::release_fit(store, {second, "Ann", "", "because"}), station::ReleaseRefused);
+  EXPECT_THROW(station::release_fit(store, {second, "Ann", "", "because"}),
+               station::ReleaseRefused);
   EXPECT_THROW(station::release_fit(store, {second, "Ann", "", ""}), station::InputError);
   station::release_fit(store, {second, "Bob", "", std::nullopt});
   EXPECT_EQ(station::current_release(store, sn)->fit_id, second);
@@ -202,7 +203,8 @@ namespace {
 
 /// `station ARGS` (stdout only) and its exit status.
 std::pair<int, std::string> station_cli(const std::string& args) {
-  const std::string cmd = std::string(STATION_BINARY_DIR) + "/station/station " + args + " 2>/dev/null";
+  const std::string cmd =
+      std::string(STATION_BINARY_DIR) + "/station/station " + args + " 2>/dev/null";
   std::string out;
   FILE* p = popen(cmd.c_str(), "r");
   if (p == nullptr) return {-1, out};
