@@ -1,47 +1,73 @@
 // Honest standard errors for least squares over bins whose noise is correlated in time.
 //
-// A gyro's 600 s bins share bias-instability noise whose correlation time is near an hour, so
-// the iid OLS formula s^2 (X'X)^-1 is optimistic. The bin errors are modelled as white noise plus
-// a first-order Gauss-Markov process (IEEE Std 952-1997, Annex C: "correlated noise"; the
-// simulator's bias instability is the same process), i.e. an AR(1)-plus-white-noise process on
-// the bin times:  Cov(e_i, e_j) = s^2 [ (1 - q) d_ij + q exp(-|t_i - t_j| / tau) ].
-// Its parameters (tau, q) are estimated by restricted maximum likelihood (REML: Patterson &
-// Thompson 1971; Harville 1977, JASA 72:320), evaluated in O(n p) by a scalar Kalman filter with
-// the regression coefficients concentrated out (Harvey, "Forecasting, structural time series
+// A gyro's 600 s bins share bias-instability noise and rate random walk, so the iid OLS formula
+// s^2 (X'X)^-1 is optimistic. The bin errors are modelled with the IEEE Std 952-1997 Annex C
+// terms that matter over hours: white noise, a first-order Gauss-Markov process ("correlated
+// noise"; a flicker floor is well approximated over one record by one such term) and a rate
+// random walk, on the bin times:
+//   Cov(e_i, e_j) = s^2 [ (1 - q) d_ij + q exp(-|t_i - t_j| / tau) + w min(h_i, h_j) ]
+// with h the hours since the run's first bin (the walk's level there is the constant B0's).
+// (tau, q, w) are weighed by their restricted likelihood (REML: Patterson & Thompson 1971;
+// Harville 1977, JASA 72:320), evaluated in O(n p) by a two-state Kalman filter with the
+// regression coefficients and s^2 concentrated out (Harvey, "Forecasting, structural time series
 // models and the Kalman filter", 1989, sec. 3.4 and 5.2). The coefficients stay the ordinary
-// least-squares ones (the paper's method); their covariance under the fitted error model is the
+// least-squares ones (the paper's method); their covariance under one error model is the
 // sandwich  s^2 (X'X)^-1 X' R X (X'X)^-1  (e.g. Greene, Econometric Analysis, 7th ed., eq. 9-9).
+//
+// Seventy bins cannot pin (tau, q, w) down: the REML point estimate regresses to the middle of
+// its range, and a standard error taken from it alone is often far too small (coverage at 2 SE
+// of 0.75-0.90 under Gauss-Markov, flicker and random-walk noise; docs/UNCERTAINTY.md). So the
+// variances are averaged over the error models the bins cannot tell apart: the most likely
+// points of the search grid (log-uniform prior on tau and w, uniform on q), each weighted by
+// its restricted likelihood, averaged on the log scale (a likelihood-weighted geometric mean,
+// which a few implausible models cannot inflate). This is Bayesian model averaging over the
+// variance parameters (Hoeting, Madigan, Raftery & Volinsky, Statistical Science 14:382, 1999)
+// with the grid as the quadrature.
 // Pure maths: no I/O.
 #pragma once
 
 #include <Eigen/Dense>
 #include <span>
 #include <string>
+#include <vector>
 
 namespace station::compensation {
 
 /// The fitted error model of a regression's bins.
 struct ErrorModel {
-  std::string method = "iid";   ///< "ar1+white (REML)" or "iid" (too few bins to estimate)
+  /// "white+gm+rrw (REML)" ("ar1+white (REML)" in fits stored before) or "iid" (too few bins
+  /// to estimate, or no correlated part found)
+  std::string method = "iid";
   double corr_time_s = 0;       ///< tau of the Gauss-Markov part, s (0: none)
-  double correlated_share = 0;  ///< q: share of the error variance in the Gauss-Markov part
-  double sigma_dph = 0;         ///< s: total error standard deviation per bin, deg/h
+  double correlated_share = 0;  ///< q: share of the stationary variance in the Gauss-Markov part
+  double sigma_dph = 0;         ///< s: stationary (white + Gauss-Markov) sd per bin, deg/h
   double rho_per_bin = 0;       ///< exp(-bin spacing / tau): correlation of neighbouring bins
   /// The estimate sits on the edge of what the search allows (q = 0.99 or tau ten record
   /// lengths): the bins look like a drift more than noise, and the errors are less certain.
   bool on_search_boundary = false;
+  /// Rate random walk of the bins, deg/h/sqrt(h): Var(e_i - e_j) grows by rrw^2 |t_i - t_j| on
+  /// top of the stationary part (0: none).
+  double rrw_dph_per_sqrt_h = 0;
+  /// The error models the bins cannot rule out, each weighted by its restricted likelihood
+  /// (empty: the point estimate above alone). The variances are averaged over them.
+  struct Component {
+    double corr_time_s = 0, correlated_share = 0, sigma_dph = 0, rrw_dph_per_sqrt_h = 0, weight = 0;
+  };
+  std::vector<Component> mixture;
 };
 
-/// Estimates the error model of y = X b + e by REML. `x` should be well conditioned (pass the
+/// Estimates the error model of y = X b + e by REML: the most likely point, and the mixture of
+/// the models the bins cannot rule out. `x` should be well conditioned (pass the
 /// orthonormal Q of X = Q R: the likelihood depends only on the column space of X). `t_s` are the
 /// bin times (increasing within a segment), `segment` the run each bin came from (bins of different
-/// runs are independent; empty: one run). Needs at least p + 4 bins; with fewer the model is "iid"
+/// runs are independent; empty: one run). Needs at least p + 5 bins; with fewer the model is "iid"
 /// with s^2 = RSS/(n-p).
 ErrorModel estimate_error_model(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
                                 std::span<const double> t_s, std::span<const int> segment);
 
-/// Variances of the OLS coefficients of y = X b + e under `model`, with X = Q R (thin QR,
-/// Q `q_basis` n x p, `r_inv` = R^-1): the diagonal of s^2 R^-1 Q' C Q R^-T, O(n p).
+/// Variances of the OLS coefficients of y = X b + e under `model` (its mixture when it has one),
+/// with X = Q R (thin QR, Q `q_basis` n x p, `r_inv` = R^-1): the diagonal of s^2 R^-1 Q' C Q R^-T,
+/// O(n p).
 Eigen::VectorXd ols_variances_under(const ErrorModel& model, const Eigen::MatrixXd& q_basis,
                                     const Eigen::MatrixXd& r_inv, std::span<const double> t_s,
                                     std::span<const int> segment);

@@ -324,7 +324,8 @@ FitResult fit_impl(const ModelInput& in, const ModelSpec& spec, const ErrorModel
       fixed != nullptr ? *fixed : estimate_error_model(q_basis, y, in.t_s, in.segment);
   // No correlated part: the model's covariance is s^2 I and the errors are the OLS ones exactly.
   const Eigen::VectorXd var_model =
-      res.error_model.correlated_share > 0
+      res.error_model.correlated_share > 0 || res.error_model.rrw_dph_per_sqrt_h > 0 ||
+              !res.error_model.mixture.empty()
           ? ols_variances_under(res.error_model, q_basis, r_inv, in.t_s, in.segment)
           : var_scaled;
   // Lag rule of Newey & West (1994): L = floor(4 (n/100)^(2/9)).
@@ -356,7 +357,9 @@ FitResult fit_impl(const ModelInput& in, const ModelSpec& spec, const ErrorModel
     res.warnings.push_back(
         "the bins' correlated noise looks like a drift (error model at the edge of its search: " +
         std::to_string(100 * res.error_model.correlated_share) + " % correlated, tau " +
-        number_text(res.error_model.corr_time_s) + " s); the uncertainties are less certain");
+        number_text(res.error_model.corr_time_s) + " s, rate random walk " +
+        number_text(res.error_model.rrw_dph_per_sqrt_h) +
+        " deg/h/sqrt(h)); the uncertainties are less certain");
   }
   check_result(res);
   return res;

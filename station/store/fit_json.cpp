@@ -37,19 +37,28 @@ nlohmann::json error_model_json(const compensation::ErrorModel& m) {
           {"correlated_share", m.correlated_share},
           {"sigma_dph", m.sigma_dph},
           {"rho_per_bin", m.rho_per_bin},
+          {"rrw_dph_per_sqrt_h", m.rrw_dph_per_sqrt_h},
+          {"models_averaged", m.mixture.size()},
           {"on_search_boundary", m.on_search_boundary}};
 }
 
 std::string error_model_text(const compensation::ErrorModel& m) {
-  if (m.correlated_share <= 0) {
-    return fmt::format("errors: {} (s = {:.2e} deg/h per bin)",
+  const std::string averaged =
+      m.mixture.size() > 1
+          ? fmt::format("; SE averaged over {} error models the bins cannot tell apart",
+                        m.mixture.size())
+          : std::string();
+  if (m.correlated_share <= 0 && m.rrw_dph_per_sqrt_h <= 0) {
+    return fmt::format("errors: {} (s = {:.2e} deg/h per bin){}",
                        m.method == "iid" ? "independent bins, no correlated noise found" : m.method,
-                       m.sigma_dph);
+                       m.sigma_dph, averaged);
   }
   return fmt::format(
-      "errors: white + Gauss-Markov noise (REML): s = {:.2e} deg/h per bin, {:.0f} % correlated "
-      "with tau {:.0f} s (neighbouring bins {:.2f})",
-      m.sigma_dph, 100.0 * m.correlated_share, m.corr_time_s, m.rho_per_bin);
+      "errors (REML, most likely): white + Gauss-Markov s = {:.2e} deg/h per bin, {:.0f} % "
+      "correlated with tau {:.0f} s (neighbouring bins {:.2f}), rate random walk {:.2e} "
+      "deg/h/sqrt(h){}",
+      m.sigma_dph, 100.0 * m.correlated_share, m.corr_time_s, m.rho_per_bin, m.rrw_dph_per_sqrt_h,
+      averaged);
 }
 
 compensation::ErrorModel error_model_from_json(const nlohmann::json& j) {
@@ -59,6 +68,7 @@ compensation::ErrorModel error_model_from_json(const nlohmann::json& j) {
   m.correlated_share = j.value("correlated_share", 0.0);
   m.sigma_dph = j.value("sigma_dph", 0.0);
   m.rho_per_bin = j.value("rho_per_bin", 0.0);
+  m.rrw_dph_per_sqrt_h = j.value("rrw_dph_per_sqrt_h", 0.0);
   m.on_search_boundary = j.value("on_search_boundary", false);
   return m;
 }

@@ -40,17 +40,20 @@ Coverage run_coverage(int gyros, std::uint64_t seed) {
   return c;
 }
 
-// 1 sigma of a normal distribution covers erf(1/sqrt 2) = 68.27 %. With 400 gyros the binomial
-// standard deviation of a coverage share is sqrt(0.683 * 0.317 / 400) = 2.3 %, so an honest
-// interval stays within +-5 % (2.1 of those sigmas) of 68.3 % for 96 % of seeds; the seed is
-// fixed, so the test is deterministic.
+// 1 sigma of a normal distribution covers erf(1/sqrt 2) = 68.27 %. The station's errors average
+// over the error models the bins cannot tell apart (correlated_errors.hpp), so they lean to the
+// conservative side; the band is docs/UNCERTAINTY.md's, 0.60-0.78 at 1 SE (as NoiseCoverage.*).
+// With 400 gyros the binomial sd of a share is 2.3 %; the seed is fixed, so the test is
+// deterministic.
 TEST(UncertaintyCoverage, HonestOneSigmaCoversTheTrueCoefficientsOfFourHundredGyros) {
   const Coverage c = run_coverage(400, 1);
   std::printf("coverage over %d gyros: k1 %.3f (OLS %.3f), k0 %.3f (OLS %.3f)\n", c.gyros,
               c.share(c.k1), c.share(c.k1_ols), c.share(c.k0), c.share(c.k0_ols));
   const double expected = std::erf(1.0 / std::sqrt(2.0));
-  EXPECT_NEAR(c.share(c.k1), expected, 0.05);
-  EXPECT_NEAR(c.share(c.k0), expected, 0.05);
+  for (double share : {c.share(c.k1), c.share(c.k0)}) {
+    EXPECT_GE(share, 0.60);
+    EXPECT_LE(share, 0.78);
+  }
   // The OLS errors assume independent bins: the same test must fail them, or it proves nothing.
   EXPECT_LT(c.share(c.k1_ols), expected - 0.05);
 }

@@ -193,11 +193,13 @@ Coverages coverage_ols_hac(double rho, int trials) {
 // still short (lag 3 bins against a ~4-bin correlation time), covers far better (~0.39): the
 // paired difference has sd ~ sqrt(0.15/400) = 2 %, so requiring 10 % keeps a 2.5 sd margin and
 // fails if HAC degenerates to OLS. The four coverages are recorded as a test property.
-// The station's reported errors (REML white + Gauss-Markov model, correlated_errors.hpp) cover
-// ~68 % under the AR(1) noise too (0.675 measured; +-8 % is 3.4 binomial sd). Under white noise
-// they are conservative, never optimistic: REML sometimes reads the slow wobble of the
-// gradient's residual as correlated noise (0.73-0.77 measured, against 0.683): the bound is
-// 0.683 - 0.08 below and 0.85 above.
+// The station's reported errors (white + Gauss-Markov + random walk, averaged over the models the
+// bins cannot tell apart; correlated_errors.hpp) are conservative, never optimistic, here. Under
+// white noise REML sometimes reads the slow wobble of the gradient's residual as correlated
+// noise (0.73-0.77 measured, against 0.683): the bound is 0.683 - 0.08 below and 0.85 above.
+// Under this pure AR(1) without any white noise (unlike a gyro, whose angle random walk is
+// always there) 66 bins cannot rule out a random walk beside it, and the errors cover 0.955:
+// bounded by 0.683 - 0.08 below (never optimistic) and 0.99 above (not meaningless).
 TEST(Fit, NeweyWestErrorsStayHonestWhenBinsAreCorrelated) {
   const auto white = coverage_ols_hac(0.0, 400);
   EXPECT_NEAR(white.ols, 0.683, 0.08);
@@ -209,7 +211,8 @@ TEST(Fit, NeweyWestErrorsStayHonestWhenBinsAreCorrelated) {
                                  white.ols, white.hac, white.honest, ar.ols, ar.hac, ar.honest}));
   EXPECT_LT(ar.ols, 0.5);
   EXPECT_GT(ar.hac, ar.ols + 0.10);
-  EXPECT_NEAR(ar.honest, 0.683, 0.08);
+  EXPECT_GT(ar.honest, 0.683 - 0.08);
+  EXPECT_LT(ar.honest, 0.99);
 }
 
 TEST(Fit, NeweyWestLagFollowsTheRuleOfThumb) {

@@ -1,0 +1,118 @@
+// Monte-Carlo coverage of the reported standard errors under every noise a gyro shows (issue 22):
+// for each noise row and protocol, the share of realizations whose true k1 and k0 lie within the
+// fit's +-1 and +-2 std_errors. An honest interval covers 68.3 % and 95.4 %; the bands asserted
+// are 0.60-0.78 at 1 SE and at least 0.92 at 2 SE. The simulator is the test's own (noise_sim.hpp).
+// GYRO_COVERAGE_REALIZATIONS overrides the count (docs/UNCERTAINTY.md's table uses 1000).
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+#include "noise_sim.hpp"
+
+namespace station::test::noise {
+namespace {
+
+constexpr double kB0 = 0.02, kK1 = 1.5e-4, kK0 = 5.5e-3;  // the paper preset's nominal gyro
+
+struct Row {
+  const char* name;
+  Levels levels;
+};
+
+const Row kRows[] = {
+    {"white only", {}},
+    {"Gauss-Markov 0.004 deg/h, tau 1.5 h", {.gm_dph = 0.004, .gm_tau_s = 5400}},
+    {"simulator's levels (GM 0.003/1 h, RRW 1e-4)",
+     {.gm_dph = 0.003, .gm_tau_s = 3600, .rrw_dphpsh = 1e-4}},
+    {"flicker B 0.006 deg/h", {.flicker_b_dph = 0.006}},
+    {"rate random walk K 0.003", {.rrw_dphpsh = 0.003}},
+    {"rate random walk K 0.001", {.rrw_dphpsh = 0.001}},
+    {"mixture: GM 0.003/1.5 h + flicker 0.004 + RRW 0.001",
+     {.gm_dph = 0.003, .gm_tau_s = 5400, .flicker_b_dph = 0.004, .rrw_dphpsh = 0.001}},
+};
+
+struct Cover {
+  int n = 0, k1_1 = 0, k1_2 = 0, k0_1 = 0, k0_2 = 0, k1_ols_2 = 0;
+
+  double share(int hits) const { return static_cast<double>(hits) / n; }
+};
+
+int realizations() {
+  const char* env = std::getenv("GYRO_COVERAGE_REALIZATIONS");
+  return env != nullptr ? std::max(50, std::atoi(env)) : 400;
+}
+
+Cover coverage(const std::vector<Protocol>& protocols, const Levels& lv, std::uint64_t seed) {
+  const compensation::ModelData design = protocols_bins(protocols);
+  std::mt19937_64 rng(seed);
+  Cover c;
+  for (int r = realizations(); r > 0; --r) {
+    compensation::ModelData d = design;
+    for (std::size_t i = 0; i < d.bias_dph.size(); ++i)
+      d.bias_dph[i] = kB0 + kK1 * (d.temp_c[i] - 25) + kK0 * d.grad_c[i];
+    add_noise(d, lv, rng);
+    const auto fit = compensation::fit_model(d.view(), {});
+    const double e1 = std::abs(fit.coefficients[1] - kK1) / fit.std_errors[1];
+    const double e0 = std::abs(fit.coefficients[2] - kK0) / fit.std_errors[2];
+    ++c.n;
+    c.k1_1 += e1 <= 1;
+    c.k1_2 += e1 <= 2;
+    c.k0_1 += e0 <= 1;
+    c.k0_2 += e0 <= 2;
+    c.k1_ols_2 += std::abs(fit.coefficients[1] - kK1) <= 2 * fit.std_errors_ols[1];
+  }
+  return c;
+}
+
+void check(const char* protocol, const std::vector<Protocol>& ps, std::uint64_t seed) {
+  for (const Row& row : kRows) {
+    const Cover c = coverage(ps, row.levels, seed++);
+    std::printf("| %s | %s | %.2f / %.2f | %.2f / %.2f |\n", protocol, row.name, c.share(c.k1_1),
+                c.share(c.k1_2), c.share(c.k0_1), c.share(c.k0_2));
+    SCOPED_TRACE(std::string(protocol) + ", " + row.name);
+    // The bands are the true coverage's; the share is an estimate from c.n realizations. A
+    // one-sided binomial test at 1 % per bound: an estimate beyond a bound by more than 2.33 of
+    // its binomial sd, sqrt(p (1 - p) / n) at the bound, rejects it (400 realizations: 0.60 ->
+    // 0.543, 0.78 -> 0.828, 0.92 -> 0.888).
+    auto slack = [&](double p) { return 2.33 * std::sqrt(p * (1 - p) / c.n); };
+    // The test can fail: the textbook OLS errors, which assume independent bins, do under
+    // Gauss-Markov noise.
+    if (row.levels.gm_dph > 0) {
+      EXPECT_LT(c.share(c.k1_ols_2), 0.92 - slack(0.92)) << "the OLS errors pass: a weak test";
+    }
+    const bool known_shortfall = row.levels.rrw_dphpsh >= 0.003;
+    for (int k1 : {1, 0}) {
+      const double s1 = c.share(k1 != 0 ? c.k1_1 : c.k0_1), s2 = c.share(k1 != 0 ? c.k1_2 : c.k0_2);
+      SCOPED_TRACE(k1 != 0 ? "k1" : "k0");
+      EXPECT_LE(s1, 0.78 + slack(0.78));
+      if (known_shortfall && k1 != 0) {
+        // Issue 22, still open: under a strong rate random walk (K = 0.003 deg/h/sqrt h, far
+        // above an RLG's) the k1 errors are optimistic: 0.50 / 0.78 on the paper cycle, 0.56 /
+        // 0.87 on the ramp pair (docs/UNCERTAINTY.md). Held here so that it cannot get worse.
+        EXPECT_GE(s1, 0.45);
+        EXPECT_GE(s2, 0.72);
+        continue;
+      }
+      EXPECT_GE(s1, 0.60 - slack(0.60));
+      EXPECT_GE(s2, 0.92 - slack(0.92));
+    }
+  }
+}
+
+TEST(NoiseCoverage, PaperCycle) {
+  check("paper cycle", {Protocol{}}, 100);
+}
+
+TEST(NoiseCoverage, Ramp20) {
+  check("ramp_20", {Protocol{.heat_c_per_h = 20, .soak_s = 1800}}, 200);
+}
+
+TEST(NoiseCoverage, Ramp10AndRamp20Pair) {
+  check("ramp_10 + ramp_20",
+        {Protocol{.soak_s = 1800}, Protocol{.heat_c_per_h = 20, .soak_s = 1800}}, 300);
+}
+
+}  // namespace
+}  // namespace station::test::noise
