@@ -129,9 +129,28 @@ void HttpServer::api_routes() {
         });
 }
 
+void HttpServer::post(const std::string& pattern, RouteHandler handler) {
+  server_->Post(pattern, handler);
+  posts_.push_back({std::regex(pattern), std::move(handler)});
+}
+
+// cpp-httplib 0.11 reads a POST without Content-Length until the connection closes and then
+// answers 400 (its issues #523, #1738): the route is called here instead, with the empty body
+// RFC 9112 6.3 gives such a request.
+bool HttpServer::dispatch_bodyless_post(const httplib::Request& req, httplib::Response& res) const {
+  for (const auto& route : posts_) {
+    httplib::Request copy = req;
+    if (!std::regex_match(copy.path, copy.matches, route.pattern)) continue;
+    copy.body.clear();
+    route.handler(copy, res);
+    return true;
+  }
+  return false;
+}
+
 void HttpServer::control_routes() {
   auto& s = *server_;
-  s.Post("/api/runs", [this](const httplib::Request& req, httplib::Response& res) {
+  post("/api/runs", [this](const httplib::Request& req, httplib::Response& res) {
     if (!may_write(req, res)) return;
     const auto body = nlohmann::json::parse(req.body, nullptr, false);
     if (body.is_discarded() || !body.is_object()) {
@@ -183,11 +202,11 @@ void HttpServer::control_routes() {
                                : nlohmann::json{{"error", r.message}});
     };
   };
-  s.Post(R"(/api/runs/([^/]+)/stop)", end_run(false));
-  s.Post(R"(/api/runs/([^/]+)/abort)", end_run(true));
-  s.Post(
-      R"(/api/fits/([^/]+)/release)",
-      [this](const httplib::Request& req, httplib::Response& res) { release_fit_route(req, res); });
+  post(R"(/api/runs/([^/]+)/stop)", end_run(false));
+  post(R"(/api/runs/([^/]+)/abort)", end_run(true));
+  post(R"(/api/fits/([^/]+)/release)", [this](const httplib::Request& req, httplib::Response& res) {
+    release_fit_route(req, res);
+  });
 }
 
 // POST /api/fits/{id}/release {"by", "note", "override"}: the same rules as `station release`,

@@ -188,11 +188,19 @@ void HttpServer::routes() {
       return refuse(411, "a POST needs a Content-Length (no Transfer-Encoding)");
     if (req.has_header("Content-Encoding"))
       return refuse(415, "a POST body must not be encoded (no Content-Encoding)");
+    // No Content-Length and no Transfer-Encoding: the body has length 0 (RFC 9112 6.3, item 7),
+    // as `curl -X POST URL` sends it.
     const std::string length = req.get_header_value("Content-Length");
     std::size_t n = 0;
     const auto [end, ec] = std::from_chars(length.data(), length.data() + length.size(), n);
-    if (length.empty() || ec != std::errc() || end != length.data() + length.size())
-      return refuse(411, "a POST needs a Content-Length header (an empty body: Content-Length: 0)");
+    if (!length.empty() && (ec != std::errc() || end != length.data() + length.size()))
+      return refuse(400, "Content-Length is not a number (RFC 9112 6.3)");
+    if (length.empty()) {
+      res.set_header("Connection", "close");
+      if (!dispatch_bodyless_post(req, res))
+        send_json(res, 404, {{"error", fmt::format("no such resource: {}", req.path)}});
+      return httplib::Server::HandlerResponse::Handled;
+    }
     if (n > options_.max_body_bytes) return refuse(413, "request body too large (limit 64 KiB)");
     return httplib::Server::HandlerResponse::Unhandled;
   });

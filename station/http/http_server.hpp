@@ -8,11 +8,14 @@
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <regex>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "station/http/run_control.hpp"
 #include "station/live/live_hub.hpp"
@@ -40,6 +43,9 @@ struct HttpOptions {
 /// Parses "HOST:PORT" (--http, [http] listen); throws InputError naming `what`.
 HttpOptions parse_listen(const std::string& address, const std::string& what);
 
+/// A route's handler, as httplib calls it.
+using RouteHandler = std::function<void(const httplib::Request&, httplib::Response&)>;
+
 class HttpServer {
  public:
   HttpServer(HttpOptions options, live::LiveHub& hub, RunControl& control);
@@ -60,6 +66,11 @@ class HttpServer {
   void routes();
   void api_routes();
   void control_routes();
+  /// Registers a POST route with httplib and in posts_, from where a POST without a body (no
+  /// Content-Length, no Transfer-Encoding) is dispatched before httplib would wait for one.
+  void post(const std::string& pattern, RouteHandler handler);
+  /// Answers a POST without Content-Length as one with an empty body; false if no route matches.
+  bool dispatch_bodyless_post(const httplib::Request& req, httplib::Response& res) const;
   /// POST /api/fits/{id}/release.
   void release_fit_route(const httplib::Request& req, httplib::Response& res);
   void stream_route();
@@ -80,6 +91,11 @@ class HttpServer {
   std::atomic<bool> done_{false};  ///< the listen thread has returned
   std::mutex store_mu_;
   std::optional<Store> store_;
+  struct PostRoute {
+    std::regex pattern;
+    RouteHandler handler;
+  };
+  std::vector<PostRoute> posts_;
 };
 
 }  // namespace station::http

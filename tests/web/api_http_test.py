@@ -869,6 +869,16 @@ def check_bad_requests(port, token, run_id):
           f"(`curl -X POST`) -> 401 with WWW-Authenticate",
           f"got {status} after {nocl.get('s', -1):.1f} s: {body[:200]!r} {note}")
     still_up(port, "a POST without Content-Length")
+    # With the token, the README's `curl -X POST -H "Authorization: Bearer $T" URL` (no body, no
+    # Content-Length) is a valid empty body: answered as any POST, not 411. Real curl, on a run
+    # that does not exist: 404 names it.
+    out = subprocess.run(["curl", "-sS", "-o", "/dev/null", "-w", "%{http_code}", "-X", "POST",
+                          "-H", f"Authorization: Bearer {token}",
+                          f"http://127.0.0.1:{port}/api/runs/999999/stop"],
+                         capture_output=True, text=True, timeout=20)
+    check(out.stdout.strip() == "404",
+          "curl -X POST with the token and no body on /api/runs/999999/stop -> 404 (not 411)",
+          f"got {out.stdout!r} {out.stderr!r}")
 
     # Every refusal above was counted.
     r = request(port, "GET", "/metrics")
