@@ -33,6 +33,20 @@ int main(int argc, char** argv) {
   station::add_history_command(app, status);
   station::add_replay_command(app, status);
   station::add_report_command(app, status);
+  if (argc > 1 && argv[1][0] != '-') {
+    // CLI11 would say only "A subcommand is required": name the word and the known commands.
+    std::string known;
+    bool found = false;
+    for (const CLI::App* sub : app.get_subcommands({})) {
+      found = found || sub->check_name(argv[1]);
+      known += (known.empty() ? "" : ", ") + sub->get_name();
+    }
+    if (!found) {
+      fmt::print(stderr, "station: unknown subcommand '{}'; known: {} (see --help)\n", argv[1],
+                 known);
+      return 2;
+    }
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -36,12 +36,13 @@ struct AnalyzeOptions {
 };
 
 /// Earth rate from the options: explicit value, or latitude + axis ("up", ..., "heading:DEG").
-double earth_rate_from(const AnalyzeOptions& o, std::vector<std::string>& warnings) {
+double earth_rate_from(const AnalyzeOptions& o) {
   if (o.earth_rate_dph) return *o.earth_rate_dph;
   if (!o.latitude_deg) {
-    warnings.emplace_back(
-        "no --earth-rate-dph or --latitude: Earth rate not removed (B0 holds it)");
-    return 0.0;
+    // Fitted into B0, Earth rate would make a bias of several deg/h that is not the gyro's.
+    throw InputError(
+        "give the site's --latitude DEG (with --axis, default up) to remove Earth rate, or "
+        "--earth-rate-dph 0 when the rates have none");
   }
   sc::EnuAxis axis;
   try {
@@ -77,26 +78,40 @@ Analysis analyze(const AnalyzeOptions& o) {
     throw InputError(fmt::format("--terms: {}", e.what()));
   }
   std::vector<std::string> cols{o.time_col, o.rate_col, o.temp_col};
-  const std::string grad_source = !o.grad_col.empty() ? o.grad_col : o.temp2_col;
+  std::string grad_col = o.grad_col, temp2_col = o.temp2_col;
+  if (grad_col.empty() && temp2_col.empty()) {
+    // The documented columns (README, "CSV input"): grad_c, else temp2_c, when the file has one.
+    const auto header = read_csv_header(o.file);
+    const auto has = [&](const char* n) {
+      return std::find(header.begin(), header.end(), n) != header.end();
+    };
+    if (has("grad_c"))
+      grad_col = "grad_c";
+    else if (has("temp2_c"))
+      temp2_col = "temp2_c";
+  }
+  const std::string grad_source = !grad_col.empty() ? grad_col : temp2_col;
   if (!grad_source.empty()) cols.push_back(grad_source);
   const bool wants_grad = std::find(terms.begin(), terms.end(), sc::Term::gradT) != terms.end();
   if (wants_grad && grad_source.empty()) {
-    throw InputError("term gradT needs --grad-col NAME or --temp2-col NAME");
+    throw InputError(
+        "term gradT needs a gradient: the file has no grad_c or temp2_c column; name one with "
+        "--grad-col NAME or --temp2-col NAME");
   }
   const CsvColumns csv = read_csv_columns(o.file, cols);
   require_increasing(csv, 0);
-  check_columns(csv, !o.grad_col.empty());
+  check_columns(csv, !grad_col.empty());
   std::vector<double> grad;
   if (!grad_source.empty()) {
     grad = csv[3];
     // With two sensors the gradient is temp2 - temp, sample by sample.
-    if (o.grad_col.empty()) {
+    if (grad_col.empty()) {
       for (std::size_t i = 0; i < grad.size(); ++i) grad[i] -= csv[2][i];
     }
   }
   Analysis a;
   a.samples = csv.lines.size();
-  a.earth_rate_dph = earth_rate_from(o, a.warnings);
+  a.earth_rate_dph = earth_rate_from(o);
   sc::BinConfig bin_cfg;
   bin_cfg.width_s = o.bin_s;
   try {
@@ -137,13 +152,14 @@ void print_table(const AnalyzeOptions& o, const Analysis& a) {
         return s;
       }(),
       o.ref_temp_c);
-  fmt::print("  {:<4} {:>14} {:>12} {:>14} {:>7}\n", "term", "value", "std error", "Newey-West",
-             "VIF");
+  fmt::print("  {:<4} {:>14} {:>12} {:>14} {:>7}  {}\n", "term", "value", "std error", "Newey-West",
+             "VIF", "unit");
   for (std::size_t i = 0; i < a.fit.names.size(); ++i) {
     const std::string vif =
         i == 0 || i > a.fit.vif.size() ? "-" : fmt::format("{:.1f}", a.fit.vif[i - 1]);
-    fmt::print("  {:<4} {:>14.6e} {:>12.3e} {:>14.3e} {:>7}\n", a.fit.names[i],
-               a.fit.coefficients[i], a.fit.std_errors[i], a.fit.std_errors_hac[i], vif);
+    fmt::print("  {:<4} {:>14.6e} {:>12.3e} {:>14.3e} {:>7}  {}\n", a.fit.names[i],
+               a.fit.coefficients[i], a.fit.std_errors[i], a.fit.std_errors_hac[i], vif,
+               sc::coefficient_unit(a.fit.names[i]));
   }
   fmt::print("\n{}\n", evaluation_text(a.eval));
   fmt::print("R^2 {:.4f}, residual RMS {:.5f} deg/h, condition number {:.1f}\n", a.fit.r2,
@@ -161,8 +177,12 @@ void add_analyze_command(CLI::App& app, CommandStatus& status) {
   cmd->add_option("--time-col", o->time_col, "time column, s")->capture_default_str();
   cmd->add_option("--rate-col", o->rate_col, "gyro rate column, deg/h")->capture_default_str();
   cmd->add_option("--temp-col", o->temp_col, "gyro temperature column, C")->capture_default_str();
-  auto* g = cmd->add_option("--grad-col", o->grad_col, "temperature-gradient column, C");
-  cmd->add_option("--temp2-col", o->temp2_col, "second sensor column: gradient = temp2 - temp")
+  auto* g =
+      cmd->add_option("--grad-col", o->grad_col,
+                      "temperature-gradient column, C (default: grad_c when the file has it)");
+  cmd->add_option(
+         "--temp2-col", o->temp2_col,
+         "second sensor column: gradient = temp2 - temp (default: temp2_c when the file has it)")
       ->excludes(g);
   cmd->add_option("--bin-s", o->bin_s, "bin width, s")
       ->capture_default_str()
@@ -177,7 +197,8 @@ void add_analyze_command(CLI::App& app, CommandStatus& status) {
   auto* er =
       cmd->add_option("--earth-rate-dph", o->earth_rate_dph, "Earth rate along the axis")
           ->check(finite_within(-1.001 * sc::kEarthRateDph, 1.001 * sc::kEarthRateDph, "deg/h"));
-  cmd->add_option("--latitude", o->latitude_deg, "site latitude, deg")
+  cmd->add_option("--latitude", o->latitude_deg,
+                  "site latitude, deg (this or --earth-rate-dph is required)")
       ->excludes(er)
       ->check(finite_within(-90.0, 90.0, "deg"));
   cmd->add_option("--axis", o->axis, "up|down|north|south|east|west|heading:DEG")

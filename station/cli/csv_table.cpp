@@ -106,6 +106,20 @@ CsvColumns read_csv_columns(const std::string& path, const std::vector<std::stri
   return out;
 }
 
+std::vector<std::string> read_csv_header(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(fmt::format("{}: cannot open file", path));
+  std::string line;
+  for (std::size_t line_no = 1; std::getline(in, line); ++line_no) {
+    if (line_no == 1 && line.rfind(kUtf8Bom, 0) == 0) line.erase(0, kUtf8Bom.size());
+    if (skippable(line)) continue;
+    std::vector<std::string> names;
+    for (auto cell : split(line)) names.emplace_back(cell);
+    return names;
+  }
+  throw InputError(fmt::format("{}: no header row", path));
+}
+
 void require_increasing(const CsvColumns& t, std::size_t c) {
   const auto& v = t.columns.at(c);
   for (std::size_t i = 1; i < v.size(); ++i) {

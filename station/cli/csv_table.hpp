@@ -25,6 +25,9 @@ struct CsvColumns {
 /// cell that is not a finite number ("FILE:LINE: column 'NAME': ...").
 CsvColumns read_csv_columns(const std::string& path, const std::vector<std::string>& names);
 
+/// The column names of `path`'s header row (what read_csv_columns reads as the header).
+std::vector<std::string> read_csv_header(const std::string& path);
+
 /// Throws InputError naming the first row whose value in column c does not increase.
 void require_increasing(const CsvColumns& t, std::size_t c);
 

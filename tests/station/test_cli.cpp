@@ -59,7 +59,7 @@ TEST(Cli, AnalyzeExampleRecoversTheGeneratorsCoefficients) {
 TEST(Cli, AnalyzeBadInputExitsTwoNamingFileLineColumn) {
   const std::string path = testing::TempDir() + "bad_cli.csv";
   std::ofstream(path) << "time_s,rate_dph,temp_c\n0,1,2\n1,x,2\n";
-  const auto o = run_station("analyze " + path + " --terms dT");
+  const auto o = run_station("analyze " + path + " --terms dT --earth-rate-dph 0");
   EXPECT_EQ(o.status, 2);
   EXPECT_NE(o.out.find("bad_cli.csv:3: column 'rate_dph': not a number: 'x'"), std::string::npos)
       << o.out;
@@ -71,15 +71,47 @@ TEST(Cli, AnalyzeTooFewBinsForTheTermsExitsTwo) {
   f << "time_s,rate_dph,temp_c\n";
   for (int i = 0; i < 1800; ++i) f << i << ",1," << i * 0.01 << "\n";
   f.close();
-  const auto o = run_station("analyze " + path + " --terms dT,dT2,dT3");
+  const auto o = run_station("analyze " + path + " --terms dT,dT2,dT3 --earth-rate-dph 0");
   EXPECT_EQ(o.status, 2);
   EXPECT_NE(o.out.find("too few bins: 3 bins for 4 coefficients"), std::string::npos) << o.out;
 }
 
 TEST(Cli, AnalyzeNeedsAGradientSourceForGradT) {
-  const auto o = run_station("analyze " + kExample);
+  const std::string path = testing::TempDir() + "no_grad_cli.csv";
+  std::ofstream f(path);
+  f << "time_s,rate_dph,temp_c\n";
+  for (int i = 0; i < 7200; ++i) f << i << ",1," << i * 0.01 << "\n";
+  f.close();
+  const auto o = run_station("analyze " + path + " --earth-rate-dph 0");
   EXPECT_EQ(o.status, 2);
-  EXPECT_NE(o.out.find("gradT needs --grad-col"), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("no grad_c or temp2_c column"), std::string::npos) << o.out;
+}
+
+// Issue 23: the shipped example as the README shows it. Its temp2_c column is picked up without
+// --temp2-col; without a latitude it is refused rather than fitting Earth rate into B0.
+TEST(Cli, AnalyzeTakesTheDocumentedColumnsAndNeedsTheLatitude) {
+  const auto o = run_station("analyze " + kExample + " --latitude 39.9");
+  ASSERT_EQ(o.status, 0) << o.out;
+  EXPECT_NE(o.out.find("k0"), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("deg/h/C (gradient)"), std::string::npos) << "unit column\n" << o.out;
+  const auto explicit_col = run_station("analyze " + kExample + " --latitude 39.9 --json");
+  const auto named =
+      run_station("analyze " + kExample + " --temp2-col temp2_c --latitude 39.9 --json");
+  ASSERT_EQ(explicit_col.status, 0);
+  EXPECT_EQ(nlohmann::json::parse(explicit_col.out)["coefficients"],
+            nlohmann::json::parse(named.out)["coefficients"]);
+  const auto no_lat = run_station("analyze " + kExample);
+  EXPECT_EQ(no_lat.status, 2);
+  EXPECT_NE(no_lat.out.find("--latitude"), std::string::npos) << no_lat.out;
+}
+
+// Issue 23: an unknown subcommand is named, with the known ones.
+TEST(Cli, AnUnknownSubcommandIsNamedWithTheKnownOnes) {
+  const auto o = run_station("bogus");
+  EXPECT_EQ(o.status, 2);
+  EXPECT_NE(o.out.find("unknown subcommand 'bogus'"), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("analyze"), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("release"), std::string::npos) << o.out;
 }
 
 TEST(Cli, AdevJsonHasRowsAndNoise) {
