@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 #include <systemd/sd-daemon.h>
+#include <unistd.h>
 
 #include <atomic>
 #include <cmath>
@@ -21,6 +22,7 @@
 #include "station/cli/live_service.hpp"
 #include "station/cli/number_options.hpp"
 #include "station/cli/probe.hpp"
+#include "station/cli/progress_display.hpp"
 #include "station/common/logging.hpp"
 #include "station/common/process_lock.hpp"
 #include "station/daemon/resume.hpp"
@@ -141,9 +143,14 @@ int run_real(const RunOptions& o) {
   OneRunControl control(g_stop, g_abort);
   LiveService live(live_options(o, o.db, config.name, false), control);
   attach_live(live, so);
+  // Progress: a redrawn line on a terminal, a line every 5 minutes of run time in a log, and
+  // systemd's status line under a service.
+  ProgressDisplay progress(stderr, ::isatty(STDERR_FILENO) != 0, 300.0, notify_status);
+  attach_progress(so, progress);
   Sequencer seq(config, protocol, rig, store, clock, so);
   sd_notify(0, "READY=1");
   const RunOutcome out = seq.run(resume);
+  progress.finish();
   live.hub().run_ended(out.run_id, out.state);
   live.shutdown();
   if (session) session->finish(store, out.run_id);

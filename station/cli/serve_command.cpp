@@ -21,6 +21,7 @@
 #include "station/cli/commands.hpp"
 #include "station/cli/daemon_setup.hpp"
 #include "station/cli/live_service.hpp"
+#include "station/cli/progress_display.hpp"
 #include "station/cli/serve_control.hpp"
 #include "station/common/logging.hpp"
 #include "station/daemon/idle_watch.hpp"
@@ -128,6 +129,9 @@ void run_one(Service& s, const Protocol& protocol, const std::optional<RunRecord
     s.control.started(id);
   };
   live::attach(s.live.hub(), so);
+  // systemd's status line (`systemctl status`): the run's progress each tick.
+  ProgressDisplay progress(nullptr, false, 0.0, notify_status);
+  attach_progress(so, progress);
   so.http_url = s.live.url();
   s.control.set_busy(true);
   // A stop or abort meant for an earlier run must not end this one.

@@ -3,6 +3,8 @@
 
 #include <cmath>
 
+#include "compensation/binning.hpp"
+
 namespace station::live {
 
 LiveBins::LiveBins(std::map<std::string, double> earth_rate_dph, double width_s)
@@ -17,15 +19,15 @@ LiveBin LiveBins::close(const std::string& serial, const Window& w) const {
   b.grad_c = w.sum_grad / n;
   b.bias_dph = w.sum_rate / n - (it == earth_rate_dph_.end() ? 0.0 : it->second);
   b.n = w.n;
-  b.complete = n >= 0.9 * width_s_;  // min_fill 0.9 at the 1 s tick (compensation/binning.hpp)
+  // The station's bin rule (compensation/binning.hpp) at the sequencer's 1 s tick.
+  b.complete = n >= compensation::BinConfig{}.min_fill * width_s_;
   return b;
 }
 
 std::vector<std::pair<std::string, LiveBin>> LiveBins::add(const std::vector<SampleRow>& rows) {
   std::vector<std::pair<std::string, LiveBin>> closed;
   for (const auto& s : rows) {
-    if (!s.recording || !s.rate_dph || !s.temp_c || !s.temp2_c || (s.flags & kUnfitFlags) != 0)
-      continue;
+    if (!sample_goes_into_bins(s)) continue;
     Window& w = open_[s.serial];
     if (!w.t0_s) w.t0_s = s.t_s;
     const long k = static_cast<long>(std::floor((s.t_s - *w.t0_s) / width_s_));
@@ -40,7 +42,7 @@ std::vector<std::pair<std::string, LiveBin>> LiveBins::add(const std::vector<Sam
     w.sum_t += s.t_s;
     w.sum_rate += *s.rate_dph;
     w.sum_temp += *s.temp_c;
-    w.sum_grad += *s.temp2_c - *s.temp_c;  // gradient = second sensor − first (calibration.cpp)
+    w.sum_grad += *gradient_c(s);
   }
   return closed;
 }

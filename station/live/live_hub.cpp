@@ -76,9 +76,9 @@ void attach(LiveHub& hub, SequencerOptions& o) {
 
 nlohmann::json LiveHub::slot_json(const SampleRow& s) const {
   const auto it = earth_rate_dph_.find(s.serial);
-  std::optional<double> bias, grad;
+  std::optional<double> bias;
+  const std::optional<double> grad = gradient_c(s);
   if (s.rate_dph && it != earth_rate_dph_.end()) bias = *s.rate_dph - it->second;
-  if (s.temp_c && s.temp2_c) grad = *s.temp2_c - *s.temp_c;  // calibration.cpp's gradient
   return {{"serial", s.serial},
           {"bias_dph", num(bias)},
           {"temp_c", num(s.temp_c)},

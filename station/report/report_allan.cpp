@@ -38,12 +38,11 @@ OneHzRecord one_hz_record(const std::vector<SampleRow>& rows, double earth_rate_
   std::vector<double> t, temp, grad;
   OneHzRecord r;
   for (const auto& s : rows) {
-    if (!s.recording || !s.rate_dph || !s.temp_c || !s.temp2_c || (s.flags & kUnfitFlags) != 0)
-      continue;
+    if (!sample_goes_into_bins(s)) continue;
     t.push_back(s.t_s);
     r.bias_dph.push_back(*s.rate_dph - earth_rate_dph);
     temp.push_back(*s.temp_c);
-    grad.push_back(*s.temp2_c - *s.temp_c);  // the gradient as bin_samples forms it
+    grad.push_back(*gradient_c(s));
   }
   if (r.bias_dph.empty()) return r;
   std::vector<double> dtdt, channel;

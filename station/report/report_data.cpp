@@ -17,11 +17,6 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kSecondsPerHour = 3600.0;
 
-/// A usable sample, as bin_samples takes it (rate and both temperatures, no unfit flag).
-bool usable(const SampleRow& s) {
-  return s.rate_dph && s.temp_c && s.temp2_c && (s.flags & kUnfitFlags) == 0;
-}
-
 Series points(std::string label, std::vector<double> x, std::vector<double> y) {
   Series s;
   s.label = std::move(label);
@@ -69,11 +64,11 @@ std::vector<RunBin> whole_run_bins(const std::vector<SampleRow>& rows, double bi
                                    double earth_rate_dph) {
   std::vector<double> t, rate, temp, grad;
   for (const auto& s : rows) {
-    if (!usable(s)) continue;
+    if (!sample_is_usable(s)) continue;
     t.push_back(s.t_s);
     rate.push_back(*s.rate_dph);
     temp.push_back(*s.temp_c);
-    grad.push_back(*s.temp2_c - *s.temp_c);
+    grad.push_back(*gradient_c(s));
   }
   sc::BinConfig cfg;
   cfg.width_s = bin_s;

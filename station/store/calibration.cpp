@@ -13,10 +13,6 @@ namespace station {
 
 namespace sc = station::compensation;
 
-bool sample_goes_into_bins(const SampleRow& s) {
-  return s.recording && s.rate_dph && s.temp_c && s.temp2_c && (s.flags & kUnfitFlags) == 0;
-}
-
 sc::ModelData record_model_data(Store& store, std::int64_t run_id, const std::string& serial) {
   double earth_rate_dph = 0;
   for (const auto& s : store.run_slots(run_id))
@@ -26,7 +22,7 @@ sc::ModelData record_model_data(Store& store, std::int64_t run_id, const std::st
     if (!sample_goes_into_bins(s)) continue;
     d.bias_dph.push_back(*s.rate_dph - earth_rate_dph);
     d.temp_c.push_back(*s.temp_c);
-    d.grad_c.push_back(*s.temp2_c - *s.temp_c);  // gradient = second sensor - first
+    d.grad_c.push_back(*gradient_c(s));
     d.t_mid_s.push_back(s.t_s);
   }
   return d;
@@ -63,7 +59,7 @@ std::vector<sc::Bin> bin_samples(const std::vector<SampleRow>& rows, double bin_
     t.push_back(s.t_s);
     rate.push_back(*s.rate_dph);
     temp.push_back(*s.temp_c);
-    grad.push_back(*s.temp2_c - *s.temp_c);  // gradient = second sensor - first (analyze's rule)
+    grad.push_back(*gradient_c(s));
   }
   sc::BinConfig cfg;
   cfg.width_s = bin_s;

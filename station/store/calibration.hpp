@@ -11,10 +11,6 @@
 
 namespace station {
 
-/// The one rule for which recorded 1 Hz samples go into bins: in the record window, with rate
-/// and both temperatures, and not flagged safe-hold or board fault (kUnfitFlags).
-bool sample_goes_into_bins(const SampleRow& s);
-
 /// One gyro's 1 Hz record in `run_id` as model input: bias (rate - the slot's Earth rate),
 /// temperature, gradient (temp2 - temp), over the samples that go into bins (gaps closed up).
 compensation::ModelData record_model_data(Store& store, std::int64_t run_id,

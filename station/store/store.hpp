@@ -87,6 +87,22 @@ struct SampleRow {
   bool recording = false;
 };
 
+/// The one rule for a usable measurement: rate and both temperatures present, and not flagged
+/// safe-hold or board fault (kUnfitFlags).
+inline bool sample_is_usable(const SampleRow& s) {
+  return s.rate_dph && s.temp_c && s.temp2_c && (s.flags & kUnfitFlags) == 0;
+}
+/// The one rule for which recorded 1 Hz samples go into bins: usable and in the record window.
+inline bool sample_goes_into_bins(const SampleRow& s) {
+  return s.recording && sample_is_usable(s);
+}
+/// The temperature gradient inside the gyro, the paper's gradT: second sensor minus first (the
+/// convention of `analyze --temp2-col` and of the simulator), C; empty without both.
+inline std::optional<double> gradient_c(const SampleRow& s) {
+  if (!s.temp_c || !s.temp2_c) return std::nullopt;
+  return *s.temp2_c - *s.temp_c;
+}
+
 /// A stored fit.
 struct FitRecord {
   std::int64_t id = 0;
