@@ -5,7 +5,8 @@
 #
 #   deb_test.sh PATH/gyro-station_VERSION_ARCH.deb
 #
-# 1. apt-get install ./deb: --version; the service user in dialout; /var/lib/gyro-station owned
+# 0. lintian on the .deb: clean (remaining tags overridden with their reasons).
+# 1. apt-get install ./deb: --version; copyright, changelog and the README's docs/*.md shipped; the service user in dialout; /var/lib/gyro-station owned
 #    by it 0750; the conffile; the unit enabled (the wants link) and not started.
 # 2. From the installed files only (an empty directory, PATH=/usr/bin:/bin): simrig, then
 #    `station probe --config` against it, then `station run --sim` (the main job), as the
@@ -47,6 +48,15 @@ leftovers() {  # what remains of the package on the machine, one path or entry p
   getent group gyro-station | sed 's/^/group: /'
 }
 
+lintian_check() {
+  # lintian on the built package: clean, each remaining tag overridden with its reason
+  # (station/package/debian/lintian-overrides).
+  if ! command -v lintian >/dev/null; then fail "lintian is not installed (scripts/dev installs it)"; return; fi
+  local out
+  out=$(lintian --tag-display-limit 0 "$DEB" 2>&1 | grep -v "running with root privileges")
+  check '[[ -z $out ]]' "lintian $(basename "$DEB"): ${out:-clean}"
+}
+
 install_checks() {
   apt-get install -y "$DEB" >"$WORK/install.log" 2>&1 || { fail "apt-get install (log below)"; cat "$WORK/install.log"; exit 1; }
   ok "apt-get install ./$(basename "$DEB")"
@@ -55,6 +65,13 @@ install_checks() {
   check '[[ $v == "station $(dpkg-query -W -f="\${Version}" gyro-station)" ]]' "station --version: $v"
   check '[[ -f /usr/share/man/man1/station.1.gz && -f /usr/share/man/man1/simrig.1.gz ]] && grep -q "^serve" <<<"$(zcat /usr/share/man/man1/station.1.gz)"' \
     "manual pages station(1) and simrig(1), made from --help"
+  # Debian policy 12.5 / 12.7: copyright and changelog; the documents the README links to.
+  check '[[ -f /usr/share/doc/gyro-station/copyright && -f /usr/share/doc/gyro-station/changelog.gz ]]' \
+    "copyright and changelog.gz in /usr/share/doc/gyro-station"
+  local missing_docs
+  missing_docs=$(grep -o "docs/[A-Z_]*\.md" /usr/share/doc/gyro-station/README.md | sort -u |
+    while read -r d; do [[ -f /usr/share/doc/gyro-station/$d ]] || echo "$d"; done)
+  check '[[ -z $missing_docs ]]' "every docs/*.md the installed README names is shipped: missing ${missing_docs:-none}"
   check 'id -nG gyro-station | grep -qw dialout' "the service user is in dialout: $(id -nG gyro-station)"
   check '[[ $(stat -c "%U:%G %a" /var/lib/gyro-station) == "gyro-station:gyro-station 750" ]]' \
     "/var/lib/gyro-station: $(stat -c '%U:%G %a' /var/lib/gyro-station)"
@@ -194,6 +211,7 @@ remove_and_purge_with_data() {
 }
 
 echo "== install, from the installed files only"
+lintian_check
 install_checks
 check 'systemd-analyze verify /usr/lib/systemd/system/gyro-station.service /usr/lib/systemd/system/gyro-station-simrig.service >"$WORK/verify.log" 2>&1 && ! [[ -s $WORK/verify.log ]]' \
   "systemd-analyze verify on the installed units: $(cat "$WORK/verify.log" 2>/dev/null)"
