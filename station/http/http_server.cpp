@@ -204,8 +204,8 @@ void HttpServer::routes() {
     if (n > options_.max_body_bytes) return refuse(413, "request body too large (limit 64 KiB)");
     return httplib::Server::HandlerResponse::Unhandled;
   });
-  s.set_logger([this](const httplib::Request&, const httplib::Response& res) {
-    hub_.metrics().http_request(res.status);
+  s.set_logger([this](const httplib::Request& req, const httplib::Response& res) {
+    hub_.metrics().http_request(res.status, req.path);
   });
   static_routes();
   api_routes();

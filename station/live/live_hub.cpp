@@ -98,6 +98,7 @@ void LiveHub::run_started(std::int64_t run_id, const Protocol& protocol,
   std::lock_guard lock(mu_);
   earth_rate_dph_.clear();
   for (const auto& s : slots) earth_rate_dph_[s.serial] = s.earth_rate_dph;
+  metrics_.set_slots(slots);
   run_id_ = last_run_id_ = run_id;
   protocol_name_ = protocol.name;
   operator_ = operator_name;

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "station/store/store.hpp"
+
 namespace station::live {
 
 namespace pm = prometheus;
@@ -57,6 +59,18 @@ LiveMetrics::LiveMetrics()
           gauge(*registry_, "station_run_id", "Id of the current or last run (0: none)").Add({})),
       http_requests_(
           counter(*registry_, "station_http_requests_total", "HTTP requests by status code")),
+      http_requests_by_route_(counter(*registry_, "station_http_route_requests_total",
+                                      "HTTP requests by route and status code")),
+      slot_rate_(gauge(*registry_, "station_gyro_rate_degrees_per_hour",
+                       "Gyro rate of the last tick, by serial and CAN node")),
+      slot_bias_(gauge(*registry_, "station_gyro_bias_degrees_per_hour",
+                       "Gyro rate minus Earth rate along its axis, by serial and CAN node")),
+      slot_temp_(gauge(*registry_, "station_gyro_temperature_celsius",
+                       "Gyro temperature (first sensor), by serial and CAN node")),
+      slot_grad_(gauge(*registry_, "station_gyro_gradient_celsius",
+                       "Temperature gradient inside the gyro (second sensor minus first)")),
+      slot_latch_lost_(counter(*registry_, "station_gyro_latch_lost_total",
+                               "Ticks without the gyro's counter answer (CAN frames lost)")),
       stream_clients_(
           gauge(*registry_, "station_event_stream_clients", "Clients attached to the event stream")
               .Add({})) {
@@ -78,7 +92,36 @@ void LiveMetrics::tick(const TickReport& r) {
   safe_hold_.Set(r.safe_hold ? 1 : 0);
   if (r.chamber) chamber(*r.chamber);
   if (r.table) table_rate_.Set(r.table->rate_dps);
-  if (r.rows != nullptr) samples_.Increment(static_cast<double>(r.rows->size()));
+  if (r.rows == nullptr) return;
+  samples_.Increment(static_cast<double>(r.rows->size()));
+  std::lock_guard lock(slots_mu_);
+  for (const SampleRow& row : *r.rows) {
+    const auto it = slots_.find(row.serial);
+    if (it == slots_.end()) continue;
+    const auto& l = it->second.labels;
+    if (row.rate_dph) {
+      slot_rate_.Add(l).Set(*row.rate_dph);
+      slot_bias_.Add(l).Set(*row.rate_dph - it->second.earth_rate_dph);
+    }
+    if (row.temp_c) slot_temp_.Add(l).Set(*row.temp_c);
+    if (const auto g = gradient_c(row)) slot_grad_.Add(l).Set(*g);
+    if ((row.flags & kLatchLost) != 0) slot_latch_lost_.Add(l).Increment();
+  }
+}
+
+void LiveMetrics::set_slots(const std::vector<RunSlot>& slots) {
+  std::lock_guard lock(slots_mu_);
+  for (const auto& [serial, old] : slots_) {
+    for (auto* f : {&slot_rate_, &slot_bias_, &slot_temp_, &slot_grad_})
+      f->Remove(&f->Add(old.labels));
+    slot_latch_lost_.Remove(&slot_latch_lost_.Add(old.labels));
+  }
+  slots_.clear();
+  for (const auto& s : slots) {
+    SlotLabels sl{{{"serial", s.serial}, {"node", std::to_string(s.node)}}, s.earth_rate_dph};
+    slot_latch_lost_.Add(sl.labels);  // at 0 from the start, like the device series
+    slots_[s.serial] = std::move(sl);
+  }
 }
 
 void LiveMetrics::io_errors(const std::vector<IoError>& errors) {
@@ -102,8 +145,47 @@ void LiveMetrics::reconnect(const std::string& device, double outage_s) {
     outage_s_.Add({{"device", device}}).Increment(outage_s);
 }
 
-void LiveMetrics::http_request(int status) {
+void LiveMetrics::http_request(int status, const std::string& path) {
   http_requests_.Add({{"code", std::to_string(status)}}).Increment();
+  http_requests_by_route_.Add({{"route", http_route_label(path)}, {"code", std::to_string(status)}})
+      .Increment();
+}
+
+std::string http_route_label(const std::string& path) {
+  // The API's routes (schemas/api.md), ids as {id}; one list, so the label set is bounded.
+  static const char* const kRoutes[] = {"/",
+                                        "/favicon.ico",
+                                        "/metrics",
+                                        "/api/status",
+                                        "/api/live",
+                                        "/api/runs",
+                                        "/api/runs/{id}",
+                                        "/api/runs/{id}/bins",
+                                        "/api/runs/{id}/events",
+                                        "/api/runs/{id}/stop",
+                                        "/api/runs/{id}/abort",
+                                        "/api/fits/{id}/release",
+                                        "/api/events/stream"};
+  std::string norm, segment;
+  const auto flush = [&] {
+    const bool id =
+        !segment.empty() && segment.find_first_not_of("0123456789") == std::string::npos;
+    norm += id ? "{id}" : segment;
+    segment.clear();
+  };
+  for (char c : path.substr(0, path.find('?'))) {
+    if (c == '/') {
+      flush();
+      norm += '/';
+    } else {
+      segment += c;
+    }
+  }
+  flush();
+  if (norm.rfind("/static/", 0) == 0) return "/static/*";
+  for (const char* r : kRoutes)
+    if (norm == r) return norm;
+  return "other";
 }
 
 void LiveMetrics::stream_clients(int n) {

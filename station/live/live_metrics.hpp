@@ -9,7 +9,9 @@
 #include <prometheus/histogram.h>
 #include <prometheus/registry.h>
 
+#include <map>
 #include <memory>
+#include <mutex>
 #include <string>
 
 #include "station/daemon/sequencer.hpp"
@@ -29,7 +31,10 @@ class LiveMetrics {
   void set_state(const std::string& state, std::int64_t run_id);
   /// A device that answered again after an outage (an 'outage' event).
   void reconnect(const std::string& device, double outage_s);
-  void http_request(int status);
+  /// An HTTP request answered: by status and by route (a bounded set: http_route_label).
+  void http_request(int status, const std::string& path = {});
+  /// The run's gyros: per-slot series labelled by serial and CAN node (old slots' series go).
+  void set_slots(const std::vector<RunSlot>& slots);
   void stream_clients(int n);
   /// The exposition text (format 0.0.4).
   std::string text() const;
@@ -50,7 +55,24 @@ class LiveMetrics {
   prometheus::Family<prometheus::Gauge>& run_state_;
   prometheus::Gauge& run_id_;
   prometheus::Family<prometheus::Counter>& http_requests_;
+  prometheus::Family<prometheus::Counter>& http_requests_by_route_;
+  /// Per gyro: rate, bias, temperature, gradient (gauges) and ticks without a counter answer.
+  prometheus::Family<prometheus::Gauge>& slot_rate_;
+  prometheus::Family<prometheus::Gauge>& slot_bias_;
+  prometheus::Family<prometheus::Gauge>& slot_temp_;
+  prometheus::Family<prometheus::Gauge>& slot_grad_;
+  prometheus::Family<prometheus::Counter>& slot_latch_lost_;
+  struct SlotLabels {
+    std::map<std::string, std::string> labels;
+    double earth_rate_dph = 0;
+  };
+  mutable std::mutex slots_mu_;
+  std::map<std::string, SlotLabels> slots_;  ///< by serial
   prometheus::Gauge& stream_clients_;
 };
+
+/// The route label of a request path: its API route with ids as {id} ("/api/runs/{id}/stop"), or
+/// "other" for anything else (so that a scan of random paths cannot grow the series).
+std::string http_route_label(const std::string& path);
 
 }  // namespace station::live

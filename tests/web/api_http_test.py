@@ -418,6 +418,26 @@ def check_metrics(port, run_id):
         check(name in m, f"metrics: {name} present")
     check(m.get("station_safe_hold") == 0, "metrics: station_safe_hold 0",
           f"got {m.get('station_safe_hold')}")
+    # Per gyro (issue 23): every series of a slot carries its serial and CAN node, and the bias
+    # is the rate minus the slot's Earth rate (a simulated gyro's bias is far below a degree/h
+    # of Earth rate, so rate - bias is the Earth rate along the axis, 0..15.04107 deg/h).
+    rates = {k: v for k, v in m.items() if k.startswith("station_gyro_rate_degrees_per_hour{")}
+    check(rates and all('serial="' in k and 'node="' in k for k in rates),
+          "metrics: station_gyro_rate_degrees_per_hour per serial and node", f"got {rates}")
+    for k, rate in rates.items():
+        bias = m.get(k.replace("station_gyro_rate_", "station_gyro_bias_"))
+        check(is_num(bias) and -0.01 <= rate - bias <= 15.05,
+              f"metrics: {k}: rate - bias is the slot's Earth rate", f"rate {rate} bias {bias}")
+        for fam in ["station_gyro_temperature_celsius", "station_gyro_gradient_celsius",
+                    "station_gyro_latch_lost_total"]:
+            labels = k[k.index("{"):]
+            check(fam + labels in m, f"metrics: {fam}{labels} present")
+    routes = {k: v for k, v in m.items() if k.startswith("station_http_route_requests_total{")}
+    check(any('route="/api/status"' in k for k in routes),
+          'metrics: station_http_route_requests_total{route="/api/status",...}', f"got {routes}")
+    check(all(re.search(r'route="(/[^"]*|other)"', k) and "{id}" in k or "{id}" not in k
+              for k in routes) and not any(re.search(r'route="[^"]*/\d', k) for k in routes),
+          "metrics: routes carry {id}, never a number", f"got {list(routes)}")
 
 
 def metric(port, key):
