@@ -188,6 +188,41 @@ void search(Point& best, Problem& pb, const Box& b, int steps) {
   }
 }
 
+/// The longest time one run spans, s (the whole series when no runs are given).
+double longest_run_s(std::span<const double> t_s, std::span<const int> segment, Eigen::Index n) {
+  double longest = 0;
+  Eigen::Index first = 0;
+  for (Eigen::Index i = 1; i <= n; ++i) {
+    if (i < n && same_run(segment, i, i - 1)) continue;
+    longest = std::max(longest, time_of(t_s, i - 1) - time_of(t_s, first));
+    first = i;
+  }
+  return longest;
+}
+
+/// The coarse grid's most likely points as the model's mixture: weights relative to the best
+/// point found, finite ones only, ties kept in grid order. The q = 0 points of every tau are all
+/// kept although tau does not matter there: each stands for the slab of small q at its tau, the
+/// quadrature weight a uniform prior on q gives it (counted once, white noise came out at 0.83
+/// at 1 SE on the paper cycle, above the 0.78 band).
+void add_mixture(ErrorModel& model, std::vector<Point>& grid, const Point& best,
+                 const Problem& pb) {
+  std::vector<Point> kept;
+  for (const Point& e : grid) {
+    if (!std::isfinite(e.profile.minus2_loglik) || !(e.profile.sigma2 > 0)) continue;
+    kept.push_back(e);
+  }
+  std::stable_sort(kept.begin(), kept.end(), [](const Point& a, const Point& b) {
+    return a.profile.minus2_loglik < b.profile.minus2_loglik;
+  });
+  for (const Point& e : kept) {
+    const double w = std::exp(-0.5 * (e.profile.minus2_loglik - best.profile.minus2_loglik));
+    if (w < kMinWeight || model.mixture.size() == kMaxComponents) break;
+    model.mixture.push_back({e.q > 0 ? std::exp(e.log_tau) : 0, e.q, std::sqrt(e.profile.sigma2),
+                             std::sqrt(e.profile.sigma2) * std::sqrt(walk_per_h(pb, e.u)), w});
+  }
+}
+
 }  // namespace
 
 ErrorModel estimate_error_model(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
@@ -200,7 +235,7 @@ ErrorModel estimate_error_model(const Eigen::MatrixXd& x, const Eigen::VectorXd&
     return model;
   }
   const double spacing_s = bin_spacing_s(t_s, segment);
-  const double span_s = std::max(time_of(t_s, n - 1) - time_of(t_s, 0), spacing_s);
+  const double span_s = std::max(longest_run_s(t_s, segment, n), spacing_s);
   // tau from a third of a bin (the Gauss-Markov part is then white) to ten record lengths
   // (then it is a drift the constant and the regressors mostly absorb).
   const double lo = std::log(spacing_s / 3.0), hi = std::log(10.0 * span_s);
@@ -211,6 +246,7 @@ ErrorModel estimate_error_model(const Eigen::MatrixXd& x, const Eigen::VectorXd&
   step_hours(pb.dt_h, t_s, segment, n);
   Point best;
   best.log_tau = lo;
+  best.u = kWalkLo;  // q = 0 and no walk: independent bins
   step_corrs(pb.phi, t_s, segment, n, std::exp(lo));
   best.profile = reml_profile(pb.z, pb.phi, pb.dt_h, {});  // iid
   std::vector<Point> grid;
@@ -231,16 +267,14 @@ ErrorModel estimate_error_model(const Eigen::MatrixXd& x, const Eigen::VectorXd&
     half_q /= 2;
     half_u /= 2;
   }
-  model.sigma_dph = std::sqrt(best.profile.sigma2);
-  std::sort(grid.begin(), grid.end(), [](const Point& a, const Point& b) {
-    return a.profile.minus2_loglik < b.profile.minus2_loglik;
-  });
-  for (const Point& e : grid) {
-    const double w = std::exp(-0.5 * (e.profile.minus2_loglik - best.profile.minus2_loglik));
-    if (w < kMinWeight || model.mixture.size() == kMaxComponents) break;
-    model.mixture.push_back({e.q > 0 ? std::exp(e.log_tau) : 0, e.q, std::sqrt(e.profile.sigma2),
-                             std::sqrt(e.profile.sigma2) * std::sqrt(walk_per_h(pb, e.u)), w});
+  if (!std::isfinite(best.profile.minus2_loglik) || !(best.profile.sigma2 > 0)) {
+    // No error model fits (a noise-free or constant bias): the OLS errors, as with too few bins.
+    const Eigen::VectorXd b = x.colPivHouseholderQr().solve(y);
+    model.sigma_dph = std::sqrt((y - x * b).squaredNorm() / static_cast<double>(n - p));
+    return model;
   }
+  model.sigma_dph = std::sqrt(best.profile.sigma2);
+  add_mixture(model, grid, best, pb);
   if (best.q <= 0 && best.u <= kWalkLo && model.mixture.empty())
     return model;  // no correlated part: independent bins
   model.method = "white+gm+rrw (REML)";
@@ -285,6 +319,7 @@ Eigen::VectorXd variances_one(const ErrorModel& model, const Eigen::MatrixXd& q_
                               std::span<const int> segment) {
   const Eigen::Index n = q_basis.rows();
   const double q = model.correlated_share, tau_s = model.corr_time_s;
+  if (!(model.sigma_dph > 0)) return Eigen::VectorXd::Zero(q_basis.cols());
   // C Q with C = (1 - q) I + q P, P_ij = exp(-|t_i - t_j| / tau) (0 across runs), in O(n p):
   // P v = f + b - v with f_i = v_i + phi_i f_(i-1) and b_i = v_i + phi_(i+1) b_(i+1), as
   // exp(-|t_i - t_j| / tau) is the product of the step correlations between them. No n x n

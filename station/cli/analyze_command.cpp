@@ -79,7 +79,10 @@ Analysis analyze(const AnalyzeOptions& o) {
   }
   std::vector<std::string> cols{o.time_col, o.rate_col, o.temp_col};
   std::string grad_col = o.grad_col, temp2_col = o.temp2_col;
-  if (grad_col.empty() && temp2_col.empty()) {
+  const bool wants_grad = std::any_of(terms.begin(), terms.end(), [](sc::Term t) {
+    return t == sc::Term::gradT || t == sc::Term::gradTdT;
+  });
+  if (wants_grad && grad_col.empty() && temp2_col.empty()) {
     // The documented columns (README, "CSV input"): grad_c, else temp2_c, when the file has one.
     const auto header = read_csv_header(o.file);
     const auto has = [&](const char* n) {
@@ -92,7 +95,6 @@ Analysis analyze(const AnalyzeOptions& o) {
   }
   const std::string grad_source = !grad_col.empty() ? grad_col : temp2_col;
   if (!grad_source.empty()) cols.push_back(grad_source);
-  const bool wants_grad = std::find(terms.begin(), terms.end(), sc::Term::gradT) != terms.end();
   if (wants_grad && grad_source.empty()) {
     throw InputError(
         "term gradT needs a gradient: the file has no grad_c or temp2_c column; name one with "

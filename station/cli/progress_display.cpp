@@ -8,17 +8,21 @@
 
 namespace station {
 
-ProgressDisplay::ProgressDisplay(std::FILE* out, bool terminal, double log_interval_s,
-                         std::function<void(const std::string&)> status)
-    : out_(out), terminal_(terminal), log_interval_s_(log_interval_s), status_(std::move(status)) {}
+ProgressDisplay::ProgressDisplay(std::FILE* out, bool terminal, double log_interval_s, double bin_s,
+                                 std::function<void(const std::string&)> status)
+    : out_(out),
+      terminal_(terminal),
+      log_interval_s_(log_interval_s),
+      bin_s_(bin_s),
+      status_(std::move(status)) {}
 
-std::string ProgressDisplay::text(const TickReport& r, long bins) {
+std::string ProgressDisplay::text(const TickReport& r, long bins, double bin_s) {
   std::string s = fmt::format("run {}  {:.2f} h  step {}/{}", r.run_id, r.t_s / 3600.0,
                               r.step_index + 1, r.steps);
   if (!r.step_label.empty()) s += " " + r.step_label;
   if (r.air_c && std::isfinite(*r.air_c)) s += fmt::format("  air {:.1f} C", *r.air_c);
   if (r.chamber) s += fmt::format("  setpoint {:.1f} C", r.chamber->setpoint_c);
-  if (r.recording) s += fmt::format("  recording, {} bins of 600 s", bins);
+  if (r.recording) s += fmt::format("  recording, {} bins of {:g} s", bins, bin_s);
   if (r.safe_hold) s += "  SAFE HOLD";
   return s;
 }
@@ -26,7 +30,8 @@ std::string ProgressDisplay::text(const TickReport& r, long bins) {
 void ProgressDisplay::tick(const TickReport& r) {
   if (r.replaying) return;
   if (r.recording) ++recorded_ticks_;
-  const std::string line = text(r, recorded_ticks_ / 600);
+  const std::string line =
+      text(r, static_cast<long>(static_cast<double>(recorded_ticks_) / bin_s_), bin_s_);
   if (status_) status_(line);
   if (out_ == nullptr) return;
   if (terminal_) {

@@ -12,22 +12,23 @@ namespace station {
 
 class ProgressDisplay {
  public:
-  /// `out` gets the progress (a terminal: redrawn each tick; otherwise a line every
-  /// `log_interval_s` of run time); `status` (may be empty) gets the same text every tick.
-  ProgressDisplay(std::FILE* out, bool terminal, double log_interval_s,
-              std::function<void(const std::string&)> status);
+  /// Bins are counted as recorded 1 s ticks per `bin_s` (this daemon's count: a resumed run
+  /// starts again at 0). `out` gets the progress (a terminal: redrawn each tick; otherwise a line
+  /// every `log_interval_s` of run time); `status` (may be empty) gets the same text every tick.
+  ProgressDisplay(std::FILE* out, bool terminal, double log_interval_s, double bin_s,
+                  std::function<void(const std::string&)> status);
 
   void tick(const TickReport& r);
   /// Ends a redrawn line (before other output or at the end of the run).
   void finish();
 
   /// The progress text of a tick: step, its label, run time, air and setpoint, bins so far.
-  static std::string text(const TickReport& r, long bins);
+  static std::string text(const TickReport& r, long bins, double bin_s = 600.0);
 
  private:
   std::FILE* out_;
   bool terminal_;
-  double log_interval_s_, next_log_s_ = 0;
+  double log_interval_s_, bin_s_, next_log_s_ = 0;
   std::function<void(const std::string&)> status_;
   long recorded_ticks_ = 0;
   bool line_open_ = false;

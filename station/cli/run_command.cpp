@@ -145,7 +145,8 @@ int run_real(const RunOptions& o) {
   attach_live(live, so);
   // Progress: a redrawn line on a terminal, a line every 5 minutes of run time in a log, and
   // systemd's status line under a service.
-  ProgressDisplay progress(stderr, ::isatty(STDERR_FILENO) != 0, 300.0, notify_status);
+  ProgressDisplay progress(stderr, ::isatty(STDERR_FILENO) != 0, 300.0, config.bin_s,
+                           notify_status);
   attach_progress(so, progress);
   Sequencer seq(config, protocol, rig, store, clock, so);
   sd_notify(0, "READY=1");

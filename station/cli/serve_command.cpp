@@ -130,7 +130,7 @@ void run_one(Service& s, const Protocol& protocol, const std::optional<RunRecord
   };
   live::attach(s.live.hub(), so);
   // systemd's status line (`systemctl status`): the run's progress each tick.
-  ProgressDisplay progress(nullptr, false, 0.0, notify_status);
+  ProgressDisplay progress(nullptr, false, 0.0, s.config.bin_s, notify_status);
   attach_progress(so, progress);
   so.http_url = s.live.url();
   s.control.set_busy(true);
@@ -141,6 +141,7 @@ void run_one(Service& s, const Protocol& protocol, const std::optional<RunRecord
     Sequencer seq(s.config, protocol, s.rig, s.store, clock, so);
     const RunOutcome out = seq.run(resume);
     s.live.hub().run_ended(out.run_id, out.state);
+    notify_status(fmt::format("idle; run {} {}", out.run_id, out.state));
     log("serve")->info("run {} {} at t = {:.0f} s after {} ticks", out.run_id, out.state, out.t_s,
                        out.ticks);
   } catch (const std::exception& e) {

@@ -69,6 +69,7 @@ std::optional<nlohmann::json> run_json(Store& store, std::int64_t run_id) {
       slot["fit"] = {{"id", f->id},
                      {"terms", f->terms},
                      {"coefficients", coefficients_json(f->fit)},
+                     {"units", units_json(f->fit)},
                      {"std_errors", std_errors_json(f->fit)},
                      {"std_before_dph", f->eval.std_before_dph},
                      {"std_after_dph", f->eval.std_after_dph},

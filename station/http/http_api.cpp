@@ -149,7 +149,6 @@ bool HttpServer::dispatch_bodyless_post(const httplib::Request& req, httplib::Re
 }
 
 void HttpServer::control_routes() {
-  auto& s = *server_;
   post("/api/runs", [this](const httplib::Request& req, httplib::Response& res) {
     if (!may_write(req, res)) return;
     const auto body = nlohmann::json::parse(req.body, nullptr, false);

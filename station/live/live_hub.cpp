@@ -179,6 +179,7 @@ void LiveHub::event(const RunEvent& e) {
 }
 
 void LiveHub::run_ended(std::int64_t run_id, const std::string& state) {
+  metrics_.set_slots({});  // a finished run's gyro series go (no stale values)
   std::lock_guard lock(mu_);
   run_id_.reset();
   last_run_id_ = run_id;

@@ -62,6 +62,7 @@ nlohmann::json gyro_report(Store& store, std::int64_t run_id, const sim::SimGyro
     return j;
   }
   j["fitted"] = coefficients_json(fit->fit);
+  j["units"] = units_json(fit->fit);
   j["std_errors"] = std_errors_json(fit->fit);
   j["std_errors_ols"] = std_errors_ols_json(fit->fit);
   j["bins"] = fit->fit.n_points;
@@ -274,7 +275,7 @@ void print_sim_report(const nlohmann::json& r) {
              r["run_id"].get<long>(), r["state"].get<std::string>(),
              r["sim_s"].get<double>() / 3600.0, r["wall_s"].get<double>());
   fmt::print("{:<10} {:>4} {:>11} {:>11} {:>9} {:>9}  {:>9} {:>9} {:>6}\n", "serial", "",
-             "B0 deg/h", "k1 /C", "k0 /C", "", "std bef", "std aft", "ratio");
+             "B0 deg/h", "k1 deg/h/C", "k0 deg/h/C", "", "std deg/h", "after", "ratio");
   for (const auto& g : r["gyros"]) {
     const auto& t = g["true"];
     fmt::print("{:<10} {:>4} {:>11.4e} {:>11.4e} {:>9.4e}\n", g["serial"].get<std::string>(),

@@ -23,6 +23,12 @@ nlohmann::json coefficients_json(const compensation::FitResult& fit) {
   return keyed(fit, fit.coefficients);
 }
 
+nlohmann::json units_json(const compensation::FitResult& fit) {
+  nlohmann::json j = nlohmann::json::object();
+  for (const auto& name : fit.names) j[name] = std::string(compensation::coefficient_unit(name));
+  return j;
+}
+
 nlohmann::json std_errors_json(const compensation::FitResult& fit) {
   return keyed(fit, fit.std_errors);
 }
@@ -80,6 +86,7 @@ nlohmann::json std_errors_hac_json(const compensation::FitResult& fit) {
 nlohmann::json fit_summary_json(const compensation::FitResult& fit,
                                 const compensation::Evaluation& eval) {
   return {{"coefficients", coefficients_json(fit)},
+          {"units", units_json(fit)},
           {"std_errors", std_errors_json(fit)},
           {"std_errors_ols", std_errors_ols_json(fit)},
           {"error_model", error_model_json(fit.error_model)},

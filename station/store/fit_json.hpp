@@ -13,6 +13,9 @@ namespace station {
 /// {"B0": value, "k1": value, ...}
 nlohmann::json coefficients_json(const compensation::FitResult& fit);
 /// {"B0": std error, "k1": std error, ...}
+/// {name: unit} of each coefficient ("B0": "deg/h", "k1": "deg/h/C", ...): the `units`
+/// object beside every JSON `coefficients`.
+nlohmann::json units_json(const compensation::FitResult& fit);
 nlohmann::json std_errors_json(const compensation::FitResult& fit);
 /// {"B0": Newey-West std error, ...}
 /// {name: OLS standard error} (iid bins; kept for comparison).

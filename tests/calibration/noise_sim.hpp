@@ -95,16 +95,25 @@ class Flicker {
     h_[0] = 1;
     for (std::size_t k = 1; k < n; ++k) h_[k] = h_[k - 1] * (k - 1 + 0.5) / k;
   }
-  /// Expected Allan variance at m bins of the filtered unit white noise (stationary part).
+  /// Expected Allan variance at m bins of the process add() generates from unit white noise:
+  /// y_j = sum_(k <= j) h_k w_(j-k) (no input before the record), averaged over every position of
+  /// the two m-bin blocks in the record.
   double avar(std::size_t m) const {
-    // (mean of bins m..2m-1) - (mean of 0..m-1) of y_j = sum_k h_k w_(j-k): weights on w.
     const std::size_t len = h_.size();
-    std::vector<double> c(len + 2 * m, 0.0);
-    for (std::size_t j = 0; j < 2 * m; ++j)
-      for (std::size_t k = 0; k < len; ++k) c[2 * m - 1 - j + k] += (j < m ? 1.0 : -1.0) * h_[k];
-    double s = 0;
-    for (double v : c) s += v * v / (m * m);
-    return s / 2;
+    if (2 * m > len) return 0;
+    double total = 0;
+    std::vector<double> c(len);
+    for (std::size_t p = 0; p + 2 * m <= len; ++p) {
+      std::fill(c.begin(), c.end(), 0.0);
+      for (std::size_t j = p; j < p + 2 * m; ++j) {
+        const double sign = j < p + m ? -1.0 : 1.0;
+        for (std::size_t i = 0; i <= j; ++i) c[i] += sign * h_[j - i];  // weight of w_i
+      }
+      double s = 0;
+      for (double v : c) s += v * v;
+      total += s / static_cast<double>(m * m) / 2;
+    }
+    return total / static_cast<double>(len - 2 * m + 1);
   }
   void add(std::vector<double>& y, std::size_t from, std::size_t n, double scale,
            std::mt19937_64& rng) const {

@@ -98,8 +98,12 @@ TEST(Cli, AnalyzeTakesTheDocumentedColumnsAndNeedsTheLatitude) {
   const auto named =
       run_station("analyze " + kExample + " --temp2-col temp2_c --latitude 39.9 --json");
   ASSERT_EQ(explicit_col.status, 0);
-  EXPECT_EQ(nlohmann::json::parse(explicit_col.out)["coefficients"],
-            nlohmann::json::parse(named.out)["coefficients"]);
+  const auto j = nlohmann::json::parse(explicit_col.out);
+  EXPECT_EQ(j["coefficients"], nlohmann::json::parse(named.out)["coefficients"]);
+  // Every JSON object with coefficients names their units.
+  EXPECT_EQ(j["units"]["B0"], "deg/h");
+  EXPECT_EQ(j["units"]["k1"], "deg/h/C");
+  EXPECT_EQ(j["units"]["k0"], "deg/h/C (gradient)");
   const auto no_lat = run_station("analyze " + kExample);
   EXPECT_EQ(no_lat.status, 2);
   EXPECT_NE(no_lat.out.find("--latitude"), std::string::npos) << no_lat.out;

@@ -44,7 +44,7 @@ TEST(ProgressDisplay, ALogGetsALineEveryIntervalAndStatusEveryTick) {
   int statuses = 0;
   std::string last;
   {
-    ProgressDisplay p(mem, false, 300.0, [&](const std::string& s) {
+    ProgressDisplay p(mem, false, 300.0, 600.0, [&](const std::string& s) {
       ++statuses;
       last = s;
     });
@@ -66,7 +66,7 @@ TEST(ProgressDisplay, ATerminalLineIsRedrawnInPlace) {
   char* buf = nullptr;
   std::size_t len = 0;
   std::FILE* mem = open_memstream(&buf, &len);
-  ProgressDisplay p(mem, true, 300.0, {});
+  ProgressDisplay p(mem, true, 300.0, 600.0, {});
   p.tick(tick(1, false));
   p.tick(tick(2, false));
   p.finish();
