@@ -69,7 +69,7 @@ struct Params {
 /// y and on every column of X with the same gains (Harvey 1989, 3.4.2): innovations v, their
 /// variances f (in units of s^2); GLS normal equations from v/sqrt(f). The walk starts at 0 in
 /// each run (its level there is the constant's, and different runs are independent).
-/// `z` holds the rows [y_i, x_i] (n x (p+1), row-major); plain loops: it runs ~600 times a fit.
+/// `z` holds the rows [y_i, x_i] (n x (p+1), row-major); plain loops: it runs ~300 times a fit.
 Profile reml_profile(
     const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>& z,
     const std::vector<double>& phi, const std::vector<double>& dt_h, Params pr) {
@@ -142,7 +142,7 @@ double bin_spacing_s(std::span<const double> t_s, std::span<const int> segment) 
 }
 
 struct Point {
-  double log_tau = 0, q = 0, u = 0;  // u: random-walk share of the record, w = u/(1-u) / span
+  double log_tau = 0, q = 0, u = 0;  // u: log10 of the walk's variance over a run, in s^2
   Profile profile;
 };
 
@@ -156,8 +156,8 @@ struct Problem {
   std::vector<Point>* record = nullptr;
 };
 
-// The walk's size: log10 of its variance over the record in units of s^2, from 1e-3 (read as no
-// walk at all) to 100.
+// The walk's size: log10 of its variance over the longest run in units of s^2, from 1e-3 (read
+// as no walk at all) to 100.
 constexpr double kWalkLo = -3, kWalkHi = 2;
 double walk_per_h(const Problem& pb, double u) {
   return u <= kWalkLo ? 0.0 : std::pow(10.0, u) / pb.span_h;
@@ -168,7 +168,7 @@ struct Box {
 };
 
 double at(double lo, double hi, int i, int steps) {
-  return steps == 1 ? lo : lo + (hi - lo) * i / (steps - 1);
+  return lo + (hi - lo) * i / (steps - 1);
 }
 
 /// Grid search over the box, `steps` points each way.
