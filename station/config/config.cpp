@@ -181,7 +181,8 @@ void check_slots_unique(const TomlView& root, const std::vector<SlotConfig>& slo
 StationConfig parse_station_config(const std::string& text, const std::string& path) {
   const toml::table tbl = TomlView::parse_text(text, path);
   const TomlView root(tbl, path);
-  root.allow_only({"station", "limits", "chamber", "turntable", "can", "gpio", "slot", "http"});
+  root.allow_only(
+      {"station", "limits", "chamber", "turntable", "can", "gpio", "slot", "http", "fleet"});
   StationConfig c;
   c.path = path;
   c.text = text;
@@ -223,6 +224,12 @@ StationConfig parse_station_config(const std::string& text, const std::string& p
       if (d->empty()) throw h->error("protocol_dir", "must not be empty");
       c.http.protocol_dir = beside(*d);
     }
+  }
+  if (auto f = root.opt_table("fleet")) {
+    // Central rows name the station that recorded them: every station of a line needs its own.
+    if (!root.opt_table("station")->opt_string("name"))
+      throw f->error("pg", "[fleet] needs [station] name, a name unique in the fleet");
+    c.fleet = read_fleet_config(*f, path);
   }
   auto chamber = root.opt_table("chamber");
   if (!chamber) throw root.error("chamber", "missing [chamber] table");

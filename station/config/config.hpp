@@ -14,6 +14,7 @@
 #include "drivers/modbus/readback.hpp"
 #include "drivers/registry/dialects.hpp"
 #include "station/common/input_error.hpp"
+#include "station/config/fleet_config.hpp"
 
 namespace station {
 
@@ -72,6 +73,8 @@ struct StationConfig {
   LimitsConfig limits;
   std::vector<SlotConfig> slots;
   HttpConfig http;
+  /// [fleet]: the central PostgreSQL this station forwards to; unset when it forwards nowhere.
+  std::optional<FleetConfig> fleet;
 };
 
 /// Reads and validates a configuration file; throws InputError ("FILE:LINE: key 'k': ...").

@@ -45,6 +45,13 @@ class Statement {
   std::int64_t column_int(int c) const { return sqlite3_column_int64(stmt_.get(), c); }
   std::string column_text(int c) const;
   bool column_is_null(int c) const { return sqlite3_column_type(stmt_.get(), c) == SQLITE_NULL; }
+  /// SQLITE_INTEGER, SQLITE_FLOAT, SQLITE_TEXT, SQLITE_BLOB or SQLITE_NULL.
+  int column_type(int c) const { return sqlite3_column_type(stmt_.get(), c); }
+  int column_count() const { return sqlite3_column_count(stmt_.get()); }
+  /// Index of a named parameter (":name"), 0 when the statement has none by that name.
+  int parameter_index(const char* name) const {
+    return sqlite3_bind_parameter_index(stmt_.get(), name);
+  }
 
  private:
   [[noreturn]] void fail(const char* what) const;

@@ -1,0 +1,32 @@
+// How one table's rows travel: SQLite rows encoded as COPY text, staged in a temporary table,
+// merged into the central table by the table's Merge rule (fleet_tables.hpp). SQL generated from
+// the table's column lists, so a column is named once.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "station/fleet/fleet_tables.hpp"
+#include "station/fleet/pg.hpp"
+#include "station/store/sqlite.hpp"
+
+namespace station::fleet {
+
+/// Rows encoded for COPY and the value of one column in the last row (a watermark).
+struct EncodedRows {
+  std::string data;
+  std::int64_t rows = 0;
+  std::optional<double> last;  ///< column `watermark_col` of the last row
+};
+
+/// Steps `st` to the end, encoding every row. Values keep their exact value: integers as
+/// decimal, reals as the shortest text that reads back to the same double (fmt "{}"), text as
+/// is. `watermark_col` < 0: none.
+EncodedRows encode_rows(Statement& st, int watermark_col = -1);
+
+/// Stages `rows` and merges them into `t` inside the caller's transaction; returns the rows the
+/// server inserted or changed. `run_uuid` scopes a replace_set's deletions.
+std::int64_t stage_and_merge(PgConnection& pg, const FleetTable& t, const EncodedRows& rows,
+                             const std::string& run_uuid);
+
+}  // namespace station::fleet

@@ -1,0 +1,119 @@
+#include "station/fleet/fleet_tables.hpp"
+
+#include <stdexcept>
+#include <string>
+
+namespace station::fleet {
+namespace {
+
+// The station that recorded a fit: the station of the first run it used (fits have no station
+// column of their own; a fit of runs no longer in the file falls back to :station).
+#define STATION_FIT_STATION(f)                                                              \
+  "coalesce((SELECT r.station FROM json_each(" f ".runs_json) AS j JOIN runs AS r ON r.id = " \
+  "j.value ORDER BY r.id LIMIT 1), :station)"
+
+const std::vector<FleetTable> kTables = {
+    {"runs", Item::run,
+     "uuid,station,local_id,started_utc,ended_utc,state,protocol_name,protocol_text,config_text,"
+     "software_version,operator,sim_seed,step_index,step_started_s,t_s,recording,record_start_s,"
+     "start_temp_c,t0_wall_s,resolved_json",
+     "uuid",
+     "SELECT uuid, station, id, started_utc, ended_utc, state, protocol_name, protocol_text, "
+     "config_text, software_version, operator, sim_seed, step_index, step_started_s, t_s, "
+     "recording, record_start_s, start_temp_c, t0_wall_s, resolved_json FROM runs WHERE id = :id",
+     Merge::upsert},
+    {"run_slots", Item::run,
+     "run_uuid,slot,node,serial,pulse_weight_arcsec,axis,earth_rate_dph,part_number,"
+     "part_limits_json",
+     "run_uuid,slot",
+     "SELECT r.uuid, s.slot, s.node, s.serial, s.pulse_weight_arcsec, s.axis, s.earth_rate_dph, "
+     "s.part_number, s.part_limits_json FROM run_slots AS s JOIN runs AS r ON r.id = s.run_id "
+     "WHERE s.run_id = :id",
+     Merge::replace_set},
+    {"bins", Item::run,
+     "run_uuid,serial,t_start_s,n,rate_dph,bias_dph,temp_c,grad_c,dtdt_c_per_h,complete",
+     "run_uuid,serial,t_start_s",
+     "SELECT r.uuid, b.serial, b.t_start_s, b.n, b.rate_dph, b.bias_dph, b.temp_c, b.grad_c, "
+     "b.dtdt_c_per_h, b.complete FROM bins AS b JOIN runs AS r ON r.id = b.run_id "
+     "WHERE b.run_id = :id",
+     Merge::replace_set},
+    {"events", Item::run,
+     "run_uuid,local_id,t_s,wall_utc,severity,source,kind,message,data_json", "run_uuid,local_id",
+     "SELECT r.uuid, e.id, e.t_s, e.wall_utc, e.severity, e.source, e.kind, e.message, "
+     "e.data_json FROM events AS e JOIN runs AS r ON r.id = e.run_id WHERE e.run_id = :id AND "
+     "e.id > :after ORDER BY e.id LIMIT :limit",
+     Merge::append},
+    {"samples", Item::run,
+     "run_uuid,serial,t_s,net_pulses,interval_s,rate_dph,temp_c,temp2_c,air_c,setpoint_c,flags,"
+     "recording",
+     "run_uuid,serial,t_s",
+     "SELECT r.uuid, s.serial, s.t_s, s.net_pulses, s.interval_s, s.rate_dph, s.temp_c, "
+     "s.temp2_c, s.air_c, s.setpoint_c, s.flags, s.recording FROM samples AS s JOIN runs AS r "
+     "ON r.id = s.run_id WHERE s.run_id = :id AND s.serial = :serial AND s.t_s > :after "
+     "ORDER BY s.t_s LIMIT :limit",
+     Merge::append},
+    {"fits", Item::fit,
+     "uuid,station,local_id,serial,created_utc,runs_json,run_uuids_json,terms,ref_temp_c,"
+     "coefficients_json,std_errors_json,n_bins,r2,residual_rms_dph,condition_number,"
+     "std_before_dph,std_after_dph,std_ratio,warnings_json,std_errors_ols_json,error_model_json,"
+     "part_number,verdict_json,adev_floor_dph",
+     "uuid",
+     "SELECT f.uuid, " STATION_FIT_STATION("f") ", f.id, f.serial, f.created_utc, f.runs_json, "
+     "(SELECT json_group_array(r.uuid) FROM json_each(f.runs_json) AS j JOIN runs AS r ON r.id = "
+     "j.value), f.terms, f.ref_temp_c, f.coefficients_json, f.std_errors_json, f.n_bins, f.r2, "
+     "f.residual_rms_dph, f.condition_number, f.std_before_dph, f.std_after_dph, f.std_ratio, "
+     "f.warnings_json, f.std_errors_ols_json, f.error_model_json, f.part_number, f.verdict_json, "
+     "f.adev_floor_dph FROM fits AS f WHERE f.id = :id",
+     Merge::upsert},
+    {"releases", Item::release,
+     "uuid,station,local_id,fit_uuid,serial,released_utc,released_by,note,override_reason,"
+     "verdict_json",
+     "uuid",
+     "SELECT l.uuid, " STATION_FIT_STATION("f") ", l.id, f.uuid, l.serial, l.released_utc, "
+     "l.released_by, l.note, l.override_reason, l.verdict_json FROM releases AS l JOIN fits AS f "
+     "ON f.id = l.fit_id WHERE l.id = :id",
+     Merge::upsert},
+    {"verifications", Item::verification,
+     "uuid,station,local_id,fit_uuid,run_uuid,serial,created_utc,result_json,part_number,"
+     "verdict_json",
+     "uuid",
+     "SELECT v.uuid, r.station, v.id, f.uuid, r.uuid, v.serial, v.created_utc, v.result_json, "
+     "v.part_number, v.verdict_json FROM verifications AS v JOIN fits AS f ON f.id = v.fit_id "
+     "JOIN runs AS r ON r.id = v.run_id WHERE v.id = :id",
+     Merge::upsert},
+};
+
+#undef STATION_FIT_STATION
+
+}  // namespace
+
+std::string_view item_name(Item i) {
+  switch (i) {
+    case Item::run: return "run";
+    case Item::fit: return "fit";
+    case Item::release: return "release";
+    case Item::verification: return "verification";
+  }
+  return "?";
+}
+
+const std::vector<FleetTable>& fleet_tables() { return kTables; }
+
+const FleetTable& fleet_table(std::string_view name) {
+  for (const auto& t : kTables)
+    if (t.name == name) return t;
+  throw std::out_of_range("no fleet table " + std::string(name));
+}
+
+std::vector<std::string_view> split_columns(std::string_view list) {
+  std::vector<std::string_view> out;
+  while (!list.empty()) {
+    const auto comma = list.find(',');
+    out.push_back(list.substr(0, comma));
+    if (comma == std::string_view::npos) break;
+    list.remove_prefix(comma + 1);
+  }
+  return out;
+}
+
+}  // namespace station::fleet

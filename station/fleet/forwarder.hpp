@@ -1,0 +1,83 @@
+// Store and forward: sends what the station's SQLite holds and PostgreSQL does not yet, item by
+// item (a run with its slots, bins, events and samples; a fit; a release; a verification), each
+// in one PostgreSQL transaction, and records the acknowledgement in SQLite's fleet_outbox
+// (migration 007) only after the server committed. Idempotent: central rows are keyed by uuids
+// minted locally, appended rows resume from the server's own watermark, merged rows are only
+// rewritten when they differ; a resend after a lost acknowledgement or a kill changes nothing.
+// Reads through its own read-only connection (one snapshot per item); its only writes are the
+// outbox's acknowledgements. Never touches the tick loop: `serve` runs it on its own thread
+// (forwarder_thread.hpp), `station sync` once.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "station/fleet/fleet_tables.hpp"
+#include "station/fleet/pg.hpp"
+#include "station/store/sqlite.hpp"
+
+namespace station::fleet {
+
+struct ForwardOptions {
+  bool samples = false;              ///< forward the 1 Hz samples too ([fleet] samples)
+  std::int64_t batch_rows = 50'000;  ///< appended rows per PostgreSQL transaction
+  std::string station;  ///< the station's name, for a fit whose runs are gone from the file
+};
+
+/// What is still to send.
+struct Backlog {
+  std::int64_t runs = 0;   ///< runs not acknowledged in their latest state
+  std::int64_t items = 0;  ///< runs, fits, releases and verifications not acknowledged
+  std::int64_t rows = 0;   ///< items plus the events (and samples, when forwarded) behind them
+};
+
+/// One pass.
+struct PassResult {
+  std::int64_t items = 0;   ///< items acknowledged complete
+  std::int64_t rows = 0;    ///< rows PostgreSQL inserted or changed
+  std::int64_t appended = 0;  ///< event and sample rows sent (each is sent once, resends none)
+  std::int64_t failed = 0;  ///< items the server refused (their outbox row holds why)
+  bool more = false;        ///< more to send right away (a batch limit was reached)
+  std::string last_error;   ///< the last refusal, empty when none
+};
+
+class Forwarder {
+ public:
+  /// No I/O: databases and the server are opened by the first pass.
+  Forwarder(std::string db_path, PgTarget target, ForwardOptions options);
+  /// Sends up to `max_items` pending items. Throws PgError when the server cannot be reached or
+  /// the link drops (nothing acknowledged that was not committed), SqliteError on a local fault.
+  PassResult pass(std::int64_t max_items = 100);
+  /// Reads the outbox (no server needed).
+  Backlog backlog();
+  /// Drops the server connection (the next pass reconnects).
+  void disconnect() { pg_.reset(); }
+
+ private:
+  struct Sent {
+    std::int64_t rows = 0;
+    std::int64_t appended = 0;
+    bool complete = true;
+    std::optional<std::int64_t> events_after;
+    std::optional<double> samples_after;
+  };
+  void open();
+  Sent send_item(Item item, std::int64_t local_id);
+  Sent send_run(std::int64_t run_id);
+  std::int64_t merge_all(const FleetTable& t, std::int64_t local_id, const std::string& run_uuid);
+  std::int64_t append_events(std::int64_t run_id, const std::string& run_uuid, Sent& sent,
+                             std::int64_t& budget);
+  std::int64_t append_samples(std::int64_t run_id, const std::string& run_uuid, Sent& sent,
+                              std::int64_t& budget);
+  void acknowledge(Item item, std::int64_t local_id, std::int64_t changes, const Sent& sent);
+  void record_error(Item item, std::int64_t local_id, const std::string& error);
+
+  std::string db_path_;
+  PgTarget target_;
+  ForwardOptions options_;
+  std::optional<Database> read_, write_;
+  std::optional<PgConnection> pg_;
+};
+
+}  // namespace station::fleet

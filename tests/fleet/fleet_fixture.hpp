@@ -1,0 +1,108 @@
+// Test helper: a throw-away PostgreSQL per test process with the fleet schema, simulated
+// station databases, and row-by-row comparison of what a station holds with what the server got.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "station/fleet/fleet_merge.hpp"
+#include "station/fleet/fleet_schema.hpp"
+#include "station/fleet/forwarder.hpp"
+#include "station/sim/sim_run.hpp"
+#include "tests/fleet/pg_server.hpp"
+#include "tests/station/sim_options.hpp"
+#include "tests/station/temp_db.hpp"
+
+namespace station::testing_support {
+
+class FleetTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    skip_ = ThrowawayPostgres::unavailable();
+    if (skip_.empty()) server_ = std::make_unique<ThrowawayPostgres>();
+  }
+  static void TearDownTestSuite() { server_.reset(); }
+  void SetUp() override {
+    if (!skip_.empty()) GTEST_SKIP() << skip_;
+    fleet::PgConnection pg(target());
+    fleet::init_fleet_schema(pg);
+  }
+  static fleet::PgTarget target() { return {server_->url(), {}}; }
+
+  /// A finished simulated run of `gyros` gyros (tests/data/short_cycle.toml, about 2.2 h of
+  /// simulated time) with its fits, in a fresh database; returns the path.
+  static std::string simulated_station(const std::string& name, int gyros, std::uint64_t seed) {
+    const auto db = fresh_db(name);
+    auto o = short_cycle_run(db, gyros);
+    o.seed = seed;
+    station::run_simulated(o);
+    return db;
+  }
+
+  /// Forwards until nothing is pending; returns the totals.
+  static fleet::PassResult forward_all(const std::string& db, bool samples,
+                                       std::int64_t batch_rows = 50'000) {
+    fleet::ForwardOptions o;
+    o.samples = samples;
+    o.batch_rows = batch_rows;
+    o.station = "test";
+    fleet::Forwarder f(db, target(), o);
+    fleet::PassResult total;
+    for (int i = 0; i < 10'000; ++i) {
+      const auto p = f.pass();
+      total.items += p.items;
+      total.rows += p.rows;
+      total.appended += p.appended;
+      total.failed += p.failed;
+      if (!p.last_error.empty()) total.last_error = p.last_error;
+      if (!p.more) break;
+    }
+    return total;
+  }
+
+  static inline std::unique_ptr<ThrowawayPostgres> server_;
+  static inline std::string skip_;
+};
+
+/// One value as both sides can be compared: numbers by their double value (the shortest text
+/// that reads back to it), uuids without dashes (SQLite keeps 32 hex digits), text as is.
+inline std::string normalized(const std::string& v) {
+  char* end = nullptr;
+  const double d = std::strtod(v.c_str(), &end);
+  if (!v.empty() && end == v.c_str() + v.size()) return fmt::format("{}", d);
+  if (v.size() == 36 && v[8] == '-' && v[13] == '-' && v[18] == '-' && v[23] == '-') {
+    std::string hex = v;
+    hex.erase(std::remove(hex.begin(), hex.end(), '-'), hex.end());
+    return hex;
+  }
+  return v;
+}
+
+/// COPY-text rows (fleet::encode_rows) as sorted rows of normalized fields.
+inline std::vector<std::string> normalized_rows(const std::string& copy_text) {
+  std::vector<std::string> rows;
+  std::size_t start = 0;
+  while (start < copy_text.size()) {
+    const auto nl = copy_text.find('\n', start);
+    const std::string line = copy_text.substr(start, nl - start);
+    start = nl + 1;
+    std::string row;
+    std::size_t f = 0;
+    for (;;) {
+      const auto tab = line.find('\t', f);
+      row += normalized(line.substr(f, tab - f)) + "|";
+      if (tab == std::string::npos) break;
+      f = tab + 1;
+    }
+    rows.push_back(row);
+  }
+  std::sort(rows.begin(), rows.end());
+  return rows;
+}
+
+}  // namespace station::testing_support

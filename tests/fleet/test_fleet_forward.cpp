@@ -1,0 +1,168 @@
+// Issue 24: store and forward to a real PostgreSQL 15 (a throw-away server per test process).
+// Every row of a simulated run arrives and equals the SQLite row; a resend after lost
+// acknowledgements changes nothing; two stations forwarding at once keep their runs apart.
+#include <gtest/gtest.h>
+
+#include <thread>
+
+#include "station/store/store.hpp"
+#include "tests/fleet/fleet_fixture.hpp"
+
+namespace {
+
+using station::Database;
+using station::OpenMode;
+using station::Statement;
+namespace fleet = station::fleet;
+using station::testing_support::FleetTest;
+using station::testing_support::normalized_rows;
+
+std::vector<std::int64_t> ids(Database& db, const std::string& sql) {
+  std::vector<std::int64_t> out;
+  auto st = db.prepare(sql);
+  while (st.step()) out.push_back(st.column_int(0));
+  return out;
+}
+
+void bind_if(Statement& st, const char* name, auto v) {
+  if (int i = st.parameter_index(name); i > 0) st.bind(i, v);
+}
+
+/// Every row the station holds for central table `t`, through the table's own SELECT.
+std::vector<std::string> station_rows(const std::string& path, const fleet::FleetTable& t) {
+  Database db(path, OpenMode::read_only);
+  std::string text;
+  const char* items[] = {"SELECT id FROM runs", "SELECT id FROM fits", "SELECT id FROM releases",
+                         "SELECT id FROM verifications"};
+  for (std::int64_t id : ids(db, items[static_cast<int>(t.item)])) {
+    std::vector<std::string> serials = {""};
+    if (t.name == "samples") {
+      serials.clear();
+      auto s = db.prepare("SELECT serial FROM run_slots WHERE run_id = ?");
+      s.bind(1, id);
+      while (s.step()) serials.push_back(s.column_text(0));
+    }
+    for (const auto& serial : serials) {
+      auto st = db.prepare(t.select);
+      bind_if(st, ":id", id);
+      bind_if(st, ":after", -1e300);
+      bind_if(st, ":limit", std::int64_t{-1});
+      bind_if(st, ":serial", std::string_view(serial));
+      bind_if(st, ":station", std::string_view("test"));
+      text += fleet::encode_rows(st).data;
+    }
+  }
+  return normalized_rows(text);
+}
+
+/// Every row the server holds in `t` (of runs with uuid in `run_uuids`, when given).
+std::vector<std::string> server_rows(const fleet::FleetTable& t, const std::string& where = "") {
+  fleet::PgConnection pg(FleetTest::target());
+  auto r = pg.exec(fmt::format("SELECT {} FROM {} {}", t.columns, t.name, where));
+  std::string text;
+  for (int i = 0; i < r.rows(); ++i) {
+    for (int c = 0; c < r.columns(); ++c) {
+      if (c > 0) text += '\t';
+      const auto v = r.opt_text(i, c);
+      fleet::append_copy_field(text, v ? std::optional<std::string_view>(*v) : std::nullopt);
+    }
+    text += '\n';
+  }
+  return normalized_rows(text);
+}
+
+std::int64_t count(const std::string& table) {
+  fleet::PgConnection pg(FleetTest::target());
+  return pg.exec("SELECT count(*) FROM " + table).integer(0, 0);
+}
+
+class FleetForward : public FleetTest {};
+
+TEST_F(FleetForward, EveryRowArrivesAndEqualsTheSqliteRow) {
+  const auto db = simulated_station("fleet_every_row", 2, 7);
+  const auto sent = forward_all(db, true, 5'000);  // several batches per run
+  EXPECT_EQ(sent.failed, 0) << sent.last_error;
+  for (const auto& t : fleet::fleet_tables()) {
+    const auto local = station_rows(db, t), central = server_rows(t);
+    if (t.name == "runs" || t.name == "samples" || t.name == "bins" || t.name == "events" ||
+        t.name == "fits" || t.name == "run_slots")
+      EXPECT_GT(local.size(), 0u) << t.name << ": the simulated run should have rows";
+    EXPECT_EQ(local, central) << t.name;
+  }
+  fleet::Forwarder f(db, target(), {.samples = true});
+  const auto left = f.backlog();
+  EXPECT_EQ(left.items, 0);
+  EXPECT_EQ(left.rows, 0);
+}
+
+TEST_F(FleetForward, ResendAfterLostAcknowledgementsChangesNothing) {
+  const auto db = simulated_station("fleet_resend", 1, 3);
+  forward_all(db, true);
+  fleet::PgConnection pg(target());
+  const auto xmin_before = pg.exec("SELECT string_agg(xmin::text, ',' ORDER BY uuid) FROM runs");
+  const auto fits_before = pg.exec("SELECT string_agg(xmin::text, ',' ORDER BY uuid) FROM fits");
+  const std::int64_t samples = count("samples"), events = count("events"), bins = count("bins");
+  {
+    // As after a restored backup or acknowledgements lost to a kill: everything pending again.
+    Database w(db, OpenMode::existing);
+    w.exec("UPDATE fleet_outbox SET acked = 0, events_acked_id = NULL, samples_acked_t_s = NULL");
+  }
+  const auto again = forward_all(db, true);
+  EXPECT_EQ(again.failed, 0) << again.last_error;
+  EXPECT_EQ(again.rows, 0) << "a resend wrote rows";
+  EXPECT_EQ(again.appended, 0) << "events or samples were sent twice";
+  EXPECT_EQ(count("samples"), samples);
+  EXPECT_EQ(count("events"), events);
+  EXPECT_EQ(count("bins"), bins);
+  // Not rewritten either: a row's xmin changes with every UPDATE (PostgreSQL MVCC).
+  EXPECT_EQ(pg.exec("SELECT string_agg(xmin::text, ',' ORDER BY uuid) FROM runs").text(0, 0),
+            xmin_before.text(0, 0));
+  EXPECT_EQ(pg.exec("SELECT string_agg(xmin::text, ',' ORDER BY uuid) FROM fits").text(0, 0),
+            fits_before.text(0, 0));
+}
+
+TEST_F(FleetForward, LocalChangesAfterForwardingArrive) {
+  const auto db = simulated_station("fleet_change", 1, 4);
+  forward_all(db, false);
+  EXPECT_EQ(count("samples"), 0) << "samples travel only when asked for";
+  {
+    Database w(db, OpenMode::existing);
+    w.exec("UPDATE fits SET part_number = 'RLG-90' WHERE id = (SELECT max(id) FROM fits)");
+    w.exec("DELETE FROM bins WHERE rowid IN (SELECT rowid FROM bins LIMIT 1)");
+  }
+  const auto again = forward_all(db, false);
+  EXPECT_EQ(again.failed, 0) << again.last_error;
+  EXPECT_GE(again.rows, 2);  // the fit updated, the bin gone
+  EXPECT_EQ(station_rows(db, fleet::fleet_table("fits")), server_rows(fleet::fleet_table("fits")));
+  EXPECT_EQ(station_rows(db, fleet::fleet_table("bins")), server_rows(fleet::fleet_table("bins")));
+}
+
+TEST_F(FleetForward, TwoStationsAtOnceKeepTheirRunsApart) {
+  const auto a = simulated_station("fleet_station_a", 2, 11);
+  const auto b = simulated_station("fleet_station_b", 2, 12);
+  for (const auto& [db, name] : {std::pair{a, "rig-a"}, std::pair{b, "rig-b"}}) {
+    Database w(db, OpenMode::existing);
+    w.exec(fmt::format("UPDATE runs SET station = '{}'", name));
+  }
+  fleet::PassResult ra, rb;
+  std::thread ta([&] { ra = forward_all(a, true, 3'000); });
+  std::thread tb([&] { rb = forward_all(b, true, 3'000); });
+  ta.join();
+  tb.join();
+  EXPECT_EQ(ra.failed + rb.failed, 0) << ra.last_error << rb.last_error;
+  for (const auto& [db, name] : {std::pair{a, "rig-a"}, std::pair{b, "rig-b"}}) {
+    Database r(db, OpenMode::read_only);
+    auto u = r.prepare("SELECT uuid FROM runs");
+    ASSERT_TRUE(u.step());
+    const std::string where =
+        fmt::format("WHERE run_uuid = '{}'", u.column_text(0));
+    for (const char* t : {"samples", "events", "bins", "run_slots"})
+      EXPECT_EQ(station_rows(db, fleet::fleet_table(t)), server_rows(fleet::fleet_table(t), where))
+          << name << " " << t;
+    EXPECT_EQ(server_rows(fleet::fleet_table("runs"),
+                          fmt::format("WHERE station = '{}'", name)),
+              station_rows(db, fleet::fleet_table("runs")));
+  }
+}
+
+}  // namespace
