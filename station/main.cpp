@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
   station::add_release_commands(app, status);
   station::add_history_command(app, status);
   station::add_sync_command(app, status);
+  station::add_fleet_command(app, status);
   station::add_replay_command(app, status);
   station::add_report_command(app, status);
   if (argc > 1 && argv[1][0] != '-') {

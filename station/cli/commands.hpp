@@ -29,6 +29,8 @@ void add_release_commands(CLI::App& app, CommandStatus& status);
 void add_history_command(CLI::App& app, CommandStatus& status);
 /// `station sync --db DB --pg URL [--init]`: forward the record to the fleet's PostgreSQL once.
 void add_sync_command(CLI::App& app, CommandStatus& status);
+/// `station fleet --pg URL [--part PN] [--out DIR]`: control charts across the fleet.
+void add_fleet_command(CLI::App& app, CommandStatus& status);
 /// `station replay LOG --db PATH --run ID`: a recorded session through the driver again.
 void add_replay_command(CLI::App& app, CommandStatus& status);
 /// `station report --db DB --run ID --out DIR [--pdf]`: a run's report as HTML pages.

@@ -1,6 +1,8 @@
-// `station history --db DB --serial SN [--json]`: every run and fit of one gyro, its
-// coefficients over time, their run-to-run scatter against the reported uncertainties, and
-// calibrations that moved more than their uncertainties allow. Read-only.
+// `station history (--db DB | --pg URL) --serial SN [--json]`: every run and fit of one gyro,
+// its coefficients over time, their run-to-run scatter against the reported uncertainties, and
+// calibrations that moved more than their uncertainties allow. Read-only. With --pg, across the
+// fleet: every station's runs and fits as forwarded to the central PostgreSQL (ids are the
+// fleet's, each row names its station).
 #include <fmt/format.h>
 
 #include <iostream>
@@ -8,6 +10,8 @@
 
 #include "station/cli/commands.hpp"
 #include "station/common/input_error.hpp"
+#include "station/config/fleet_config.hpp"
+#include "station/fleet/fleet_history.hpp"
 #include "station/parts/history.hpp"
 #include "station/parts/verdict.hpp"
 #include "station/release/releases.hpp"
@@ -18,7 +22,7 @@ namespace {
 using nlohmann::json;
 
 struct HistoryOptions {
-  std::string db, serial;
+  std::string db, pg, serial;
   bool json = false;
 };
 
@@ -46,7 +50,8 @@ json fit_row_json(const SerialFitRow& f) {
           {"std_after_dph", f.std_after_dph},
           {"std_ratio", opt(f.std_ratio)},
           {"part_number", f.part_number ? json(*f.part_number) : json()},
-          {"verdict", v ? verdict_json(*v) : json()}};
+          {"verdict", v ? verdict_json(*v) : json()},
+          {"station", f.station.empty() ? json() : json(f.station)}};
 }
 
 json releases_json(const std::vector<ReleaseRow>& releases) {
@@ -127,17 +132,18 @@ void print_history(const std::string& serial, const std::vector<SerialRun>& runs
   fmt::print("{}: {} runs, {} fits, {} calibrations\n", serial, runs.size(), fits.size(),
              h.calibrations.size());
   for (const auto& r : runs) {
-    fmt::print("  run {:>4} {} {:<10} {:<12} slot {:>2} part {}\n", r.run_id, r.started_utc,
-               r.state, r.protocol_name, r.slot, r.part_number.value_or("-"));
+    fmt::print("  run {:>4} {} {:<10} {:<12} slot {:>2} part {} station {}\n", r.run_id,
+               r.started_utc, r.state, r.protocol_name, r.slot, r.part_number.value_or("-"),
+               r.station);
   }
   fmt::print("  {:>6} {:<24} {:<10} {:>24} {:>24} {:>7}  verdict\n", "fit", "created", "runs",
              "k1 deg/h/C", "k0 deg/h/C", "ratio");
   for (const auto& f : fits) {
-    fmt::print("  {:>5}{} {:<24} {:<10} {:>24} {:>24} {:>7}  {}\n", f.fit_id,
+    fmt::print("  {:>5}{} {:<24} {:<10} {:>24} {:>24} {:>7}  {}{}\n", f.fit_id,
                f.fit_id == released ? "*" : " ", f.created_utc,
                fmt::format("{}", fmt::join(f.runs, ",")), pm(f, "k1"), pm(f, "k0"),
                f.std_ratio ? fmt::format("{:.3f}", *f.std_ratio) : "undef",
-               verdict_text(verdict_of(f)));
+               verdict_text(verdict_of(f)), f.station.empty() ? "" : "  station " + f.station);
   }
   print_releases(releases);
   for (const auto& s : h.scatter) {
@@ -161,14 +167,23 @@ void print_history(const std::string& serial, const std::vector<SerialRun>& runs
                kDriftZetaLimit);
 }
 
-void run_history(const HistoryOptions& o) {
+fleet::FleetSerialHistory read_history(const HistoryOptions& o) {
+  if (!o.pg.empty()) {
+    if (auto why = pg_url_problem(o.pg)) throw InputError(fmt::format("--pg: {}", *why));
+    fleet::PgConnection pg({o.pg, {}});
+    return fleet::fleet_serial_history(pg, o.serial);
+  }
   Store store(o.db, OpenMode::read_only);
-  const auto runs = serial_runs(store, o.serial);
-  const auto fits = serial_fits(store, o.serial);
+  return {serial_runs(store, o.serial), serial_fits(store, o.serial), releases_of(store, o.serial)};
+}
+
+void run_history(const HistoryOptions& o) {
+  if (o.db.empty() == o.pg.empty()) throw InputError("give one of --db DB or --pg URL");
+  const auto [runs, fits, releases] = read_history(o);
   if (runs.empty() && fits.empty())
-    throw InputError(fmt::format("{}: no run or fit of serial '{}'", o.db, o.serial));
+    throw InputError(
+        fmt::format("{}: no run or fit of serial '{}'", o.pg.empty() ? o.db : o.pg, o.serial));
   const auto h = serial_history_stats(fits);
-  const auto releases = releases_of(store, o.serial);
   if (o.json) {
     std::cout << history_json(o.serial, runs, fits, h, releases).dump(2) << '\n';
     return;
@@ -182,7 +197,9 @@ void add_history_command(CLI::App& app, CommandStatus& status) {
   auto o = std::make_shared<HistoryOptions>();
   auto* cmd = app.add_subcommand(
       "history", "Every run and fit of one gyro, the scatter of its coefficients and drift");
-  cmd->add_option("--db", o->db, "SQLite database (opened read-only)")->required();
+  cmd->add_option("--db", o->db, "SQLite database (opened read-only)");
+  cmd->add_option("--pg", o->pg,
+                  "the fleet's PostgreSQL (libpq URL): every station's calibrations of the gyro");
   cmd->add_option("--serial", o->serial, "gyro serial number")->required();
   cmd->add_flag("--json", o->json, "print JSON");
   cmd->callback([o, &status] {

@@ -28,6 +28,7 @@
 #include "station/daemon/resume.hpp"
 #include "station/daemon/rig.hpp"
 #include "station/daemon/sequencer.hpp"
+#include "station/fleet/forwarder_thread.hpp"
 #include "station/parts/judged_fit.hpp"
 
 namespace station {
@@ -207,12 +208,23 @@ int serve(const ServeOptions& o) {
             std::move(part_limits),
             sd_watchdog_enabled(0, &watchdog_usec) > 0,
             std::nullopt};
+  // Store and forward ([fleet]): its own thread and connections; stopped before the hub goes.
+  std::optional<fleet::ForwarderThread> forwarder;
+  if (config.fleet)
+    forwarder.emplace(o.db, fleet::fleet_target(*config.fleet),
+                      fleet::ForwardOptions{config.fleet->samples, 50'000, config.name},
+                      config.fleet->interval_s, [&live](const fleet::ForwarderStatus& f) {
+                        live.hub().fleet(f.to_json());
+                        live.hub().metrics().fleet(f.backlog.runs, f.backlog.rows,
+                                                   f.last_success_unix_s, f.errors_total);
+                      });
   sd_notify(0, "READY=1");
   // A run a killed daemon left unfinished goes on first, exactly as `station run` resumes it.
   const ResumeDecision rd = decide_resume(store, config, false, false);
   if (rd.run) run_one(s, *rd.protocol, rd.run, rd.run->operator_name);
   idle_until_stopped(s);
   sd_notify(0, "STOPPING=1");
+  forwarder.reset();
   live.shutdown();
   if (g_detach.load()) {
     // Everything is committed (each tick is its own transaction). Leave now, as a kill would:

@@ -40,7 +40,7 @@ Resolved resolve(const SyncOptions& o, Store& store) {
   if (!o.config.empty()) {
     const auto cfg = load_station_config(o.config);
     if (!cfg.fleet) throw InputError(fmt::format("{}: no [fleet] table (pg = URL)", o.config));
-    r.target = {cfg.fleet->pg, cfg.fleet->keywords};
+    r.target = fleet::fleet_target(*cfg.fleet);
     r.forward.samples = cfg.fleet->samples;
     r.forward.station = cfg.name;
   }
@@ -78,12 +78,10 @@ int run_sync(const SyncOptions& o) {
   }
   const auto left = fwd.backlog();
   if (o.json) {
-    std::cout << nlohmann::json{{"items_sent", total.items}, {"rows_written", total.rows},
-                                {"rows_appended", total.appended},
-                                {"items_refused", total.failed},
-                                {"last_error", total.last_error},
-                                {"pending_runs", left.runs}, {"pending_items", left.items},
-                                {"pending_rows", left.rows}}
+    std::cout << nlohmann::json{{"items_sent", total.items},       {"rows_written", total.rows},
+                                {"rows_appended", total.appended}, {"items_refused", total.failed},
+                                {"last_error", total.last_error},  {"pending_runs", left.runs},
+                                {"pending_items", left.items},     {"pending_rows", left.rows}}
                      .dump(2)
               << '\n';
   } else {

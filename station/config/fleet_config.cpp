@@ -34,8 +34,8 @@ std::optional<std::string> pg_url_problem(const std::string& url) {
 }
 
 FleetConfig read_fleet_config(const TomlView& t, const std::string& path) {
-  t.allow_only({"pg", "password_file", "samples", "interval_s", "sslmode", "sslrootcert",
-                "sslcert", "sslkey", "sslcrl"});
+  t.allow_only({"pg", "password_file", "samples", "interval_s", "sslmode", "sslrootcert", "sslcert",
+                "sslkey", "sslcrl"});
   FleetConfig f;
   f.pg = t.get_string("pg");
   if (auto why = pg_url_problem(f.pg)) throw t.error("pg", *why);
@@ -47,8 +47,8 @@ FleetConfig read_fleet_config(const TomlView& t, const std::string& path) {
     f.keywords.emplace_back("passfile", beside(*p));
   }
   if (auto m = t.opt_string("sslmode")) {
-    static const char* const kModes[] = {"disable", "allow", "prefer", "require", "verify-ca",
-                                         "verify-full"};
+    static const char* const kModes[] = {"disable", "allow",     "prefer",
+                                         "require", "verify-ca", "verify-full"};
     if (std::find(std::begin(kModes), std::end(kModes), *m) == std::end(kModes))
       throw t.error("sslmode",
                     "must be disable, allow, prefer, require, verify-ca or verify-full (libpq)");

@@ -10,7 +10,8 @@ namespace {
 
 std::string prefixed(const std::vector<std::string_view>& cols, std::string_view prefix) {
   std::string out;
-  for (const auto& c : cols) fmt::format_to(std::back_inserter(out), "{}{}{}", out.empty() ? "" : ", ", prefix, c);
+  for (const auto& c : cols)
+    fmt::format_to(std::back_inserter(out), "{}{}{}", out.empty() ? "" : ", ", prefix, c);
   return out;
 }
 
@@ -26,14 +27,15 @@ std::vector<std::string_view> non_key(const FleetTable& t) {
 // DO UPDATE only WHERE the stored row IS DISTINCT FROM the incoming one, so an identical resend
 // writes nothing.
 std::string merge_sql(const FleetTable& t) {
-  const std::string insert = fmt::format("INSERT INTO {0} AS t ({1}) SELECT {1} FROM stage_{0} ",
-                                         t.name, t.columns);
+  const std::string insert =
+      fmt::format("INSERT INTO {0} AS t ({1}) SELECT {1} FROM stage_{0} ", t.name, t.columns);
   if (t.merge == Merge::append) return insert + fmt::format("ON CONFLICT ({}) DO NOTHING", t.key);
   const auto rest = non_key(t);
-  return insert + fmt::format(
-                      "ON CONFLICT ({}) DO UPDATE SET ({}) = ROW({}) WHERE ({}) IS DISTINCT FROM ({})",
-                      t.key, prefixed(rest, ""), prefixed(rest, "EXCLUDED."),
-                      prefixed(rest, "t."), prefixed(rest, "EXCLUDED."));
+  return insert +
+         fmt::format(
+             "ON CONFLICT ({}) DO UPDATE SET ({}) = ROW({}) WHERE ({}) IS DISTINCT FROM ({})",
+             t.key, prefixed(rest, ""), prefixed(rest, "EXCLUDED."), prefixed(rest, "t."),
+             prefixed(rest, "EXCLUDED."));
 }
 
 std::string prune_sql(const FleetTable& t) {
@@ -53,9 +55,15 @@ EncodedRows encode_rows(Statement& st, int watermark_col) {
     for (int c = 0; c < n; ++c) {
       if (c > 0) out.data += '\t';
       switch (st.column_type(c)) {
-        case SQLITE_NULL: append_copy_field(out.data, std::nullopt); break;
-        case SQLITE_INTEGER: out.data += std::to_string(st.column_int(c)); break;
-        case SQLITE_FLOAT: out.data += fmt::format("{}", st.column_double(c)); break;
+        case SQLITE_NULL:
+          append_copy_field(out.data, std::nullopt);
+          break;
+        case SQLITE_INTEGER:
+          out.data += std::to_string(st.column_int(c));
+          break;
+        case SQLITE_FLOAT:
+          out.data += fmt::format("{}", st.column_double(c));
+          break;
         default: {
           const std::string text = st.column_text(c);
           append_copy_field(out.data, std::string_view(text));

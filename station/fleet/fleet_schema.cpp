@@ -12,7 +12,9 @@ constexpr long long kSchemaLockKey = 0x4754434C;
 
 }  // namespace
 
-int fleet_schema_version() { return static_cast<int>(schemas::kFleetMigrations.size()); }
+int fleet_schema_version() {
+  return static_cast<int>(schemas::kFleetMigrations.size());
+}
 
 int server_schema_version(PgConnection& pg) {
   auto exists = pg.exec("SELECT to_regclass('fleet_schema') IS NOT NULL");
@@ -36,8 +38,8 @@ int init_fleet_schema(PgConnection& pg) {
 void require_fleet_schema(PgConnection& pg) {
   const int have = server_schema_version(pg), want = fleet_schema_version();
   if (have == 0)
-    throw PgError(fmt::format("PostgreSQL {}: no fleet schema; create it with `station sync --init`",
-                              pg.where()));
+    throw PgError(fmt::format(
+        "PostgreSQL {}: no fleet schema; create it with `station sync --init`", pg.where()));
   if (have < want)
     throw PgError(fmt::format(
         "PostgreSQL {}: fleet schema version {} is older than this station's {}; refusing to "

@@ -8,8 +8,9 @@ namespace {
 
 // The station that recorded a fit: the station of the first run it used (fits have no station
 // column of their own; a fit of runs no longer in the file falls back to :station).
-#define STATION_FIT_STATION(f)                                                              \
-  "coalesce((SELECT r.station FROM json_each(" f ".runs_json) AS j JOIN runs AS r ON r.id = " \
+#define STATION_FIT_STATION(f)                   \
+  "coalesce((SELECT r.station FROM json_each(" f \
+  ".runs_json) AS j JOIN runs AS r ON r.id = "   \
   "j.value ORDER BY r.id LIMIT 1), :station)"
 
 const std::vector<FleetTable> kTables = {
@@ -37,8 +38,8 @@ const std::vector<FleetTable> kTables = {
      "b.dtdt_c_per_h, b.complete FROM bins AS b JOIN runs AS r ON r.id = b.run_id "
      "WHERE b.run_id = :id",
      Merge::replace_set},
-    {"events", Item::run,
-     "run_uuid,local_id,t_s,wall_utc,severity,source,kind,message,data_json", "run_uuid,local_id",
+    {"events", Item::run, "run_uuid,local_id,t_s,wall_utc,severity,source,kind,message,data_json",
+     "run_uuid,local_id",
      "SELECT r.uuid, e.id, e.t_s, e.wall_utc, e.severity, e.source, e.kind, e.message, "
      "e.data_json FROM events AS e JOIN runs AS r ON r.id = e.run_id WHERE e.run_id = :id AND "
      "e.id > :after ORDER BY e.id LIMIT :limit",
@@ -58,20 +59,26 @@ const std::vector<FleetTable> kTables = {
      "std_before_dph,std_after_dph,std_ratio,warnings_json,std_errors_ols_json,error_model_json,"
      "part_number,verdict_json,adev_floor_dph",
      "uuid",
-     "SELECT f.uuid, " STATION_FIT_STATION("f") ", f.id, f.serial, f.created_utc, f.runs_json, "
-     "(SELECT json_group_array(r.uuid) FROM json_each(f.runs_json) AS j JOIN runs AS r ON r.id = "
-     "j.value), f.terms, f.ref_temp_c, f.coefficients_json, f.std_errors_json, f.n_bins, f.r2, "
-     "f.residual_rms_dph, f.condition_number, f.std_before_dph, f.std_after_dph, f.std_ratio, "
-     "f.warnings_json, f.std_errors_ols_json, f.error_model_json, f.part_number, f.verdict_json, "
-     "f.adev_floor_dph FROM fits AS f WHERE f.id = :id",
+     "SELECT f.uuid, " STATION_FIT_STATION(
+         "f") ", f.id, f.serial, f.created_utc, f.runs_json, "
+              "(SELECT json_group_array(r.uuid) FROM json_each(f.runs_json) AS j JOIN runs AS r ON "
+              "r.id = "
+              "j.value), f.terms, f.ref_temp_c, f.coefficients_json, f.std_errors_json, f.n_bins, "
+              "f.r2, "
+              "f.residual_rms_dph, f.condition_number, f.std_before_dph, f.std_after_dph, "
+              "f.std_ratio, "
+              "f.warnings_json, f.std_errors_ols_json, f.error_model_json, f.part_number, "
+              "f.verdict_json, "
+              "f.adev_floor_dph FROM fits AS f WHERE f.id = :id",
      Merge::upsert},
     {"releases", Item::release,
      "uuid,station,local_id,fit_uuid,serial,released_utc,released_by,note,override_reason,"
      "verdict_json",
      "uuid",
      "SELECT l.uuid, " STATION_FIT_STATION("f") ", l.id, f.uuid, l.serial, l.released_utc, "
-     "l.released_by, l.note, l.override_reason, l.verdict_json FROM releases AS l JOIN fits AS f "
-     "ON f.id = l.fit_id WHERE l.id = :id",
+                                                "l.released_by, l.note, l.override_reason, "
+                                                "l.verdict_json FROM releases AS l JOIN fits AS f "
+                                                "ON f.id = l.fit_id WHERE l.id = :id",
      Merge::upsert},
     {"verifications", Item::verification,
      "uuid,station,local_id,fit_uuid,run_uuid,serial,created_utc,result_json,part_number,"
@@ -89,15 +96,21 @@ const std::vector<FleetTable> kTables = {
 
 std::string_view item_name(Item i) {
   switch (i) {
-    case Item::run: return "run";
-    case Item::fit: return "fit";
-    case Item::release: return "release";
-    case Item::verification: return "verification";
+    case Item::run:
+      return "run";
+    case Item::fit:
+      return "fit";
+    case Item::release:
+      return "release";
+    case Item::verification:
+      return "verification";
   }
   return "?";
 }
 
-const std::vector<FleetTable>& fleet_tables() { return kTables; }
+const std::vector<FleetTable>& fleet_tables() {
+  return kTables;
+}
 
 const FleetTable& fleet_table(std::string_view name) {
   for (const auto& t : kTables)

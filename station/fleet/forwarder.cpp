@@ -148,11 +148,11 @@ Forwarder::Sent Forwarder::send_run(std::int64_t run_id) {
   return sent;
 }
 
-std::int64_t Forwarder::append_events(std::int64_t run_id, const std::string& run_uuid,
-                                      Sent& sent, std::int64_t& budget) {
+std::int64_t Forwarder::append_events(std::int64_t run_id, const std::string& run_uuid, Sent& sent,
+                                      std::int64_t& budget) {
   const auto& t = fleet_table("events");
-  auto have = pg_->exec("SELECT coalesce(max(local_id), 0) FROM events WHERE run_uuid = $1",
-                        {run_uuid});
+  auto have =
+      pg_->exec("SELECT coalesce(max(local_id), 0) FROM events WHERE run_uuid = $1", {run_uuid});
   const std::int64_t after = have.integer(0, 0);
   auto st = read_->prepare(t.select);
   bind_named(st, ":id", run_id);
@@ -166,8 +166,8 @@ std::int64_t Forwarder::append_events(std::int64_t run_id, const std::string& ru
   return stage_and_merge(*pg_, t, rows, run_uuid);
 }
 
-std::int64_t Forwarder::append_samples(std::int64_t run_id, const std::string& run_uuid,
-                                       Sent& sent, std::int64_t& budget) {
+std::int64_t Forwarder::append_samples(std::int64_t run_id, const std::string& run_uuid, Sent& sent,
+                                       std::int64_t& budget) {
   const auto& t = fleet_table("samples");
   auto serials = read_->prepare("SELECT serial FROM run_slots WHERE run_id = ? ORDER BY slot");
   serials.bind(1, run_id);
@@ -208,15 +208,18 @@ void Forwarder::acknowledge(Item item, std::int64_t local_id, std::int64_t chang
       "samples_acked_t_s = coalesce(?5, samples_acked_t_s), last_error = NULL "
       "WHERE item = ?6 AND local_id = ?7");
   st.bind(1, sent.complete ? 1 : 0).bind(2, changes).bind(3, utc_now());
-  if (sent.events_after) st.bind(4, *sent.events_after);
-  else st.bind_null(4);
+  if (sent.events_after)
+    st.bind(4, *sent.events_after);
+  else
+    st.bind_null(4);
   st.bind(5, sent.samples_after);
   st.bind(6, item_name(item)).bind(7, local_id);
   st.step();
 }
 
 void Forwarder::record_error(Item item, std::int64_t local_id, const std::string& error) {
-  auto st = write_->prepare("UPDATE fleet_outbox SET last_error = ? WHERE item = ? AND local_id = ?");
+  auto st =
+      write_->prepare("UPDATE fleet_outbox SET last_error = ? WHERE item = ? AND local_id = ?");
   st.bind(1, error).bind(2, item_name(item)).bind(3, local_id);
   st.step();
 }

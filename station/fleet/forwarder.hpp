@@ -13,6 +13,7 @@
 #include <optional>
 #include <string>
 
+#include "station/config/fleet_config.hpp"
 #include "station/fleet/fleet_tables.hpp"
 #include "station/fleet/pg.hpp"
 #include "station/store/sqlite.hpp"
@@ -25,6 +26,11 @@ struct ForwardOptions {
   std::string station;  ///< the station's name, for a fit whose runs are gone from the file
 };
 
+/// Where [fleet] says to connect.
+inline PgTarget fleet_target(const FleetConfig& f) {
+  return {f.pg, f.keywords};
+}
+
 /// What is still to send.
 struct Backlog {
   std::int64_t runs = 0;   ///< runs not acknowledged in their latest state
@@ -34,12 +40,12 @@ struct Backlog {
 
 /// One pass.
 struct PassResult {
-  std::int64_t items = 0;   ///< items acknowledged complete
-  std::int64_t rows = 0;    ///< rows PostgreSQL inserted or changed
+  std::int64_t items = 0;     ///< items acknowledged complete
+  std::int64_t rows = 0;      ///< rows PostgreSQL inserted or changed
   std::int64_t appended = 0;  ///< event and sample rows sent (each is sent once, resends none)
-  std::int64_t failed = 0;  ///< items the server refused (their outbox row holds why)
-  bool more = false;        ///< more to send right away (a batch limit was reached)
-  std::string last_error;   ///< the last refusal, empty when none
+  std::int64_t failed = 0;    ///< items the server refused (their outbox row holds why)
+  bool more = false;          ///< more to send right away (a batch limit was reached)
+  std::string last_error;     ///< the last refusal, empty when none
 };
 
 class Forwarder {

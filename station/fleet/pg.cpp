@@ -30,7 +30,9 @@ long long PgResult::integer(int row, int col) const {
   return std::strtoll(PQgetvalue(r_.get(), row, col), nullptr, 10);
 }
 
-long long PgResult::affected() const { return std::atoll(PQcmdTuples(r_.get())); }
+long long PgResult::affected() const {
+  return std::atoll(PQcmdTuples(r_.get()));
+}
 
 // Keywords before "dbname" are defaults the URL may override; the configured ones come after it
 // and win (expand_dbname = 1: "later keywords override", libpq-connect.html, PQconnectdbParams).
@@ -58,8 +60,8 @@ PgConnection::PgConnection(const PgTarget& t) {
   conn_.reset(PQconnectdbParams(keys.data(), values.data(), 1));
   if (!conn_) throw PgError("PostgreSQL: out of memory");
   const char* host = PQhost(conn_.get());
-  where_ = fmt::format("{}:{}/{}", host != nullptr ? host : "?", PQport(conn_.get()),
-                       PQdb(conn_.get()));
+  where_ =
+      fmt::format("{}:{}/{}", host != nullptr ? host : "?", PQport(conn_.get()), PQdb(conn_.get()));
   if (PQstatus(conn_.get()) != CONNECTION_OK)
     throw PgError(fmt::format("PostgreSQL {}: {}", where_, trimmed(PQerrorMessage(conn_.get()))));
 }
@@ -92,8 +94,8 @@ long long PgConnection::copy_in(std::string_view table_and_columns, std::string_
   check(PQexec(conn_.get(), sql.c_str()), sql);
   if (PQputCopyData(conn_.get(), data.data(), static_cast<int>(data.size())) != 1 ||
       PQputCopyEnd(conn_.get(), nullptr) != 1) {
-    throw PgError(fmt::format("PostgreSQL {}: {}: {}", where_, sql,
-                              trimmed(PQerrorMessage(conn_.get()))));
+    throw PgError(
+        fmt::format("PostgreSQL {}: {}: {}", where_, sql, trimmed(PQerrorMessage(conn_.get()))));
   }
   PGresult* raw = PQgetResult(conn_.get());
   const long long rows = raw != nullptr ? std::atoll(PQcmdTuples(raw)) : 0;
@@ -110,16 +112,27 @@ void append_copy_field(std::string& out, const std::optional<std::string_view>& 
   }
   for (char ch : *value) {
     switch (ch) {
-      case '\\': out += "\\\\"; break;
-      case '\t': out += "\\t"; break;
-      case '\n': out += "\\n"; break;
-      case '\r': out += "\\r"; break;
-      default: out += ch;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\r':
+        out += "\\r";
+        break;
+      default:
+        out += ch;
     }
   }
 }
 
-PgTransaction::PgTransaction(PgConnection& c) : c_(c) { c_.exec("BEGIN"); }
+PgTransaction::PgTransaction(PgConnection& c) : c_(c) {
+  c_.exec("BEGIN");
+}
 
 PgTransaction::~PgTransaction() {
   if (done_) return;

@@ -251,12 +251,18 @@ nlohmann::json LiveHub::status_locked() const {
                                                 : std::nullopt))}}},
       {"ticks", ticks_},
       {"last_tick_ms", last_ ? nlohmann::json(last_->tick_wall_s * 1e3) : nlohmann::json(nullptr)},
-      {"last_run_id", last_run_id_ ? nlohmann::json(*last_run_id_) : nlohmann::json(nullptr)}};
+      {"last_run_id", last_run_id_ ? nlohmann::json(*last_run_id_) : nlohmann::json(nullptr)},
+      {"fleet", fleet_}};
   if (!fault_.empty() || !run_failure_.empty())
     j["fault"] = run_failure_.empty() ? fault_
                  : fault_.empty()     ? run_failure_
                                       : run_failure_ + "; " + fault_;
   return j;
+}
+
+void LiveHub::fleet(const nlohmann::json& forwarder) {
+  std::lock_guard lock(mu_);
+  fleet_ = forwarder;
 }
 
 nlohmann::json LiveHub::status() const {

@@ -56,6 +56,10 @@ class LiveHub {
   /// An idle look at the rig (serve between runs): devices as read, safety inputs, the fault.
   void idle(const IdleReading& r);
 
+  /// The forwarder's state ([fleet]; station/fleet/forwarder_thread.hpp): in status() as
+  /// "fleet" and on the page; null when the station forwards nowhere.
+  void fleet(const nlohmann::json& forwarder);
+
   nlohmann::json status() const;
   /// status + trend + live bins + latest events + the last stream id they include.
   nlohmann::json live() const;
@@ -97,6 +101,7 @@ class LiveHub {
   std::string fault_;                ///< the idle rig's fault (serve), empty when clear
   std::string run_failure_;          ///< why the last run failed; kept until the next run starts
   std::optional<IdleReading> idle_;  ///< the last idle look (serve)
+  nlohmann::json fleet_;             ///< the forwarder's state; null: no [fleet]
   // What the page draws
   std::vector<std::array<double, 3>> trend_;  ///< t_s, air_c, setpoint_c
   int trend_stride_ = 1;

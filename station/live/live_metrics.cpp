@@ -198,4 +198,31 @@ std::string LiveMetrics::text() const {
   return out.str();
 }
 
+// Registered only on a station that forwards, so a scrape of one that does not shows no fleet.
+void LiveMetrics::fleet(std::int64_t pending_runs, std::int64_t pending_rows,
+                        double last_success_unix_s, std::int64_t errors_total) {
+  std::lock_guard lock(fleet_mu_);
+  if (fleet_runs_ == nullptr) {
+    fleet_runs_ = &gauge(*registry_, "station_fleet_pending_runs",
+                         "Runs the fleet forwarder has not delivered in their latest state")
+                       .Add({});
+    fleet_rows_ = &gauge(*registry_, "station_fleet_pending_rows",
+                         "Rows still to forward: items, and the events and samples behind them")
+                       .Add({});
+    fleet_success_ = &gauge(*registry_, "station_fleet_last_success_timestamp_seconds",
+                            "Unix time of the last pass that reached the fleet server (0: none)")
+                          .Add({});
+    fleet_errors_ = &counter(*registry_, "station_fleet_errors_total",
+                             "Forwarder failures: server unreachable or items refused")
+                         .Add({});
+  }
+  fleet_runs_->Set(static_cast<double>(pending_runs));
+  fleet_rows_->Set(static_cast<double>(pending_rows));
+  fleet_success_->Set(last_success_unix_s);
+  if (errors_total > fleet_errors_seen_) {
+    fleet_errors_->Increment(static_cast<double>(errors_total - fleet_errors_seen_));
+    fleet_errors_seen_ = errors_total;
+  }
+}
+
 }  // namespace station::live

@@ -36,6 +36,9 @@ class LiveMetrics {
   /// The run's gyros: per-slot series labelled by serial and CAN node (old slots' series go).
   void set_slots(const std::vector<RunSlot>& slots);
   void stream_clients(int n);
+  /// The fleet forwarder ([fleet]): backlog, last success (Unix s, 0: none), failures so far.
+  void fleet(std::int64_t pending_runs, std::int64_t pending_rows, double last_success_unix_s,
+             std::int64_t errors_total);
   /// The exposition text (format 0.0.4).
   std::string text() const;
 
@@ -69,6 +72,13 @@ class LiveMetrics {
   mutable std::mutex slots_mu_;
   std::map<std::string, SlotLabels> slots_;  ///< by serial
   prometheus::Gauge& stream_clients_;
+  /// Registered by the first fleet(): runs and rows pending, last success.
+  prometheus::Gauge* fleet_runs_ = nullptr;
+  prometheus::Gauge* fleet_rows_ = nullptr;
+  prometheus::Gauge* fleet_success_ = nullptr;
+  prometheus::Counter* fleet_errors_ = nullptr;
+  std::int64_t fleet_errors_seen_ = 0;
+  std::mutex fleet_mu_;
 };
 
 /// The route label of a request path: its API route with ids as {id} ("/api/runs/{id}/stop"), or

@@ -242,6 +242,10 @@ std::string verification_index(const RunReport& r) {
 
 }  // namespace
 
+std::string figure_html(const Figure& f) {
+  return figure_box(f);
+}
+
 std::string verdict_text(const FitExtras& e) {
   if (!e.verdict) return "no verdict (no part limits applied)";
   if (e.verdict->value("pass", false)) return "PASS";

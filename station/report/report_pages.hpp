@@ -19,6 +19,9 @@ extern const std::string_view kRenderJs;
 std::string page_html(std::string_view title, std::string_view body, const nlohmann::json& figures,
                       const Assets& a);
 
+/// A figure's box: title, chart and legend elements kRenderJs draws into, and its note.
+std::string figure_html(const Figure& f);
+
 /// The verdict for people: "PASS", "FAIL: limit value (bound b); ..." or "no verdict".
 std::string verdict_text(const FitExtras& e);
 

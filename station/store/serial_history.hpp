@@ -33,6 +33,7 @@ struct SerialFitRow {
   std::optional<double> std_ratio;
   double std_after_dph = 0;
   std::optional<std::string> part_number, verdict_json;
+  std::string station;  ///< the station that made it (fleet history); empty for a local read
   /// Value of coefficient `name` (empty when the fit has no such term).
   std::optional<double> coefficient(const std::string& name) const;
   /// Its standard error (empty when the fit has no such term).

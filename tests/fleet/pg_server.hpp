@@ -37,7 +37,8 @@ class ThrowawayPostgres {
       if (chown(dir_.c_str(), pw->pw_uid, pw->pw_gid) != 0) throw std::runtime_error("chown");
       as_user_ = "runuser -u postgres -- ";
     }
-    run(fmt::format("{}{}/initdb -D {}/data -A trust -U station -E UTF8 --locale=C --no-sync "
+    run(
+        fmt::format("{}{}/initdb -D {}/data -A trust -U station -E UTF8 --locale=C --no-sync "
                     ">{}/initdb.log 2>&1",
                     as_user_, kPgBin, dir_, dir_));
     start();
@@ -53,7 +54,8 @@ class ThrowawayPostgres {
 
   /// Starts (again) and waits until it accepts connections.
   void start() {
-    run(fmt::format("{}{}/pg_ctl -D {}/data -l {}/server.log -w -t 60 -o \"-c "
+    run(
+        fmt::format("{}{}/pg_ctl -D {}/data -l {}/server.log -w -t 60 -o \"-c "
                     "listen_addresses='' -c unix_socket_directories={} -c fsync=off -c "
                     "full_page_writes=off\" start >/dev/null",
                     as_user_, kPgBin, dir_, dir_, dir_));

@@ -154,13 +154,11 @@ TEST_F(FleetForward, TwoStationsAtOnceKeepTheirRunsApart) {
     Database r(db, OpenMode::read_only);
     auto u = r.prepare("SELECT uuid FROM runs");
     ASSERT_TRUE(u.step());
-    const std::string where =
-        fmt::format("WHERE run_uuid = '{}'", u.column_text(0));
+    const std::string where = fmt::format("WHERE run_uuid = '{}'", u.column_text(0));
     for (const char* t : {"samples", "events", "bins", "run_slots"})
       EXPECT_EQ(station_rows(db, fleet::fleet_table(t)), server_rows(fleet::fleet_table(t), where))
           << name << " " << t;
-    EXPECT_EQ(server_rows(fleet::fleet_table("runs"),
-                          fmt::format("WHERE station = '{}'", name)),
+    EXPECT_EQ(server_rows(fleet::fleet_table("runs"), fmt::format("WHERE station = '{}'", name)),
               station_rows(db, fleet::fleet_table("runs")));
   }
 }

@@ -128,8 +128,7 @@ TEST(FleetConfig, ReadsTheTableAndRefusesCredentials) {
   };
   refused(rig("name = \"rig-3\"", "pg = \"postgresql://fleet:secret@db/line\""), "password");
   refused(rig("name = \"rig-3\"", "pg = \"host=db password=secret\""), "password");
-  refused(rig("name = \"rig-3\"", "pg = \"postgresql://db/line\"\nsslmode = \"maybe\""),
-          "sslmode");
+  refused(rig("name = \"rig-3\"", "pg = \"postgresql://db/line\"\nsslmode = \"maybe\""), "sslmode");
   refused(rig("", "pg = \"postgresql://db/line\""), "[station] name");
   refused(rig("name = \"rig-3\"", "pg = \"postgresql://db/line\"\nuser = \"x\""), "user");
 }

@@ -1,0 +1,33 @@
+// Shewhart control chart for individual values (X chart with the moving range of two), ISO
+// 7870-2:2023 "Control charts — Part 2: Shewhart control charts", §7 and Table 3 (charts for
+// individuals): centre line X̄, σ̂ = MR̄ / d₂ with MR_i = |x_i − x_{i−1}| and d₂ = 1.128 for
+// subgroups of two, control limits X̄ ± 3σ̂. The moving range estimates the short-term
+// (point-to-point) spread, so a shift or a drift between stations widens nothing and shows as
+// points outside the limits. Pure: values in time order in, the chart out.
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <span>
+#include <vector>
+
+namespace station::compensation {
+
+/// d₂ for subgroups of n = 2: the expected range of two standard normal values, 2/√π
+/// (ISO 7870-2:2023 Table 2: 1.128).
+inline constexpr double kD2Pairs = 1.1283791670955126;
+
+struct IndividualsChart {
+  std::size_t n = 0;                 ///< points
+  double centre = 0;                 ///< X̄
+  double mr_bar = 0;                 ///< mean moving range of consecutive points
+  double sigma = 0;                  ///< σ̂ = MR̄ / d₂
+  double lcl = 0, ucl = 0;           ///< X̄ ∓ 3σ̂
+  std::vector<std::size_t> outside;  ///< indices of points beyond a control limit
+};
+
+/// The chart of `x` (time order); empty with fewer than 2 points (no moving range). Non-finite
+/// values are not allowed (the caller leaves out fits without the coefficient).
+std::optional<IndividualsChart> individuals_chart(std::span<const double> x);
+
+}  // namespace station::compensation

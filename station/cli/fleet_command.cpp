@@ -1,0 +1,82 @@
+// `station fleet --pg URL [--part PN] [--since DATE] [--out DIR] [--json]`: control charts of
+// the calibrations every station forwarded (station/fleet/fleet_charts.hpp), as JSON and as a
+// self-contained page DIR/fleet.html; the points beyond a limit are listed. Read-only.
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+#include "station/cli/commands.hpp"
+#include "station/common/input_error.hpp"
+#include "station/config/fleet_config.hpp"
+#include "station/fleet/fleet_charts.hpp"
+#include "station/fleet/fleet_page.hpp"
+
+namespace station {
+namespace {
+
+struct FleetOptions {
+  std::string pg, part, since, out;
+  bool json = false;
+};
+
+std::string filter_text(const FleetOptions& o) {
+  return fmt::format("part {}, calibrations since {}", o.part.empty() ? "any" : o.part,
+                     o.since.empty() ? "the first" : o.since);
+}
+
+void print_outside(const nlohmann::json& charts) {
+  for (const auto& part : charts["parts"]) {
+    fmt::print("part {}: {} calibrations at {} stations, {} points beyond a limit\n",
+               part["part"].get<std::string>(), part["calibrations"].get<int>(),
+               part["stations"].size(), part["outside"].size());
+    for (const auto& o : part["outside"])
+      fmt::print("  {} {} {} fit {} ({}): {:.4g} beyond the {} {}\n",
+                 o["metric"].get<std::string>(), o["station"].get<std::string>(),
+                 o["serial"].get<std::string>(), o["fleet_id"].get<long long>(),
+                 o["created_utc"].get<std::string>(), o["value"].get<double>(),
+                 o["chart"].get<std::string>(), o["limit"].get<std::string>());
+  }
+}
+
+void run_fleet(const FleetOptions& o) {
+  if (auto why = pg_url_problem(o.pg)) throw InputError(fmt::format("--pg: {}", *why));
+  fleet::ChartFilter f;
+  if (!o.part.empty()) f.part = o.part;
+  if (!o.since.empty()) f.since = o.since;
+  const report::Assets assets =
+      o.out.empty() ? report::Assets{} : report::read_dygraphs(std::string(report::kDygraphsDir));
+  fleet::PgConnection pg({o.pg, {}});
+  const auto charts = fleet::fleet_charts_json(fleet::fleet_points(pg, f));
+  if (!o.out.empty()) {
+    std::filesystem::create_directories(o.out);
+    const auto path = std::filesystem::path(o.out) / "fleet.html";
+    std::ofstream(path) << fleet::fleet_html(charts, filter_text(o), assets);
+    fmt::print(stderr, "wrote {}\n", path.string());
+  }
+  if (o.json) {
+    std::cout << charts.dump(2) << '\n';
+    return;
+  }
+  print_outside(charts);
+}
+
+}  // namespace
+
+void add_fleet_command(CLI::App& app, CommandStatus& status) {
+  auto o = std::make_shared<FleetOptions>();
+  auto* cmd = app.add_subcommand(
+      "fleet", "Control charts of k1, k0, B0 and the std ratio across the fleet's stations");
+  cmd->add_option("--pg", o->pg, "the fleet's PostgreSQL (libpq URL)")->required();
+  cmd->add_option("--part", o->part, "only this part number");
+  cmd->add_option("--since", o->since, "only calibrations created at or after (ISO-8601)");
+  cmd->add_option("--out", o->out, "write DIR/fleet.html");
+  cmd->add_flag("--json", o->json, "print the charts as JSON");
+  cmd->callback([o, &status] {
+    run_fleet(*o);
+    status.exit_code = 0;
+  });
+}
+
+}  // namespace station

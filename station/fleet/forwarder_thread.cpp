@@ -1,0 +1,107 @@
+#include "station/fleet/forwarder_thread.hpp"
+
+#include <algorithm>
+#include <chrono>
+
+#include "station/common/logging.hpp"
+
+namespace station::fleet {
+namespace {
+
+double unix_now_s() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+}  // namespace
+
+nlohmann::json ForwarderStatus::to_json() const {
+  return {{"state", state},
+          {"pending_runs", backlog.runs},
+          {"pending_items", backlog.items},
+          {"pending_rows", backlog.rows},
+          {"last_success_unix_s",
+           last_success_unix_s > 0 ? nlohmann::json(last_success_unix_s) : nlohmann::json()},
+          {"last_error", last_error},
+          {"backoff_s", backoff_s},
+          {"items_total", items_total},
+          {"rows_total", rows_total},
+          {"errors_total", errors_total}};
+}
+
+double next_backoff_s(double previous_s) {
+  return previous_s <= 0 ? 0.5 : std::min(60.0, previous_s * 2);
+}
+
+ForwarderThread::ForwarderThread(std::string db_path, PgTarget target, ForwardOptions options,
+                                 double interval_s, OnStatus on_status)
+    : forwarder_(std::move(db_path), std::move(target), std::move(options)),
+      interval_s_(interval_s),
+      on_status_(std::move(on_status)),
+      thread_([this](std::stop_token stop) { loop(stop); }) {}
+
+ForwarderThread::~ForwarderThread() {
+  thread_.request_stop();
+  cv_.notify_all();
+}
+
+ForwarderStatus ForwarderThread::status() const {
+  std::lock_guard lock(mu_);
+  return status_;
+}
+
+void ForwarderThread::publish(ForwarderStatus s) {
+  {
+    std::lock_guard lock(mu_);
+    status_ = s;
+  }
+  if (on_status_) on_status_(s);
+}
+
+bool ForwarderThread::pause(std::stop_token& stop, double seconds) {
+  std::unique_lock lock(mu_);
+  cv_.wait_for(lock, stop, std::chrono::duration<double>(seconds), [] { return false; });
+  return !stop.stop_requested();
+}
+
+void ForwarderThread::loop(std::stop_token stop) {
+  ForwarderStatus s;
+  std::string logged_error;
+  while (!stop.stop_requested()) {
+    double wait_s = interval_s_;
+    try {
+      const PassResult p = forwarder_.pass();
+      s.items_total += p.items;
+      s.rows_total += p.rows;
+      s.errors_total += p.failed;
+      s.last_success_unix_s = unix_now_s();
+      s.backlog = forwarder_.backlog();
+      if (p.failed > 0) s.last_error = p.last_error;
+      // Refused items are retried, but no faster than a failing link would be.
+      s.backoff_s = p.failed > 0 && p.items == 0 ? next_backoff_s(s.backoff_s) : 0;
+      s.state = p.more ? "sending" : p.failed > 0 ? "refusing items" : "idle";
+      wait_s = p.more ? 0 : std::max(interval_s_, s.backoff_s);
+      if (p.failed > 0 && p.last_error != logged_error)
+        log("fleet")->warn("the server refused {} item(s): {}", p.failed, p.last_error);
+      logged_error = p.failed > 0 ? p.last_error : "";
+    } catch (const std::exception& e) {
+      forwarder_.disconnect();
+      s.backoff_s = next_backoff_s(s.backoff_s);
+      s.state = "backing off";
+      s.last_error = e.what();
+      ++s.errors_total;
+      try {
+        s.backlog = forwarder_.backlog();
+      } catch (const std::exception&) {  // the local file answers later
+      }
+      if (s.last_error != logged_error)
+        log("fleet")->warn("{} (retrying in {:.1f} s, doubling to 60 s)", s.last_error,
+                           s.backoff_s);
+      logged_error = s.last_error;
+      wait_s = s.backoff_s;
+    }
+    publish(s);
+    if (wait_s > 0 && !pause(stop, wait_s)) break;
+  }
+}
+
+}  // namespace station::fleet
