@@ -1,0 +1,63 @@
+// The fleet's control charts from calibrations (no server needed: fleet_charts_json is pure).
+// A station whose gyros drift away from the others shows as points beyond the fleet's limits.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "station/fleet/fleet_charts.hpp"
+
+namespace {
+
+using station::fleet::FleetPoint;
+
+std::vector<FleetPoint> line_of_two_stations(double rig_b_shift_dph_per_c) {
+  std::vector<FleetPoint> pts;
+  for (int i = 0; i < 40; ++i) {
+    FleetPoint p;
+    p.fleet_id = i + 1;
+    p.station = i < 30 ? "rig-a" : "rig-b";  // rig-b calibrates the last ten
+    p.serial = "RLG-" + std::to_string(i);
+    p.created_utc = "2026-11-" + std::to_string(10 + i / 4) + "T00:00:00Z";
+    p.part = "RLG-90";
+    // A deterministic ±1e-4 scatter; rig-b's gyros shifted.
+    const double scatter = 1e-4 * std::sin(1.7 * i);
+    p.k1 = 0.01 + scatter + (i >= 30 ? rig_b_shift_dph_per_c : 0);
+    p.k0 = 0.02 + scatter;
+    p.b0 = 0.5;
+    p.std_ratio = 0.2;
+    p.pass = i % 7 != 0;
+    pts.push_back(p);
+  }
+  return pts;
+}
+
+TEST(FleetCharts, AStationThatDriftsAwayShowsBeyondTheLimits) {
+  const auto j = station::fleet::fleet_charts_json(line_of_two_stations(2e-3));
+  ASSERT_EQ(j["parts"].size(), 1u);
+  const auto& part = j["parts"][0];
+  EXPECT_EQ(part["calibrations"], 40);
+  int k1_out_b = 0, k1_out_a = 0, k0_out = 0;
+  for (const auto& o : part["outside"]) {
+    if (o["metric"] == "k1" && o["chart"] == "overall")
+      (o["station"] == "rig-b" ? k1_out_b : k1_out_a)++;
+    if (o["metric"] == "k0") ++k0_out;
+  }
+  // The shift is 20x the scatter: every rig-b point is beyond the fleet's UCL, no rig-a point.
+  EXPECT_EQ(k1_out_b, 10);
+  EXPECT_EQ(k1_out_a, 0);
+  EXPECT_EQ(k0_out, 0);
+  // Verdicts per station: i % 7 == 0 fail (i = 0, 7, ..., 28 at rig-a; 35 at rig-b).
+  EXPECT_EQ(part["verdicts"]["rig-a"]["fail"], 5);
+  EXPECT_EQ(part["verdicts"]["rig-b"]["fail"], 1);
+  EXPECT_EQ(part["charts"][0]["unit"], "deg/h/C");
+  EXPECT_EQ(part["charts"][3]["unit"], "1");
+  // Each station's own chart is centred on its own gyros.
+  EXPECT_NEAR(part["charts"][0]["by_station"]["rig-b"]["centre"].get<double>(), 0.012, 1e-4);
+}
+
+TEST(FleetCharts, WithoutADriftNothingIsFlagged) {
+  const auto j = station::fleet::fleet_charts_json(line_of_two_stations(0));
+  EXPECT_TRUE(j["parts"][0]["outside"].empty()) << j["parts"][0]["outside"].dump();
+}
+
+}  // namespace
