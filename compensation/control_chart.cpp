@@ -18,6 +18,8 @@ std::optional<IndividualsChart> individuals_chart(std::span<const double> x) {
   c.sigma = c.mr_bar / kD2Pairs;
   c.lcl = c.centre - 3 * c.sigma;
   c.ucl = c.centre + 3 * c.sigma;
+  // σ̂ = 0 (every value the same): limits of zero width say nothing; no point is outside.
+  if (c.sigma == 0) return c;
   for (std::size_t i = 0; i < x.size(); ++i)
     if (x[i] < c.lcl || x[i] > c.ucl) c.outside.push_back(i);
   return c;

@@ -18,12 +18,13 @@ namespace station::compensation {
 inline constexpr double kD2Pairs = 1.1283791670955126;
 
 struct IndividualsChart {
-  std::size_t n = 0;                 ///< points
-  double centre = 0;                 ///< X̄
-  double mr_bar = 0;                 ///< mean moving range of consecutive points
-  double sigma = 0;                  ///< σ̂ = MR̄ / d₂
-  double lcl = 0, ucl = 0;           ///< X̄ ∓ 3σ̂
-  std::vector<std::size_t> outside;  ///< indices of points beyond a control limit
+  std::size_t n = 0;        ///< points
+  double centre = 0;        ///< X̄
+  double mr_bar = 0;        ///< mean moving range of consecutive points
+  double sigma = 0;         ///< σ̂ = MR̄ / d₂
+  double lcl = 0, ucl = 0;  ///< X̄ ∓ 3σ̂
+  /// Indices of points beyond a control limit (none when σ̂ = 0: all values equal).
+  std::vector<std::size_t> outside;
 };
 
 /// The chart of `x` (time order); empty with fewer than 2 points (no moving range). Non-finite

@@ -82,8 +82,9 @@ json metric_json(const Metric& m, const std::vector<const FleetPoint*>& points, 
     const auto* p = have[i];
     const double v = all[i];
     const auto& sc_chart = station_charts[p->station];
-    const bool out_all = overall && (v < overall->lcl || v > overall->ucl);
-    const bool out_station = sc_chart && (v < sc_chart->lcl || v > sc_chart->ucl);
+    const bool out_all = overall && overall->sigma > 0 && (v < overall->lcl || v > overall->ucl);
+    const bool out_station =
+        sc_chart && sc_chart->sigma > 0 && (v < sc_chart->lcl || v > sc_chart->ucl);
     jp.push_back({{"fleet_id", p->fleet_id},
                   {"station", p->station},
                   {"serial", p->serial},

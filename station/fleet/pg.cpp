@@ -38,7 +38,9 @@ long long PgResult::affected() const {
 // and win (expand_dbname = 1: "later keywords override", libpq-connect.html, PQconnectdbParams).
 PgConnection::PgConnection(const PgTarget& t) {
   const std::string timeout = std::to_string(t.connect_timeout_s);
-  const std::string options = fmt::format("-c statement_timeout={}", t.statement_timeout_ms);
+  // client_min_messages: a NOTICE ("stage table exists, skipping") is not for the operator.
+  const std::string options =
+      fmt::format("-c statement_timeout={} -c client_min_messages=warning", t.statement_timeout_ms);
   std::vector<std::pair<std::string, std::string>> kv = {
       {"connect_timeout", timeout},
       {"application_name", "gyro-station"},

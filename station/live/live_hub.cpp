@@ -260,9 +260,12 @@ nlohmann::json LiveHub::status_locked() const {
   return j;
 }
 
+// A `fleet` stream message when what the page shows changes (not on every pass).
 void LiveHub::fleet(const nlohmann::json& forwarder) {
   std::lock_guard lock(mu_);
+  if (forwarder == fleet_) return;
   fleet_ = forwarder;
+  publish("fleet", fleet_);
 }
 
 nlohmann::json LiveHub::status() const {

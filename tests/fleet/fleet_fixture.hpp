@@ -21,6 +21,10 @@
 namespace station::testing_support {
 
 class FleetTest : public ::testing::Test {
+ public:
+  /// The test's own central database (a fresh one per test, on the process's server).
+  static fleet::PgTarget target() { return {server_->url(db_), {}}; }
+
  protected:
   static void SetUpTestSuite() {
     skip_ = ThrowawayPostgres::unavailable();
@@ -29,11 +33,11 @@ class FleetTest : public ::testing::Test {
   static void TearDownTestSuite() { server_.reset(); }
   void SetUp() override {
     if (!skip_.empty()) GTEST_SKIP() << skip_;
+    db_ = "fleet_" + std::to_string(++tests_);
+    server_->create_db(db_);
     fleet::PgConnection pg(target());
     fleet::init_fleet_schema(pg);
   }
-  static fleet::PgTarget target() { return {server_->url(), {}}; }
-
   /// A finished simulated run of `gyros` gyros (tests/data/short_cycle.toml, about 2.2 h of
   /// simulated time) with its fits, in a fresh database; returns the path.
   static std::string simulated_station(const std::string& name, int gyros, std::uint64_t seed) {
@@ -67,6 +71,8 @@ class FleetTest : public ::testing::Test {
 
   static inline std::unique_ptr<ThrowawayPostgres> server_;
   static inline std::string skip_;
+  static inline std::string db_ = "postgres";
+  static inline int tests_ = 0;
 };
 
 /// One value as both sides can be compared: numbers by their double value (the shortest text

@@ -36,15 +36,17 @@ TEST(FleetCharts, AStationThatDriftsAwayShowsBeyondTheLimits) {
   ASSERT_EQ(j["parts"].size(), 1u);
   const auto& part = j["parts"][0];
   EXPECT_EQ(part["calibrations"], 40);
-  int k1_out_b = 0, k1_out_a = 0, k0_out = 0;
+  int k1_above_b = 0, k1_station_b = 0, k0_out = 0;
   for (const auto& o : part["outside"]) {
-    if (o["metric"] == "k1" && o["chart"] == "overall")
-      (o["station"] == "rig-b" ? k1_out_b : k1_out_a)++;
+    const bool b = o["metric"] == "k1" && o["station"] == "rig-b";
+    if (b && o["chart"] == "overall" && o["limit"] == "UCL") ++k1_above_b;
+    if (b && o["chart"] == "station") ++k1_station_b;
     if (o["metric"] == "k0") ++k0_out;
   }
-  // The shift is 20x the scatter: every rig-b point is beyond the fleet's UCL, no rig-a point.
-  EXPECT_EQ(k1_out_b, 10);
-  EXPECT_EQ(k1_out_a, 0);
+  // The shift is 20x the scatter: every rig-b point is above the fleet's UCL, while within its
+  // own chart rig-b is in control; k0, not shifted, shows nothing.
+  EXPECT_EQ(k1_above_b, 10);
+  EXPECT_EQ(k1_station_b, 0);
   EXPECT_EQ(k0_out, 0);
   // Verdicts per station: i % 7 == 0 fail (i = 0, 7, ..., 28 at rig-a; 35 at rig-b).
   EXPECT_EQ(part["verdicts"]["rig-a"]["fail"], 5);

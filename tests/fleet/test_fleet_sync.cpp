@@ -52,7 +52,7 @@ TEST_F(FleetSync, KilledMidBatchThenRerunSendsNothingTwice) {
     station::Store migrate(db);  // the outbox exists before the process starts
   }
   const std::int64_t total = local_count(db, "samples") + local_count(db, "events");
-  const std::string url = server_->url();
+  const std::string url = target().url;
   std::vector<std::string> args = {kStation, "sync",      "--db",         db,   "--pg",
                                    url,      "--samples", "--batch-rows", "500"};
   std::vector<char*> argv;
