@@ -2,8 +2,8 @@
 // 7870-2:2023 "Control charts — Part 2: Shewhart control charts", §7 and Table 3 (charts for
 // individuals): centre line X̄, σ̂ = MR̄ / d₂ with MR_i = |x_i − x_{i−1}| and d₂ = 1.128 for
 // subgroups of two, control limits X̄ ± 3σ̂. The moving range estimates the short-term
-// (point-to-point) spread, so a shift or a drift between stations widens nothing and shows as
-// points outside the limits. Pure: values in time order in, the chart out.
+// (point-to-point) spread; a sustained shift shows as points beyond the limits (and raises σ̂
+// only by the one range that spans it). Pure: values in time order in, the chart out.
 #pragma once
 
 #include <cstddef>
@@ -30,5 +30,14 @@ struct IndividualsChart {
 /// The chart of `x` (time order); empty with fewer than 2 points (no moving range). Non-finite
 /// values are not allowed (the caller leaves out fits without the coefficient).
 std::optional<IndividualsChart> individuals_chart(std::span<const double> x);
+
+/// The same over points from several sources (`group[i]`: the station of point i): moving ranges
+/// only between consecutive points of one group, pooled, so σ̂ is the point-to-point spread within
+/// a source and an offset between sources — points of two stations interleaved in time — shows as
+/// points beyond the limits instead of widening them (ISO 7870-2's rational subgroups: limits
+/// from the variation within a subgroup, never between them). Empty without two points in one
+/// group.
+std::optional<IndividualsChart> individuals_chart(std::span<const double> x,
+                                                  std::span<const int> group);
 
 }  // namespace station::compensation

@@ -7,13 +7,16 @@
 -- station that recorded them. Child rows of a run carry its uuid and their natural key. No foreign
 -- keys: a fit may arrive before the run it names (they travel independently) and a station's
 -- rows must land whatever another station sent. fleet_id: an id across the fleet (local ids
--- collide between stations), assigned on first arrival and never changed.
+-- collide between stations), assigned on first arrival and never changed. rev: the station's
+-- revision of the item (fleet_outbox.changes); a row is only ever replaced by a higher one, so a
+-- station file restored from a backup cannot write an older state over a newer one.
 CREATE TABLE fleet_schema (
   version     integer NOT NULL,
   applied_utc timestamptz NOT NULL DEFAULT now()
 );
 
 CREATE TABLE runs (
+  rev               bigint NOT NULL,
   fleet_id          bigint GENERATED ALWAYS AS IDENTITY UNIQUE,
   uuid              uuid PRIMARY KEY,
   station           text NOT NULL,
@@ -97,6 +100,7 @@ CREATE TABLE samples (
 );
 
 CREATE TABLE fits (
+  rev               bigint NOT NULL,
   fleet_id             bigint GENERATED ALWAYS AS IDENTITY UNIQUE,
   uuid                 uuid PRIMARY KEY,
   station              text NOT NULL,
@@ -127,6 +131,7 @@ CREATE INDEX fits_by_serial ON fits (serial, created_utc);
 CREATE INDEX fits_by_part ON fits (part_number, created_utc);
 
 CREATE TABLE releases (
+  rev               bigint NOT NULL,
   uuid             uuid PRIMARY KEY,
   station          text NOT NULL,
   local_id         bigint NOT NULL,
@@ -141,6 +146,7 @@ CREATE TABLE releases (
 CREATE INDEX releases_by_serial ON releases (serial, released_utc);
 
 CREATE TABLE verifications (
+  rev               bigint NOT NULL,
   uuid          uuid PRIMARY KEY,
   station       text NOT NULL,
   local_id      bigint NOT NULL,

@@ -5,8 +5,12 @@
 --   duplicate nor overwrite another row (two stations' local ids collide, their uuids do not).
 -- * fleet_outbox: one row per run, fit, release and verification. Triggers bump `changes` on
 --   every local write that concerns it (a run's record, slots, bins and events; a fit's verdict);
---   the forwarder sets `acked` to the `changes` it read once PostgreSQL has committed all of it.
---   Pending: acked < changes. Written for every station, configured for a fleet or not: a station
+--   the forwarder sets `acked` to the `changes` it read once PostgreSQL has committed all of it,
+--   and sends `changes` as the central row's `rev`: the server keeps the highest, so a file
+--   restored from a backup (its `changes` behind the server's `rev`) is held, never written over
+--   what the server has (`held_reason`). Pending: acked < changes, or a run whose samples are
+--   wanted and not all sent since its last change (samples_done = 0), unless held or refused
+--   until retry_after_unix. Written for every station, configured for a fleet or not: a station
 --   that joins a fleet later forwards its whole history.
 ALTER TABLE runs ADD COLUMN uuid TEXT;
 ALTER TABLE fits ADD COLUMN uuid TEXT;
@@ -37,10 +41,13 @@ CREATE TABLE fleet_outbox (
   acked_utc          TEXT,
   events_acked_id    INTEGER,  -- runs: highest events.id PostgreSQL holds
   samples_acked_t_s  REAL,     -- runs: highest samples.t_s PostgreSQL holds
+  samples_done       INTEGER NOT NULL DEFAULT 0,  -- runs: every sample sent since the last change
   last_error         TEXT,     -- the last refusal for this item (NULL after a success)
+  refusals           INTEGER NOT NULL DEFAULT 0,  -- refusals in a row (the retry back-off)
+  retry_after_unix   REAL,     -- a refused item waits until then (Unix s)
+  held_reason        TEXT,     -- set: never forwarded again until `station sync --retry-held`
   PRIMARY KEY (item, local_id)
 );
-CREATE INDEX fleet_outbox_pending ON fleet_outbox (item, local_id) WHERE acked < changes;
 INSERT INTO fleet_outbox (item, local_id) SELECT 'run', id FROM runs;
 INSERT INTO fleet_outbox (item, local_id) SELECT 'fit', id FROM fits;
 INSERT INTO fleet_outbox (item, local_id) SELECT 'release', id FROM releases;
@@ -48,37 +55,37 @@ INSERT INTO fleet_outbox (item, local_id) SELECT 'verification', id FROM verific
 
 CREATE TRIGGER outbox_run_insert AFTER INSERT ON runs BEGIN
   INSERT INTO fleet_outbox (item, local_id) VALUES ('run', NEW.id)
-    ON CONFLICT (item, local_id) DO UPDATE SET changes = changes + 1; END;
+    ON CONFLICT (item, local_id) DO UPDATE SET changes = changes + 1, samples_done = 0; END;
 CREATE TRIGGER outbox_run_update AFTER UPDATE ON runs BEGIN
   INSERT INTO fleet_outbox (item, local_id) VALUES ('run', NEW.id)
-    ON CONFLICT (item, local_id) DO UPDATE SET changes = changes + 1; END;
+    ON CONFLICT (item, local_id) DO UPDATE SET changes = changes + 1, samples_done = 0; END;
 CREATE TRIGGER outbox_slot_insert AFTER INSERT ON run_slots BEGIN
   INSERT INTO fleet_outbox (item, local_id) VALUES ('run', NEW.run_id)
-    ON CONFLICT (item, local_id) DO UPDATE SET changes = changes + 1; END;
+    ON CONFLICT (item, local_id) DO UPDATE SET changes = changes + 1, samples_done = 0; END;
 CREATE TRIGGER outbox_slot_update AFTER UPDATE ON run_slots BEGIN
   INSERT INTO fleet_outbox (item, local_id) VALUES ('run', NEW.run_id)
-    ON CONFLICT (item, local_id) DO UPDATE SET changes = changes + 1; END;
+    ON CONFLICT (item, local_id) DO UPDATE SET changes = changes + 1, samples_done = 0; END;
 CREATE TRIGGER outbox_bin_insert AFTER INSERT ON bins BEGIN
   INSERT INTO fleet_outbox (item, local_id) VALUES ('run', NEW.run_id)
-    ON CONFLICT (item, local_id) DO UPDATE SET changes = changes + 1; END;
+    ON CONFLICT (item, local_id) DO UPDATE SET changes = changes + 1, samples_done = 0; END;
 CREATE TRIGGER outbox_bin_delete AFTER DELETE ON bins BEGIN
   INSERT INTO fleet_outbox (item, local_id) VALUES ('run', OLD.run_id)
-    ON CONFLICT (item, local_id) DO UPDATE SET changes = changes + 1; END;
+    ON CONFLICT (item, local_id) DO UPDATE SET changes = changes + 1, samples_done = 0; END;
 CREATE TRIGGER outbox_event_insert AFTER INSERT ON events WHEN NEW.run_id IS NOT NULL BEGIN
   INSERT INTO fleet_outbox (item, local_id) VALUES ('run', NEW.run_id)
-    ON CONFLICT (item, local_id) DO UPDATE SET changes = changes + 1; END;
+    ON CONFLICT (item, local_id) DO UPDATE SET changes = changes + 1, samples_done = 0; END;
 CREATE TRIGGER outbox_fit_insert AFTER INSERT ON fits BEGIN
   INSERT INTO fleet_outbox (item, local_id) VALUES ('fit', NEW.id)
-    ON CONFLICT (item, local_id) DO UPDATE SET changes = changes + 1; END;
+    ON CONFLICT (item, local_id) DO UPDATE SET changes = changes + 1, samples_done = 0; END;
 CREATE TRIGGER outbox_fit_update AFTER UPDATE ON fits BEGIN
   INSERT INTO fleet_outbox (item, local_id) VALUES ('fit', NEW.id)
-    ON CONFLICT (item, local_id) DO UPDATE SET changes = changes + 1; END;
+    ON CONFLICT (item, local_id) DO UPDATE SET changes = changes + 1, samples_done = 0; END;
 CREATE TRIGGER outbox_release_insert AFTER INSERT ON releases BEGIN
   INSERT INTO fleet_outbox (item, local_id) VALUES ('release', NEW.id)
-    ON CONFLICT (item, local_id) DO UPDATE SET changes = changes + 1; END;
+    ON CONFLICT (item, local_id) DO UPDATE SET changes = changes + 1, samples_done = 0; END;
 CREATE TRIGGER outbox_release_update AFTER UPDATE ON releases BEGIN
   INSERT INTO fleet_outbox (item, local_id) VALUES ('release', NEW.id)
-    ON CONFLICT (item, local_id) DO UPDATE SET changes = changes + 1; END;
+    ON CONFLICT (item, local_id) DO UPDATE SET changes = changes + 1, samples_done = 0; END;
 CREATE TRIGGER outbox_verification_insert AFTER INSERT ON verifications BEGIN
   INSERT INTO fleet_outbox (item, local_id) VALUES ('verification', NEW.id)
-    ON CONFLICT (item, local_id) DO UPDATE SET changes = changes + 1; END;
+    ON CONFLICT (item, local_id) DO UPDATE SET changes = changes + 1, samples_done = 0; END;

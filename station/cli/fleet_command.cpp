@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <regex>
 
 #include "station/cli/commands.hpp"
 #include "station/common/input_error.hpp"
@@ -44,7 +45,13 @@ void run_fleet(const FleetOptions& o) {
   if (auto why = pg_url_problem(o.pg)) throw InputError(fmt::format("--pg: {}", *why));
   fleet::ChartFilter f;
   if (!o.part.empty()) f.part = o.part;
-  if (!o.since.empty()) f.since = o.since;
+  if (!o.since.empty()) {
+    // Compared as text with the stored ISO-8601 UTC times: only that form sorts right.
+    if (!std::regex_match(o.since, std::regex(R"(\d{4}-\d{2}-\d{2}(T\d{2}:\d{2}(:\d{2})?Z?)?)")))
+      throw InputError(
+          fmt::format("--since '{}': not an ISO-8601 date (YYYY-MM-DD[THH:MM[:SS]Z])", o.since));
+    f.since = o.since;
+  }
   const report::Assets assets =
       o.out.empty() ? report::Assets{} : report::read_dygraphs(std::string(report::kDygraphsDir));
   fleet::PgConnection pg({o.pg, {}});

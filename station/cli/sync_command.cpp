@@ -20,7 +20,7 @@ namespace {
 
 struct SyncOptions {
   std::string db, pg, config, station;
-  bool init = false, samples = false, json = false;
+  bool init = false, samples = false, json = false, retry_held = false;
   std::int64_t batch_rows = 50'000;
 };
 
@@ -66,6 +66,7 @@ int run_sync(const SyncOptions& o) {
                fleet::fleet_schema_version());
   }
   fleet::Forwarder fwd(o.db, r.target, r.forward);
+  if (o.retry_held) fwd.release_held();
   fleet::PassResult total;
   for (;;) {
     const auto p = fwd.pass();
@@ -88,9 +89,14 @@ int run_sync(const SyncOptions& o) {
     fmt::print("sent {} items ({} rows written); pending: {} runs, {} items, {} rows\n",
                total.items, total.rows, left.runs, left.items, left.rows);
     if (total.failed > 0)
-      fmt::print(stderr, "{} items refused, last: {}\n", total.failed, total.last_error);
+      fmt::print(stderr, "{} items refused or held, last: {}\n", total.failed, total.last_error);
+    if (left.held > 0)
+      fmt::print(stderr,
+                 "{} items held: the server has a newer state of them than this file (a restored "
+                 "backup?); nothing of them was written\n",
+                 left.held);
   }
-  return total.failed > 0 ? 1 : 0;
+  return total.failed > 0 || left.held > 0 ? 1 : 0;
 }
 
 }  // namespace
@@ -105,6 +111,8 @@ void add_sync_command(CLI::App& app, CommandStatus& status) {
   cmd->add_option("--station", o->station, "station name for fits whose runs are gone");
   cmd->add_flag("--init", o->init, "create or migrate the central schema first");
   cmd->add_flag("--samples", o->samples, "forward the 1 Hz samples too");
+  cmd->add_flag("--retry-held", o->retry_held,
+                "check items held (the server had a newer state) again");
   cmd->add_option("--batch-rows", o->batch_rows, "appended rows per transaction")
       ->check(CLI::Range(1, 10'000'000));
   cmd->add_flag("--json", o->json, "print the totals as JSON");

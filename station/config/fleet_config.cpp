@@ -24,10 +24,12 @@ std::optional<std::string> pg_url_problem(const std::string& url) {
   }
   std::optional<std::string> problem;
   for (auto* o = opts; o->keyword != nullptr; ++o) {
-    if (std::string_view(o->keyword) == "password" && o->val != nullptr && *o->val != '\0')
-      problem =
-          "holds a password: put it in a password file (password_file, libpq's passfile) or "
-          "the PGPASSWORD environment variable, never in the configuration or on a command line";
+    const std::string_view k = o->keyword;
+    if ((k == "password" || k == "sslpassword") && o->val != nullptr && *o->val != '\0')
+      problem = fmt::format(
+          "holds a {}: put it in a password file (password_file, libpq's passfile) or the "
+          "PGPASSWORD environment variable, never in the configuration or on a command line",
+          k);
   }
   PQconninfoFree(opts);
   return problem;

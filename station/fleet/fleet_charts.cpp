@@ -1,6 +1,7 @@
 #include "station/fleet/fleet_charts.hpp"
 
 #include <map>
+#include <tuple>
 
 #include "compensation/fit.hpp"
 
@@ -27,6 +28,8 @@ FleetPoint point_of(const PgResult& r, int i) {
   p.k0 = coefficient(c, "k0");
   p.b0 = coefficient(c, "B0");
   if (!r.is_null(i, 6)) p.std_ratio = r.number(i, 6);
+  p.terms = r.text(i, 8);
+  p.ref_temp_c = r.number(i, 9);
   if (auto v = r.opt_text(i, 7)) {
     const json j = json::parse(*v, nullptr, false);
     if (j.is_object() && j.contains("pass")) p.pass = j["pass"].get<bool>();
@@ -63,14 +66,18 @@ const char* side(const sc::IndividualsChart& c, double v) {
 json metric_json(const Metric& m, const std::vector<const FleetPoint*>& points, json& outside) {
   std::vector<const FleetPoint*> have;
   std::vector<double> all;
+  std::vector<int> group;
+  std::map<std::string, int> station_index;
   std::map<std::string, std::vector<double>> by_station;
   for (const auto* p : points) {
     if (!(p->*m.field)) continue;
     have.push_back(p);
     all.push_back(*(p->*m.field));
+    group.push_back(station_index.try_emplace(p->station, static_cast<int>(station_index.size()))
+                        .first->second);
     by_station[p->station].push_back(*(p->*m.field));
   }
-  const auto overall = sc::individuals_chart(all);
+  const auto overall = sc::individuals_chart(all, group);
   std::map<std::string, std::optional<sc::IndividualsChart>> station_charts;
   json js = json::object();
   for (const auto& [s, v] : by_station) {
@@ -110,7 +117,7 @@ json metric_json(const Metric& m, const std::vector<const FleetPoint*>& points, 
           {"points", jp}};
 }
 
-json part_json(const std::string& part, const std::vector<const FleetPoint*>& points) {
+json part_json(const std::vector<const FleetPoint*>& points) {
   json charts = json::array(), outside = json::array(), verdicts = json::object();
   std::map<std::string, int> stations;
   for (const auto* p : points) {
@@ -121,8 +128,15 @@ json part_json(const std::string& part, const std::vector<const FleetPoint*>& po
     v[k] = v[k].get<int>() + 1;
   }
   for (const auto& m : kMetrics) charts.push_back(metric_json(m, points, outside));
-  return {{"part", part},     {"calibrations", points.size()}, {"stations", stations},
-          {"charts", charts}, {"verdicts", verdicts},          {"outside", outside}};
+  const FleetPoint& first = *points.front();
+  return {{"part", first.part},
+          {"terms", first.terms},
+          {"ref_temp_c", first.ref_temp_c},
+          {"calibrations", points.size()},
+          {"stations", stations},
+          {"charts", charts},
+          {"verdicts", verdicts},
+          {"outside", outside}};
 }
 
 }  // namespace
@@ -130,9 +144,10 @@ json part_json(const std::string& part, const std::vector<const FleetPoint*>& po
 std::vector<FleetPoint> fleet_points(PgConnection& pg, const ChartFilter& f) {
   auto r = pg.exec(
       "SELECT fleet_id, station, serial, created_utc, part_number, coefficients_json, std_ratio, "
-      "verdict_json FROM (SELECT DISTINCT ON (station, serial, runs_json, terms) * FROM fits "
+      "verdict_json, terms, ref_temp_c FROM (SELECT DISTINCT ON (station, serial, run_uuids_json, "
+      "terms) * FROM fits "
       "WHERE ($1::text IS NULL OR part_number = $1) AND ($2::text IS NULL OR created_utc >= $2) "
-      "ORDER BY station, serial, runs_json, terms, created_utc DESC, fleet_id DESC) AS c "
+      "ORDER BY station, serial, run_uuids_json, terms, created_utc DESC, fleet_id DESC) AS c "
       "ORDER BY created_utc, fleet_id",
       {f.part, f.since});
   std::vector<FleetPoint> out;
@@ -141,10 +156,11 @@ std::vector<FleetPoint> fleet_points(PgConnection& pg, const ChartFilter& f) {
 }
 
 json fleet_charts_json(const std::vector<FleetPoint>& points) {
-  std::map<std::string, std::vector<const FleetPoint*>> by_part;
-  for (const auto& p : points) by_part[p.part].push_back(&p);
+  // One chart set per part and model: k1 of another model or another T_ref is another quantity.
+  std::map<std::tuple<std::string, std::string, double>, std::vector<const FleetPoint*>> by_part;
+  for (const auto& p : points) by_part[{p.part, p.terms, p.ref_temp_c}].push_back(&p);
   json parts = json::array();
-  for (const auto& [part, pts] : by_part) parts.push_back(part_json(part, pts));
+  for (const auto& [key, pts] : by_part) parts.push_back(part_json(pts));
   return {{"parts", parts}};
 }
 

@@ -19,6 +19,8 @@ namespace station::fleet {
 struct FleetPoint {
   std::int64_t fleet_id = 0;
   std::string station, serial, created_utc, part;
+  std::string terms;      ///< the fitted model: a chart never mixes models
+  double ref_temp_c = 0;  ///< T_ref of the fit: k1 and B0 mean something else at another
   std::optional<double> k1, k0, b0, std_ratio;
   std::optional<bool> pass;  ///< the verdict; empty: none
 };
@@ -31,9 +33,10 @@ struct ChartFilter {
 /// Calibrations from the central database, oldest first.
 std::vector<FleetPoint> fleet_points(PgConnection& pg, const ChartFilter& filter);
 
-/// The charts of every part among `points` as JSON: {"parts": [{"part", "calibrations",
-/// "stations", "charts": [{"metric", "unit", "overall", "by_station", "points"}], "verdicts",
-/// "outside"}]} (schemas/api.md, "station fleet --json").
+/// The charts of every part and model among `points` as JSON: {"parts": [{"part", "terms",
+/// "ref_temp_c", "calibrations", "stations", "charts": [{"metric", "unit", "overall",
+/// "by_station", "points"}], "verdicts", "outside"}]}. The overall chart's σ̂ pools the moving
+/// ranges within each station (compensation::individuals_chart with groups).
 nlohmann::json fleet_charts_json(const std::vector<FleetPoint>& points);
 
 /// The part label of a calibration without a part number.

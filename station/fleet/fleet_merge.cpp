@@ -31,11 +31,15 @@ std::string merge_sql(const FleetTable& t) {
       fmt::format("INSERT INTO {0} AS t ({1}) SELECT {1} FROM stage_{0} ", t.name, t.columns);
   if (t.merge == Merge::append) return insert + fmt::format("ON CONFLICT ({}) DO NOTHING", t.key);
   const auto rest = non_key(t);
-  return insert +
-         fmt::format(
-             "ON CONFLICT ({}) DO UPDATE SET ({}) = ROW({}) WHERE ({}) IS DISTINCT FROM ({})",
-             t.key, prefixed(rest, ""), prefixed(rest, "EXCLUDED."), prefixed(rest, "t."),
-             prefixed(rest, "EXCLUDED."));
+  // An item's row carries its revision: only a higher one replaces it (an older file, restored
+  // from a backup, never writes over a newer state). Its children: replaced when they differ.
+  const auto cols = split_columns(t.columns);
+  const bool has_rev = std::find(cols.begin(), cols.end(), "rev") != cols.end();
+  const std::string when = has_rev ? std::string("EXCLUDED.rev > t.rev")
+                                   : fmt::format("({}) IS DISTINCT FROM ({})", prefixed(rest, "t."),
+                                                 prefixed(rest, "EXCLUDED."));
+  return insert + fmt::format("ON CONFLICT ({}) DO UPDATE SET ({}) = ROW({}) WHERE {}", t.key,
+                              prefixed(rest, ""), prefixed(rest, "EXCLUDED."), when);
 }
 
 std::string prune_sql(const FleetTable& t) {
@@ -71,26 +75,53 @@ EncodedRows encode_rows(Statement& st, int watermark_col) {
       }
     }
     out.data += '\n';
-    if (watermark_col >= 0) out.last = st.column_double(watermark_col);
+    if (watermark_col >= 0) {
+      out.last = st.column_double(watermark_col);
+      if (!out.first) out.first = out.last;
+    }
     ++out.rows;
   }
   return out;
 }
 
-std::int64_t stage_and_merge(PgConnection& pg, const FleetTable& t, const EncodedRows& rows,
-                             const std::string& run_uuid) {
+void stage_rows(PgConnection& pg, const FleetTable& t, const EncodedRows& rows) {
   pg.exec(fmt::format(
       "CREATE TEMP TABLE IF NOT EXISTS stage_{0} ON COMMIT DROP AS SELECT {1} FROM {0} WITH NO "
       "DATA; TRUNCATE stage_{0}",
       t.name, t.columns));
   if (rows.rows > 0) pg.copy_in(fmt::format("stage_{} ({})", t.name, t.columns), rows.data);
-  std::int64_t changed = 0;
-  if (rows.rows > 0) {
-    auto r = pg.exec(merge_sql(t));
-    changed = r.affected();
-  }
+}
+
+// A staged row the server already holds with other content (or, for an item, at a higher
+// revision, or at the same revision with other content): the file and the server no longer
+// share a past.
+std::int64_t count_diverged(PgConnection& pg, const FleetTable& t) {
+  const auto key = split_columns(t.key);
+  std::string on;
+  for (const auto& k : key) on += fmt::format("{0}s.{1} = c.{1}", on.empty() ? "" : " AND ", k);
+  const auto rest = non_key(t);
+  const std::string differs = fmt::format("({}) IS DISTINCT FROM ({})", prefixed(rest, "s."),
+                                          prefixed(rest, "c."));
+  const auto cols = split_columns(t.columns);
+  const bool has_rev = std::find(cols.begin(), cols.end(), "rev") != cols.end();
+  const std::string when =
+      has_rev ? fmt::format("c.rev > s.rev OR (c.rev = s.rev AND {})", differs) : differs;
+  return pg
+      .exec(fmt::format("SELECT count(*) FROM stage_{0} AS s JOIN {0} AS c ON {1} WHERE {2}",
+                        t.name, on, when))
+      .integer(0, 0);
+}
+
+std::int64_t merge_staged(PgConnection& pg, const FleetTable& t, const std::string& run_uuid) {
+  std::int64_t changed = pg.exec(merge_sql(t)).affected();
   if (t.merge == Merge::replace_set) changed += pg.exec(prune_sql(t), {run_uuid}).affected();
   return changed;
+}
+
+std::int64_t stage_and_merge(PgConnection& pg, const FleetTable& t, const EncodedRows& rows,
+                             const std::string& run_uuid) {
+  stage_rows(pg, t, rows);
+  return merge_staged(pg, t, run_uuid);
 }
 
 }  // namespace station::fleet

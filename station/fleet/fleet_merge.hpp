@@ -16,7 +16,7 @@ namespace station::fleet {
 struct EncodedRows {
   std::string data;
   std::int64_t rows = 0;
-  std::optional<double> last;  ///< column `watermark_col` of the last row
+  std::optional<double> first, last;  ///< column `watermark_col` of the first and last rows
 };
 
 /// Steps `st` to the end, encoding every row. Values keep their exact value: integers as
@@ -24,8 +24,16 @@ struct EncodedRows {
 /// is. `watermark_col` < 0: none.
 EncodedRows encode_rows(Statement& st, int watermark_col = -1);
 
-/// Stages `rows` and merges them into `t` inside the caller's transaction; returns the rows the
-/// server inserted or changed. `run_uuid` scopes a replace_set's deletions.
+/// Copies `rows` into the transaction's staging table for `t` (emptied first).
+void stage_rows(PgConnection& pg, const FleetTable& t, const EncodedRows& rows);
+/// Staged rows the server holds with other content — or, for an item's own row (it has `rev`),
+/// at a higher revision or at the same one with other content: the station's file and the
+/// server have parted (a restored backup, a copied file).
+std::int64_t count_diverged(PgConnection& pg, const FleetTable& t);
+/// Merges the staged rows into `t` by its Merge rule inside the caller's transaction; returns
+/// the rows the server inserted or changed. `run_uuid` scopes a replace_set's deletions.
+std::int64_t merge_staged(PgConnection& pg, const FleetTable& t, const std::string& run_uuid);
+/// stage_rows then merge_staged.
 std::int64_t stage_and_merge(PgConnection& pg, const FleetTable& t, const EncodedRows& rows,
                              const std::string& run_uuid);
 

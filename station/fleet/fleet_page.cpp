@@ -110,10 +110,10 @@ std::string fleet_html(const json& charts, const std::string& filter_text,
   std::size_t i = 0;
   for (const auto& part : charts["parts"]) {
     body += fmt::format(
-        "<section class=\"part\" data-part=\"{0}\">\n<h2>Part {0}: {1} "
-        "calibrations at {2} stations</h2>\n",
-        html_escape(part["part"].get<std::string>()), part["calibrations"].get<int>(),
-        part["stations"].size());
+        "<section class=\"part\" data-part=\"{0}\">\n<h2>Part {0} (model {1}, T_ref {2} "
+        "\u00b0C): {3} calibrations at {4} stations</h2>\n",
+        html_escape(part["part"].get<std::string>()), html_escape(part["terms"].get<std::string>()),
+        num(part["ref_temp_c"]), part["calibrations"].get<int>(), part["stations"].size());
     body += station_table(part);
     for (const auto& c : part["charts"]) {
       const auto f = metric_figure(c, i);

@@ -35,16 +35,19 @@ int init_fleet_schema(PgConnection& pg) {
   return have;
 }
 
-void require_fleet_schema(PgConnection& pg) {
-  const int have = server_schema_version(pg), want = fleet_schema_version();
-  if (have == 0)
-    throw PgError(fmt::format(
-        "PostgreSQL {}: no fleet schema; create it with `station sync --init`", pg.where()));
+std::optional<std::string> fleet_schema_problem(int have, int want) {
+  if (have == 0) return "no fleet schema; create it with `station sync --init`";
   if (have < want)
-    throw PgError(fmt::format(
-        "PostgreSQL {}: fleet schema version {} is older than this station's {}; refusing to "
-        "forward (migrate the server with `station sync --init`)",
-        pg.where(), have, want));
+    return fmt::format(
+        "fleet schema version {} is older than this station's {}; refusing to forward (migrate "
+        "the server with `station sync --init`)",
+        have, want);
+  return std::nullopt;
+}
+
+void require_fleet_schema(PgConnection& pg) {
+  if (auto why = fleet_schema_problem(server_schema_version(pg), fleet_schema_version()))
+    throw PgError(fmt::format("PostgreSQL {}: {}", pg.where(), *why));
 }
 
 }  // namespace station::fleet

@@ -2,6 +2,9 @@
 // version a server holds, and the rule a station follows about it.
 #pragma once
 
+#include <optional>
+#include <string>
+
 #include "station/fleet/pg.hpp"
 
 namespace station::fleet {
@@ -16,6 +19,10 @@ int server_schema_version(PgConnection& pg);
 /// advisory lock so two stations initialising at once do not both migrate. Returns the version
 /// the server held before.
 int init_fleet_schema(PgConnection& pg);
+
+/// Why a server holding version `have` cannot take this station's `want` (empty: it can): none
+/// (0), or older. A newer server is accepted (its migrations only add).
+std::optional<std::string> fleet_schema_problem(int have, int want);
 
 /// Throws PgError (one line) when the server's schema is missing or older than this station's:
 /// the station would write columns the server lacks. A newer server is accepted (its

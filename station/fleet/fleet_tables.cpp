@@ -8,6 +8,10 @@ namespace {
 
 // The station that recorded a fit: the station of the first run it used (fits have no station
 // column of their own; a fit of runs no longer in the file falls back to :station).
+// The item's revision: its outbox `changes` in the same snapshot (migration 007).
+#define STATION_REV(item, id) \
+  "(SELECT o.changes FROM fleet_outbox AS o WHERE o.item = '" item "' AND o.local_id = " id ")"
+
 #define STATION_FIT_STATION(f)                   \
   "coalesce((SELECT r.station FROM json_each(" f \
   ".runs_json) AS j JOIN runs AS r ON r.id = "   \
@@ -15,13 +19,17 @@ namespace {
 
 const std::vector<FleetTable> kTables = {
     {"runs", Item::run,
-     "uuid,station,local_id,started_utc,ended_utc,state,protocol_name,protocol_text,config_text,"
+     "rev,uuid,station,local_id,started_utc,ended_utc,state,protocol_name,protocol_text,config_"
+     "text,"
      "software_version,operator,sim_seed,step_index,step_started_s,t_s,recording,record_start_s,"
      "start_temp_c,t0_wall_s,resolved_json",
      "uuid",
-     "SELECT uuid, station, id, started_utc, ended_utc, state, protocol_name, protocol_text, "
-     "config_text, software_version, operator, sim_seed, step_index, step_started_s, t_s, "
-     "recording, record_start_s, start_temp_c, t0_wall_s, resolved_json FROM runs WHERE id = :id",
+     "SELECT " STATION_REV("run", "runs.id") ", uuid, station, id, started_utc, ended_utc, state, "
+                                             "protocol_name, protocol_text, "
+                                             "config_text, software_version, operator, sim_seed, "
+                                             "step_index, step_started_s, t_s, "
+                                             "recording, record_start_s, start_temp_c, t0_wall_s, "
+                                             "resolved_json FROM runs WHERE id = :id",
      Merge::upsert},
     {"run_slots", Item::run,
      "run_uuid,slot,node,serial,pulse_weight_arcsec,axis,earth_rate_dph,part_number,"
@@ -54,12 +62,12 @@ const std::vector<FleetTable> kTables = {
      "ORDER BY s.t_s LIMIT :limit",
      Merge::append},
     {"fits", Item::fit,
-     "uuid,station,local_id,serial,created_utc,runs_json,run_uuids_json,terms,ref_temp_c,"
+     "rev,uuid,station,local_id,serial,created_utc,runs_json,run_uuids_json,terms,ref_temp_c,"
      "coefficients_json,std_errors_json,n_bins,r2,residual_rms_dph,condition_number,"
      "std_before_dph,std_after_dph,std_ratio,warnings_json,std_errors_ols_json,error_model_json,"
      "part_number,verdict_json,adev_floor_dph",
      "uuid",
-     "SELECT f.uuid, " STATION_FIT_STATION(
+     "SELECT " STATION_REV("fit", "f.id") ", f.uuid, " STATION_FIT_STATION(
          "f") ", f.id, f.serial, f.created_utc, f.runs_json, "
               "(SELECT json_group_array(r.uuid) FROM json_each(f.runs_json) AS j JOIN runs AS r ON "
               "r.id = "
@@ -72,25 +80,30 @@ const std::vector<FleetTable> kTables = {
               "f.adev_floor_dph FROM fits AS f WHERE f.id = :id",
      Merge::upsert},
     {"releases", Item::release,
-     "uuid,station,local_id,fit_uuid,serial,released_utc,released_by,note,override_reason,"
+     "rev,uuid,station,local_id,fit_uuid,serial,released_utc,released_by,note,override_reason,"
      "verdict_json",
      "uuid",
-     "SELECT l.uuid, " STATION_FIT_STATION("f") ", l.id, f.uuid, l.serial, l.released_utc, "
-                                                "l.released_by, l.note, l.override_reason, "
-                                                "l.verdict_json FROM releases AS l JOIN fits AS f "
-                                                "ON f.id = l.fit_id WHERE l.id = :id",
+     "SELECT " STATION_REV("release", "l.id") ", l.uuid, " STATION_FIT_STATION(
+         "f") ", l.id, f.uuid, l.serial, l.released_utc, "
+              "l.released_by, l.note, l.override_reason, "
+              "l.verdict_json FROM releases AS l JOIN fits AS f "
+              "ON f.id = l.fit_id WHERE l.id = :id",
      Merge::upsert},
     {"verifications", Item::verification,
-     "uuid,station,local_id,fit_uuid,run_uuid,serial,created_utc,result_json,part_number,"
+     "rev,uuid,station,local_id,fit_uuid,run_uuid,serial,created_utc,result_json,part_number,"
      "verdict_json",
      "uuid",
-     "SELECT v.uuid, r.station, v.id, f.uuid, r.uuid, v.serial, v.created_utc, v.result_json, "
-     "v.part_number, v.verdict_json FROM verifications AS v JOIN fits AS f ON f.id = v.fit_id "
-     "JOIN runs AS r ON r.id = v.run_id WHERE v.id = :id",
+     "SELECT " STATION_REV("verification",
+                           "v.id") ", v.uuid, r.station, v.id, f.uuid, r.uuid, v.serial, "
+                                   "v.created_utc, v.result_json, "
+                                   "v.part_number, v.verdict_json FROM verifications AS v JOIN "
+                                   "fits AS f ON f.id = v.fit_id "
+                                   "JOIN runs AS r ON r.id = v.run_id WHERE v.id = :id",
      Merge::upsert},
 };
 
 #undef STATION_FIT_STATION
+#undef STATION_REV
 
 }  // namespace
 

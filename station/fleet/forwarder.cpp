@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <chrono>
+#include <cmath>
 #include <ctime>
 
 #include "station/fleet/fleet_merge.hpp"
@@ -50,6 +52,32 @@ std::string utc_now() {
   return buf;
 }
 
+double unix_now_s() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+/// An item the server will not take now: refused (retried after a back-off) or held (the server
+/// has a newer state of it; never written over).
+struct ItemRefused : std::runtime_error {
+  ItemRefused(const std::string& what, bool held) : std::runtime_error(what), hold(held) {}
+  bool hold;
+};
+
+ItemRefused held(Item item, std::int64_t local_id, const std::string& what) {
+  return ItemRefused(fmt::format("{} {}: the server holds {} (restored from a backup?); held, "
+                                 "nothing of it written (`station sync --retry-held` checks "
+                                 "again)",
+                                 item_name(item), local_id, what),
+                     true);
+}
+
+/// The central table whose row is the item itself (its key is the item's uuid).
+const FleetTable& item_table(Item item) {
+  for (const auto& t : fleet_tables())
+    if (t.item == item && t.key == "uuid") return t;
+  throw std::logic_error("no item table");
+}
+
 std::int64_t item_order(std::string_view item) {
   for (Item i : {Item::run, Item::fit, Item::release, Item::verification})
     if (item_name(i) == item) return static_cast<std::int64_t>(i);
@@ -61,43 +89,76 @@ std::int64_t item_order(std::string_view item) {
 Forwarder::Forwarder(std::string db_path, PgTarget target, ForwardOptions options)
     : db_path_(std::move(db_path)), target_(std::move(target)), options_(std::move(options)) {}
 
+double next_backoff_s(double previous_s) {
+  return previous_s <= 0 ? 0.5 : std::min(60.0, previous_s * 2);
+}
+
 void Forwarder::open() {
   if (!read_) read_.emplace(db_path_, OpenMode::read_only);
   if (!write_) write_.emplace(db_path_, OpenMode::existing);
   if (!pg_) {
+    std::lock_guard lock(pg_mu_);
     pg_.emplace(target_);
-    require_fleet_schema(*pg_);
   }
+  // Every pass: a server migrated meanwhile is seen (a cheap query).
+  require_fleet_schema(*pg_);
 }
 
-PassResult Forwarder::pass(std::int64_t max_items) {
+void Forwarder::disconnect() {
+  std::lock_guard lock(pg_mu_);
+  pg_.reset();
+}
+
+void Forwarder::cancel() {
+  std::lock_guard lock(pg_mu_);
+  if (pg_) pg_->cancel();
+}
+
+void Forwarder::release_held() {
+  if (!write_) write_.emplace(db_path_, OpenMode::existing);
+  write_->exec(
+      "UPDATE fleet_outbox SET held_reason = NULL, retry_after_unix = NULL, refusals = 0 WHERE "
+      "held_reason IS NOT NULL");
+}
+
+PassResult Forwarder::pass(std::int64_t max_items, const std::function<bool()>& stop) {
   open();
   std::vector<std::pair<Item, std::int64_t>> pending;
   {
     auto st = read_->prepare(
-        "SELECT item, local_id FROM fleet_outbox WHERE acked < changes ORDER BY CASE item WHEN "
-        "'run' THEN 0 WHEN 'fit' THEN 1 WHEN 'release' THEN 2 ELSE 3 END, local_id LIMIT ?");
-    st.bind(1, max_items);
+        "SELECT item, local_id FROM fleet_outbox WHERE held_reason IS NULL AND "
+        "coalesce(retry_after_unix, 0) <= ?1 AND (acked < changes OR (?2 AND item = 'run' AND "
+        "samples_done = 0)) ORDER BY CASE item WHEN 'run' THEN 0 WHEN 'fit' THEN 1 WHEN "
+        "'release' THEN 2 ELSE 3 END, local_id LIMIT ?3");
+    st.bind(1, unix_now_s()).bind(2, options_.samples ? 1 : 0).bind(3, max_items);
     while (st.step())
       pending.emplace_back(static_cast<Item>(item_order(st.column_text(0))), st.column_int(1));
   }
   PassResult r;
   r.more = static_cast<std::int64_t>(pending.size()) == max_items;
   for (const auto& [item, id] : pending) {
+    if (stop && stop()) {
+      r.more = true;
+      break;
+    }
     try {
       const Sent sent = send_item(item, id);
       r.rows += sent.rows;
       r.appended += sent.appended;
       if (sent.complete) ++r.items;
       r.more = r.more || !sent.complete;
+    } catch (const ItemRefused& e) {
+      ++r.failed;
+      r.last_error = e.what();
+      record_error(item, id, e.what(), e.hold);
     } catch (const PgError& e) {
       if (!pg_->ok()) {  // the link, not the data: nothing more this pass
-        pg_.reset();
+        disconnect();
         throw;
       }
       ++r.failed;
       r.last_error = e.what();
-      record_error(item, id, e.what());
+      record_error(item, id, e.what(), false);
     }
   }
   return r;
@@ -109,138 +170,170 @@ Forwarder::Sent Forwarder::send_item(Item item, std::int64_t local_id) {
   ch.bind(1, item_name(item)).bind(2, local_id);
   const std::int64_t changes = ch.step() ? ch.column_int(0) : 0;
   Sent sent;
-  if (item == Item::run) {
-    sent = send_run(local_id);
-  } else {
-    PgTransaction tx(*pg_);
-    for (const auto& t : fleet_tables())
-      if (t.item == item) sent.rows += merge_all(t, local_id, {});
-    tx.commit();
-  }
+  PgTransaction tx(*pg_);
+  const std::string uuid = send_item_row(item, local_id, sent);
+  if (item == Item::run) send_run(local_id, uuid, sent);
+  tx.commit();
   acknowledge(item, local_id, changes, sent);
   return sent;
 }
 
-std::int64_t Forwarder::merge_all(const FleetTable& t, std::int64_t local_id,
-                                  const std::string& run_uuid) {
+// The item's own row: it must be readable with what it refers to (a release whose fit is gone
+// would otherwise be acknowledged unsent), and the server must not hold a newer or a different
+// state of it (a file restored from a backup is held, nothing of it written).
+std::string Forwarder::send_item_row(Item item, std::int64_t local_id, Sent& sent) {
+  const auto& t = item_table(item);
   auto st = read_->prepare(t.select);
   bind_named(st, ":id", local_id);
   bind_named(st, ":station", std::string_view(options_.station));
-  return stage_and_merge(*pg_, t, encode_rows(st), run_uuid);
+  const auto rows = encode_rows(st);
+  if (rows.rows != 1)
+    throw ItemRefused(fmt::format("{} {}: not readable with what it refers to (its run or fit is "
+                                  "gone from the file)",
+                                  item_name(item), local_id),
+                      false);
+  stage_rows(*pg_, t, rows);
+  if (count_diverged(*pg_, t) > 0)
+    throw held(item, local_id, "a newer or different state of it than this file");
+  sent.rows += merge_staged(*pg_, t, {});
+  auto u = read_->prepare(fmt::format("SELECT uuid FROM {} WHERE id = ?", t.name));
+  u.bind(1, local_id);
+  u.step();
+  return u.column_text(0);
 }
 
-Forwarder::Sent Forwarder::send_run(std::int64_t run_id) {
-  auto u = read_->prepare("SELECT uuid FROM runs WHERE id = ?");
-  u.bind(1, run_id);
-  if (!u.step() || u.column_is_null(0))
-    throw PgError(fmt::format("run {}: no such run, or no uuid (schema older than 7?)", run_id));
-  const std::string uuid = u.column_text(0);
-  Sent sent;
+void Forwarder::send_run(std::int64_t run_id, const std::string& uuid, Sent& sent) {
   std::int64_t budget = options_.batch_rows;
-  PgTransaction tx(*pg_);
   for (const auto& t : fleet_tables()) {
-    if (t.item != Item::run || t.merge == Merge::append) continue;
-    sent.rows += merge_all(t, run_id, uuid);
+    if (t.item != Item::run || t.merge != Merge::replace_set) continue;
+    auto st = read_->prepare(t.select);
+    bind_named(st, ":id", run_id);
+    sent.rows += stage_and_merge(*pg_, t, encode_rows(st), uuid);
   }
-  sent.rows += append_events(run_id, uuid, sent, budget);
-  if (options_.samples) sent.rows += append_samples(run_id, uuid, sent, budget);
-  tx.commit();
-  return sent;
+  append_events(run_id, uuid, sent, budget);
+  if (options_.samples) append_samples(run_id, uuid, sent, budget);
 }
 
-std::int64_t Forwarder::append_events(std::int64_t run_id, const std::string& run_uuid, Sent& sent,
-                                      std::int64_t& budget) {
+// Appended rows resume at the server's high-water mark, and restate the row at the mark: the
+// file must hold it, with the same content, or the two have parted (held).
+void Forwarder::append_from(const FleetTable& t, Statement& st, std::optional<double> mark,
+                            int mark_col, Sent& sent, std::int64_t& budget,
+                            const std::string& run_uuid, std::int64_t run_id,
+                            std::optional<double>& reached) {
+  const auto rows = encode_rows(st, mark_col);
+  if (mark && rows.first != mark)
+    throw held(Item::run, run_id, fmt::format("{} this file does not have", t.name));
+  stage_rows(*pg_, t, rows);
+  if (mark && count_diverged(*pg_, t) > 0)
+    throw held(Item::run, run_id, fmt::format("other {} than this file", t.name));
+  const std::int64_t fresh = rows.rows - (mark ? 1 : 0);
+  sent.appended += fresh;
+  budget -= fresh;
+  if (budget <= 0) sent.complete = false;
+  reached = rows.last ? rows.last : mark;
+  sent.rows += merge_staged(*pg_, t, run_uuid);
+}
+
+void Forwarder::append_events(std::int64_t run_id, const std::string& run_uuid, Sent& sent,
+                              std::int64_t& budget) {
   const auto& t = fleet_table("events");
-  auto have =
-      pg_->exec("SELECT coalesce(max(local_id), 0) FROM events WHERE run_uuid = $1", {run_uuid});
-  const std::int64_t after = have.integer(0, 0);
+  auto have = pg_->exec("SELECT max(local_id) FROM events WHERE run_uuid = $1", {run_uuid});
+  const std::optional<double> mark =
+      have.is_null(0, 0) ? std::nullopt : std::optional<double>(have.number(0, 0));
   auto st = read_->prepare(t.select);
   bind_named(st, ":id", run_id);
-  bind_named(st, ":after", after);
-  bind_named(st, ":limit", budget);
-  const auto rows = encode_rows(st, 1);
-  budget -= rows.rows;
-  sent.appended += rows.rows;
-  if (budget <= 0) sent.complete = false;
-  sent.events_after = rows.last ? static_cast<std::int64_t>(*rows.last) : after;
-  return stage_and_merge(*pg_, t, rows, run_uuid);
+  bind_named(st, ":after", static_cast<std::int64_t>(mark.value_or(1)) - 1);  // from the mark
+  bind_named(st, ":limit", budget + 1);
+  std::optional<double> reached;
+  append_from(t, st, mark, 1, sent, budget, run_uuid, run_id, reached);
+  if (reached) sent.events_after = static_cast<std::int64_t>(*reached);
 }
 
-std::int64_t Forwarder::append_samples(std::int64_t run_id, const std::string& run_uuid, Sent& sent,
-                                       std::int64_t& budget) {
+void Forwarder::append_samples(std::int64_t run_id, const std::string& run_uuid, Sent& sent,
+                               std::int64_t& budget) {
   const auto& t = fleet_table("samples");
   auto serials = read_->prepare("SELECT serial FROM run_slots WHERE run_id = ? ORDER BY slot");
   serials.bind(1, run_id);
-  std::int64_t changed = 0;
   std::optional<double> lowest;
   while (serials.step()) {
     const std::string serial = serials.column_text(0);
     auto have = pg_->exec("SELECT max(t_s) FROM samples WHERE run_uuid = $1 AND serial = $2",
                           {run_uuid, serial});
-    const double after = have.is_null(0, 0) ? kBeforeAnySample : have.number(0, 0);
-    if (budget <= 0) {
+    const std::optional<double> mark =
+        have.is_null(0, 0) ? std::nullopt : std::optional<double>(have.number(0, 0));
+    std::optional<double> reached = mark;
+    if (budget > 0) {
+      auto st = read_->prepare(t.select);
+      bind_named(st, ":id", run_id);
+      bind_named(st, ":serial", std::string_view(serial));
+      // t_s > the double just below the mark: from the mark itself.
+      bind_named(st, ":after", mark ? std::nextafter(*mark, -HUGE_VAL) : kBeforeAnySample);
+      bind_named(st, ":limit", budget + 1);
+      append_from(t, st, mark, 2, sent, budget, run_uuid, run_id, reached);
+    } else {
       sent.complete = false;
-      lowest = lowest ? std::min(*lowest, after) : after;
-      continue;
     }
-    auto st = read_->prepare(t.select);
-    bind_named(st, ":id", run_id);
-    bind_named(st, ":serial", std::string_view(serial));
-    bind_named(st, ":after", after);
-    bind_named(st, ":limit", budget);
-    const auto rows = encode_rows(st, 2);
-    budget -= rows.rows;
-    sent.appended += rows.rows;
-    if (budget <= 0) sent.complete = false;
-    const double reached = rows.last.value_or(after);
-    lowest = lowest ? std::min(*lowest, reached) : reached;
-    changed += stage_and_merge(*pg_, t, rows, run_uuid);
+    const double at = reached.value_or(kBeforeAnySample);
+    lowest = lowest ? std::min(*lowest, at) : at;
   }
   sent.samples_after = lowest;
-  return changed;
 }
 
 void Forwarder::acknowledge(Item item, std::int64_t local_id, std::int64_t changes,
                             const Sent& sent) {
   auto st = write_->prepare(
       "UPDATE fleet_outbox SET acked = CASE WHEN ?1 THEN max(acked, ?2) ELSE acked END, "
+      "samples_done = CASE WHEN ?1 AND ?8 AND changes = ?2 THEN 1 ELSE samples_done END, "
       "acked_utc = ?3, events_acked_id = coalesce(?4, events_acked_id), "
-      "samples_acked_t_s = coalesce(?5, samples_acked_t_s), last_error = NULL "
-      "WHERE item = ?6 AND local_id = ?7");
+      "samples_acked_t_s = coalesce(?5, samples_acked_t_s), last_error = NULL, refusals = 0, "
+      "retry_after_unix = NULL WHERE item = ?6 AND local_id = ?7");
   st.bind(1, sent.complete ? 1 : 0).bind(2, changes).bind(3, utc_now());
   if (sent.events_after)
     st.bind(4, *sent.events_after);
   else
     st.bind_null(4);
   st.bind(5, sent.samples_after);
-  st.bind(6, item_name(item)).bind(7, local_id);
+  st.bind(6, item_name(item)).bind(7, local_id).bind(8, options_.samples ? 1 : 0);
   st.step();
 }
 
-void Forwarder::record_error(Item item, std::int64_t local_id, const std::string& error) {
-  auto st =
-      write_->prepare("UPDATE fleet_outbox SET last_error = ? WHERE item = ? AND local_id = ?");
-  st.bind(1, error).bind(2, item_name(item)).bind(3, local_id);
+// A refused item waits 0.5 s doubling to 60 s before its next attempt (so one the server keeps
+// refusing neither spins nor blocks the items behind it); a held one waits for a person.
+void Forwarder::record_error(Item item, std::int64_t local_id, const std::string& error,
+                             bool hold) {
+  auto st = write_->prepare(
+      "UPDATE fleet_outbox SET last_error = ?1, refusals = refusals + 1, retry_after_unix = ?2 + "
+      "min(60.0, 0.5 * (1 << min(refusals, 7))), held_reason = CASE WHEN ?3 THEN ?1 END "
+      "WHERE item = ?4 AND local_id = ?5");
+  st.bind(1, error).bind(2, unix_now_s()).bind(3, hold ? 1 : 0);
+  st.bind(4, item_name(item)).bind(5, local_id);
   st.step();
 }
 
+// Rows behind the pending runs, by index ranges only: events by id, samples per serial by t_s
+// (the samples' key is run, serial, t_s) — no scan of what was sent.
 Backlog Forwarder::backlog() {
   if (!read_) read_.emplace(db_path_, OpenMode::read_only);
   ReadSnapshot snap(*read_);
   Backlog b;
   auto n = read_->prepare(
-      "SELECT count(*) FILTER (WHERE item = 'run'), count(*) FROM fleet_outbox WHERE acked < "
-      "changes");
+      "SELECT count(*) FILTER (WHERE item = 'run' AND held_reason IS NULL), "
+      "count(*) FILTER (WHERE held_reason IS NULL), count(*) FILTER (WHERE held_reason IS NOT "
+      "NULL) FROM fleet_outbox WHERE acked < changes OR (?1 AND item = 'run' AND samples_done = "
+      "0)");
+  n.bind(1, options_.samples ? 1 : 0);
   n.step();
   b.runs = n.column_int(0);
   b.items = n.column_int(1);
-  auto rows = read_->prepare(fmt::format(
+  b.held = n.column_int(2);
+  auto rows = read_->prepare(
       "SELECT coalesce(sum((SELECT count(*) FROM events AS e WHERE e.run_id = o.local_id AND "
-      "e.id > coalesce(o.events_acked_id, 0)){}), 0) FROM fleet_outbox AS o WHERE o.item = 'run' "
-      "AND o.acked < o.changes",
-      options_.samples ? " + (SELECT count(*) FROM samples AS s WHERE s.run_id = o.local_id AND "
-                         "s.t_s > coalesce(o.samples_acked_t_s, -1e300))"
-                       : ""));
+      "e.id > coalesce(o.events_acked_id, 0)) + CASE WHEN ?1 THEN (SELECT count(*) FROM "
+      "run_slots AS rs JOIN samples AS s ON s.run_id = rs.run_id AND s.serial = rs.serial AND "
+      "s.t_s > coalesce(o.samples_acked_t_s, -1e300) WHERE rs.run_id = o.local_id) ELSE 0 END), "
+      "0) FROM fleet_outbox AS o WHERE o.item = 'run' AND o.held_reason IS NULL AND (o.acked < "
+      "o.changes OR (?1 AND o.samples_done = 0))");
+  rows.bind(1, options_.samples ? 1 : 0);
   rows.step();
   b.rows = b.items + rows.column_int(0);
   return b;

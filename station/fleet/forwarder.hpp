@@ -10,6 +10,8 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <mutex>
 #include <optional>
 #include <string>
 
@@ -36,7 +38,12 @@ struct Backlog {
   std::int64_t runs = 0;   ///< runs not acknowledged in their latest state
   std::int64_t items = 0;  ///< runs, fits, releases and verifications not acknowledged
   std::int64_t rows = 0;   ///< items plus the events (and samples, when forwarded) behind them
+  std::int64_t held = 0;   ///< items held: the server has a newer state (a restored file)
 };
+
+/// The pause after a failure that followed a pause of `previous_s` (0: the first failure):
+/// 0.5 s, doubling, at most 60 s (issue 24). For the link and for each refused item.
+double next_backoff_s(double previous_s);
 
 /// One pass.
 struct PassResult {
@@ -52,13 +59,20 @@ class Forwarder {
  public:
   /// No I/O: databases and the server are opened by the first pass.
   Forwarder(std::string db_path, PgTarget target, ForwardOptions options);
-  /// Sends up to `max_items` pending items. Throws PgError when the server cannot be reached or
-  /// the link drops (nothing acknowledged that was not committed), SqliteError on a local fault.
-  PassResult pass(std::int64_t max_items = 100);
+  /// Sends up to `max_items` pending items, stopping early once `stop` says so (checked
+  /// between items). Throws PgError when the server cannot be reached, the link drops or its
+  /// schema is older (nothing acknowledged that was not committed), SqliteError on a local
+  /// fault. An item the server refuses, or holds a newer state of, is recorded in the outbox and
+  /// the pass goes on.
+  PassResult pass(std::int64_t max_items = 100, const std::function<bool()>& stop = {});
   /// Reads the outbox (no server needed).
   Backlog backlog();
   /// Drops the server connection (the next pass reconnects).
-  void disconnect() { pg_.reset(); }
+  void disconnect();
+  /// Cancels the statement in flight (from another thread: a stopping service).
+  void cancel();
+  /// Forwards held items again (`station sync --retry-held`): each is checked anew.
+  void release_held();
 
  private:
   struct Sent {
@@ -70,20 +84,24 @@ class Forwarder {
   };
   void open();
   Sent send_item(Item item, std::int64_t local_id);
-  Sent send_run(std::int64_t run_id);
-  std::int64_t merge_all(const FleetTable& t, std::int64_t local_id, const std::string& run_uuid);
-  std::int64_t append_events(std::int64_t run_id, const std::string& run_uuid, Sent& sent,
-                             std::int64_t& budget);
-  std::int64_t append_samples(std::int64_t run_id, const std::string& run_uuid, Sent& sent,
-                              std::int64_t& budget);
+  std::string send_item_row(Item item, std::int64_t local_id, Sent& sent);
+  void send_run(std::int64_t run_id, const std::string& uuid, Sent& sent);
+  void append_events(std::int64_t run_id, const std::string& run_uuid, Sent& sent,
+                     std::int64_t& budget);
+  void append_samples(std::int64_t run_id, const std::string& run_uuid, Sent& sent,
+                      std::int64_t& budget);
+  void append_from(const FleetTable& t, Statement& st, std::optional<double> mark, int mark_col,
+                   Sent& sent, std::int64_t& budget, const std::string& run_uuid,
+                   std::int64_t run_id, std::optional<double>& reached);
   void acknowledge(Item item, std::int64_t local_id, std::int64_t changes, const Sent& sent);
-  void record_error(Item item, std::int64_t local_id, const std::string& error);
+  void record_error(Item item, std::int64_t local_id, const std::string& error, bool hold);
 
   std::string db_path_;
   PgTarget target_;
   ForwardOptions options_;
   std::optional<Database> read_, write_;
   std::optional<PgConnection> pg_;
+  std::mutex pg_mu_;  ///< guards pg_'s lifetime against cancel() from another thread
 };
 
 }  // namespace station::fleet

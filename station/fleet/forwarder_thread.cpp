@@ -19,6 +19,7 @@ nlohmann::json ForwarderStatus::to_json() const {
           {"pending_runs", backlog.runs},
           {"pending_items", backlog.items},
           {"pending_rows", backlog.rows},
+          {"held_items", backlog.held},
           {"last_success_unix_s",
            last_success_unix_s > 0 ? nlohmann::json(last_success_unix_s) : nlohmann::json()},
           {"last_error", last_error},
@@ -28,10 +29,6 @@ nlohmann::json ForwarderStatus::to_json() const {
           {"errors_total", errors_total}};
 }
 
-double next_backoff_s(double previous_s) {
-  return previous_s <= 0 ? 0.5 : std::min(60.0, previous_s * 2);
-}
-
 ForwarderThread::ForwarderThread(std::string db_path, PgTarget target, ForwardOptions options,
                                  double interval_s, OnStatus on_status)
     : forwarder_(std::move(db_path), std::move(target), std::move(options)),
@@ -39,8 +36,11 @@ ForwarderThread::ForwarderThread(std::string db_path, PgTarget target, ForwardOp
       on_status_(std::move(on_status)),
       thread_([this](std::stop_token stop) { loop(stop); }) {}
 
+// A pass in flight is cut short: the stop is checked between items and the statement in flight
+// is cancelled, so a slow server cannot hold the service's shutdown.
 ForwarderThread::~ForwarderThread() {
   thread_.request_stop();
+  forwarder_.cancel();
   cv_.notify_all();
 }
 
@@ -54,7 +54,11 @@ void ForwarderThread::publish(ForwarderStatus s) {
     std::lock_guard lock(mu_);
     status_ = s;
   }
-  if (on_status_) on_status_(s);
+  try {
+    if (on_status_) on_status_(s);
+  } catch (const std::exception& e) {  // nothing may leave the thread (std::terminate)
+    log("fleet")->error("status: {}", e.what());
+  }
 }
 
 bool ForwarderThread::pause(std::stop_token& stop, double seconds) {
@@ -66,20 +70,25 @@ bool ForwarderThread::pause(std::stop_token& stop, double seconds) {
 void ForwarderThread::loop(std::stop_token stop) {
   ForwarderStatus s;
   std::string logged_error;
+  auto backlog_at = std::chrono::steady_clock::time_point{};
   while (!stop.stop_requested()) {
     double wait_s = interval_s_;
     try {
-      const PassResult p = forwarder_.pass();
+      const PassResult p = forwarder_.pass(100, [&stop] { return stop.stop_requested(); });
       s.items_total += p.items;
       s.rows_total += p.rows;
       s.errors_total += p.failed;
       s.last_success_unix_s = unix_now_s();
-      s.backlog = forwarder_.backlog();
+      // The backlog at rest, and every 10 s of a catch-up (it counts what is pending).
+      const auto now = std::chrono::steady_clock::now();
+      if (!p.more || now - backlog_at > std::chrono::seconds(10)) {
+        s.backlog = forwarder_.backlog();
+        backlog_at = now;
+      }
       if (p.failed > 0) s.last_error = p.last_error;
-      // Refused items are retried, but no faster than a failing link would be.
-      s.backoff_s = p.failed > 0 && p.items == 0 ? next_backoff_s(s.backoff_s) : 0;
-      s.state = p.more ? "sending" : p.failed > 0 ? "refusing items" : "idle";
-      wait_s = p.more ? 0 : std::max(interval_s_, s.backoff_s);
+      s.backoff_s = 0;
+      s.state = p.more ? "sending" : p.failed > 0 || s.backlog.held > 0 ? "refusing items" : "idle";
+      wait_s = p.more ? 0 : interval_s_;
       if (p.failed > 0 && p.last_error != logged_error)
         log("fleet")->warn("the server refused {} item(s): {}", p.failed, p.last_error);
       logged_error = p.failed > 0 ? p.last_error : "";

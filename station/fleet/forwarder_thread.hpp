@@ -18,7 +18,7 @@
 namespace station::fleet {
 
 struct ForwarderStatus {
-  std::string state = "starting";  ///< sending, idle, backing off, refusing items
+  std::string state = "starting";  ///< sending, idle, backing off, refusing items (or holding)
   Backlog backlog;
   double last_success_unix_s = 0;  ///< wall time of the last pass that reached the server; 0: none
   std::string last_error;          ///< the last failure (link or refusal), empty when none yet
@@ -26,10 +26,6 @@ struct ForwarderStatus {
   std::int64_t items_total = 0, rows_total = 0, errors_total = 0;
   nlohmann::json to_json() const;
 };
-
-/// The pause after a failure that followed a pause of `previous_s` (0: the first failure):
-/// 0.5 s, doubling, at most 60 s.
-double next_backoff_s(double previous_s);
 
 class ForwarderThread {
  public:

@@ -34,13 +34,30 @@ long long PgResult::affected() const {
   return std::atoll(PQcmdTuples(r_.get()));
 }
 
+namespace {
+
+/// The `options` keyword of `url` (command-line options for the server, e.g. -c search_path=x),
+/// empty when it has none: ours are appended to it, never put in its place.
+std::string url_options(const std::string& url) {
+  std::string out;
+  if (PQconninfoOption* opts = PQconninfoParse(url.c_str(), nullptr)) {
+    for (auto* o = opts; o->keyword != nullptr; ++o)
+      if (std::string_view(o->keyword) == "options" && o->val != nullptr) out = o->val;
+    PQconninfoFree(opts);
+  }
+  return out;
+}
+
+}  // namespace
+
 // Keywords before "dbname" are defaults the URL may override; the configured ones come after it
 // and win (expand_dbname = 1: "later keywords override", libpq-connect.html, PQconnectdbParams).
+// client_min_messages: a NOTICE ("stage table exists, skipping") is not for the operator.
 PgConnection::PgConnection(const PgTarget& t) {
   const std::string timeout = std::to_string(t.connect_timeout_s);
-  // client_min_messages: a NOTICE ("stage table exists, skipping") is not for the operator.
-  const std::string options =
-      fmt::format("-c statement_timeout={} -c client_min_messages=warning", t.statement_timeout_ms);
+  std::string options = url_options(t.url);
+  options += fmt::format("{}-c statement_timeout={} -c client_min_messages=warning",
+                         options.empty() ? "" : " ", t.statement_timeout_ms);
   std::vector<std::pair<std::string, std::string>> kv = {
       {"connect_timeout", timeout},
       {"application_name", "gyro-station"},
@@ -52,6 +69,7 @@ PgConnection::PgConnection(const PgTarget& t) {
       {"dbname", t.url}};
   kv.insert(kv.end(), t.keywords.begin(), t.keywords.end());
   kv.emplace_back("options", options);
+  kv.emplace_back("client_encoding", "UTF8");
   std::vector<const char*> keys, values;
   for (const auto& [k, v] : kv) {
     keys.push_back(k.c_str());
@@ -66,6 +84,12 @@ PgConnection::PgConnection(const PgTarget& t) {
       fmt::format("{}:{}/{}", host != nullptr ? host : "?", PQport(conn_.get()), PQdb(conn_.get()));
   if (PQstatus(conn_.get()) != CONNECTION_OK)
     throw PgError(fmt::format("PostgreSQL {}: {}", where_, trimmed(PQerrorMessage(conn_.get()))));
+  cancel_.reset(PQgetCancel(conn_.get()));
+}
+
+void PgConnection::cancel() const {
+  char err[256];
+  if (cancel_) PQcancel(cancel_.get(), err, sizeof err);
 }
 
 PgResult PgConnection::check(PGresult* raw, std::string_view what) {

@@ -28,6 +28,9 @@ struct PgFinish {
 struct PgClear {
   void operator()(PGresult* r) const noexcept { PQclear(r); }
 };
+struct PgFreeCancel {
+  void operator()(PGcancel* c) const noexcept { PQfreeCancel(c); }
+};
 
 /// One query's rows (text format). Move-only through its unique_ptr.
 class PgResult {
@@ -69,6 +72,9 @@ class PgConnection {
   /// COPY `table_and_columns` FROM STDIN (text format); `data` is the rows already encoded
   /// (copy_field / '\t' / '\n'). Returns the number of rows the server took.
   long long copy_in(std::string_view table_and_columns, std::string_view data);
+  /// Asks the server to cancel the statement in flight; callable from another thread while this
+  /// one waits (PQcancel with the PGcancel made at connect, libpq-cancel.html).
+  void cancel() const;
   /// False once the connection is lost (a failure then is the link's, not the data's).
   bool ok() const { return PQstatus(conn_.get()) == CONNECTION_OK; }
   /// Where it is connected ("host:port/db"), for messages.
@@ -77,6 +83,7 @@ class PgConnection {
  private:
   PgResult check(PGresult* r, std::string_view what);
   std::unique_ptr<PGconn, PgFinish> conn_;
+  std::unique_ptr<PGcancel, PgFreeCancel> cancel_;
   std::string where_;
 };
 

@@ -260,12 +260,16 @@ nlohmann::json LiveHub::status_locked() const {
   return j;
 }
 
-// A `fleet` stream message when what the page shows changes (not on every pass).
+// A `fleet` stream message when the forwarder's state changes, not for the time of each pass.
 void LiveHub::fleet(const nlohmann::json& forwarder) {
+  const auto without_time = [](nlohmann::json j) {
+    if (j.is_object()) j.erase("last_success_unix_s");
+    return j;
+  };
   std::lock_guard lock(mu_);
-  if (forwarder == fleet_) return;
+  const bool changed = without_time(forwarder) != without_time(fleet_);
   fleet_ = forwarder;
-  publish("fleet", fleet_);
+  if (changed) publish("fleet", fleet_);
 }
 
 nlohmann::json LiveHub::status() const {

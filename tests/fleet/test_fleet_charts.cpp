@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "compensation/control_chart.hpp"
 #include "station/fleet/fleet_charts.hpp"
 
 namespace {
@@ -60,6 +61,36 @@ TEST(FleetCharts, AStationThatDriftsAwayShowsBeyondTheLimits) {
 TEST(FleetCharts, WithoutADriftNothingIsFlagged) {
   const auto j = station::fleet::fleet_charts_json(line_of_two_stations(0));
   EXPECT_TRUE(j["parts"][0]["outside"].empty()) << j["parts"][0]["outside"].dump();
+}
+
+// Stations calibrating in turn (rig-b every fourth gyro): the moving ranges of the overall chart
+// are taken within each station, so rig-b's offset does not widen the limits it must break.
+TEST(FleetCharts, AnOffsetStationInterleavedInTimeStillShows) {
+  auto pts = line_of_two_stations(0);
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    pts[i].station = i % 4 == 3 ? "rig-b" : "rig-a";
+    if (pts[i].station == "rig-b") *pts[i].k1 += 2e-3;
+  }
+  const auto j = station::fleet::fleet_charts_json(pts);
+  int above = 0;
+  for (const auto& o : j["parts"][0]["outside"])
+    if (o["metric"] == "k1" && o["station"] == "rig-b" && o["limit"] == "UCL") ++above;
+  EXPECT_EQ(above, 10);
+  // Without the groups (one sequence), the ranges across stations swallow the offset.
+  std::vector<double> k1;
+  for (const auto& p : pts) k1.push_back(*p.k1);
+  const auto pooled = station::compensation::individuals_chart(k1);
+  ASSERT_TRUE(pooled.has_value());
+  EXPECT_TRUE(pooled->outside.empty());
+}
+
+TEST(FleetCharts, ModelsAndReferenceTemperaturesAreChartedApart) {
+  auto pts = line_of_two_stations(0);
+  for (std::size_t i = 0; i < pts.size(); i += 2) pts[i].ref_temp_c = 20;
+  const auto j = station::fleet::fleet_charts_json(pts);
+  ASSERT_EQ(j["parts"].size(), 2u);
+  EXPECT_EQ(j["parts"][0]["calibrations"].get<int>() + j["parts"][1]["calibrations"].get<int>(),
+            40);
 }
 
 }  // namespace

@@ -3,6 +3,8 @@
 // acknowledgements changes nothing; two stations forwarding at once keep their runs apart.
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <cstdio>
 #include <thread>
 
 #include "station/store/store.hpp"
@@ -163,6 +165,87 @@ TEST_F(FleetForward, TwoStationsAtOnceKeepTheirRunsApart) {
     EXPECT_EQ(server_rows(fleet::fleet_table("runs"), fmt::format("WHERE station = '{}'", name)),
               station_rows(db, fleet::fleet_table("runs")));
   }
+}
+
+std::string xmins(fleet::PgConnection& pg, const std::string& table) {
+  return pg.exec("SELECT coalesce(string_agg(xmin::text, ',' ORDER BY uuid), '') FROM " + table)
+      .text(0, 0);
+}
+
+// The station's disk is lost after it forwarded changes made since its last backup; the backup
+// is restored and records something new. The restored file's run and fit are behind the server
+// (their revision is lower): held, nothing of them written; the server keeps what it had.
+TEST_F(FleetForward, ARestoredBackupIsHeldAndWritesNothingOverTheServer) {
+  const auto db = simulated_station("fleet_restore", 1, 31);
+  const auto backup = db + ".backup";
+  std::remove(backup.c_str());
+  {
+    Database w(db, OpenMode::existing);
+    w.exec("VACUUM INTO '" + backup + "'");
+    w.exec("UPDATE fits SET part_number = 'RLG-90'");
+    w.exec(
+        "INSERT INTO events (run_id, t_s, wall_utc, severity, source, kind, message) SELECT "
+        "max(id), 9000, '2026-11-26T00:00:00Z', 'info', 'test', 'note', 'after the backup' FROM "
+        "runs");
+  }
+  forward_all(db, false);
+  fleet::PgConnection pg(target());
+  const auto runs = xmins(pg, "runs"), fits = xmins(pg, "fits");
+  const std::int64_t events = count("events");
+  {
+    Database w(backup, OpenMode::existing);
+    w.exec(
+        "INSERT INTO events (run_id, t_s, wall_utc, severity, source, kind, message) SELECT "
+        "max(id), 9000, '2026-11-26T01:00:00Z', 'info', 'test', 'note', 'after the restore' FROM "
+        "runs");
+  }
+  const auto restored = forward_all(backup, false);
+  EXPECT_EQ(restored.failed, 2) << restored.last_error;  // the run and its fit
+  EXPECT_NE(restored.last_error.find("restored from a backup"), std::string::npos)
+      << restored.last_error;
+  EXPECT_EQ(restored.rows, 0);
+  EXPECT_EQ(xmins(pg, "runs"), runs);
+  EXPECT_EQ(xmins(pg, "fits"), fits);
+  EXPECT_EQ(count("events"), events);
+  fleet::Forwarder f(backup, target(), {});
+  EXPECT_EQ(f.backlog().held, 2);
+  EXPECT_EQ(f.pass().failed, 0) << "a held item is not tried again by itself";
+  std::remove(backup.c_str());
+}
+
+// Samples not wanted at first (a pass without them acknowledges the run), wanted later: they go.
+TEST_F(FleetForward, SamplesWantedLaterAreSentForRunsAlreadyAcknowledged) {
+  const auto db = simulated_station("fleet_samples_later", 1, 32);
+  forward_all(db, false);
+  EXPECT_EQ(count("samples"), 0);
+  fleet::Forwarder f(db, target(), {.samples = true, .batch_rows = 50'000, .station = "test"});
+  EXPECT_GT(f.backlog().rows, 1000) << "the samples are pending once wanted";
+  const auto later = forward_all(db, true);
+  EXPECT_EQ(station_rows(db, fleet::fleet_table("samples")),
+            server_rows(fleet::fleet_table("samples")));
+  EXPECT_GT(later.appended, 1000);
+  EXPECT_EQ(forward_all(db, true).appended, 0) << "then nothing is pending";
+}
+
+// An item the server refuses waits its back-off (0.5 s doubling): the pass goes on with the
+// others, does not spin on it, and it arrives once the server takes it.
+TEST_F(FleetForward, ARefusedItemWaitsItsTurnAndTheOthersGoOn) {
+  const auto db = simulated_station("fleet_refused", 2, 33);
+  fleet::PgConnection pg(target());
+  pg.exec("ALTER TABLE fits ADD CONSTRAINT refuse_one CHECK (serial <> 'SIM-0001')");
+  const auto first = forward_all(db, false);
+  EXPECT_EQ(first.failed, 1) << first.last_error;
+  EXPECT_NE(first.last_error.find("refuse_one"), std::string::npos) << first.last_error;
+  EXPECT_EQ(count("fits"), 1);
+  EXPECT_EQ(count("runs"), 1);
+  fleet::Forwarder f(db, target(), {});
+  const auto again = f.pass();
+  EXPECT_EQ(again.items + again.failed, 0) << "retried before its back-off";
+  pg.exec("ALTER TABLE fits DROP CONSTRAINT refuse_one");
+  std::this_thread::sleep_for(std::chrono::milliseconds(600));
+  const auto later = f.pass();
+  EXPECT_EQ(later.items, 1);
+  EXPECT_EQ(count("fits"), 2);
 }
 
 }  // namespace

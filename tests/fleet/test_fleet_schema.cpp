@@ -77,6 +77,11 @@ TEST_F(FleetSchema, AnOlderServerIsRefusedInOneLineANewerOneAccepted) {
   }
   pg.exec("INSERT INTO fleet_schema (version) VALUES (99)");
   EXPECT_NO_THROW(fleet::require_fleet_schema(pg));
+  // A server one version behind a station: refused, saying both versions.
+  const auto older = fleet::fleet_schema_problem(1, 2);
+  ASSERT_TRUE(older.has_value());
+  EXPECT_NE(older->find("version 1 is older than this station's 2"), std::string::npos) << *older;
+  EXPECT_FALSE(fleet::fleet_schema_problem(3, 2).has_value());
 }
 
 TEST_F(FleetSchema, AnUnreachableServerIsAnErrorNotAHang) {
