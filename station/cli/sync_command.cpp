@@ -1,4 +1,4 @@
-// `station sync --db DB (--pg URL | --config FILE) [--init] [--samples]`: forwards what the
+// `station sync [--db DB] (--pg URL | --config FILE) [--init] [--samples]`: forwards what the
 // station's database holds to the fleet's PostgreSQL once, until nothing is pending (the
 // forwarder `serve` runs on its own thread, station/fleet/forwarder.hpp). --init creates or
 // migrates the central schema first. Exit 0: everything acknowledged; 1: the server refused
@@ -7,6 +7,7 @@
 
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "station/cli/commands.hpp"
 #include "station/common/input_error.hpp"
@@ -35,7 +36,7 @@ struct Resolved {
   fleet::ForwardOptions forward;
 };
 
-Resolved resolve(const SyncOptions& o, Store& store) {
+Resolved resolve(const SyncOptions& o, Store* store) {
   Resolved r;
   if (!o.config.empty()) {
     const auto cfg = load_station_config(o.config);
@@ -52,18 +53,22 @@ Resolved resolve(const SyncOptions& o, Store& store) {
   r.forward.samples = r.forward.samples || o.samples;
   r.forward.batch_rows = o.batch_rows;
   if (!o.station.empty()) r.forward.station = o.station;
-  if (r.forward.station.empty()) r.forward.station = recorded_station(store);
+  if (r.forward.station.empty() && store) r.forward.station = recorded_station(*store);
   return r;
 }
 
 int run_sync(const SyncOptions& o) {
-  Store store(o.db, OpenMode::existing);  // migrates: the outbox is migration 7
-  const Resolved r = resolve(o, store);
+  if (o.db.empty() && !o.init) throw InputError("--db DB is required (or --init alone)");
+  // The station file first (migrates it: the outbox is migration 7), unless only --init.
+  std::optional<Store> store;
+  if (!o.db.empty()) store.emplace(o.db, OpenMode::existing);
+  const Resolved r = resolve(o, store ? &*store : nullptr);
   if (o.init) {
     fleet::PgConnection pg(r.target);
     const int before = fleet::init_fleet_schema(pg);
     fmt::print(stderr, "fleet schema on {}: version {} -> {}\n", pg.where(), before,
                fleet::fleet_schema_version());
+    if (o.db.empty()) return 0;
   }
   fleet::Forwarder fwd(o.db, r.target, r.forward);
   if (o.retry_held) fwd.release_held();
@@ -105,7 +110,7 @@ void add_sync_command(CLI::App& app, CommandStatus& status) {
   auto o = std::make_shared<SyncOptions>();
   auto* cmd = app.add_subcommand(
       "sync", "Forward the database's runs, fits and releases to the fleet's PostgreSQL once");
-  cmd->add_option("--db", o->db, "SQLite database of the station")->required();
+  cmd->add_option("--db", o->db, "SQLite database of the station (optional with --init)");
   cmd->add_option("--pg", o->pg, "libpq connection URL (no password: PGPASSWORD or a passfile)");
   cmd->add_option("--config", o->config, "station configuration with a [fleet] table");
   cmd->add_option("--station", o->station, "station name for fits whose runs are gone");
