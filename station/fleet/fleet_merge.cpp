@@ -85,9 +85,11 @@ EncodedRows encode_rows(Statement& st, int watermark_col) {
 }
 
 void stage_rows(PgConnection& pg, const FleetTable& t, const EncodedRows& rows) {
+  // Made once per connection (its rows go at each commit), emptied before each use: a table
+  // made and dropped in every transaction would churn the server's catalog.
   pg.exec(fmt::format(
-      "CREATE TEMP TABLE IF NOT EXISTS stage_{0} ON COMMIT DROP AS SELECT {1} FROM {0} WITH NO "
-      "DATA; TRUNCATE stage_{0}",
+      "CREATE TEMP TABLE IF NOT EXISTS stage_{0} ON COMMIT DELETE ROWS AS SELECT {1} FROM {0} "
+      "WITH NO DATA; TRUNCATE stage_{0}",
       t.name, t.columns));
   if (rows.rows > 0) pg.copy_in(fmt::format("stage_{} ({})", t.name, t.columns), rows.data);
 }

@@ -49,8 +49,9 @@ std::string simulated_db(const std::string& tag, const std::string& protocol, in
 }
 
 // A fresh central database per iteration: every iteration forwards everything.
-fleet::PgTarget fresh_target(int iteration) {
-  const std::string name = "bench" + std::to_string(iteration);
+fleet::PgTarget fresh_target() {
+  static int made = 0;
+  const std::string name = "bench" + std::to_string(++made);
   server()->create_db(name);
   fleet::PgConnection pg({server()->url(name), {}});
   fleet::init_fleet_schema(pg);
@@ -74,11 +75,10 @@ fleet::PassResult forward_all(const std::string& db, const fleet::PgTarget& t, b
 }
 
 void run_forward(benchmark::State& state, const std::string& db, bool samples, int runs) {
-  int iteration = 0;
   std::int64_t rows = 0;
   for (auto _ : state) {
     state.PauseTiming();
-    const auto t = fresh_target(iteration++);
+    const auto t = fresh_target();
     state.ResumeTiming();
     rows = forward_all(db, t, samples).appended;
   }
