@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "station/cli/commands.hpp"
+#include "station/cli/exit_status.hpp"
 #include "station/common/input_error.hpp"
 #include "station/parts/history.hpp"
 #include "station/parts/verdict.hpp"
@@ -182,6 +183,7 @@ void add_history_command(CLI::App& app, CommandStatus& status) {
   auto o = std::make_shared<HistoryOptions>();
   auto* cmd = app.add_subcommand(
       "history", "Every run and fit of one gyro, the scatter of its coefficients and drift");
+  cmd->footer(exit_status_footer({{0, "the history was printed"}}));
   cmd->add_option("--db", o->db, "SQLite database (opened read-only)")->required();
   cmd->add_option("--serial", o->serial, "gyro serial number")->required();
   cmd->add_flag("--json", o->json, "print JSON");

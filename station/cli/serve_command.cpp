@@ -20,6 +20,7 @@
 #include "drivers/common/clock.hpp"
 #include "station/cli/commands.hpp"
 #include "station/cli/daemon_setup.hpp"
+#include "station/cli/exit_status.hpp"
 #include "station/cli/live_service.hpp"
 #include "station/cli/progress_display.hpp"
 #include "station/cli/serve_control.hpp"
@@ -39,7 +40,6 @@ std::atomic<bool> g_run_abort{false};  // ... without bins or fit (API abort)
 std::atomic<bool> g_detach{false};     // SIGUSR1: leave the run resumable, exit for a restart
 
 /// The exit status after SIGUSR1 (sysexits.h EX_TEMPFAIL): "restart me", not a failure of a run.
-constexpr int kExitRestart = 75;
 
 std::atomic<bool> g_terminated{false};  // SIGTERM/SIGINT seen: a stop beats a hand-over
 
@@ -236,6 +236,10 @@ void add_serve_command(CLI::App& app, CommandStatus& status) {
       "serve",
       "Run the station as a service: rig watched between runs, live page, JSON API, "
       "metrics; runs started and stopped over HTTP (schemas/api.md)");
+  cmd->footer(exit_status_footer(
+      {{0, "stopped by SIGTERM or SIGINT (a running run ends as stopped)"},
+       {kExitRestart,
+        "SIGUSR1: everything committed, a running run left resumable; the unit restarts it"}}));
   cmd->add_option("--config", o->config, "station configuration (TOML)")->required();
   cmd->add_option("--db", o->db, "SQLite database")->required();
   cmd->add_option("--http", o->http,
