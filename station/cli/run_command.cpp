@@ -153,12 +153,12 @@ int run_real(const RunOptions& o) {
   sd_notify(0, "READY=1");
   const RunOutcome out = seq.run(resume);
   progress.finish();
-  live.hub().run_ended(out.run_id, out.state);
+  live.hub().run_ended(out.run_id, std::string(to_string(out.state)));
   live.shutdown();
   if (session) session->finish(store, out.run_id);
   sd_notify(0, "STOPPING=1");
-  fmt::print("run {} {} at t = {:.0f} s after {} ticks\n", out.run_id, out.state, out.t_s,
-             out.ticks);
+  fmt::print("run {} {} at t = {:.0f} s after {} ticks\n", out.run_id, to_string(out.state),
+             out.t_s, out.ticks);
   print_verdicts(store, out.run_id);
   live.exit_if_abandoned(0);
   return 0;

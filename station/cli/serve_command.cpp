@@ -84,9 +84,10 @@ struct Service {
 bool close_failed_run(Service& s, const UnclosedRun& u) {
   try {
     const auto run = s.store.find_run(u.id);
-    if (!run || run->state != "running") return true;  // closed already
-    s.store.add_event(u.id, run->last_tick_s.value_or(0), "error", "serve", "run_failed", u.reason);
-    s.store.finish_run(u.id, "aborted");
+    if (!run || run->state != RunState::running) return true;  // closed already
+    s.store.add_event(u.id, run->last_tick_s.value_or(0), Severity::error, "serve",
+                      EventKind::run_failed, u.reason);
+    s.store.finish_run(u.id, RunState::aborted);
     log("serve")->info("run {} closed as aborted (run_failed: {})", u.id, u.reason);
     return true;
   } catch (const std::exception& e) {
@@ -140,10 +141,10 @@ void run_one(Service& s, const Protocol& protocol, const std::optional<RunRecord
   try {
     Sequencer seq(s.config, protocol, s.rig, s.store, clock, so);
     const RunOutcome out = seq.run(resume);
-    s.live.hub().run_ended(out.run_id, out.state);
-    notify_status(fmt::format("idle; run {} {}", out.run_id, out.state));
-    log("serve")->info("run {} {} at t = {:.0f} s after {} ticks", out.run_id, out.state, out.t_s,
-                       out.ticks);
+    s.live.hub().run_ended(out.run_id, std::string(to_string(out.state)));
+    notify_status(fmt::format("idle; run {} {}", out.run_id, to_string(out.state)));
+    log("serve")->info("run {} {} at t = {:.0f} s after {} ticks", out.run_id, to_string(out.state),
+                       out.t_s, out.ticks);
   } catch (const std::exception& e) {
     run_failed(s, run_id, e.what());
   }
