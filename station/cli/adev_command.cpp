@@ -10,6 +10,7 @@
 #include "compensation/limits.hpp"
 #include "station/cli/commands.hpp"
 #include "station/cli/csv_table.hpp"
+#include "station/cli/exit_status.hpp"
 #include "station/cli/number_options.hpp"
 
 namespace station {
@@ -113,6 +114,7 @@ void print_table(const AdevOptions& o, std::size_t n, const std::vector<sc::Adev
 void add_adev_command(CLI::App& app, CommandStatus& status) {
   auto o = std::make_shared<AdevOptions>();
   auto* cmd = app.add_subcommand("adev", "Overlapping Allan deviation of a CSV column");
+  cmd->footer(exit_status_footer({{0, "the deviation and noise terms were printed"}}));
   cmd->add_option("file", o->file, "CSV with a header row")->required();
   cmd->add_option("--col", o->col, "column holding the rate series")->required();
   cmd->add_option("--rate-hz", o->rate_hz, "sample rate, Hz")

@@ -12,6 +12,7 @@
 #include "compensation/limits.hpp"
 #include "station/cli/commands.hpp"
 #include "station/cli/csv_table.hpp"
+#include "station/cli/exit_status.hpp"
 #include "station/cli/number_options.hpp"
 #include "station/store/fit_json.hpp"
 
@@ -175,6 +176,7 @@ void add_analyze_command(CLI::App& app, CommandStatus& status) {
   auto o = std::make_shared<AnalyzeOptions>();
   auto* cmd =
       app.add_subcommand("analyze", "Bin, fit and evaluate the thermal bias model of a CSV");
+  cmd->footer(exit_status_footer({{0, "the model was fitted and evaluated"}}));
   cmd->add_option("file", o->file, "CSV with a header row")->required();
   cmd->add_option("--time-col", o->time_col, "time column, s")->capture_default_str();
   cmd->add_option("--rate-col", o->rate_col, "gyro rate column, deg/h")->capture_default_str();

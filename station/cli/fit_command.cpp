@@ -8,6 +8,7 @@
 
 #include "compensation/cross_validation.hpp"
 #include "station/cli/commands.hpp"
+#include "station/cli/exit_status.hpp"
 #include "station/common/input_error.hpp"
 #include "station/parts/judged_fit.hpp"
 #include "station/store/calibration.hpp"
@@ -160,6 +161,9 @@ int run_fit(const FitOptions& o) {
 void add_fit_commands(CLI::App& app, CommandStatus& status) {
   auto o = std::make_shared<FitOptions>();
   auto* fit = app.add_subcommand("fit", "Fit the thermal model per serial number from stored runs");
+  fit->footer(exit_status_footer(
+      {{0, "every serial was fitted and stored"},
+       {1, "a serial had nothing to fit (one line each on stderr; the others are stored)"}}));
   fit->add_option("--db", o->db, "SQLite database")->required();
   auto* serial = fit->add_option("--serial", o->serial, "gyro serial number");
   fit->add_option("--runs", o->runs, "run ids (default: every run of the serial)")->delimiter(',');

@@ -9,6 +9,7 @@
 #include <regex>
 
 #include "station/cli/commands.hpp"
+#include "station/cli/exit_status.hpp"
 #include "station/common/input_error.hpp"
 #include "station/config/fleet_config.hpp"
 #include "station/fleet/fleet_charts.hpp"
@@ -75,6 +76,7 @@ void add_fleet_command(CLI::App& app, CommandStatus& status) {
   auto o = std::make_shared<FleetOptions>();
   auto* cmd = app.add_subcommand(
       "fleet", "Control charts of k1, k0, B0 and the std ratio across the fleet's stations");
+  cmd->footer(exit_status_footer({{kExitOk, "the charts were written"}}));
   cmd->add_option("--pg", o->pg, "the fleet's PostgreSQL (libpq URL)")->required();
   cmd->add_option("--part", o->part, "only this part number");
   cmd->add_option("--since", o->since, "only calibrations created at or after (ISO-8601)");

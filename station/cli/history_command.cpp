@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "station/cli/commands.hpp"
+#include "station/cli/exit_status.hpp"
 #include "station/common/input_error.hpp"
 #include "station/config/fleet_config.hpp"
 #include "station/fleet/fleet_history.hpp"
@@ -197,6 +198,7 @@ void add_history_command(CLI::App& app, CommandStatus& status) {
   auto o = std::make_shared<HistoryOptions>();
   auto* cmd = app.add_subcommand(
       "history", "Every run and fit of one gyro, the scatter of its coefficients and drift");
+  cmd->footer(exit_status_footer({{0, "the history was printed"}}));
   cmd->add_option("--db", o->db, "SQLite database (opened read-only)");
   cmd->add_option("--pg", o->pg,
                   "the fleet's PostgreSQL (libpq URL): every station's calibrations of the gyro");

@@ -9,6 +9,7 @@
 
 #include "drivers/counters/counter_frames.hpp"
 #include "station/cli/commands.hpp"
+#include "station/cli/exit_status.hpp"
 #include "station/cli/probe.hpp"
 
 namespace station {
@@ -289,6 +290,8 @@ void add_probe_command(CLI::App& app, CommandStatus& status) {
   };
   auto o = std::make_shared<Options>();
   auto* cmd = app.add_subcommand("probe", "Read every configured device once (commissioning)");
+  cmd->footer(exit_status_footer({{0, "every configured device answered"},
+                                  {1, "a device did not answer (named in the report)"}}));
   cmd->add_option("--config", o->config, "station configuration file (TOML)")->required();
   cmd->add_flag("--json", o->json, "print one JSON object");
   cmd->callback([o, &status] {

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "station/cli/commands.hpp"
+#include "station/cli/exit_status.hpp"
 #include "station/common/input_error.hpp"
 #include "station/parts/judged_fit.hpp"
 #include "station/release/block_formats.hpp"
@@ -166,6 +167,7 @@ int run_verify(const VerifyOptions& o) {
 void add_release(CLI::App& app, CommandStatus& status) {
   auto o = std::make_shared<ReleaseOptions>();
   auto* c = app.add_subcommand("release", "Make a fit the gyro's released calibration");
+  c->footer(exit_status_footer({{0, "the fit is the released calibration"}}));
   c->add_option("--db", o->db, "SQLite database")->required();
   c->add_option("--fit", o->fit_id, "fit id (station fit / history)")->required();
   c->add_option("--by", o->by, "who releases")->required();
@@ -182,6 +184,7 @@ void add_export(CLI::App& app, CommandStatus& status) {
   auto o = std::make_shared<ExportOptions>();
   auto* c = app.add_subcommand(
       "export", "Write the released calibration of gyros for the navigation computer");
+  c->footer(exit_status_footer({{0, "the released calibration was written"}}));
   c->add_option("--db", o->db, "SQLite database")->required();
   c->add_option("--serial", o->serials, "gyro serial number(s)")->delimiter(',');
   c->add_option("--fit", o->fit_id, "export this fit (warns when it is not the released one)");
@@ -204,6 +207,9 @@ void add_export(CLI::App& app, CommandStatus& status) {
 void add_verify(CLI::App& app, CommandStatus& status) {
   auto o = std::make_shared<VerifyOptions>();
   auto* c = app.add_subcommand("verify", "Apply a calibration to a run it was not fitted on");
+  c->footer(
+      exit_status_footer({{0, "verified: the verdict passed, or there are no limits to judge"},
+                          {1, "the verdict failed (the result is stored)"}}));
   c->add_option("--db", o->db, "SQLite database")->required();
   c->add_option("--serial", o->serial, "gyro serial number")->required();
   c->add_option("--run", o->run_id, "the independent run")->required();

@@ -12,6 +12,7 @@
 #include "drivers/can/replay_transport.hpp"
 #include "drivers/counters/counter_boards.hpp"
 #include "station/cli/commands.hpp"
+#include "station/cli/exit_status.hpp"
 #include "station/common/logging.hpp"
 #include "station/config/config.hpp"
 #include "station/daemon/sample.hpp"
@@ -146,6 +147,9 @@ void add_replay_command(CLI::App& app, CommandStatus& status) {
       "replay",
       "Replay a recorded session directory through the daemon and compare with its result "
       "(exit 0 same, 1 differs, 2 bad session); or a run's CAN log against its database");
+  cmd->footer(exit_status_footer(
+      {{0, "the replay gives what was recorded (within the tolerances)"},
+       {1, "it differs, or a recorded file was changed (named with its line)"}}));
   cmd->add_option("source", o->log,
                   "session directory (run --record DIR), or a candump log (run --record-can)")
       ->required();

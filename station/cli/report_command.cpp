@@ -2,6 +2,7 @@
 #include <fmt/format.h>
 
 #include "station/cli/commands.hpp"
+#include "station/cli/exit_status.hpp"
 #include "station/report/report.hpp"
 
 namespace station {
@@ -11,6 +12,7 @@ void add_report_command(CLI::App& app, CommandStatus& status) {
   auto* cmd = app.add_subcommand(
       "report",
       "Write a run's calibration report: self-contained HTML pages (the paper's figures)");
+  cmd->footer(exit_status_footer({{0, "the report was written"}}));
   cmd->add_option("--db", o->db, "SQLite database (opened read-only)")->required();
   cmd->add_option("--run", o->run_id, "run id")->required();
   cmd->add_option("--out", o->out_dir, "output directory (created when missing)")->required();

@@ -19,6 +19,7 @@
 #include "drivers/registry/dialects.hpp"
 #include "station/cli/commands.hpp"
 #include "station/cli/daemon_setup.hpp"
+#include "station/cli/exit_status.hpp"
 #include "station/cli/live_service.hpp"
 #include "station/cli/number_options.hpp"
 #include "station/cli/probe.hpp"
@@ -152,12 +153,12 @@ int run_real(const RunOptions& o) {
   sd_notify(0, "READY=1");
   const RunOutcome out = seq.run(resume);
   progress.finish();
-  live.hub().run_ended(out.run_id, out.state);
+  live.hub().run_ended(out.run_id, std::string(to_string(out.state)));
   live.shutdown();
   if (session) session->finish(store, out.run_id);
   sd_notify(0, "STOPPING=1");
-  fmt::print("run {} {} at t = {:.0f} s after {} ticks\n", out.run_id, out.state, out.t_s,
-             out.ticks);
+  fmt::print("run {} {} at t = {:.0f} s after {} ticks\n", out.run_id, to_string(out.state),
+             out.t_s, out.ticks);
   print_verdicts(store, out.run_id);
   live.exit_if_abandoned(0);
   return 0;
@@ -222,6 +223,11 @@ int run_sim(const RunOptions& o) {
 void add_run_command(CLI::App& app, CommandStatus& status) {
   auto o = std::make_shared<RunOptions>();
   auto* cmd = app.add_subcommand("run", "Run a test protocol on a rig (or on the simulated rig)");
+  cmd->footer(exit_status_footer(
+      {{0, "the run ended: completed, incomplete, stopped (SIGTERM, SIGINT, the API) or aborted"},
+       {2,
+        "bad input or setup (options, configuration, protocol, a database or device in use), "
+        "or the store could not write mid-run (disk full): the run stays resumable"}}));
   auto* sim = cmd->add_flag("--sim", o->sim, "simulated rig on the simulated clock");
   cmd->add_option("--config", o->config, "station configuration (TOML)")->excludes(sim);
   cmd->add_option("--protocol", o->protocol, "protocol file or shipped name")

@@ -20,6 +20,7 @@
 #include "drivers/common/clock.hpp"
 #include "station/cli/commands.hpp"
 #include "station/cli/daemon_setup.hpp"
+#include "station/cli/exit_status.hpp"
 #include "station/cli/live_service.hpp"
 #include "station/cli/progress_display.hpp"
 #include "station/cli/serve_control.hpp"
@@ -40,7 +41,6 @@ std::atomic<bool> g_run_abort{false};  // ... without bins or fit (API abort)
 std::atomic<bool> g_detach{false};     // SIGUSR1: leave the run resumable, exit for a restart
 
 /// The exit status after SIGUSR1 (sysexits.h EX_TEMPFAIL): "restart me", not a failure of a run.
-constexpr int kExitRestart = 75;
 
 std::atomic<bool> g_terminated{false};  // SIGTERM/SIGINT seen: a stop beats a hand-over
 
@@ -85,9 +85,10 @@ struct Service {
 bool close_failed_run(Service& s, const UnclosedRun& u) {
   try {
     const auto run = s.store.find_run(u.id);
-    if (!run || run->state != "running") return true;  // closed already
-    s.store.add_event(u.id, run->last_tick_s.value_or(0), "error", "serve", "run_failed", u.reason);
-    s.store.finish_run(u.id, "aborted");
+    if (!run || run->state != RunState::running) return true;  // closed already
+    s.store.add_event(u.id, run->last_tick_s.value_or(0), Severity::error, "serve",
+                      EventKind::run_failed, u.reason);
+    s.store.finish_run(u.id, RunState::aborted);
     log("serve")->info("run {} closed as aborted (run_failed: {})", u.id, u.reason);
     return true;
   } catch (const std::exception& e) {
@@ -141,10 +142,10 @@ void run_one(Service& s, const Protocol& protocol, const std::optional<RunRecord
   try {
     Sequencer seq(s.config, protocol, s.rig, s.store, clock, so);
     const RunOutcome out = seq.run(resume);
-    s.live.hub().run_ended(out.run_id, out.state);
-    notify_status(fmt::format("idle; run {} {}", out.run_id, out.state));
-    log("serve")->info("run {} {} at t = {:.0f} s after {} ticks", out.run_id, out.state, out.t_s,
-                       out.ticks);
+    s.live.hub().run_ended(out.run_id, std::string(to_string(out.state)));
+    notify_status(fmt::format("idle; run {} {}", out.run_id, to_string(out.state)));
+    log("serve")->info("run {} {} at t = {:.0f} s after {} ticks", out.run_id, to_string(out.state),
+                       out.t_s, out.ticks);
   } catch (const std::exception& e) {
     run_failed(s, run_id, e.what());
   }
@@ -248,6 +249,10 @@ void add_serve_command(CLI::App& app, CommandStatus& status) {
       "serve",
       "Run the station as a service: rig watched between runs, live page, JSON API, "
       "metrics; runs started and stopped over HTTP (schemas/api.md)");
+  cmd->footer(exit_status_footer(
+      {{0, "stopped by SIGTERM or SIGINT (a running run ends as stopped)"},
+       {kExitRestart,
+        "SIGUSR1: everything committed, a running run left resumable; the unit restarts it"}}));
   cmd->add_option("--config", o->config, "station configuration (TOML)")->required();
   cmd->add_option("--db", o->db, "SQLite database")->required();
   cmd->add_option("--http", o->http,

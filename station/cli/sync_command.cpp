@@ -10,6 +10,7 @@
 #include <optional>
 
 #include "station/cli/commands.hpp"
+#include "station/cli/exit_status.hpp"
 #include "station/common/input_error.hpp"
 #include "station/config/config.hpp"
 #include "station/fleet/fleet_schema.hpp"
@@ -110,6 +111,11 @@ void add_sync_command(CLI::App& app, CommandStatus& status) {
   auto o = std::make_shared<SyncOptions>();
   auto* cmd = app.add_subcommand(
       "sync", "Forward the database's runs, fits and releases to the fleet's PostgreSQL once");
+  cmd->footer(exit_status_footer(
+      {{kExitOk, "everything pending was acknowledged by the server"},
+       {kExitFailure,
+        "the server could not be reached, refused items, or holds a newer state of some "
+        "(a restored file: held)"}}));
   cmd->add_option("--db", o->db, "SQLite database of the station (optional with --init)");
   cmd->add_option("--pg", o->pg, "libpq connection URL (no password: PGPASSWORD or a passfile)");
   cmd->add_option("--config", o->config, "station configuration with a [fleet] table");

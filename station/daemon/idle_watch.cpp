@@ -61,11 +61,13 @@ IdleReading IdleWatch::look() {
     const std::string message = cleared ? fmt::format("idle rig clear (was: {})", last_key_)
                                         : fmt::format("idle rig: {}", r.fault);
     log("serve")->log(cleared ? spdlog::level::info : spdlog::level::warn, "{}", message);
-    const std::string severity = cleared ? "info" : "warn";
-    const std::string kind = cleared ? "idle_clear" : "idle_fault";
+    const Severity severity = cleared ? Severity::info : Severity::warn;
+    const EventKind kind = cleared ? EventKind::idle_clear : EventKind::idle_fault;
+    const nlohmann::json data =
+        cleared ? nlohmann::json{{"was", last_key_}} : nlohmann::json{{"fault", r.fault_key}};
     try {
-      const auto id = store_.add_event(std::nullopt, 0, severity, "serve", kind, message);
-      if (on_event_) on_event_({id, 0, 0, severity, "serve", kind, message, std::nullopt});
+      const auto id = store_.add_event(std::nullopt, 0, severity, "serve", kind, message, data);
+      if (on_event_) on_event_({id, 0, 0, severity, "serve", kind, message, data});
       last_key_ = r.fault_key;
       r.storage_error.clear();
     } catch (const SqliteError& e) {

@@ -37,12 +37,15 @@ std::vector<Outage> OutageTracker::close_all(double t_s) {
   return out;
 }
 
-std::string outage_json(const Outage& o) {
-  return nlohmann::json{{"device", o.device},
-                        {"start_s", o.start_s},
-                        {"end_s", o.end_s},
-                        {"ticks_lost", o.ticks_lost}}
-      .dump();
+nlohmann::json outage_json(const Outage& o, OutageEnd ended) {
+  const char* const how = ended == OutageEnd::answered  ? "answered"
+                          : ended == OutageEnd::run_end ? "run_end"
+                                                        : "abort";
+  return {{"device", o.device},
+          {"start_s", o.start_s},
+          {"end_s", o.end_s},
+          {"ticks_lost", o.ticks_lost},
+          {"ended", how}};
 }
 
 WindowLoss record_window_loss(const std::vector<SampleRow>& recorded, double period_s) {

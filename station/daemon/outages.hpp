@@ -52,8 +52,12 @@ class OutageTracker {
   std::map<std::string, Outage> open_;
 };
 
-/// An outage as the JSON stored in events.data_json: {"device","start_s","end_s","ticks_lost"}.
-std::string outage_json(const Outage& o);
+/// How an outage ended: the device answered again, or the run ended (or was aborted) first.
+enum class OutageEnd { answered, run_end, abort };
+
+/// An 'outage' event's data (schemas/events.md): {"device","start_s","end_s","ticks_lost",
+/// "ended"} with `ended` "answered", "run_end" or "abort".
+nlohmann::json outage_json(const Outage& o, OutageEnd ended);
 
 /// Ticks of a record window and how many of them have no rate.
 struct WindowLoss {

@@ -30,8 +30,10 @@ void ProtocolRunner::enter(const Step& s, const Observation& obs, Actions& a) {
   entered_ = true;
   stable_since_s_.reset();
   a.events.push_back(
-      {"info", "step_start",
-       fmt::format("step {} '{}' (line {})", progress_.step_index, s.label, s.line)});
+      {Severity::info,
+       EventKind::step_start,
+       fmt::format("step {} '{}' (line {})", progress_.step_index, s.label, s.line),
+       {{"step_index", progress_.step_index}, {"label", s.label}, {"line", s.line}}});
   switch (s.kind) {
     case StepKind::set_temperature:
       ramp_origin_c_ =
@@ -40,9 +42,11 @@ void ProtocolRunner::enter(const Step& s, const Observation& obs, Actions& a) {
         // Back from a safe hold: the ramp goes on at its rate from where the chamber was held.
         ramp_origin_c_ = *resume_from_c_;
         progress_.step_started_s = obs.t_s;
-        a.events.push_back({"info", "ramp_resume",
+        a.events.push_back({Severity::info,
+                            EventKind::ramp_resume,
                             fmt::format("ramp resumes from {:.2f} C at {:.1f} C/h", ramp_origin_c_,
-                                        s.ramp_c_per_h)});
+                                        s.ramp_c_per_h),
+                            {{"from_c", ramp_origin_c_}, {"ramp_c_per_h", s.ramp_c_per_h}}});
       }
       setpoint_c_ = target_of(s);
       ramp_sent_c_.reset();
@@ -60,13 +64,13 @@ void ProtocolRunner::enter(const Step& s, const Observation& obs, Actions& a) {
     case StepKind::record_start:
       progress_.recording = true;
       progress_.record_start_s = obs.t_s;
-      a.events.push_back(
-          {"info", "record_start", fmt::format("record window opens at {:.0f} s", obs.t_s)});
+      a.events.push_back({Severity::info, EventKind::record_start,
+                          fmt::format("record window opens at {:.0f} s", obs.t_s)});
       break;
     case StepKind::record_stop:
       progress_.recording = false;
-      a.events.push_back(
-          {"info", "record_stop", fmt::format("record window closes at {:.0f} s", obs.t_s)});
+      a.events.push_back({Severity::info, EventKind::record_stop,
+                          fmt::format("record window closes at {:.0f} s", obs.t_s)});
       break;
     default:
       break;
@@ -132,13 +136,15 @@ bool ProtocolRunner::finished(const Step& s, const Observation& obs) {
   }
 }
 
-void ProtocolRunner::advance(const Observation& obs, Actions& a, const std::string& kind,
-                             const std::string& sev) {
+void ProtocolRunner::advance(const Observation& obs, Actions& a, EventKind kind, Severity sev) {
   const Step& s = protocol_.steps[static_cast<std::size_t>(progress_.step_index)];
-  a.events.push_back({sev, kind,
-                      fmt::format("step {} '{}' {} after {:.0f} s", progress_.step_index, s.label,
-                                  kind == "step_timeout" ? "timed out" : "done",
-                                  obs.t_s - progress_.step_started_s)});
+  const double after_s = obs.t_s - progress_.step_started_s;
+  a.events.push_back(
+      {sev,
+       kind,
+       fmt::format("step {} '{}' {} after {:.0f} s", progress_.step_index, s.label,
+                   kind == EventKind::step_timeout ? "timed out" : "done", after_s),
+       {{"step_index", progress_.step_index}, {"label", s.label}, {"after_s", after_s}}});
   ++progress_.step_index;
   progress_.step_started_s = obs.t_s;
   entered_ = false;
@@ -154,17 +160,18 @@ Actions ProtocolRunner::tick(const Observation& obs) {
     if (s.kind == StepKind::set_temperature && s.ramp_c_per_h > 0) ramp(s, obs, a);
     if (s.kind == StepKind::lock_turntable) lock_table(s, obs, a);
     if (finished(s, obs)) {
-      advance(obs, a, "step_done", "info");
+      advance(obs, a, EventKind::step_done, Severity::info);
       continue;
     }
     if (s.timeout_s > 0 && obs.t_s - progress_.step_started_s > s.timeout_s) {
-      advance(obs, a, "step_timeout", "warn");
+      advance(obs, a, EventKind::step_timeout, Severity::warn);
       continue;
     }
     break;
   }
-  if (done() && !a.events.empty() && a.events.back().kind != "done") {
-    a.events.push_back({"info", "done", fmt::format("protocol '{}' complete", protocol_.name)});
+  if (done() && !a.events.empty() && a.events.back().kind != EventKind::done) {
+    a.events.push_back(
+        {Severity::info, EventKind::done, fmt::format("protocol '{}' complete", protocol_.name)});
   }
   return a;
 }

@@ -9,6 +9,7 @@
 #include "drivers/chamber/chamber.hpp"
 #include "drivers/turntable/turntable.hpp"
 #include "station/config/protocol.hpp"
+#include "station/store/events.hpp"
 #include "station/store/store.hpp"
 
 namespace station {
@@ -24,12 +25,9 @@ struct Observation {
   std::optional<bool> table_locked;       ///< axis lock read back
 };
 
-/// A note for the event log.
-struct RunnerEvent {
-  std::string severity;  ///< info | warn
-  std::string kind;      ///< step_start, step_done, step_timeout, record_start, record_stop, done
-  std::string message;
-};
+/// A note for the event log: step_start, step_done, step_timeout, ramp_resume, record_start,
+/// record_stop, done (schemas/events.md).
+using RunnerEvent = EventNote;
 
 /// What to do this tick.
 struct Actions {
@@ -67,7 +65,7 @@ class ProtocolRunner {
  private:
   void enter(const Step& s, const Observation& obs, Actions& a);
   bool finished(const Step& s, const Observation& obs);
-  void advance(const Observation& obs, Actions& a, const std::string& kind, const std::string& sev);
+  void advance(const Observation& obs, Actions& a, EventKind kind, Severity sev);
   double target_of(const Step& s) const;
   /// Target of the last set_temperature step before the current one, if any.
   std::optional<double> previous_target() const;

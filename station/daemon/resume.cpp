@@ -24,8 +24,9 @@ namespace {
 using nlohmann::json;
 
 void abort_run(Store& store, const RunRecord& run, const std::string& why) {
-  store.add_event(run.id, run.last_tick_s.value_or(0), "warn", "seq", "aborted", why);
-  store.finish_run(run.id, "aborted");
+  store.add_event(run.id, run.last_tick_s.value_or(0), Severity::warn, "seq", EventKind::aborted,
+                  why);
+  store.finish_run(run.id, RunState::aborted);
 }
 
 json meaning_of(const StationConfig& c) {

@@ -152,7 +152,7 @@ SafetyDecision Safety::decide(const SafetyInputs& in) {
   blind_ticks_ = blind(in) ? blind_ticks_ + 1 : 0;
   if (blind_ticks_ == kBlindTicks) {
     d.events.push_back(
-        {"error", "inputs_unreadable",
+        {Severity::error, EventKind::inputs_unreadable,
          fmt::format("interlock / e-stop unreadable for {} ticks: treated as open", kBlindTicks)});
   }
   // Each input is judged from its own reading; one that could not be read keeps its own last
@@ -202,17 +202,18 @@ void Safety::finish(SafetyDecision& d, bool was, const std::optional<std::string
   d.holding = holding_;
   if (change && holding_ && !was) {
     d.entered = true;
-    d.events.push_back({"error", "safe_hold",
+    d.events.push_back({Severity::error, EventKind::safe_hold,
                         *change + ": chamber held at its air temperature, turntable stopped"});
     hold_air_c_ = air_c;
     hold_acknowledged_ = false;
     table_stopped_ = !sources_.table;
   } else if (change && holding_) {
-    d.events.push_back({"error", "safe_hold_changed", *change});
+    d.events.push_back({Severity::error, EventKind::safe_hold_changed, *change});
   } else if (change && was) {
     d.cleared = true;
     d.hold_air_c = hold_air_c_;
-    d.events.push_back({"info", "safe_hold_cleared", *change + ": resuming the protocol step"});
+    d.events.push_back(
+        {Severity::info, EventKind::safe_hold_cleared, *change + ": resuming the protocol step"});
   }
   if (holding_) {
     // The hold setpoint needs one air reading; it is retried every tick until accepted.

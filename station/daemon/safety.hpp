@@ -10,6 +10,7 @@
 #include "drivers/chamber/chamber.hpp"
 #include "station/config/config.hpp"
 #include "station/config/protocol.hpp"
+#include "station/store/events.hpp"
 
 namespace station {
 
@@ -59,9 +60,7 @@ struct SafetyCauses {
 };
 
 /// One event to store (source "safety").
-struct SafetyEvent {
-  std::string severity, kind, message;
-};
+using SafetyEvent = EventNote;
 
 /// What to do this tick. The caller sends the commands, then reports with acknowledge().
 struct SafetyDecision {

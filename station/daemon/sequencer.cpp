@@ -53,28 +53,28 @@ Sequencer::Sequencer(const StationConfig& config, const Protocol& protocol, Rig&
       options_(std::move(options)),
       safety_(config.limits, sources_of(rig)) {}
 
-void Sequencer::emit(double t_s, const std::string& severity, const std::string& source,
-                     const std::string& kind, const std::string& message,
-                     const std::optional<std::string>& data_json) {
+void Sequencer::emit(double t_s, Severity severity, const std::string& source, EventKind kind,
+                     const std::string& message, const nlohmann::json& data) {
   if (replaying_) return;
-  const auto lvl = severity == "error"  ? spdlog::level::err
-                   : severity == "warn" ? spdlog::level::warn
-                                        : spdlog::level::info;
-  log(source)->log(lvl, "{} t_s={:.0f} run={} {}", kind, t_s, run_id_, message);
-  const auto id = store_.add_event(run_id_, t_s, severity, source, kind, message, data_json);
+  const auto lvl = severity == Severity::error  ? spdlog::level::err
+                   : severity == Severity::warn ? spdlog::level::warn
+                                                : spdlog::level::info;
+  log(source)->log(lvl, "{} t_s={:.0f} run={} {}", to_string(kind), t_s, run_id_, message);
+  const auto id = store_.add_event(run_id_, t_s, severity, source, kind, message, data);
   if (options_.on_event)
-    options_.on_event({id, run_id_, t_s, severity, source, kind, message, data_json});
+    options_.on_event({id, run_id_, t_s, severity, source, kind, message, data});
 }
 
 void Sequencer::connect_devices() {
   if (auto r = rig_.chamber->connect(); !r)
-    emit(0, "warn", "chamber", "connect", r.error().message);
+    emit(0, Severity::warn, "chamber", EventKind::connect, r.error().message);
   if (rig_.turntable) {
     if (auto r = rig_.turntable->connect(); !r)
-      emit(0, "warn", "table", "connect", r.error().message);
+      emit(0, Severity::warn, "table", EventKind::connect, r.error().message);
   }
   if (rig_.gpio) {
-    if (auto r = rig_.gpio->open(); !r) emit(0, "warn", "gpio", "open", r.error().message);
+    if (auto r = rig_.gpio->open(); !r)
+      emit(0, Severity::warn, "gpio", EventKind::open, r.error().message);
   }
 }
 
@@ -119,13 +119,14 @@ void Sequencer::note_link(double t_s, const std::string& device, std::optional<b
   const Outage& o = news->outage;
   switch (news->change) {
     case OutageChange::started:
-      emit(t_s, "warn", device, "outage_start", fmt::format("not answering: {}", o.error));
+      emit(t_s, Severity::warn, device, EventKind::outage_start,
+           fmt::format("not answering: {}", o.error), {{"device", device}, {"error", o.error}});
       return;
     case OutageChange::ended:
-      emit(t_s, "warn", device, "outage",
+      emit(t_s, Severity::warn, device, EventKind::outage,
            fmt::format("back after {} lost ticks (down since t = {:.0f} s: {})", o.ticks_lost,
                        o.start_s, o.error),
-           outage_json(o));
+           outage_json(o, OutageEnd::answered));
       return;
   }
 }
@@ -144,16 +145,18 @@ void Sequencer::note_counters(double t_s, const TickData& d, const std::string& 
     if (r == nullptr || !r->answered) continue;
     switch (r->chain) {
       case dr::counters::LatchChain::reset:
-        emit(t_s, "warn", device, "board_reset",
+        emit(t_s, Severity::warn, device, EventKind::board_reset,
              fmt::format("{}: counters restarted (reset flag, or counts or board clock went "
                          "backwards): re-baselined, no rate for this latch",
-                         r->serial));
+                         r->serial),
+             {{"serial", r->serial}});
         break;
       case dr::counters::LatchChain::unproven:
-        emit(t_s, "warn", device, "counts_rebaselined",
+        emit(t_s, Severity::warn, device, EventKind::counts_rebaselined,
              fmt::format("{}: board clock disagrees with the time since its last good latch: "
                          "continuity unproven, re-baselined, no rate for this latch",
-                         r->serial));
+                         r->serial),
+             {{"serial", r->serial}});
         break;
       case dr::counters::LatchChain::first:
       case dr::counters::LatchChain::continuous:
@@ -164,10 +167,10 @@ void Sequencer::note_counters(double t_s, const TickData& d, const std::string& 
 
 std::map<std::string, std::string> Sequencer::close_outages(double t_s) {
   for (const auto& o : outages_.close_all(t_s)) {
-    emit(t_s, "error", o.device, "outage",
+    emit(t_s, Severity::error, o.device, EventKind::outage,
          fmt::format("still down at the end of the run: {} lost ticks since t = {:.0f} s ({})",
                      o.ticks_lost, o.start_s, o.error),
-         outage_json(o));
+         outage_json(o, OutageEnd::run_end));
   }
   std::map<std::string, std::string> out;
   for (const auto& slot : config_.slots) {
@@ -179,7 +182,8 @@ std::map<std::string, std::string> Sequencer::close_outages(double t_s) {
         "max_lost_share {:.1f} %)",
         run_id_, slot.serial, loss.lost, loss.ticks, 100 * loss.share(),
         100 * config_.max_lost_share);
-    emit(t_s, "warn", "seq", "incomplete", out[slot.serial]);
+    emit(t_s, Severity::warn, "seq", EventKind::incomplete, out[slot.serial],
+         {{"serial", slot.serial}, {"lost_ticks", loss.lost}, {"window_ticks", loss.ticks}});
   }
   return out;
 }
@@ -188,8 +192,9 @@ void Sequencer::read_gpio(double t_s, TickData& d) {
   if (!rig_.gpio) return;
   if (auto ev = rig_.gpio->read_events(); ev) {
     for (const auto& e : ev.value()) {
-      emit(t_s, "info", "gpio", "edge",
-           fmt::format("{} {}", e.role, e.rising ? "rising" : "falling"));
+      emit(t_s, Severity::info, "gpio", EventKind::edge,
+           fmt::format("{} {}", e.role, e.rising ? "rising" : "falling"),
+           {{"role", e.role}, {"rising", e.rising}});
     }
   }
   const auto has = [this](std::string_view role) {
@@ -266,7 +271,7 @@ void Sequencer::watch_inputs_until(double deadline_s, double t_s) {
 }
 
 void Sequencer::act_on_safety(double t_s, const SafetyDecision& d) {
-  for (const auto& e : d.events) emit(t_s, e.severity, "safety", e.kind, e.message);
+  for (const auto& e : d.events) emit(t_s, "safety", e);
   if (d.entered) {
     pending_chamber_.reset();  // nothing the protocol asked for goes out during the hold
     pending_table_.reset();
@@ -276,13 +281,13 @@ void Sequencer::act_on_safety(double t_s, const SafetyDecision& d) {
     const auto r = rig_.chamber->command(*d.chamber);
     chamber_ok = r.ok();
     if (!r && command_failures_++ % 60 == 0)
-      emit(t_s, "error", "chamber", "hold_failed", r.error().message);
+      emit(t_s, Severity::error, "chamber", EventKind::hold_failed, r.error().message);
   }
   if (d.stop_table && rig_.turntable) {
     const auto r = rig_.turntable->stop();
     table_ok = r.ok();
     if (!r && command_failures_++ % 60 == 0)
-      emit(t_s, "error", "table", "stop_failed", r.error().message);
+      emit(t_s, Severity::error, "table", EventKind::stop_failed, r.error().message);
   }
   safety_.acknowledge(chamber_ok, table_ok);
   drive_outputs(t_s, d.outputs);
@@ -304,17 +309,17 @@ void Sequencer::drive_outputs(double t_s, const SafetyOutputs& o) {
     if (auto r = rig_.gpio->write(role, on); r) {
       outputs_[role] = on;
     } else if (command_failures_++ % 60 == 0) {
-      emit(t_s, "warn", "gpio", "output_failed", r.error().message);
+      emit(t_s, Severity::warn, "gpio", EventKind::output_failed, r.error().message);
     }
   }
 }
 
 void Sequencer::apply_actions(double t_s, const Actions& a) {
-  for (const auto& e : a.events) emit(t_s, e.severity, "seq", e.kind, e.message);
+  for (const auto& e : a.events) emit(t_s, "seq", e);
   if (a.chamber) {
     std::vector<std::string> notes;
     pending_chamber_ = safety_.clamp(*a.chamber, notes);
-    for (const auto& n : notes) emit(t_s, "warn", "safety", "clamp", n);
+    for (const auto& n : notes) emit(t_s, Severity::warn, "safety", EventKind::clamp, n);
   }
   if (a.table) pending_table_ = a.table;
   // Commands are retried every tick until the device accepts them.
@@ -323,14 +328,14 @@ void Sequencer::apply_actions(double t_s, const Actions& a) {
       pending_chamber_.reset();
       command_failures_ = 0;
     } else if (command_failures_++ % 60 == 0) {
-      emit(t_s, "warn", "chamber", "command_failed", r.error().message);
+      emit(t_s, Severity::warn, "chamber", EventKind::command_failed, r.error().message);
     }
   }
   if (pending_table_ && rig_.turntable) {
     if (auto r = rig_.turntable->command(*pending_table_); r) {
       pending_table_.reset();
     } else if (command_failures_++ % 60 == 0) {
-      emit(t_s, "warn", "table", "command_failed", r.error().message);
+      emit(t_s, Severity::warn, "table", EventKind::command_failed, r.error().message);
     }
   }
 }

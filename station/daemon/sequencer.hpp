@@ -56,8 +56,11 @@ struct RunEvent {
   std::int64_t id = 0;  ///< events.id
   std::int64_t run_id = 0;
   double t_s = 0;
-  std::string severity, source, kind, message;
-  std::optional<std::string> data_json;
+  Severity severity = Severity::info;
+  std::string source;
+  EventKind kind = EventKind::done;
+  std::string message;
+  nlohmann::json data = nullptr;  ///< the kind's fields (schemas/events.md), or null
 };
 
 /// How to run.
@@ -101,8 +104,8 @@ struct SequencerOptions {
 /// How a run ended.
 struct RunOutcome {
   std::int64_t run_id = 0;
-  std::string state;  ///< completed | incomplete | stopped | aborted | detached
-  double t_s = 0;     ///< last tick
+  RunState state = RunState::completed;  ///< completed | incomplete | stopped | aborted | detached
+  double t_s = 0;                        ///< last tick
   std::int64_t ticks = 0;
 };
 
@@ -153,16 +156,19 @@ class Sequencer {
   void assemble_samples(double t_s, TickData& d);
   /// Ends the run: closes open outages, bins and fits; returns the final state ('incomplete'
   /// instead of 'completed' when a slot lost more than max_lost_share of its record window).
-  std::string finish(const std::string& state, double t_s);
+  RunState finish(RunState state, double t_s);
   /// Ends the run without bins or fit (SequencerOptions::abort): state 'aborted'.
-  std::string abort(double t_s);
+  RunState abort(double t_s);
   /// Judges a slot's fit against its part (options_.part_limits): verdict stored and an event.
   void judge(double t_s, const SerialFit& f);
   /// Stores each slot's part and a snapshot of its limits with a new run.
   void save_parts();
-  void emit(double t_s, const std::string& severity, const std::string& source,
-            const std::string& kind, const std::string& message,
-            const std::optional<std::string>& data_json = std::nullopt);
+  /// Stores an event of the run (not while a resumed simulation replays) and tells on_event.
+  void emit(double t_s, Severity severity, const std::string& source, EventKind kind,
+            const std::string& message, const nlohmann::json& data = nullptr);
+  void emit(double t_s, const std::string& source, const EventNote& e) {
+    emit(t_s, e.severity, source, e.kind, e.message, e.data);
+  }
   /// Outage bookkeeping: one tick's news about a device (see OutageTracker::observe).
   void note_link(double t_s, const std::string& device, std::optional<bool> answered,
                  const std::string& error);

@@ -22,10 +22,11 @@
 
 namespace station {
 
-std::string Sequencer::finish(const std::string& end_state, double t_s) {
+RunState Sequencer::finish(RunState end_state, double t_s) {
   drive_outputs(t_s, SafetyOutputs{});    // the run is over: gyro power off, lamps dark
   const auto lossy = close_outages(t_s);  // serial -> why its record window is incomplete
-  const std::string state = end_state == "completed" && !lossy.empty() ? "incomplete" : end_state;
+  const RunState state =
+      end_state == RunState::completed && !lossy.empty() ? RunState::incomplete : end_state;
   bin_run(store_, run_id_, config_.bin_s);
   for (const auto& slot : config_.slots) {
     try {
@@ -35,38 +36,42 @@ std::string Sequencer::finish(const std::string& end_state, double t_s) {
                      compensation::ModelSpec{{compensation::Term::dT, compensation::Term::gradT},
                                              config_.ref_temp_c},
                      it == lossy.end() ? std::vector<std::string>{} : std::vector{it->second});
-      emit(t_s, "info", "seq", "fit",
+      emit(t_s, Severity::info, "seq", EventKind::fit,
            fmt::format("{}: k1 {:.4e} deg/h/C, k0 {:.4e} deg/h/C, std ratio {} over {} bins",
                        slot.serial, f.fit.coefficients[1], f.fit.coefficients[2],
-                       std_ratio_text(f.eval), f.fit.n_points));
+                       std_ratio_text(f.eval), f.fit.n_points),
+           {{"serial", slot.serial}});
       judge(t_s, f);
     } catch (const InputError& e) {
-      emit(t_s, "warn", "seq", "fit_skipped", e.what());
+      emit(t_s, Severity::warn, "seq", EventKind::fit_skipped, e.what());
     }
   }
   store_.finish_run(run_id_, state);
-  emit(t_s, "info", "seq", "run_end", fmt::format("run {} {}", run_id_, state));
+  emit(t_s, Severity::info, "seq", EventKind::run_end,
+       fmt::format("run {} {}", run_id_, to_string(state)), {{"state", to_string(state)}});
   return state;
 }
 
-std::string Sequencer::abort(double t_s) {
+RunState Sequencer::abort(double t_s) {
   drive_outputs(t_s, SafetyOutputs{});  // gyro power off, lamps dark
   for (const auto& o : outages_.close_all(t_s))
-    emit(t_s, "warn", o.device, "outage",
+    emit(t_s, Severity::warn, o.device, EventKind::outage,
          fmt::format("still down when the run was aborted: {} lost ticks since t = {:.0f} s ({})",
                      o.ticks_lost, o.start_s, o.error),
-         outage_json(o));
-  store_.finish_run(run_id_, "aborted");
-  emit(t_s, "warn", "seq", "run_end", fmt::format("run {} aborted (no bins, no fit)", run_id_));
-  return "aborted";
+         outage_json(o, OutageEnd::abort));
+  store_.finish_run(run_id_, RunState::aborted);
+  emit(t_s, Severity::warn, "seq", EventKind::run_end,
+       fmt::format("run {} aborted (no bins, no fit)", run_id_),
+       {{"state", to_string(RunState::aborted)}});
+  return RunState::aborted;
 }
 
 void Sequencer::judge(double t_s, const SerialFit& f) {
   const auto it = options_.part_limits.find(f.serial);
   if (it == options_.part_limits.end()) return;
   const auto j = judge_and_store(store_, f, it->second);
-  emit(t_s, j.verdict->pass ? "info" : "warn", "seq", "verdict",
-       fmt::format("{}: {}", f.serial, verdict_text(j.verdict)), verdict_json(*j.verdict).dump());
+  emit(t_s, j.verdict->pass ? Severity::info : Severity::warn, "seq", EventKind::verdict,
+       fmt::format("{}: {}", f.serial, verdict_text(j.verdict)), verdict_json(*j.verdict));
 }
 
 void Sequencer::save_parts() {
@@ -95,21 +100,21 @@ double Sequencer::resume_first_tick(const RunRecord& resume) {
     else if (std::isfinite(elapsed_s))
       t_first = std::max(t_first, std::floor(elapsed_s / period) * period);
     if (t_first > last_s + period) {
-      emit(last_s, "warn", "seq", "resume_gap",
+      emit(last_s, Severity::warn, "seq", EventKind::resume_gap,
            fmt::format("no samples from t = {:.0f} s to {:.0f} s (daemon down)", last_s, t_first),
-           nlohmann::json{{"from_s", last_s}, {"to_s", t_first}}.dump());
+           {{"from_s", last_s}, {"to_s", t_first}});
     }
   }
   if (!options_.replay_until_t_s) restore_outages(resume.id, last_s);
-  emit(std::max(last_s, 0.0), "warn", "seq", "resume",
+  emit(std::max(last_s, 0.0), Severity::warn, "seq", EventKind::resume,
        fmt::format("resuming run {} at step {} after t = {:.0f} s (next tick t = {:.0f} s)",
-                   run_id_, resume.progress.step_index, last_s, t_first));
+                   run_id_, resume.progress.step_index, last_s, t_first),
+       {{"step_index", resume.progress.step_index}, {"last_s", last_s}, {"next_s", t_first}});
   if (options_.on_resume) options_.on_resume(last_s, t_first);
   return t_first;
 }
 
 void Sequencer::restore_outages(std::int64_t run_id, double last_s) {
-  constexpr std::string_view kPrefix = "not answering: ";
   for (const auto& e : store_.open_outages(run_id)) {
     Outage o;
     o.device = e.device;
@@ -117,7 +122,7 @@ void Sequencer::restore_outages(std::int64_t run_id, double last_s) {
     // Every stored tick from its start to the last one lost the device.
     o.ticks_lost =
         std::max<std::int64_t>(1, std::llround((last_s - e.start_s) / options_.period_s) + 1);
-    o.error = e.message.starts_with(kPrefix) ? e.message.substr(kPrefix.size()) : e.message;
+    o.error = e.error;
     outages_.restore(std::move(o));
   }
 }
@@ -143,20 +148,22 @@ RunOutcome Sequencer::run(const std::optional<RunRecord>& resume) {
                  resolved_meaning_json(config_)};
     run_id_ = store_.create_run(info, run_slots_of(config_));
     save_parts();
-    emit(0, "info", "seq", "run_start",
+    emit(0, Severity::info, "seq", EventKind::run_start,
          fmt::format("run {} protocol '{}' with {} gyros", run_id_, protocol_.name,
-                     config_.slots.size()));
+                     config_.slots.size()),
+         {{"protocol", protocol_.name}, {"gyros", config_.slots.size()}});
   }
   // The safety layer's limits apply to the whole protocol before anything moves.
   std::vector<std::string> notes;
   protocol_ = safety_.clamp_protocol(protocol_, notes, rig_.chamber->controller_ramp());
   if (!resume) {
-    for (const auto& n : notes) emit(0, "warn", "safety", "clamp", n);
+    for (const auto& n : notes) emit(0, Severity::warn, "safety", EventKind::clamp, n);
   }
   runner_.emplace(protocol_, progress);
   if (options_.on_run_start) options_.on_run_start(run_id_, protocol_, run_slots_of(config_));
   if (!options_.http_url.empty())
-    emit(t_first, "info", "http", "listen", fmt::format("live page at {}", options_.http_url));
+    emit(t_first, Severity::info, "http", EventKind::listen,
+         fmt::format("live page at {}", options_.http_url), {{"url", options_.http_url}});
   connect_devices();
   try {
     return tick_loop(t_first);
@@ -182,11 +189,10 @@ void Sequencer::note_tick_gap(double t_s, std::int64_t skipped) {
   rig_.counters->note_skipped_ticks(static_cast<int>(skipped));  // next delta spans them
   // In the record, like an outage: which ticks are missing, and why (the process was stopped
   // or starved; absolute deadlines skip late ticks, they never shift the schedule).
-  emit(
-      t_s, "warn", "seq", "tick_gap",
-      fmt::format("{} tick(s) missed from t = {:.0f} s to {:.0f} s (the daemon was late)", skipped,
-                  from_s, t_s - period),
-      nlohmann::json{{"start_s", from_s}, {"end_s", t_s - period}, {"ticks_lost", skipped}}.dump());
+  emit(t_s, Severity::warn, "seq", EventKind::tick_gap,
+       fmt::format("{} tick(s) missed from t = {:.0f} s to {:.0f} s (the daemon was late)", skipped,
+                   from_s, t_s - period),
+       {{"start_s", from_s}, {"end_s", t_s - period}, {"ticks_lost", skipped}});
 }
 
 RunOutcome Sequencer::tick_loop(double t_first) {
@@ -236,13 +242,13 @@ std::optional<RunOutcome> Sequencer::end_of_run(double t_s, std::int64_t ticks) 
   if (options_.abort != nullptr && options_.abort->load())
     return RunOutcome{run_id_, abort(t_s), t_s, ticks};
   if (options_.detach != nullptr && options_.detach->load()) {
-    emit(t_s, "info", "seq", "detach",
+    emit(t_s, Severity::info, "seq", EventKind::detach,
          fmt::format("run {} left resumable at t = {:.0f} s (service restart)", run_id_, t_s));
-    return RunOutcome{run_id_, "detached", t_s, ticks};
+    return RunOutcome{run_id_, RunState::detached, t_s, ticks};
   }
   const bool stop = options_.stop != nullptr && options_.stop->load();
   if (!runner_->done() && !stop) return std::nullopt;
-  const std::string state = runner_->done() ? "completed" : "stopped";
+  const RunState state = runner_->done() ? RunState::completed : RunState::stopped;
   const double n = static_cast<double>(ticks) / 1e6;  // -> microseconds per tick
   log("seq")->info(
       "tick phases, mean us: world {:.0f} can {:.0f} chamber {:.0f} table {:.0f} gpio {:.0f} "

@@ -37,6 +37,29 @@ const char* mime_of(std::string_view name) {
   return "application/octet-stream";
 }
 
+/// A handler threw: 500 with what it said, logged.
+void answer_exception(const httplib::Request& req, httplib::Response& res, std::exception_ptr ep) {
+  std::string what = "unknown error";
+  try {
+    if (ep) std::rethrow_exception(ep);
+  } catch (const std::exception& e) {
+    what = e.what();
+  } catch (...) {
+  }
+  log("http")->warn("{} {}: {}", req.method, req.path, what);
+  send_json(res, 500, {{"error", what}});
+}
+
+/// httplib's own errors (no route, body too large, malformed) as the API's JSON error body.
+void answer_error(const httplib::Request& req, httplib::Response& res) {
+  if (!res.body.empty()) return;
+  std::string what = fmt::format("HTTP {}", res.status);
+  if (res.status == 413) what = "request body too large (limit 64 KiB)";
+  if (res.status == 404) what = fmt::format("no such resource: {}", req.path);
+  if (res.status == 400 && what.starts_with("HTTP")) what = "malformed request";
+  send_json(res, res.status, {{"error", what}});
+}
+
 }  // namespace
 
 void send_json(httplib::Response& res, int status, const nlohmann::json& body) {
@@ -97,35 +120,73 @@ bool HttpServer::may_write(const httplib::Request& req, httplib::Response& res) 
   return true;
 }
 
-void HttpServer::static_routes() {
-  auto& s = *server_;
-  s.Get("/", [](const httplib::Request&, httplib::Response& res) {
-    for (const auto& [name, text] : builtin::kWebFiles)
-      if (name == "index.html") res.set_content(std::string(text), mime_of(name));
-  });
-  s.Get("/favicon.ico", [](const httplib::Request&, httplib::Response& res) { res.status = 204; });
-  // Only the embedded files: nothing on disk is reachable by name, so no path can traverse.
-  s.Get(R"(/static/([^/]+))", [](const httplib::Request& req, httplib::Response& res) {
-    for (const auto& [name, text] : builtin::kWebFiles) {
-      if (name == req.matches[1].str()) {
-        res.set_content(std::string(text), mime_of(name));
-        return;
-      }
-    }
-    send_json(res, 404, {{"error", fmt::format("no static file '{}'", req.matches[1].str())}});
-  });
-  s.Get(R"(/static/dygraphs/(dygraph\.min\.(js|css)))", [this](const httplib::Request& req,
-                                                               httplib::Response& res) {
-    const std::string path = options_.dygraphs_dir + "/" + req.matches[1].str();
-    std::ifstream in(path, std::ios::binary);
-    if (!in) {
-      send_json(res, 404, {{"error", fmt::format("{}: not installed (libjs-dygraphs)", path)}});
+void HttpServer::page(const httplib::Request&, httplib::Response& res) {
+  for (const auto& [name, text] : builtin::kWebFiles)
+    if (name == "index.html") res.set_content(std::string(text), mime_of(name));
+}
+
+void HttpServer::favicon(const httplib::Request&, httplib::Response& res) {
+  res.status = 204;
+}
+
+// Only the embedded files: nothing on disk is reachable by name, so no path can traverse.
+void HttpServer::static_file(const httplib::Request& req, httplib::Response& res) {
+  for (const auto& [name, text] : builtin::kWebFiles) {
+    if (name == req.matches[1].str()) {
+      res.set_content(std::string(text), mime_of(name));
       return;
     }
-    std::ostringstream text;
-    text << in.rdbuf();
-    res.set_content(text.str(), mime_of(path));
-  });
+  }
+  send_json(res, 404, {{"error", fmt::format("no static file '{}'", req.matches[1].str())}});
+}
+
+void HttpServer::dygraphs_file(const httplib::Request& req, httplib::Response& res) {
+  const std::string path = options_.dygraphs_dir + "/" + req.matches[1].str();
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    send_json(res, 404, {{"error", fmt::format("{}: not installed (libjs-dygraphs)", path)}});
+    return;
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  res.set_content(text.str(), mime_of(path));
+}
+
+// Before any body is read (httplib checks its size limit only for Content-Length bodies and
+// inflates gzip without one): a POST must carry the token and a plain Content-Length within
+// the limit, no Transfer-Encoding, no Content-Encoding. Refused requests close the connection.
+bool HttpServer::check_post(const httplib::Request& req, httplib::Response& res) {
+  if (req.method == "GET" || req.method == "HEAD") return false;
+  const auto refuse = [&res](int status, const std::string& what) {
+    res.set_header("Connection", "close");
+    send_json(res, status, {{"error", what}});
+    return true;
+  };
+  if (req.method != "POST")
+    return refuse(405, fmt::format("method {} not allowed", req.method.substr(0, 16)));
+  if (!may_write(req, res)) {
+    res.set_header("Connection", "close");
+    return true;
+  }
+  if (req.has_header("Transfer-Encoding"))
+    return refuse(411, "a POST needs a Content-Length (no Transfer-Encoding)");
+  if (req.has_header("Content-Encoding"))
+    return refuse(415, "a POST body must not be encoded (no Content-Encoding)");
+  // No Content-Length and no Transfer-Encoding: the body has length 0 (RFC 9112 6.3, item 7),
+  // as `curl -X POST URL` sends it.
+  const std::string length = req.get_header_value("Content-Length");
+  std::size_t n = 0;
+  const auto [end, ec] = std::from_chars(length.data(), length.data() + length.size(), n);
+  if (!length.empty() && (ec != std::errc() || end != length.data() + length.size()))
+    return refuse(400, "Content-Length is not a number (RFC 9112 6.3)");
+  if (length.empty()) {
+    res.set_header("Connection", "close");
+    if (!dispatch_bodyless_post(req, res))
+      send_json(res, 404, {{"error", fmt::format("no such resource: {}", req.path)}});
+    return true;
+  }
+  if (n > options_.max_body_bytes) return refuse(413, "request body too large (limit 64 KiB)");
+  return false;
 }
 
 void HttpServer::routes() {
@@ -147,70 +208,16 @@ void HttpServer::routes() {
                          {"Content-Security-Policy",
                           "default-src 'self'; style-src 'self' 'unsafe-inline'; "
                           "frame-ancestors 'none'"}});
-  s.set_exception_handler(
-      [](const httplib::Request& req, httplib::Response& res, std::exception_ptr ep) {
-        std::string what = "unknown error";
-        try {
-          if (ep) std::rethrow_exception(ep);
-        } catch (const std::exception& e) {
-          what = e.what();
-        } catch (...) {
-        }
-        log("http")->warn("{} {}: {}", req.method, req.path, what);
-        send_json(res, 500, {{"error", what}});
-      });
-  s.set_error_handler([](const httplib::Request& req, httplib::Response& res) {
-    if (!res.body.empty()) return;
-    std::string what = fmt::format("HTTP {}", res.status);
-    if (res.status == 413) what = "request body too large (limit 64 KiB)";
-    if (res.status == 404) what = fmt::format("no such resource: {}", req.path);
-    if (res.status == 400 && what.starts_with("HTTP")) what = "malformed request";
-    send_json(res, res.status, {{"error", what}});
-  });
-  // Before any body is read (httplib checks its size limit only for Content-Length bodies and
-  // inflates gzip without one): a POST must carry the token and a plain Content-Length within
-  // the limit, no Transfer-Encoding, no Content-Encoding. Refused requests close the connection.
+  s.set_exception_handler(answer_exception);
+  s.set_error_handler(answer_error);
   s.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
-    if (req.method == "GET" || req.method == "HEAD")
-      return httplib::Server::HandlerResponse::Unhandled;
-    const auto refuse = [&res](int status, const std::string& what) {
-      res.set_header("Connection", "close");
-      send_json(res, status, {{"error", what}});
-      return httplib::Server::HandlerResponse::Handled;
-    };
-    if (req.method != "POST")
-      return refuse(405, fmt::format("method {} not allowed", req.method.substr(0, 16)));
-    if (!may_write(req, res)) {
-      res.set_header("Connection", "close");
-      return httplib::Server::HandlerResponse::Handled;
-    }
-    if (req.has_header("Transfer-Encoding"))
-      return refuse(411, "a POST needs a Content-Length (no Transfer-Encoding)");
-    if (req.has_header("Content-Encoding"))
-      return refuse(415, "a POST body must not be encoded (no Content-Encoding)");
-    // No Content-Length and no Transfer-Encoding: the body has length 0 (RFC 9112 6.3, item 7),
-    // as `curl -X POST URL` sends it.
-    const std::string length = req.get_header_value("Content-Length");
-    std::size_t n = 0;
-    const auto [end, ec] = std::from_chars(length.data(), length.data() + length.size(), n);
-    if (!length.empty() && (ec != std::errc() || end != length.data() + length.size()))
-      return refuse(400, "Content-Length is not a number (RFC 9112 6.3)");
-    if (length.empty()) {
-      res.set_header("Connection", "close");
-      if (!dispatch_bodyless_post(req, res))
-        send_json(res, 404, {{"error", fmt::format("no such resource: {}", req.path)}});
-      return httplib::Server::HandlerResponse::Handled;
-    }
-    if (n > options_.max_body_bytes) return refuse(413, "request body too large (limit 64 KiB)");
-    return httplib::Server::HandlerResponse::Unhandled;
+    return check_post(req, res) ? httplib::Server::HandlerResponse::Handled
+                                : httplib::Server::HandlerResponse::Unhandled;
   });
   s.set_logger([this](const httplib::Request& req, const httplib::Response& res) {
-    hub_.metrics().http_request(res.status, req.path);
+    hub_.metrics().http_request(res.status, route_label(req.path));
   });
-  static_routes();
-  api_routes();
-  control_routes();
-  stream_route();
+  register_routes();
 }
 
 int HttpServer::start() {

@@ -13,7 +13,9 @@
 #include <mutex>
 #include <optional>
 #include <regex>
+#include <span>
 #include <string>
+#include <string_view>
 #include <thread>
 #include <vector>
 
@@ -46,6 +48,10 @@ HttpOptions parse_listen(const std::string& address, const std::string& what);
 /// A route's handler, as httplib calls it.
 using RouteHandler = std::function<void(const httplib::Request&, httplib::Response&)>;
 
+/// The metrics label of a request path: the documented path of the route it matches ("/api/runs/
+/// {id}/stop"; "/static/*" for the page's files), or "other" (a scan cannot grow the series).
+std::string route_label(const std::string& path);
+
 class HttpServer {
  public:
   HttpServer(HttpOptions options, live::LiveHub& hub, RunControl& control);
@@ -62,19 +68,52 @@ class HttpServer {
   /// "http://HOST:PORT/" once started.
   std::string url() const;
 
+  /// One endpoint: one row of the route table, one entry in schemas/api.md's endpoint table.
+  struct Route {
+    std::string_view method;   ///< GET | POST
+    std::string_view path;     ///< as schemas/api.md writes it: /api/runs/{id}/bins
+    std::string_view pattern;  ///< the regex httplib matches the request path against
+    void (HttpServer::*handler)(const httplib::Request&, httplib::Response&);
+  };
+  /// Every endpoint, in the order httplib tries them (http_routes.cpp).
+  static std::span<const Route> route_table();
+
  private:
+  /// Limits, timeouts, headers, error bodies, the POST check, the request counter, the routes.
   void routes();
-  void api_routes();
-  void control_routes();
+  /// Registers every row of route_table() with httplib.
+  void register_routes();
+  /// Before routing: a POST's token and body framing (answered and true when refused, and for a
+  /// POST without Content-Length, dispatched here); false lets httplib go on.
+  bool check_post(const httplib::Request& req, httplib::Response& res);
   /// Registers a POST route with httplib and in posts_, from where a POST without a body (no
   /// Content-Length, no Transfer-Encoding) is dispatched before httplib would wait for one.
   void post(const std::string& pattern, RouteHandler handler);
   /// Answers a POST without Content-Length as one with an empty body; false if no route matches.
   bool dispatch_bodyless_post(const httplib::Request& req, httplib::Response& res) const;
-  /// POST /api/fits/{id}/release.
-  void release_fit_route(const httplib::Request& req, httplib::Response& res);
-  void stream_route();
-  void static_routes();
+  // The handlers, one per row of route_table().
+  void page(const httplib::Request& req, httplib::Response& res);
+  void favicon(const httplib::Request& req, httplib::Response& res);
+  void static_file(const httplib::Request& req, httplib::Response& res);
+  void dygraphs_file(const httplib::Request& req, httplib::Response& res);
+  void get_status(const httplib::Request& req, httplib::Response& res);
+  void get_live(const httplib::Request& req, httplib::Response& res);
+  void get_metrics(const httplib::Request& req, httplib::Response& res);
+  void list_runs(const httplib::Request& req, httplib::Response& res);
+  void get_run(const httplib::Request& req, httplib::Response& res);
+  void get_bins(const httplib::Request& req, httplib::Response& res);
+  void get_events(const httplib::Request& req, httplib::Response& res);
+  void event_stream(const httplib::Request& req, httplib::Response& res);
+  void start_run(const httplib::Request& req, httplib::Response& res);
+  void stop_run(const httplib::Request& req, httplib::Response& res);
+  void abort_run(const httplib::Request& req, httplib::Response& res);
+  void release_fit(const httplib::Request& req, httplib::Response& res);
+  /// Ends the running run `{id}` (stop: bins and fits; abort: neither); 409/404 for another.
+  void end_run(const httplib::Request& req, httplib::Response& res, bool abort);
+  /// Runs `body` on the read-only store after the read check, one request at a time; a database
+  /// that cannot be read is a 503 naming it.
+  void db_read(const httplib::Request& req, httplib::Response& res,
+               const std::function<void(Store&)>& body);
   /// Whether the request may read (loopback, or the token); answers 401/403 when not.
   bool may_read(const httplib::Request& req, httplib::Response& res) const;
   bool may_write(const httplib::Request& req, httplib::Response& res) const;

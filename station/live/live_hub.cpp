@@ -44,9 +44,10 @@ nlohmann::json bin_json(const LiveBin& b) {
 }
 
 nlohmann::json event_json(const RunEvent& e) {
-  return {
-      {"id", e.id},         {"run_id", e.run_id}, {"t_s", e.t_s},        {"severity", e.severity},
-      {"source", e.source}, {"kind", e.kind},     {"message", e.message}};
+  return {{"id", e.id},          {"run_id", e.run_id},
+          {"t_s", e.t_s},        {"severity", to_string(e.severity)},
+          {"source", e.source},  {"kind", to_string(e.kind)},
+          {"message", e.message}};
 }
 
 }  // namespace
@@ -163,15 +164,9 @@ void LiveHub::tick(const TickReport& r) {
 
 void LiveHub::event(const RunEvent& e) {
   std::lock_guard lock(mu_);
-  // An 'outage' event ends an outage; only "back after …" ones are a device answering again
-  // (the others close outages still open at a run's end or abort).
-  if (e.kind == "outage" && e.data_json && e.message.starts_with("back after")) {
-    // {"device","start_s","end_s","ticks_lost"} (sequencer: outage_json)
-    const auto j = nlohmann::json::parse(*e.data_json, nullptr, false);
-    if (j.is_object() && j.contains("start_s") && j.contains("end_s") && j["start_s"].is_number() &&
-        j["end_s"].is_number())
-      metrics_.reconnect(e.source, j["end_s"].get<double>() - j["start_s"].get<double>());
-  }
+  // An outage the device itself ended (not one closed at a run's end or abort): schemas/events.md.
+  if (e.kind == EventKind::outage && e.data.is_object() && e.data.value("ended", "") == "answered")
+    metrics_.reconnect(e.source, e.data["end_s"].get<double>() - e.data["start_s"].get<double>());
   auto j = event_json(e);
   events_.push_back(j);
   if (events_.size() > kEventsMax) events_.pop_front();

@@ -145,47 +145,9 @@ void LiveMetrics::reconnect(const std::string& device, double outage_s) {
     outage_s_.Add({{"device", device}}).Increment(outage_s);
 }
 
-void LiveMetrics::http_request(int status, const std::string& path) {
+void LiveMetrics::http_request(int status, const std::string& route) {
   http_requests_.Add({{"code", std::to_string(status)}}).Increment();
-  http_requests_by_route_.Add({{"route", http_route_label(path)}, {"code", std::to_string(status)}})
-      .Increment();
-}
-
-std::string http_route_label(const std::string& path) {
-  // The API's routes (schemas/api.md), ids as {id}; one list, so the label set is bounded.
-  static const char* const kRoutes[] = {"/",
-                                        "/favicon.ico",
-                                        "/metrics",
-                                        "/api/status",
-                                        "/api/live",
-                                        "/api/runs",
-                                        "/api/runs/{id}",
-                                        "/api/runs/{id}/bins",
-                                        "/api/runs/{id}/events",
-                                        "/api/runs/{id}/stop",
-                                        "/api/runs/{id}/abort",
-                                        "/api/fits/{id}/release",
-                                        "/api/events/stream"};
-  std::string norm, segment;
-  const auto flush = [&] {
-    const bool id =
-        !segment.empty() && segment.find_first_not_of("0123456789") == std::string::npos;
-    norm += id ? "{id}" : segment;
-    segment.clear();
-  };
-  for (char c : path.substr(0, path.find('?'))) {
-    if (c == '/') {
-      flush();
-      norm += '/';
-    } else {
-      segment += c;
-    }
-  }
-  flush();
-  if (norm.rfind("/static/", 0) == 0) return "/static/*";
-  for (const char* r : kRoutes)
-    if (norm == r) return norm;
-  return "other";
+  http_requests_by_route_.Add({{"route", route}, {"code", std::to_string(status)}}).Increment();
 }
 
 void LiveMetrics::stream_clients(int n) {

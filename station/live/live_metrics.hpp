@@ -31,8 +31,9 @@ class LiveMetrics {
   void set_state(const std::string& state, std::int64_t run_id);
   /// A device that answered again after an outage (an 'outage' event).
   void reconnect(const std::string& device, double outage_s);
-  /// An HTTP request answered: by status and by route (a bounded set: http_route_label).
-  void http_request(int status, const std::string& path = {});
+  /// An HTTP request answered: by status and by route (a bounded set of labels: the HTTP
+  /// service's route_label, "other" when no route was matched).
+  void http_request(int status, const std::string& route = "other");
   /// The run's gyros: per-slot series labelled by serial and CAN node (old slots' series go).
   void set_slots(const std::vector<RunSlot>& slots);
   void stream_clients(int n);
@@ -80,9 +81,5 @@ class LiveMetrics {
   std::int64_t fleet_errors_seen_ = 0;
   std::mutex fleet_mu_;
 };
-
-/// The route label of a request path: its API route with ids as {id} ("/api/runs/{id}/stop"), or
-/// "other" for anything else (so that a scan of random paths cannot grow the series).
-std::string http_route_label(const std::string& path);
 
 }  // namespace station::live

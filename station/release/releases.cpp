@@ -93,8 +93,9 @@ void add_release_event(Store& store, const FitRecord& fit, const ReleaseRow& r) 
       {"serial", r.serial},
       {"by", r.released_by},
       {"override", r.override_reason ? nlohmann::json(*r.override_reason) : nlohmann::json()}};
-  store.add_event(run, t_s, r.override_reason ? "warn" : "info", "release", "release",
-                  fmt::format("{}: fit {} {}", r.serial, r.fit_id, release_text(r)), data.dump());
+  store.add_event(run, t_s, r.override_reason ? Severity::warn : Severity::info, "release",
+                  EventKind::release,
+                  fmt::format("{}: fit {} {}", r.serial, r.fit_id, release_text(r)), data);
 }
 
 }  // namespace

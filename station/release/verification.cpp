@@ -80,8 +80,9 @@ VerificationResult verify_fit(Store& store, const FitRecord& fit, std::int64_t r
     record[i] = gyro_tc_correct(&c, rec.bias_dph[i], rec.temp_c[i], rec.grad_c[i]);
   if (const auto floor = sc::adev_floor(record, 1.0)) v.adev_floor_dph = floor->adev;
   const auto run = store.find_run(run_id);
-  if (run && run->state != "completed")
-    v.warnings.push_back(fmt::format("run {} ended '{}', not completed", run_id, run->state));
+  if (run && run->state != RunState::completed)
+    v.warnings.push_back(
+        fmt::format("run {} ended '{}', not completed", run_id, to_string(run->state)));
   const bool enough = v.bins >= kMinVerifyBins;
   if (!enough)
     v.warnings.push_back(
@@ -136,11 +137,11 @@ std::int64_t save_verification(Store& store, VerificationResult& v) {
   const auto run = store.find_run(v.run_id);
   const bool failed = v.verdict && !v.verdict->pass;
   store.add_event(
-      v.run_id, run && run->last_tick_s ? *run->last_tick_s : 0.0, failed ? "warn" : "info",
-      "verify", "verification",
+      v.run_id, run && run->last_tick_s ? *run->last_tick_s : 0.0,
+      failed ? Severity::warn : Severity::info, "verify", EventKind::verification,
       fmt::format("{}: fit {} applied to this run: std {:.5f} -> {:.5f} deg/h, {}", v.serial,
                   v.fit_id, v.eval.std_before_dph, v.eval.std_after_dph, verdict_text(v.verdict)),
-      json{{"verification_id", v.id}, {"fit_id", v.fit_id}}.dump());
+      json{{"verification_id", v.id}, {"fit_id", v.fit_id}});
   tx.commit();
   return v.id;
 }

@@ -269,7 +269,7 @@ std::string run_record_html(const RunReport& r) {
   t += row({"configuration SHA-256", "<code>" + html_escape(r.config_sha256) + "</code>"});
   t += row({"operator", html_escape(run.operator_name.empty() ? "-" : run.operator_name)});
   t += row({"protocol", html_escape(run.protocol_name)});
-  t += row({"state", html_escape(run.state)});
+  t += row({"state", html_escape(std::string(to_string(run.state)))});
   t += row({"started (UTC)", html_escape(run.started_utc)});
   t += row({"ended (UTC)", html_escape(run.ended_utc.empty() ? "-" : run.ended_utc)});
   if (run.sim_seed) t += row({"simulation seed", std::to_string(*run.sim_seed)});

@@ -261,9 +261,12 @@ SessionEnd read_session_end(const std::string& path) {
 json session_result_head_json(Store& store, std::int64_t run_id) {
   const auto run = store.find_run(run_id);
   const auto slots = store.run_slots(run_id);
-  return {{"format_version", kSessionFormatVersion},   {"run_id", run_id},
-          {"state", run ? run->state : std::string()}, {"sample_columns", sample_columns()},
-          {"bins", bins_json(store, run_id, slots)},   {"events", events_json(store, run_id)},
+  return {{"format_version", kSessionFormatVersion},
+          {"run_id", run_id},
+          {"state", run ? std::string(to_string(run->state)) : std::string()},
+          {"sample_columns", sample_columns()},
+          {"bins", bins_json(store, run_id, slots)},
+          {"events", events_json(store, run_id)},
           {"fits", fits_json(store, run_id, slots)}};
 }
 

@@ -43,7 +43,7 @@ void SessionRecording::finish(Store& store, std::int64_t run_id) {
   store.flush();
   write_session_result(store, run_id, dir_);
   const auto run = store.find_run(run_id);
-  append_session_end(dir_, {run ? run->state : std::string("unknown"),
+  append_session_end(dir_, {run ? std::string(to_string(run->state)) : std::string("unknown"),
                             run ? run->last_tick_s.value_or(0.0) : 0.0});
   // Last: the digest covers session.toml (with its [end]), the logs and result.json.
   write_session_digest(dir_);

@@ -289,8 +289,8 @@ std::int64_t replay_daemons(const ReplayOptions& o, const Session& session, Stor
     so.on_tick = [&](const TickReport& r) {
       last_tick_s = r.t_s;
       if (!killed && r.t_s >= session.end.last_tick_s) {
-        stop = session.end.state == "stopped";
-        abort = session.end.state == "aborted";
+        stop = session.end.state == to_string(RunState::stopped);
+        abort = session.end.state == to_string(RunState::aborted);
       }
       if (!killed || r.t_s < resumes[k].after_tick_s) return;
       store.flush();  // what the killed daemon had committed

@@ -178,9 +178,9 @@ nlohmann::json run_simulated(const SimRunOptions& o) {
   std::optional<RunRecord> resume = rd.run;
   if (resume && (resume->sim_seed != static_cast<std::int64_t>(o.seed) ||
                  rd.protocol->text != protocol.text)) {
-    store.add_event(resume->id, resume->last_tick_s.value_or(0), "warn", "seq", "aborted",
-                    "superseded by a simulation with another seed or protocol");
-    store.finish_run(resume->id, "aborted");
+    store.add_event(resume->id, resume->last_tick_s.value_or(0), Severity::warn, "seq",
+                    EventKind::aborted, "superseded by a simulation with another seed or protocol");
+    store.finish_run(resume->id, RunState::aborted);
     resume.reset();
   }
   SequencerOptions so;
@@ -229,7 +229,7 @@ nlohmann::json run_simulated(const SimRunOptions& o) {
   if (session) session->finish(store, out.run_id);
   nlohmann::json report{
       {"run_id", out.run_id},
-      {"state", out.state},
+      {"state", to_string(out.state)},
       {"sim_s", out.t_s},
       {"wall_s",
        std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count()},

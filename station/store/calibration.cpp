@@ -95,7 +95,7 @@ SerialFit fit_serial(Store& store, const std::string& serial, std::vector<std::i
   out.eval = sc::evaluate(data.bias_dph, sc::compensate(out.fit, data.view()));
   for (const auto id : runs) {
     const auto run = store.find_run(id);
-    if (run && run->state == "incomplete")
+    if (run && run->state == RunState::incomplete)
       warnings.push_back(
           fmt::format("run {} ended incomplete: its record window lost more "
                       "than the configured share of ticks (see its events)",

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <nlohmann/json.hpp>
 
+#include "station/common/logging.hpp"
 #include "station/store/fit_json.hpp"
 
 namespace station {
@@ -39,15 +40,16 @@ std::int64_t Store::create_run(const RunInfo& info, const std::vector<RunSlot>& 
   auto st = db_.prepare(
       "INSERT INTO runs (started_utc, state, protocol_name, protocol_text, config_text, "
       "software_version, station, operator, sim_seed, t0_wall_s, resolved_json) "
-      "VALUES (?,'running',?,?,?,?,?,?,?,?,?)");
-  st.bind(1, utc_now_iso()).bind(2, info.protocol_name).bind(3, info.protocol_text);
-  st.bind(4, info.config_text).bind(5, info.software_version).bind(6, info.station);
-  st.bind(7, info.operator_name);
+      "VALUES (?,?,?,?,?,?,?,?,?,?,?)");
+  st.bind(1, utc_now_iso()).bind(2, to_string(RunState::running));
+  st.bind(3, info.protocol_name).bind(4, info.protocol_text);
+  st.bind(5, info.config_text).bind(6, info.software_version).bind(7, info.station);
+  st.bind(8, info.operator_name);
   if (info.sim_seed)
-    st.bind(8, *info.sim_seed);
+    st.bind(9, *info.sim_seed);
   else
-    st.bind_null(8);
-  st.bind(9, info.t0_wall_s).bind(10, info.resolved_json.empty() ? "{}" : info.resolved_json);
+    st.bind_null(9);
+  st.bind(10, info.t0_wall_s).bind(11, info.resolved_json.empty() ? "{}" : info.resolved_json);
   st.step();
   const std::int64_t id = db_.last_insert_id();
   auto gyro = db_.prepare("INSERT OR IGNORE INTO gyros (serial, first_seen_utc) VALUES (?, ?)");
@@ -76,7 +78,10 @@ constexpr const char* kRunColumns =
 RunRecord read_run(const Statement& st) {
   RunRecord r;
   r.id = st.column_int(0);
-  r.state = st.column_text(1);
+  const std::string state = st.column_text(1);
+  const auto parsed = parse_run_state(state);
+  if (!parsed) throw SqliteError(fmt::format("run {}: unknown state '{}'", r.id, state));
+  r.state = *parsed;
   r.protocol_name = st.column_text(2);
   r.protocol_text = st.column_text(3);
   r.config_text = st.column_text(4);
@@ -106,8 +111,8 @@ std::optional<RunRecord> Store::find_run(std::int64_t id) {
 }
 
 std::optional<RunRecord> Store::find_unfinished_run() {
-  auto st =
-      db_.prepare(std::string(kRunColumns) + "WHERE state = 'running' ORDER BY id DESC LIMIT 1");
+  auto st = db_.prepare(std::string(kRunColumns) + "WHERE state = ? ORDER BY id DESC LIMIT 1");
+  st.bind(1, to_string(RunState::running));
   if (!st.step()) return std::nullopt;
   return read_run(st);
 }
@@ -125,10 +130,10 @@ std::vector<RunSlot> Store::run_slots(std::int64_t run_id) {
   return out;
 }
 
-void Store::finish_run(std::int64_t run_id, const std::string& state) {
+void Store::finish_run(std::int64_t run_id, RunState state) {
   flush();
   auto st = db_.prepare("UPDATE runs SET state = ?, ended_utc = ? WHERE id = ?");
-  st.bind(1, state).bind(2, utc_now_iso()).bind(3, run_id);
+  st.bind(1, to_string(state)).bind(2, utc_now_iso()).bind(3, run_id);
   st.step();
 }
 
@@ -375,10 +380,13 @@ std::optional<FitRecord> Store::latest_fit_of_run(const std::string& serial, std
   return read_fit(st);
 }
 
-std::int64_t Store::add_event(std::optional<std::int64_t> run_id, double t_s,
-                              const std::string& severity, const std::string& source,
-                              const std::string& kind, const std::string& message,
-                              const std::optional<std::string>& data_json) {
+std::int64_t Store::add_event(std::optional<std::int64_t> run_id, double t_s, Severity severity,
+                              const std::string& source, EventKind kind, const std::string& message,
+                              const nlohmann::json& data) {
+  // A kind's data follows its row in events.cpp (schemas/events.md); a slip is a bug to see in
+  // the log, never a reason to lose the event.
+  if (const auto why = event_mismatch(kind, severity, data); !why.empty())
+    log("db")->error("event {} does not follow schemas/events.md: {}", to_string(kind), why);
   auto st = db_.prepare(
       "INSERT INTO events (run_id, t_s, wall_utc, severity, source, kind, message, data_json) "
       "VALUES (?,?,?,?,?,?,?,?)");
@@ -386,12 +394,12 @@ std::int64_t Store::add_event(std::optional<std::int64_t> run_id, double t_s,
     st.bind(1, *run_id);
   else
     st.bind_null(1);
-  st.bind(2, t_s).bind(3, utc_now_iso()).bind(4, severity).bind(5, source).bind(6, kind);
-  st.bind(7, message);
-  if (data_json)
-    st.bind(8, *data_json);
-  else
+  st.bind(2, t_s).bind(3, utc_now_iso()).bind(4, to_string(severity)).bind(5, source);
+  st.bind(6, to_string(kind)).bind(7, message);
+  if (data.is_null())
     st.bind_null(8);
+  else
+    st.bind(8, data.dump());
   st.step();
   return db_.last_insert_id();
 }
@@ -421,13 +429,21 @@ std::vector<EventRow> Store::event_rows(std::int64_t run_id) {
 
 std::vector<OpenOutageEvent> Store::open_outages(std::int64_t run_id) {
   auto st = db_.prepare(
-      "SELECT source, MAX(t_s), message FROM events AS s WHERE run_id = ?1 AND "
-      "kind = 'outage_start' AND NOT EXISTS (SELECT 1 FROM events AS e WHERE e.run_id = ?1 AND "
-      "e.source = s.source AND e.kind = 'outage' AND e.id > s.id) GROUP BY source "
-      "ORDER BY source");
-  st.bind(1, run_id);
+      "SELECT source, MAX(t_s), message, data_json FROM events AS s WHERE run_id = ?1 AND "
+      "kind = ?2 AND NOT EXISTS (SELECT 1 FROM events AS e WHERE e.run_id = ?1 AND "
+      "e.source = s.source AND e.kind = ?3 AND e.id > s.id) GROUP BY source ORDER BY source");
+  st.bind(1, run_id).bind(2, to_string(EventKind::outage_start));
+  st.bind(3, to_string(EventKind::outage));
   std::vector<OpenOutageEvent> out;
-  while (st.step()) out.push_back({st.column_text(0), st.column_double(1), st.column_text(2)});
+  while (st.step()) {
+    // The error is the data's (databases before issue 23 have it only in the message).
+    const auto data = st.column_is_null(3)
+                          ? nlohmann::json()
+                          : nlohmann::json::parse(st.column_text(3), nullptr, false);
+    const bool has_error = data.is_object() && data.contains("error") && data["error"].is_string();
+    out.push_back({st.column_text(0), st.column_double(1),
+                   has_error ? data["error"].get<std::string>() : st.column_text(2)});
+  }
   return out;
 }
 

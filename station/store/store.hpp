@@ -11,6 +11,8 @@
 
 #include "compensation/binning.hpp"
 #include "compensation/fit.hpp"
+#include "station/store/events.hpp"
+#include "station/store/run_state.hpp"
 #include "station/store/sqlite.hpp"
 
 namespace station {
@@ -26,7 +28,7 @@ struct EventRow {
 struct OpenOutageEvent {
   std::string device;  ///< the event's source
   double start_s = 0;  ///< the event's tick
-  std::string message;
+  std::string error;   ///< its data's `error` (older databases: its message)
 };
 
 /// What a new run records about itself.
@@ -49,7 +51,8 @@ struct RunProgress {
 /// A run as stored.
 struct RunRecord {
   std::int64_t id = 0;
-  std::string state, protocol_name, protocol_text, config_text, station;
+  RunState state = RunState::running;
+  std::string protocol_name, protocol_text, config_text, station;
   std::optional<std::int64_t> sim_seed;
   double t0_wall_s = 0;
   std::string resolved_json;
@@ -123,7 +126,7 @@ class Store {
   /// The newest run still in state 'running' (a daemon killed mid-run), if any.
   std::optional<RunRecord> find_unfinished_run();
   std::vector<RunSlot> run_slots(std::int64_t run_id);
-  void finish_run(std::int64_t run_id, const std::string& state);
+  void finish_run(std::int64_t run_id, RunState state);
 
   /// Tick `t_s`: its samples, the run's progress and t_s as the run's last tick, committed
   /// together with the ticks of its batch (see set_ticks_per_commit); a kill loses only ticks
@@ -158,13 +161,11 @@ class Store {
   /// The newest fit of `serial` whose runs include `run_id` (the report of that run).
   std::optional<FitRecord> latest_fit_of_run(const std::string& serial, std::int64_t run_id);
 
-  /// One event; `data_json` (column events.data_json, migration 2) is structured detail, e.g. an
-  /// outage's {"device","start_s","end_s","ticks_lost"}.
-  /// Stores an event; returns its id (events.id, increasing).
-  std::int64_t add_event(std::optional<std::int64_t> run_id, double t_s,
-                         const std::string& severity, const std::string& source,
-                         const std::string& kind, const std::string& message,
-                         const std::optional<std::string>& data_json = std::nullopt);
+  /// Stores an event; returns its id (events.id, increasing). `data` (column events.data_json,
+  /// migration 2; NULL when null) has the fields schemas/events.md lists for `kind`.
+  std::int64_t add_event(std::optional<std::int64_t> run_id, double t_s, Severity severity,
+                         const std::string& source, EventKind kind, const std::string& message,
+                         const nlohmann::json& data = nullptr);
   /// Events of a run as "kind: message" in order.
   std::vector<std::string> events(std::int64_t run_id);
   /// Events of a run, in order, every column.

@@ -6,7 +6,7 @@
 #   deb_test.sh PATH/gyro-station_VERSION_ARCH.deb
 #
 # 0. lintian on the .deb: clean (remaining tags overridden with their reasons).
-# 1. apt-get install ./deb: --version; copyright, changelog and the README's docs/*.md shipped; the service user in dialout; /var/lib/gyro-station owned
+# 1. apt-get install ./deb: --version; manual pages (station-SUB(1) per subcommand); copyright, changelog and the README's docs/*.md shipped; the service user in dialout; /var/lib/gyro-station owned
 #    by it 0750; the conffile; the unit enabled (the wants link) and not started.
 # 2. From the installed files only (an empty directory, PATH=/usr/bin:/bin): simrig, then
 #    `station probe --config` against it, then `station run --sim` (the main job), as the
@@ -65,6 +65,21 @@ install_checks() {
   check '[[ $v == "station $(dpkg-query -W -f="\${Version}" gyro-station)" ]]' "station --version: $v"
   check '[[ -f /usr/share/man/man1/station.1.gz && -f /usr/share/man/man1/simrig.1.gz ]] && grep -q "^serve" <<<"$(zcat /usr/share/man/man1/station.1.gz)"' \
     "manual pages station(1) and simrig(1), made from --help"
+  # Issue 23 point 9: every subcommand `station --help` lists has its page station-SUB(1), found
+  # by man, made from its --help with an EXIT STATUS section, and named in station(1).
+  local subs sub page bad_pages=""
+  subs=$(/usr/bin/station --help | sed -n '/^[Ss][Uu][Bb][Cc][Oo][Mm][Mm][Aa][Nn][Dd][Ss]:/,$p' |
+    awk 'NR > 1 && /^  [a-z]/ {print $1}')
+  for sub in $subs; do
+    page=$(man -w "station-$sub" 2>/dev/null)
+    if [[ -z $page ]] || ! zcat "$page" | grep -q '^\.SH "\?EXIT STATUS' ||
+      ! zcat "$page" | grep -q "^\.SH OPTIONS" ||
+      ! zcat /usr/share/man/man1/station.1.gz | grep -q "station-$sub"; then
+      bad_pages+=" $sub"
+    fi
+  done
+  check '[[ -n $subs && -z $bad_pages ]]' \
+    "man station-SUB for each of $(wc -w <<<"$subs") subcommands, with EXIT STATUS, in station(1) SEE ALSO: ${bad_pages:-all}"
   # Debian policy 12.5 / 12.7: copyright and changelog; the documents the README links to.
   check '[[ -f /usr/share/doc/gyro-station/copyright && -f /usr/share/doc/gyro-station/changelog.gz ]]' \
     "copyright and changelog.gz in /usr/share/doc/gyro-station"

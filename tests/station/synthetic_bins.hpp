@@ -49,7 +49,7 @@ inline std::int64_t store_synthetic_run(Store& store, const std::vector<std::str
   const auto run = store.create_run(info, slots);
   for (std::size_t i = 0; i < serials.size(); ++i)
     store.replace_bins(run, serials[i], synthetic_bins(gyros[i]), 0.0);
-  store.finish_run(run, "completed");
+  store.finish_run(run, station::RunState::completed);
   return run;
 }
 

@@ -161,7 +161,7 @@ TEST(KillResume, SigtermEndsTheRunCleanlyAsStopped) {
   EXPECT_FALSE(s.find_unfinished_run().has_value()) << "a stopped run is not left 'running'";
   const auto run = s.find_run(1);
   ASSERT_TRUE(run.has_value());
-  EXPECT_EQ(run->state, "stopped");
+  EXPECT_EQ(run->state, station::RunState::stopped);
   const auto events = s.events(1);
   ASSERT_FALSE(events.empty());
   EXPECT_EQ(events.back(), "run_end: run 1 stopped");

@@ -199,7 +199,7 @@ RunResult run_rig(Cut cut, const std::string& name) {
   station::Sequencer seq(config, station::load_protocol(proto), rig, store, clock, so);
   const auto out = seq.run();
   RunResult r;
-  r.state = out.state;
+  r.state = station::to_string(out.state);
   for (const auto& g : world.gyros())
     r.samples[g.serial] = store.samples(out.run_id, g.serial, false);
   auto st = store.db().prepare(
@@ -262,6 +262,7 @@ TEST(LinkOutage, CutLinkReconnectsIsOneOutageAndTheGapIsExact) {
     EXPECT_EQ(j["start_s"], kCutS);
     EXPECT_EQ(j["end_s"], kBackS);
     EXPECT_EQ(j["ticks_lost"], kLost);
+    EXPECT_EQ(j["ended"], "answered");  // the bus came back (not closed at the run's end)
   }
   for (const auto& [serial, rows] : r.samples) {
     SCOPED_TRACE(serial);

@@ -91,7 +91,8 @@ TEST(LiveHub, ASlowReaderIsToldToResyncAndEventsAreNeverDropped) {
   hub.run_started(1, p, "", {});
   const auto start = hub.last_id();
   // 600 events: more than the 512 the stream keeps.
-  for (int i = 0; i < 600; ++i) hub.event({i + 1, 1, double(i), "info", "seq", "k", "m", {}});
+  for (int i = 0; i < 600; ++i)
+    hub.event({i + 1, 1, double(i), station::Severity::info, "seq", station::EventKind::done, "m"});
   std::vector<StreamMessage> out;
   ASSERT_TRUE(hub.wait(start, out, std::chrono::milliseconds(0)));
   ASSERT_FALSE(out.empty());
@@ -101,7 +102,14 @@ TEST(LiveHub, ASlowReaderIsToldToResyncAndEventsAreNeverDropped) {
   out.clear();
   const auto now = hub.last_id();
   for (int i = 0; i < 50; ++i) hub.tick(tick_at(1000 + i, 1));
-  hub.event({700, 1, 1050, "warn", "chamber", "outage_start", "not answering", {}});
+  hub.event({700,
+             1,
+             1050,
+             station::Severity::warn,
+             "chamber",
+             station::EventKind::outage_start,
+             "not answering",
+             {{"device", "chamber"}, {"error", "timeout"}}});
   ASSERT_TRUE(hub.wait(now, out, std::chrono::milliseconds(0)));
   int ticks = 0, events = 0;
   for (const auto& m : out) {

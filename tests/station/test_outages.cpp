@@ -28,9 +28,13 @@ TEST(Outages, OneStartAndOneEndPerOutageWithTheTicksItCost) {
   EXPECT_TRUE(end->outage.recovered);
   EXPECT_EQ(end->outage.error, "connect refused");  // the first lost tick's reason
   EXPECT_FALSE(t.down("chamber"));
-  const auto j = nlohmann::json::parse(station::outage_json(end->outage));
-  EXPECT_EQ(j, (nlohmann::json{
-                   {"device", "chamber"}, {"start_s", 1.0}, {"end_s", 5.0}, {"ticks_lost", 4}}));
+  const auto j = station::outage_json(end->outage, station::OutageEnd::answered);
+  EXPECT_EQ(j, (nlohmann::json{{"device", "chamber"},
+                               {"start_s", 1.0},
+                               {"end_s", 5.0},
+                               {"ticks_lost", 4},
+                               {"ended", "answered"}}));
+  EXPECT_EQ(station::outage_json(end->outage, station::OutageEnd::abort)["ended"], "abort");
 }
 
 // A board behind a lost bus has no news: nothing starts; an outage it was already in goes on

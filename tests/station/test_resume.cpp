@@ -60,10 +60,10 @@ TEST(Resume, NewOrMismatchMarksTheOldRunAborted) {
   station::Store s(fresh_db("resume-new"));
   const auto first = start_run(s);
   EXPECT_FALSE(station::decide_resume(s, config_with("B"), true, false).run.has_value());
-  EXPECT_EQ(s.find_run(first)->state, "aborted");
+  EXPECT_EQ(s.find_run(first)->state, station::RunState::aborted);
   const auto second = start_run(s);
   EXPECT_FALSE(station::decide_resume(s, config_with("C"), false, true).run.has_value());
-  EXPECT_EQ(s.find_run(second)->state, "aborted");
+  EXPECT_EQ(s.find_run(second)->state, station::RunState::aborted);
   EXPECT_EQ(s.events(second).back().rfind("aborted: run", 0), 0u);
 }
 

@@ -76,7 +76,7 @@ const station::SafetySources kGpio{false, true, true};
 
 bool has_event(const station::SafetyDecision& d, const std::string& kind) {
   for (const auto& e : d.events)
-    if (e.kind == kind) return true;
+    if (station::to_string(e.kind) == kind) return true;
   return false;
 }
 
@@ -89,7 +89,7 @@ TEST(Safety, ReadingsOutOfLimitsHoldUntilTheyAreBackInside) {
   d = s.decide(inputs(150.0, 25.0));
   ASSERT_TRUE(d.entered);
   ASSERT_EQ(d.events.size(), 1u);
-  EXPECT_EQ(d.events[0].kind, "safe_hold");
+  EXPECT_EQ(station::to_string(d.events[0].kind), "safe_hold");
   EXPECT_EQ(d.events[0].message.rfind("enter: ", 0), 0u) << d.events[0].message;
   EXPECT_NE(d.events[0].message.find("out of limits: chamber setpoint read back 150.00 C"),
             std::string::npos);
@@ -106,7 +106,7 @@ TEST(Safety, ReadingsOutOfLimitsHoldUntilTheyAreBackInside) {
   s.acknowledge(true, true);
   d = s.decide(inputs(25.0, 25.0));
   ASSERT_TRUE(d.cleared);
-  EXPECT_EQ(d.events[0].kind, "safe_hold_cleared");
+  EXPECT_EQ(station::to_string(d.events[0].kind), "safe_hold_cleared");
   EXPECT_EQ(d.events[0].message.rfind("clear: ", 0), 0u) << d.events[0].message;
   ASSERT_TRUE(d.hold_air_c);
   EXPECT_DOUBLE_EQ(*d.hold_air_c, 25.0);
@@ -126,7 +126,7 @@ TEST(Safety, AFaultDuringAnInterlockHoldKeepsTheHoldAfterTheInterlockCloses) {
   open.chamber->setpoint_c = 150.0;
   d = s.decide(open);
   ASSERT_EQ(d.events.size(), 1u);
-  EXPECT_EQ(d.events[0].kind, "safe_hold_changed");
+  EXPECT_EQ(station::to_string(d.events[0].kind), "safe_hold_changed");
   EXPECT_EQ(d.events[0].message.rfind("still holding: ", 0), 0u) << d.events[0].message;
   d = s.decide(inputs(150.0, 25.0));
   EXPECT_TRUE(d.holding);

@@ -101,7 +101,7 @@ TEST(Store, TicksAndProgressRoundTrip) {
   ASSERT_TRUE(unfinished->last_tick_s.has_value());
   EXPECT_DOUBLE_EQ(*unfinished->last_tick_s, 4.0);
   EXPECT_EQ(unfinished->sim_seed, 42);
-  s.finish_run(run, "completed");
+  s.finish_run(run, station::RunState::completed);
   EXPECT_FALSE(s.find_unfinished_run().has_value());
   EXPECT_EQ(s.run_slots(run).at(0).serial, "SN1");
 }
@@ -237,7 +237,7 @@ TEST(Store, ReadOnlyOpenServesReadsAndRefusesWrites) {
   }
   station::Store ro(path, station::OpenMode::read_only);
   EXPECT_EQ(ro.run_slots(run).size(), 1u);
-  EXPECT_THROW(ro.finish_run(run, "completed"), station::SqliteError);
+  EXPECT_THROW(ro.finish_run(run, station::RunState::completed), station::SqliteError);
 }
 
 namespace {
@@ -314,11 +314,11 @@ TEST(Store, MigratesAVersion1DatabaseKeepingItsRunsAndLastTick) {
   station::Store s(path);
   const auto run = s.find_run(1);
   ASSERT_TRUE(run.has_value());
-  EXPECT_EQ(run->state, "running");
+  EXPECT_EQ(run->state, station::RunState::running);
   EXPECT_DOUBLE_EQ(run->last_tick_s.value(), 41.0);
   EXPECT_EQ(run->resolved_json, "{}");
-  s.finish_run(1, "incomplete");  // allowed by version 2
-  EXPECT_EQ(s.find_run(1)->state, "incomplete");
+  s.finish_run(1, station::RunState::incomplete);  // allowed by version 2
+  EXPECT_EQ(s.find_run(1)->state, station::RunState::incomplete);
   // The file as version 1 left it is kept beside it, whole and readable, with its run and
   // sample; no temporary is left.
   const auto copies = copies_of(path);

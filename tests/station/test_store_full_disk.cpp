@@ -84,8 +84,9 @@ TEST(StoreFullDisk, AFailedCommitRollsBackAndTheStoreWritesOnOnceThereIsRoom) {
   // With room again the same store goes on: the lost ticks are written again, then events.
   for (int t = 51; t <= 100; ++t) s.append_tick(run, t, rows_at(t), {});
   EXPECT_NO_THROW(s.flush());
-  EXPECT_NO_THROW(s.add_event(run, 100, "error", "test", "run_failed", "disk was full"));
-  EXPECT_NO_THROW(s.finish_run(run, "aborted"));
+  EXPECT_NO_THROW(s.add_event(run, 100, station::Severity::error, "test",
+                              station::EventKind::run_failed, "disk was full"));
+  EXPECT_NO_THROW(s.finish_run(run, station::RunState::aborted));
   EXPECT_EQ(s.sample_count(run), 100 * 16);
-  EXPECT_EQ(s.find_run(run)->state, "aborted");
+  EXPECT_EQ(s.find_run(run)->state, station::RunState::aborted);
 }

@@ -1,0 +1,47 @@
+// What the routes read from a request (see route_params.hpp).
+#include "station/http/route_params.hpp"
+
+#include <fmt/format.h>
+
+#include <charconv>
+
+#include "station/http/json_reply.hpp"
+
+// Last: httplib.h pulls in <resolv.h>, whose `_res` macro breaks Eigen headers included after it.
+#include <httplib.h>
+
+namespace station::http {
+
+std::optional<std::int64_t> positive_int(const std::string& text) {
+  std::int64_t v = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (text.empty() || ec != std::errc() || end != text.data() + text.size() || v <= 0)
+    return std::nullopt;
+  return v;
+}
+
+std::optional<std::int64_t> non_negative_int(const std::string& text) {
+  return text == "0" ? std::optional<std::int64_t>(0) : positive_int(text);
+}
+
+std::optional<std::int64_t> path_id(const httplib::Request& req, httplib::Response& res,
+                                    const char* what) {
+  const auto id = positive_int(req.matches[1].str());
+  if (!id)
+    send_json(res, 400,
+              {{"error",
+                fmt::format("{} '{}': expected a positive integer", what, req.matches[1].str())}});
+  return id;
+}
+
+std::optional<std::string> string_field(const nlohmann::json& body, const char* key,
+                                        std::size_t max_len, std::string& error) {
+  if (!body.contains(key)) return std::nullopt;
+  if (!body[key].is_string() || body[key].get<std::string>().size() > max_len) {
+    error = fmt::format("field '{}': expected a string of at most {} characters", key, max_len);
+    return std::nullopt;
+  }
+  return body[key].get<std::string>();
+}
+
+}  // namespace station::http

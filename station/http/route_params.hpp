@@ -1,0 +1,33 @@
+// What the routes read from a request: ids in the path, numbers in the query, string fields of a
+// JSON body. Each answers 400 (or reports why) in the API's one wording.
+#pragma once
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+
+namespace httplib {
+struct Request;
+struct Response;
+}  // namespace httplib
+
+namespace station::http {
+
+/// A positive decimal integer, or nullopt.
+std::optional<std::int64_t> positive_int(const std::string& text);
+
+/// A decimal integer >= 0, or nullopt.
+std::optional<std::int64_t> non_negative_int(const std::string& text);
+
+/// The path's first capture as a positive id, or nullopt with a 400 answered naming `what`
+/// ("run id", "fit id").
+std::optional<std::int64_t> path_id(const httplib::Request& req, httplib::Response& res,
+                                    const char* what);
+
+/// A string field of a JSON object body: nullopt when absent or wrong (then `error` says why:
+/// not a string, or longer than `max_len` characters).
+std::optional<std::string> string_field(const nlohmann::json& body, const char* key,
+                                        std::size_t max_len, std::string& error);
+
+}  // namespace station::http
