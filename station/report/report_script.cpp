@@ -23,16 +23,31 @@ td.num { text-align: right; font-family: monospace; }
 )css";
 
 // Each figure to Dygraph with the station's tickers (station/web/ticks.js, inlined before this
-// script); once drawn, the label room is fitted (a redraw) before the figure is marked drawn.
+// script); a figure whose labels need more room is drawn anew with it before it is marked drawn.
 const std::string_view kRenderJs = R"js(
 (function () {
   "use strict";
   var T = window.StationTicks;
+  // Drawn; once the drawing returns, drawn anew with wider label room if a label needs it.
+  function draw(box, rows, opts, tries) {
+    var settled = false;
+    opts.drawCallback = function (g) {
+      if (settled) return;
+      settled = true;
+      setTimeout(function () {
+        var more = tries < 3 ? T.room(g, box) : null;
+        if (!more) { box.setAttribute("data-drawn", "true"); return; }
+        g.destroy();
+        draw(box, rows, T.widen(opts, more), tries + 1);
+      }, 0);
+    };
+    new Dygraph(box.querySelector(".chart"), rows, opts);
+  }
   var figures = JSON.parse(document.getElementById("report-figures").textContent);
   figures.forEach(function (f) {
     var box = document.querySelector('[data-figure="' + f.id + '"]');
     if (!box || f.rows.length === 0) return;
-    var opts = f.options, fits = 0;
+    var opts = f.options;
     opts.labelsDiv = box.querySelector(".legend");
     opts.axes = opts.axes || {};
     ["x", "y", "y2"].forEach(function (a) {
@@ -40,16 +55,7 @@ const std::string_view kRenderJs = R"js(
       opts.axes[a].ticker = T.numeric(a === "x");
     });
     opts.axes.y2.independentTicks = true;  // its own round values, not y's positions
-    // Fitted after the drawing returns (a redraw from inside dygraphs' own drawing leaves the
-    // first one's plot on the canvas); the redraw calls back here, until the labels fit.
-    opts.drawCallback = function (g) {
-      if (box.getAttribute("data-drawn") === "true") return;
-      setTimeout(function () {
-        if (fits++ < 3 && T.fit(g, box)) return;
-        box.setAttribute("data-drawn", "true");
-      }, 0);
-    };
-    new Dygraph(box.querySelector(".chart"), f.rows, opts);
+    draw(box, f.rows, opts, 0);
   });
 })();
 )js";

@@ -21,6 +21,7 @@
     runId: null,
     dirty: {temp: false, bins: false},
     charts: {},        // id -> Dygraph
+    rows: {},          // id -> the rows it draws
     loading: false,    // a /api/live read is under way: stream messages wait in `held`
     reloadAgain: false,
     held: [],
@@ -408,19 +409,34 @@
       delete S.charts[id];
       g = null;
     }
+    S.rows[id] = rows;
     if (!g) {
       var T = window.StationTicks;
       opts.axes = opts.axes || {};
       ["x", "y"].forEach(function (a) { opts.axes[a] = opts.axes[a] || {}; });
       opts.axes.x.ticker = opts.axes.x.ticker || T.numeric(true);
       opts.axes.y.ticker = T.numeric(false);
-      // Room for the labels: widened after a drawing when a label needs more (never narrowed).
-      opts.drawCallback = function (g2) { setTimeout(function () { T.fit(g2, el); }, 0); };
-      S.charts[id] = new Dygraph(el, rows, opts);
+      create(id, el, opts);
     } else {
       g.updateOptions({file: rows});
     }
     el.setAttribute("data-points", String(points));
+  }
+
+  // A chart whose labels need more room than they have is drawn anew with it (widths only
+  // grow, so this settles; updateOptions would leave the old plot beside the new plot area).
+  function create(id, el, opts) {
+    var T = window.StationTicks;
+    opts.drawCallback = function (g) {
+      setTimeout(function () {
+        if (S.charts[id] !== g) return;
+        var more = T.room(g, el);
+        if (!more) return;
+        g.destroy();
+        create(id, el, T.widen(opts, more));
+      }, 0);
+    };
+    S.charts[id] = new Dygraph(el, S.rows[id], opts);
   }
 
   function draw() {

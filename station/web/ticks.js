@@ -8,8 +8,10 @@
 //    horizontal axis the step grows until neighbouring labels do not touch.
 //  - hours(): the same for a time axis in hours, labelled h:mm at 1, 2, 5, 10, 15, 20, 30 min,
 //    1, 2, 3, 6, 12, 24 h steps.
-//  - fit(g, el): after a drawing, widens each axis' label room to its widest label plus the
-//    rotated axis title's strip (dygraphs reserves none for it); true when it asked for a redraw.
+//  - room(g, el): after a drawing, the label width each axis needs beyond what it has (its widest
+//    label plus, for y and y2, the rotated axis title's strip, which dygraphs does not reserve),
+//    or null; widen(opts, more) the options with those widths. A chart that needs more room is
+//    drawn anew with them (dygraphs' updateOptions keeps the old plot outside the new plot area).
 (function () {
   "use strict";
   var FONT_PX = 14;  // dygraphs' axisLabelFontSize
@@ -111,17 +113,32 @@
     });
     return w;
   }
-  function fit(g, el) {
-    var title = g.getOption("yLabelWidth") + 6, changed = {}, any = false;
+  // Label widths each axis needs beyond what it has ({x: {axisLabelWidth: px}, ...}), or null.
+  function room(g, el) {
+    var title = g.getOption("yLabelWidth") + 6, more = {}, any = false;
     [["y", title], ["y2", title], ["x", 8]].forEach(function (a) {
       var need = widest(el, a[0]) + a[1];
       if (need > g.getOptionForAxis("axisLabelWidth", a[0])) {
-        changed[a[0]] = {axisLabelWidth: need};
+        more[a[0]] = {axisLabelWidth: need};
         any = true;
       }
     });
-    if (any) g.updateOptions({axes: changed});
-    return any;
+    return any ? more : null;
   }
-  window.StationTicks = {numeric: numeric, hours: hours, fit: fit, hm: hm};
+  // `opts` with the label widths of `more` (a new object; opts.axes copied one level deep).
+  function widen(opts, more) {
+    var o = {}, axes = {};
+    Object.keys(opts).forEach(function (k) { o[k] = opts[k]; });
+    Object.keys(opts.axes || {}).forEach(function (a) {
+      axes[a] = {};
+      Object.keys(opts.axes[a]).forEach(function (k) { axes[a][k] = opts.axes[a][k]; });
+    });
+    Object.keys(more).forEach(function (a) {
+      axes[a] = axes[a] || {};
+      axes[a].axisLabelWidth = more[a].axisLabelWidth;
+    });
+    o.axes = axes;
+    return o;
+  }
+  window.StationTicks = {numeric: numeric, hours: hours, room: room, widen: widen, hm: hm};
 })();
