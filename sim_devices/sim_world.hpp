@@ -22,7 +22,7 @@
 namespace station::sim {
 
 /// Which kind of gyro the simulated slots hold.
-///  - station: distinct coefficients over a wide range (|k1| 0.5..2e-3, |k0| 0.01..0.04), a strong
+///  - station: distinct coefficients over a wide range (|k1| 2..5e-3, |k0| 0.01..0.04), a strong
 ///    thermal effect against the noise, and a physical gradient across the gyro (sim_thermal:
 ///    ~0.25 C at 10 C/h, ~1.5 C at 60 C/h);
 ///  - paper: the thermal effect and noise in the proportions of the paper's gyros: on the paper's
