@@ -22,8 +22,9 @@
 namespace station::sim {
 
 /// Which kind of gyro the simulated slots hold.
-///  - station: distinct coefficients over a wide range (|k1| 0.5..2e-3, |k0| 0.01..0.04), a strong
-///    thermal effect against the noise (std ratio 0.014..0.07 on the paper's cycle);
+///  - station: distinct coefficients over a wide range (|k1| 2..5e-3, |k0| 0.01..0.04), a strong
+///    thermal effect against the noise, and a physical gradient across the gyro (sim_thermal:
+///    ~0.25 C at 10 C/h, ~1.5 C at 60 C/h);
 ///  - paper: the thermal effect and noise in the proportions of the paper's gyros: on the paper's
 ///    cycle the std of the bias after compensation is ~0.13 of the std before (docs/SIMRIG.md).
 enum class GyroPreset { station, paper };
@@ -138,6 +139,8 @@ class SimWorld {
 /// (k2 = 0 so the paper's model B0 + k1 dT + k0 gradT is exact).
 TrueCoefficients sim_coefficients(std::uint64_t seed, int index,
                                   GyroPreset preset = GyroPreset::station);
+/// The thermal lags of a preset's gyros (initial_c left at its default; the world sets it).
+ThermalParams sim_thermal(GyroPreset preset);
 /// Serial number of simulated gyro `index`: SIM-0001... (station), PAP-0001... (paper).
 std::string sim_serial(GyroPreset preset, int index);
 

@@ -157,17 +157,29 @@ std::vector<std::string> builtin_protocol_names() {
   return out;
 }
 
-double Protocol::nominal_duration_s(double start_c) const {
-  double t = 0, temp = start_c;
+std::vector<std::optional<double>> Protocol::nominal_step_durations_s(
+    std::optional<double> start_c) const {
+  std::vector<std::optional<double>> out;
+  std::optional<double> temp = start_c;  // the chamber's target when the step starts
   for (const auto& s : steps) {
+    std::optional<double> d = 0.0;
     if (s.kind == StepKind::set_temperature) {
-      const double target = s.to_start ? start_c : *s.setpoint_c;
-      if (s.ramp_c_per_h > 0) t += std::abs(target - temp) / s.ramp_c_per_h * 3600.0;
+      const std::optional<double> target = s.to_start ? start_c : s.setpoint_c;
+      if (s.ramp_c_per_h > 0)
+        d = temp && target ? std::optional(std::abs(*target - *temp) / s.ramp_c_per_h * 3600.0)
+                           : std::nullopt;
       temp = target;
     } else if (s.kind == StepKind::soak || s.kind == StepKind::hold) {
-      t += s.duration_s;
+      d = s.duration_s;
     }
+    out.push_back(d);
   }
+  return out;
+}
+
+double Protocol::nominal_duration_s(double start_c) const {
+  double t = 0;
+  for (const auto& d : nominal_step_durations_s(start_c)) t += d.value_or(0.0);
   return t;
 }
 

@@ -42,6 +42,10 @@ struct Protocol {
   std::vector<Step> steps;
   /// Sum of the nominal durations (ramps at their rate from `start_c`), s: for progress.
   double nominal_duration_s(double start_c) const;
+  /// Each step's nominal duration, s: a ramp |target - previous target| / rate (empty when an
+  /// end is the start temperature and `start_c` is not known), soak and hold their duration_s,
+  /// other steps (and set_temperature without a ramp) 0; waits for the air are not counted.
+  std::vector<std::optional<double>> nominal_step_durations_s(std::optional<double> start_c) const;
   /// Refuses a step that would take longer than the longest step allowed (7 days): a ramp is
   /// judged over the span from the previous step's setpoint, or, where that is the run's start
   /// temperature (the first ramp, `to_start`), over the widest span within [lo_c, hi_c] (the

@@ -348,6 +348,8 @@ TickReport Sequencer::report(double t_s, const TickData& d) const {
   if (r.step_index >= 0 && r.step_index < r.steps)
     r.step_label = protocol_.steps[static_cast<std::size_t>(r.step_index)].label;
   r.recording = runner_->progress().recording;
+  r.target_c = runner_->setpoint_c();
+  r.start_temp_c = runner_->progress().start_temp_c;
   r.safe_hold = safety_.holding();
   r.air_c = d.obs.air_c;
   r.run_id = run_id_;

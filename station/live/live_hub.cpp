@@ -43,6 +43,39 @@ nlohmann::json bin_json(const LiveBin& b) {
           {"bias_dph", b.bias_dph}, {"n", b.n},           {"complete", b.complete}};
 }
 
+nlohmann::json safety_json(bool safe_hold, std::optional<bool> door_closed,
+                           std::optional<bool> estop_pressed,
+                           std::optional<bool> table_interlock_open) {
+  return {{"safe_hold", safe_hold},
+          {"door_closed", opt_bool(door_closed)},
+          {"estop_pressed", opt_bool(estop_pressed)},
+          {"table_interlock_open", opt_bool(table_interlock_open)}};
+}
+
+/// The protocol's steps as the page lists them: what each does, its target and how long it
+/// nominally takes (Protocol::nominal_step_durations_s; a `to_start` target is known once the
+/// run's start temperature is).
+nlohmann::json steps_json(const Protocol& p, std::optional<double> start_c) {
+  const auto durations = p.nominal_step_durations_s(start_c);
+  nlohmann::json out = nlohmann::json::array();
+  for (std::size_t i = 0; i < p.steps.size(); ++i) {
+    const Step& s = p.steps[i];
+    nlohmann::json j{
+        {"label", s.label}, {"kind", to_string(s.kind)}, {"duration_s", num(durations[i])}};
+    if (s.kind == StepKind::set_temperature) {
+      j["target_c"] = num(s.to_start ? start_c : s.setpoint_c);
+      j["to_start"] = s.to_start;
+      j["ramp_c_per_h"] = s.ramp_c_per_h;
+    } else if (s.kind == StepKind::soak) {
+      j["tolerance_c"] = s.tolerance_c;
+    } else if (s.kind == StepKind::lock_turntable) {
+      j["position_deg"] = s.position_deg;
+    }
+    out.push_back(std::move(j));
+  }
+  return out;
+}
+
 nlohmann::json event_json(const RunEvent& e) {
   return {{"id", e.id},          {"run_id", e.run_id},
           {"t_s", e.t_s},        {"severity", to_string(e.severity)},
@@ -101,10 +134,8 @@ void LiveHub::run_started(std::int64_t run_id, const Protocol& protocol,
   for (const auto& s : slots) earth_rate_dph_[s.serial] = s.earth_rate_dph;
   metrics_.set_slots(slots);
   run_id_ = last_run_id_ = run_id;
-  protocol_name_ = protocol.name;
   operator_ = operator_name;
-  steps_.clear();
-  for (const auto& s : protocol.steps) steps_.emplace_back(s.label, to_string(s.kind));
+  protocol_ = protocol;
   last_.reset();
   last_rows_.clear();
   run_failure_.clear();
@@ -150,16 +181,22 @@ void LiveHub::tick(const TickReport& r) {
   for (const auto& s : last_rows_) {
     slots.push_back(slot_json(s));
   }
-  publish("tick",
-          {{"t_s", r.t_s},
-           {"state", state_locked()},
-           {"step_index", r.step_index},
-           {"step_label", r.step_label},
-           {"recording", r.recording},
-           {"safe_hold", r.safe_hold},
-           {"air_c", num(r.chamber ? std::optional(r.chamber->air_c) : std::nullopt)},
-           {"setpoint_c", num(r.chamber ? std::optional(r.chamber->setpoint_c) : std::nullopt)},
-           {"slots", slots}});
+  publish(
+      "tick",
+      {{"t_s", r.t_s},
+       {"state", state_locked()},
+       {"step_index", r.step_index},
+       {"step_label", r.step_label},
+       {"recording", r.recording},
+       {"safe_hold", r.safe_hold},
+       {"air_c", num(r.chamber ? std::optional(r.chamber->air_c) : std::nullopt)},
+       {"setpoint_c", num(r.chamber ? std::optional(r.chamber->setpoint_c) : std::nullopt)},
+       {"target_c", num(r.target_c)},
+       // Everything the page shows comes with each tick, so it is all of one time.
+       {"chamber", chamber_json(r.chamber)},
+       {"table", table_json(r.table)},
+       {"safety", safety_json(r.safe_hold, r.door_closed, r.estop_pressed, r.table_interlock_open)},
+       {"slots", slots}});
 }
 
 void LiveHub::event(const RunEvent& e) {
@@ -200,16 +237,15 @@ std::string LiveHub::state_locked() const {
 nlohmann::json LiveHub::status_locked() const {
   nlohmann::json run = nullptr;
   if (run_id_) {
-    nlohmann::json steps = nlohmann::json::array();
-    for (const auto& [label, kind] : steps_) steps.push_back({{"label", label}, {"kind", kind}});
     run = {{"id", *run_id_},
-           {"protocol", protocol_name_},
+           {"protocol", protocol_.name},
            {"operator", operator_},
            {"t_s", last_ ? nlohmann::json(last_->t_s) : nlohmann::json(nullptr)},
            {"step_index", last_ ? last_->step_index : 0},
            {"step_label", last_ ? last_->step_label : std::string()},
            {"recording", last_ && last_->recording},
-           {"steps", steps}};
+           {"target_c", num(last_ ? last_->target_c : std::nullopt)},
+           {"steps", steps_json(protocol_, last_ ? last_->start_temp_c : std::nullopt)}};
   }
   nlohmann::json slots = nlohmann::json::array();
   for (const auto& s : last_rows_) {
@@ -232,18 +268,16 @@ nlohmann::json LiveHub::status_locked() const {
                            : idle_ ? idle_->table
                                    : std::nullopt)},
       {"slots", slots},
-      {"safety",
-       {{"safe_hold", live && last_->safe_hold},
-        {"door_closed", opt_bool(live    ? last_->door_closed
-                                 : idle_ ? idle_->door_closed
-                                         : std::nullopt)},
-        {"estop_pressed", opt_bool(live    ? last_->estop_pressed
-                                   : idle_ ? idle_->estop_pressed
-                                           : std::nullopt)},
-        {"table_interlock_open",
-         opt_bool(live ? last_->table_interlock_open
-                       : (idle_ && idle_->table ? std::optional(idle_->table->interlock_open)
-                                                : std::nullopt))}}},
+      {"safety", safety_json(live && last_->safe_hold,
+                             live    ? last_->door_closed
+                             : idle_ ? idle_->door_closed
+                                     : std::nullopt,
+                             live    ? last_->estop_pressed
+                             : idle_ ? idle_->estop_pressed
+                                     : std::nullopt,
+                             live                    ? last_->table_interlock_open
+                             : idle_ && idle_->table ? std::optional(idle_->table->interlock_open)
+                                                     : std::nullopt)},
       {"ticks", ticks_},
       {"last_tick_ms", last_ ? nlohmann::json(last_->tick_wall_s * 1e3) : nlohmann::json(nullptr)},
       {"last_run_id", last_run_id_ ? nlohmann::json(*last_run_id_) : nlohmann::json(nullptr)},

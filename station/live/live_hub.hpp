@@ -92,10 +92,10 @@ class LiveHub {
   std::string http_url_;
   // The run
   std::optional<std::int64_t> run_id_, last_run_id_;
-  std::string protocol_name_, operator_;
-  std::map<std::string, double> earth_rate_dph_;            ///< per serial of the run
-  std::vector<std::pair<std::string, std::string>> steps_;  ///< label, kind
-  std::optional<TickReport> last_;                          ///< last tick (rows pointer cleared)
+  Protocol protocol_;  ///< the run's (steps, targets, durations for the page)
+  std::string operator_;
+  std::map<std::string, double> earth_rate_dph_;  ///< per serial of the run
+  std::optional<TickReport> last_;                ///< last tick (rows pointer cleared)
   std::vector<SampleRow> last_rows_;
   std::int64_t ticks_ = 0;
   std::string fault_;                ///< the idle rig's fault (serve), empty when clear

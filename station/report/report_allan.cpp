@@ -73,7 +73,7 @@ AllanCurves allan_curves(const OneHzRecord& record) {
 
 Figure figure_5b(const AllanCurves& curves) {
   Figure f = make_figure("5b", "Allan deviation of the 1 Hz record before and after compensation",
-                         "averaging time \u03c4, s", "Allan deviation, deg/h");
+                         "averaging time \u03c4 (s)", "Allan deviation (\u00b0/h)");
   f.log_axes = true;
   for (const auto* curve : {&curves.before, &curves.after}) {
     Series s;

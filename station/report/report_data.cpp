@@ -85,8 +85,8 @@ std::vector<RunBin> whole_run_bins(const std::vector<SampleRow>& rows, double bi
 }
 
 Figure figure_2a(const std::vector<RunBin>& bins) {
-  Figure f = make_figure("2a", "Bias (600 s bins) and temperatures against time", "time, h",
-                         "bias, deg/h", "temperature, \u00b0C");
+  Figure f = make_figure("2a", "Bias (600 s bins) and temperatures against time", "time (h)",
+                         "bias (\u00b0/h)", "temperature (\u00b0C)");
   Series bias = points("bias", {}, {}), gyro = points("gyro temperature", {}, {}),
          air = points("chamber air", {}, {});
   for (const auto& b : bins) {
@@ -104,7 +104,7 @@ Figure figure_2a(const std::vector<RunBin>& bins) {
 
 Figure figure_2b(const std::vector<RunBin>& bins) {
   Figure f = make_figure("2b", "Bias against temperature: heating and cooling branches",
-                         "gyro temperature, \u00b0C", "bias, deg/h");
+                         "gyro temperature (\u00b0C)", "bias (\u00b0/h)");
   Series heating = points("heating", {}, {}), cooling = points("cooling", {}, {}),
          steady = points("steady", {}, {});
   for (const auto& b : bins) {
@@ -121,7 +121,7 @@ Figure figure_2b(const std::vector<RunBin>& bins) {
 Figure figure_3(const std::vector<RampRun>& ramps) {
   Figure f =
       make_figure("3", "Bias against temperature at 0, 10 and 20 \u00b0C/h (hysteresis study)",
-                  "gyro temperature, \u00b0C", "bias, deg/h");
+                  "gyro temperature (\u00b0C)", "bias (\u00b0/h)");
   std::vector<std::string> missing{"ramp_00", "ramp_10", "ramp_20"};
   for (const auto& r : ramps) {
     f.series.push_back(points(r.protocol + " (run " + std::to_string(r.run_id) + ")", r.data.temp_c,
@@ -158,7 +158,8 @@ std::vector<std::string> temperature_terms(const sc::FitResult& fit) {
 
 Figure figure_4(const sc::FitResult& fit, const sc::ModelData& data) {
   Figure f = make_figure("4", "Bias after removing k1\u00b7\u0394T against the gradient \u2207T",
-                         "gradient \u2207T = T2 - T1, \u00b0C", "bias - k1\u00b7\u0394T, deg/h");
+                         "gradient \u2207T = T2 \u2212 T1 (\u00b0C)",
+                         "bias \u2212 k1\u00b7\u0394T (\u00b0/h)");
   const auto temps = model_part(fit, data.view(), temperature_terms(fit));
   std::vector<double> y(data.bias_dph.size());
   for (std::size_t i = 0; i < y.size(); ++i) y[i] = data.bias_dph[i] - temps[i];
@@ -177,7 +178,7 @@ Figure figure_4(const sc::FitResult& fit, const sc::ModelData& data) {
 
 Figure figure_5a(const sc::FitResult& fit, const sc::ModelData& data) {
   Figure f = make_figure("5a", "Bias before and after compensation against temperature",
-                         "gyro temperature, \u00b0C", "bias, deg/h");
+                         "gyro temperature (\u00b0C)", "bias (\u00b0/h)");
   auto kept = temperature_terms(fit);
   kept.insert(kept.begin(), "B0");
   const auto temps = model_part(fit, data.view(), kept);
@@ -195,7 +196,7 @@ Figure figure_6(std::int64_t fit_id, const std::vector<double>& temp_c,
                          fmt::format("Verification: bias before and after fit {} (fitted on other "
                                      "runs) against temperature",
                                      fit_id),
-                         "gyro temperature, \u00b0C", "bias, deg/h");
+                         "gyro temperature (\u00b0C)", "bias (\u00b0/h)");
   f.series = {points("before", temp_c, before_dph),
               points(fmt::format("after fit {} (gyro_tc_correct)", fit_id), temp_c, after_dph)};
   return f;

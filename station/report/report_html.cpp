@@ -7,9 +7,11 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <stdexcept>
 
 #include "station/common/input_error.hpp"
 #include "station/report/report_pages.hpp"
+#include "station/web/builtin_web.hpp"
 
 namespace station::report {
 
@@ -24,6 +26,14 @@ std::string read_package_file(const std::string& path) {
   std::stringstream ss;
   ss << in.rdbuf();
   return ss.str();
+}
+
+/// The live page's tick script (station/web/ticks.js, embedded at build time): one ticker for
+/// both.
+std::string_view ticks_js() {
+  for (const auto& [name, text] : builtin::kWebFiles)
+    if (name == "ticks.js") return text;
+  throw std::logic_error("ticks.js is not embedded (station/CMakeLists.txt)");
 }
 
 /// Per-series dygraphs options: lines, or points only (a scatter plot), and the axis.
@@ -48,8 +58,8 @@ json figure_options(const Figure& f, bool bars) {
          {"legend", "always"},
          {"customBars", bars},
          {"sigFigs", 4}};
-  // Room for tick labels such as "-0.0004" beside the axis title.
-  o["axes"] = {{"y", {{"axisLabelWidth", 64}}}, {"y2", {{"axisLabelWidth", 56}}}};
+  // Ticks and label widths: the page's script (report_script.cpp) sets them for each axis.
+  o["axes"] = json::object();
   if (!f.y2_label.empty()) o["y2label"] = f.y2_label;
   if (f.log_axes) {
     o["logscale"] = true;
@@ -145,9 +155,9 @@ std::string page_html(std::string_view title, std::string_view body, const json&
       "<title>{}</title>\n<style>\n{}\n</style>\n<style>\n{}\n</style>\n"
       "<script>\n{}\n</script>\n</head>\n<body>\n{}\n"
       "<script type=\"application/json\" id=\"report-figures\">{}</script>\n"
-      "<script>\n{}\n</script>\n</body>\n</html>\n",
+      "<script>\n{}\n{}\n</script>\n</body>\n</html>\n",
       html_escape(title), a.dygraphs_css, kReportCss, a.dygraphs_js, body, script_json(figures),
-      kRenderJs);
+      ticks_js(), kRenderJs);
 }
 
 }  // namespace station::report

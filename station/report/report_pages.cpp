@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <optional>
 
 #include "compensation/fit.hpp"
@@ -12,39 +13,6 @@ namespace station::report {
 
 using nlohmann::json;
 namespace sc = station::compensation;
-
-const std::string_view kReportCss = R"(
-body { font-family: sans-serif; margin: 1.5em; color: #222; max-width: 1400px; }
-h1 { font-size: 1.5em; } h2 { font-size: 1.15em; margin-top: 1.4em; }
-table { border-collapse: collapse; margin: 0.5em 0; font-size: 0.9em; }
-th, td { border: 1px solid #bbb; padding: 0.2em 0.6em; text-align: left; }
-td.num { text-align: right; font-family: monospace; }
-.pass { color: #17702a; font-weight: bold; } .fail { color: #b01818; font-weight: bold; }
-.figures { display: grid; grid-template-columns: 1fr 1fr; gap: 1em 2em; }
-.figure { break-inside: avoid; }
-.figure h3 { font-size: 1em; margin: 0.3em 0; }
-.figure .chart { width: 100%; height: 280px; }
-.figure .legend { font-size: 0.8em; min-height: 1.2em; }
-.figure .legend .dygraph-legend { position: static; width: auto; background: none; }
-.note { font-style: italic; color: #8a5a00; }
-)";
-
-const std::string_view kRenderJs = R"(
-(function () {
-  "use strict";
-  var figures = JSON.parse(document.getElementById("report-figures").textContent);
-  figures.forEach(function (f) {
-    var box = document.querySelector('[data-figure="' + f.id + '"]');
-    if (!box || f.rows.length === 0) return;
-    var opts = f.options;
-    opts.labelsDiv = box.querySelector(".legend");
-    opts.drawCallback = function (g, initial) {
-      if (initial) box.setAttribute("data-drawn", "true");
-    };
-    new Dygraph(box.querySelector(".chart"), f.rows, opts);
-  });
-})();
-)";
 
 namespace {
 
@@ -59,6 +27,42 @@ std::string row(std::initializer_list<std::string> cells) {
   std::string out = "<tr>";
   for (const auto& c : cells) out += "<td>" + c + "</td>";
   return out + "</tr>\n";
+}
+
+/// A row whose first cell heads it (names the quantity and its unit).
+std::string kv(const std::string& head, std::initializer_list<std::string> cells) {
+  std::string out = "<tr><th scope=\"row\">" + head + "</th>";
+  for (const auto& c : cells) out += "<td>" + c + "</td>";
+  return out + "</tr>\n";
+}
+
+/// A coefficient's unit as people write it: "deg/h/C^2" -> "°/h/°C²" (compensation::
+/// coefficient_unit spells units in ASCII for files and JSON).
+std::string unit_html(std::string_view ascii) {
+  std::string out;
+  for (std::size_t i = 0; i < ascii.size(); ++i) {
+    if (ascii.substr(i, 3) == "deg") {
+      out += "\u00b0";
+      i += 2;
+    } else if (ascii[i] == 'C' && (i == 0 || ascii[i - 1] == '/' || ascii[i - 1] == '(')) {
+      out += "\u00b0C";
+    } else if (ascii[i] == '^' && i + 1 < ascii.size() && ascii[i + 1] >= '2' &&
+               ascii[i + 1] <= '4') {
+      static const char* const kSup[] = {"\u00b2", "\u00b3", "\u2074"};
+      out += kSup[ascii[i + 1] - '2'];
+      ++i;
+    } else {
+      out += ascii[i];
+    }
+  }
+  return html_escape(out);
+}
+
+/// "k1 (°/h/°C)": a coefficient's name and unit.
+std::string coefficient_head(const std::string& name) {
+  const std::string_view unit = sc::coefficient_unit(name);
+  // The unit alone: "deg/h/C (gradient)" says what the term is in its name already.
+  return html_escape(name) + " (" + unit_html(unit.substr(0, unit.find(" ("))) + ")";
 }
 
 std::string verdict_html(const FitExtras& e) {
@@ -76,81 +80,99 @@ std::string figure_box(const Figure& f) {
 
 std::string coefficient_table(const FitRecord& rec, const FitExtras& e) {
   std::string t =
-      "<table class=\"coefficients\">\n<tr><th>term</th><th>value</th><th>unit</th>"
-      "<th>uncertainty (1&sigma;)</th><th>OLS uncertainty</th></tr>\n";
+      "<table class=\"coefficients\">\n<tr><th>term (unit)</th><th>value (term's unit)</th>"
+      "<th>uncertainty, 1&sigma; (term's unit)</th><th>OLS uncertainty, 1&sigma; (term's unit)"
+      "</th></tr>\n";
   const auto& f = rec.fit;
   for (std::size_t i = 0; i < f.names.size(); ++i) {
     const bool ols = e.std_errors_ols && i < e.std_errors_ols->size();
-    t += row({html_escape(f.names[i]), num(f.coefficients[i], "{:.6e}"),
-              html_escape(std::string(sc::coefficient_unit(f.names[i]))),
-              num(i < f.std_errors.size() ? f.std_errors[i] : NAN, "{:.3e}"),
-              ols ? num((*e.std_errors_ols)[i], "{:.3e}") : "-"});
+    t += kv(coefficient_head(f.names[i]),
+            {num(f.coefficients[i], "{:.6e}"),
+             num(i < f.std_errors.size() ? f.std_errors[i] : NAN, "{:.3e}"),
+             ols ? num((*e.std_errors_ols)[i], "{:.3e}") : "-"});
   }
   return t + "</table>\n";
 }
 
 std::string evaluation_table(const FitRecord& rec) {
   std::string t = "<table class=\"evaluation\">\n";
-  t += row({"std before", num(rec.eval.std_before_dph) + " deg/h"});
-  t += row({"std after", num(rec.eval.std_after_dph) + " deg/h"});
-  t += row({"std ratio", html_escape(std_ratio_text(rec.eval))});
-  t += row({"bins", std::to_string(rec.fit.n_points)});
-  t += row({"R\u00b2", num(rec.fit.r2)});
-  t += row({"uncertainty model", html_escape(error_model_text(rec.fit.error_model))});
-  t += row({"fit", fmt::format("{} ({}, runs {})", rec.id, html_escape(rec.created_utc),
-                               fmt::join(rec.runs, ","))});
-  for (const auto& w : rec.fit.warnings) t += row({"warning", html_escape(w)});
+  t += kv("std before (\u00b0/h)", {num(rec.eval.std_before_dph)});
+  t += kv("std after (\u00b0/h)", {num(rec.eval.std_after_dph)});
+  t += kv("std ratio (after / before)", {html_escape(std_ratio_text(rec.eval))});
+  t += kv("bins (count)", {std::to_string(rec.fit.n_points)});
+  t += kv("R\u00b2 (fraction)", {num(rec.fit.r2)});
+  t += kv("uncertainty model", {html_escape(error_model_text(rec.fit.error_model))});
+  t += kv("fit", {fmt::format("{} ({}, runs {})", rec.id, html_escape(rec.created_utc),
+                              fmt::join(rec.runs, ","))});
+  for (const auto& w : rec.fit.warnings) t += kv("warning", {html_escape(w)});
   return t + "</table>\n";
 }
 
 std::string noise_table(const AllanCurves& a) {
   std::string t =
       "<table class=\"noise\">\n<tr><th>noise term (IEEE 952 Table C.2), fitted over the whole "
-      "Allan "
-      "variance</th><th>before</th>"
-      "<th>after</th></tr>\n";
+      "Allan variance (unit)</th><th>before (term's unit)</th><th>after (term's unit)</th></tr>\n";
   const auto& b = a.noise_before;
   const auto& c = a.noise_after;
   // value ± standard error of the weighted fit over the whole curve (compensation/allan.hpp).
   const auto pm = [](const std::optional<double>& v, const std::optional<double>& se) {
     return v ? num(v) + (se ? " &plusmn; " + num(se, "{:.2g}") : std::string()) : "0 (not in fit)";
   };
-  t += row({"quantization Q, arcsec", pm(b.quantization_arcsec, b.quantization_se),
-            pm(c.quantization_arcsec, c.quantization_se)});
-  t += row({"angle random walk N, deg/\u221ah",
-            pm(b.angle_random_walk_deg_rth, b.angle_random_walk_se),
-            pm(c.angle_random_walk_deg_rth, c.angle_random_walk_se)});
-  t += row({"bias instability B, deg/h", pm(b.bias_instability_dph, b.bias_instability_se),
-            pm(c.bias_instability_dph, c.bias_instability_se)});
-  t += row({"flattest at \u03c4, s", num(b.bias_instability_tau_s), num(c.bias_instability_tau_s)});
-  t += row({"rate random walk K, deg/h/\u221ah",
-            pm(b.rate_random_walk_dph_rth, b.rate_random_walk_se),
-            pm(c.rate_random_walk_dph_rth, c.rate_random_walk_se)});
-  t += row({"fit \u03c7\u00b2/dof", num(b.fit_chi2_per_dof, "{:.2f}"),
-            num(c.fit_chi2_per_dof, "{:.2f}")});
+  t += kv("quantization Q (arcsec)", {pm(b.quantization_arcsec, b.quantization_se),
+                                      pm(c.quantization_arcsec, c.quantization_se)});
+  t += kv("angle random walk N (\u00b0/\u221ah)",
+          {pm(b.angle_random_walk_deg_rth, b.angle_random_walk_se),
+           pm(c.angle_random_walk_deg_rth, c.angle_random_walk_se)});
+  t += kv("bias instability B (\u00b0/h)", {pm(b.bias_instability_dph, b.bias_instability_se),
+                                            pm(c.bias_instability_dph, c.bias_instability_se)});
+  t += kv("flattest at \u03c4 (s)", {num(b.bias_instability_tau_s), num(c.bias_instability_tau_s)});
+  t += kv("rate random walk K (\u00b0/h/\u221ah)",
+          {pm(b.rate_random_walk_dph_rth, b.rate_random_walk_se),
+           pm(c.rate_random_walk_dph_rth, c.rate_random_walk_se)});
+  t += kv("fit \u03c7\u00b2/dof (ratio)",
+          {num(b.fit_chi2_per_dof, "{:.2f}"), num(c.fit_chi2_per_dof, "{:.2f}")});
   return t + "</table>\n";
 }
 
 std::string release_cell(const SerialReport& s);
 
-std::string serial_summary_row(const RunReport& r, std::size_t i, const std::string& page) {
+/// Coefficient names of every serial's fit, in order of first appearance: the index's columns.
+std::vector<std::string> coefficient_columns(const RunReport& r) {
+  std::vector<std::string> out;
+  for (const auto& s : r.serials)
+    if (s.fit)
+      for (const auto& n : s.fit->fit.names)
+        if (std::find(out.begin(), out.end(), n) == out.end()) out.push_back(n);
+  return out;
+}
+
+std::string serial_summary_row(const RunReport& r, std::size_t i, const std::string& page,
+                               const std::vector<std::string>& columns) {
   const auto& s = r.serials[i];
   const std::string name = page.empty() ? html_escape(s.slot.serial)
                                         : fmt::format("<a href=\"{}\">{}</a>", html_escape(page),
                                                       html_escape(s.slot.serial));
-  if (!s.fit)
-    return row({name, std::to_string(s.slot.slot), "no fit stored for this run", "", "", "", "", "",
-                release_cell(s)});
-  const auto& f = s.fit->fit;
-  std::string coef;
-  for (std::size_t k = 0; k < f.names.size(); ++k)
-    coef += fmt::format("{}{} = {} &plusmn; {}", k ? "<br>" : "", html_escape(f.names[k]),
-                        num(f.coefficients[k], "{:.4e}"),
-                        num(k < f.std_errors.size() ? f.std_errors[k] : NAN, "{:.2e}"));
-  return row({name, std::to_string(s.slot.slot), verdict_html(s.extras), coef,
-              num(s.fit->eval.std_before_dph), num(s.fit->eval.std_after_dph),
-              html_escape(std_ratio_text(s.fit->eval)), std::to_string(f.n_points),
-              release_cell(s)});
+  std::string t = "<tr><td>" + name + "</td><td>" + std::to_string(s.slot.slot) + "</td><td>" +
+                  (s.fit ? verdict_html(s.extras) : "no fit stored for this run") + "</td>";
+  for (const auto& c : columns) {
+    std::string cell = "-";
+    if (s.fit) {
+      const auto& f = s.fit->fit;
+      const auto k =
+          static_cast<std::size_t>(std::find(f.names.begin(), f.names.end(), c) - f.names.begin());
+      if (k < f.names.size())
+        cell = num(f.coefficients[k], "{:.4e}") + " &plusmn; " +
+               num(k < f.std_errors.size() ? f.std_errors[k] : NAN, "{:.2e}");
+    }
+    t += "<td>" + cell + "</td>";
+  }
+  const auto* e = s.fit ? &s.fit->eval : nullptr;
+  t += "<td>" + (e ? num(e->std_before_dph) : "-") + "</td><td>" +
+       (e ? num(e->std_after_dph) : "-") + "</td><td>" +
+       (e ? html_escape(std_ratio_text(*e)) : "-") + "</td><td>" +
+       (s.fit ? std::to_string(s.fit->fit.n_points) : "-") + "</td><td>" + release_cell(s) +
+       "</td></tr>\n";
+  return t;
 }
 
 std::string release_line(const ReleaseRow& r) {
@@ -189,22 +211,24 @@ std::string release_cell(const SerialReport& s) {
 
 std::string verification_rows(const VerificationResult& v) {
   std::string t;
-  t += row({"calibration applied", fmt::format("fit {} (fitted on other runs; the navigation "
-                                               "computer's gyro_tc_correct, clamped to its span)",
-                                               v.fit_id)});
-  t +=
-      row({"bins", fmt::format("{} ({} outside the fit's span, clamped)", v.bins, v.clamped_bins)});
-  t += row({"std before", num(v.eval.std_before_dph) + " deg/h"});
-  t += row({"std after", num(v.eval.std_after_dph) + " deg/h"});
-  t += row({"std ratio", v.eval.std_ratio ? num(*v.eval.std_ratio, "{:.3f}") : "undefined"});
-  t += row({"mean residual", num(v.mean_residual_dph) + " deg/h"});
+  t += kv("calibration applied", {fmt::format("fit {} (fitted on other runs; the navigation "
+                                              "computer's gyro_tc_correct, clamped to its span)",
+                                              v.fit_id)});
+  t += kv("bins (count)",
+          {fmt::format("{} ({} outside the fit's span, clamped)", v.bins, v.clamped_bins)});
+  t += kv("std before (\u00b0/h)", {num(v.eval.std_before_dph)});
+  t += kv("std after (\u00b0/h)", {num(v.eval.std_after_dph)});
+  t += kv("std ratio (after / before)",
+          {v.eval.std_ratio ? num(*v.eval.std_ratio, "{:.3f}") : "undefined"});
+  t += kv("mean residual (\u00b0/h)", {num(v.mean_residual_dph)});
   if (v.drift_dph_per_c)
-    t += row({"residual drift against T", num(*v.drift_dph_per_c, "{:.3e}") + " &plusmn; " +
-                                              num(v.drift_se_dph_per_c, "{:.1e}") + " deg/h/C"});
-  t += row({"ADEV floor (compensated 1 Hz)", num(v.adev_floor_dph) + " deg/h"});
+    t += kv(
+        "residual drift against T (\u00b0/h/\u00b0C)",
+        {num(*v.drift_dph_per_c, "{:.3e}") + " &plusmn; " + num(v.drift_se_dph_per_c, "{:.1e}")});
+  t += kv("ADEV floor, compensated 1 Hz (\u00b0/h)", {num(v.adev_floor_dph)});
   const std::string cls = !v.verdict ? "" : (v.verdict->pass ? "pass" : "fail");
-  t += row({"verdict", fmt::format("<span class=\"verdict {}\">{}</span>", cls,
-                                   html_escape(station::verdict_text(v.verdict)))});
+  t += kv("verdict", {fmt::format("<span class=\"verdict {}\">{}</span>", cls,
+                                  html_escape(station::verdict_text(v.verdict)))});
   return t;
 }
 
@@ -234,8 +258,9 @@ std::string verification_index(const RunReport& r) {
                 num(v.mean_residual_dph), html_escape(station::verdict_text(v.verdict))});
   if (t.empty()) return "";
   return "<section class=\"verification\">\n<h2>Verification on this run</h2>\n<table>\n"
-         "<tr><th>serial</th><th>fit applied</th><th>std before, deg/h</th>"
-         "<th>std after, deg/h</th><th>ratio</th><th>mean residual, deg/h</th><th>verdict</th>"
+         "<tr><th>serial</th><th>fit applied</th><th>std before (\u00b0/h)</th>"
+         "<th>std after (\u00b0/h)</th><th>std ratio (after / before)</th>"
+         "<th>mean residual (\u00b0/h)</th><th>verdict</th>"
          "</tr>\n" +
          t + "</table>\n</section>\n";
 }
@@ -263,22 +288,22 @@ std::string verdict_text(const FitExtras& e) {
 std::string run_record_html(const RunReport& r) {
   const auto& run = r.run;
   std::string t = "<section class=\"run-record\">\n<h2>Run record</h2>\n<table>\n";
-  t += row({"run", std::to_string(run.id)});
-  t += row({"station", html_escape(run.station)});
-  t += row({"software version", html_escape(run.software_version)});
-  t += row({"configuration SHA-256", "<code>" + html_escape(r.config_sha256) + "</code>"});
-  t += row({"operator", html_escape(run.operator_name.empty() ? "-" : run.operator_name)});
-  t += row({"protocol", html_escape(run.protocol_name)});
-  t += row({"state", html_escape(std::string(to_string(run.state)))});
-  t += row({"started (UTC)", html_escape(run.started_utc)});
-  t += row({"ended (UTC)", html_escape(run.ended_utc.empty() ? "-" : run.ended_utc)});
-  if (run.sim_seed) t += row({"simulation seed", std::to_string(*run.sim_seed)});
+  t += kv("run", {std::to_string(run.id)});
+  t += kv("station", {html_escape(run.station)});
+  t += kv("software version", {html_escape(run.software_version)});
+  t += kv("configuration SHA-256", {"<code>" + html_escape(r.config_sha256) + "</code>"});
+  t += kv("operator", {html_escape(run.operator_name.empty() ? "-" : run.operator_name)});
+  t += kv("protocol", {html_escape(run.protocol_name)});
+  t += kv("state", {html_escape(std::string(to_string(run.state)))});
+  t += kv("started (UTC)", {html_escape(run.started_utc)});
+  t += kv("ended (UTC)", {html_escape(run.ended_utc.empty() ? "-" : run.ended_utc)});
+  if (run.sim_seed) t += kv("simulation seed", {std::to_string(*run.sim_seed)});
   return t + "</table>\n</section>\n";
 }
 
 std::string events_html(const RunReport& r) {
   std::string t = fmt::format(
-      "<section class=\"events\">\n<h2>Events ({})</h2>\n<table>\n<tr><th>t, s</th>"
+      "<section class=\"events\">\n<h2>Events ({})</h2>\n<table>\n<tr><th>t (s)</th>"
       "<th>severity</th><th>source</th><th>kind</th><th>message</th></tr>\n",
       r.events.size());
   for (const auto& e : r.events)
@@ -290,13 +315,16 @@ std::string events_html(const RunReport& r) {
 std::string index_html(const RunReport& r, const Assets& a, const std::vector<std::string>& pages) {
   const std::string title =
       fmt::format("Run {} ({}): calibration report", r.run.id, r.run.protocol_name);
+  const auto columns = coefficient_columns(r);
   std::string body = "<h1>" + html_escape(title) +
                      "</h1>\n<section class=\"serials\">\n"
-                     "<h2>Serials</h2>\n<table>\n<tr><th>serial</th><th>slot</th><th>verdict</th>"
-                     "<th>coefficients &plusmn; 1&sigma;</th><th>std before, deg/h</th>"
-                     "<th>std after, deg/h</th><th>ratio</th><th>bins</th><th>release</th></tr>\n";
+                     "<h2>Serials</h2>\n<table>\n<tr><th>serial</th><th>slot</th><th>verdict</th>";
+  for (const auto& c : columns) body += "<th>" + coefficient_head(c) + " &plusmn; 1&sigma;</th>";
+  body +=
+      "<th>std before (\u00b0/h)</th><th>std after (\u00b0/h)</th><th>std ratio (after / "
+      "before)</th><th>bins (count)</th><th>release</th></tr>\n";
   for (std::size_t i = 0; i < r.serials.size(); ++i)
-    body += serial_summary_row(r, i, i < pages.size() ? pages[i] : "");
+    body += serial_summary_row(r, i, i < pages.size() ? pages[i] : "", columns);
   body += "</table>\n</section>\n" + verification_index(r) + run_record_html(r) + events_html(r);
   return page_html(title, body, json::array(), a);
 }

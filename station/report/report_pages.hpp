@@ -11,8 +11,9 @@ namespace station::report {
 
 /// The report's own style sheet (after dygraphs').
 extern const std::string_view kReportCss;
-/// The one script of a page: parses #report-figures and hands each figure to Dygraph; marks its
-/// element data-drawn="true" once drawn. No data is ever written into it.
+/// The page's script (after station/web/ticks.js): parses #report-figures and hands each figure
+/// to Dygraph with round ticks; marks its element data-drawn="true" once drawn with room for its
+/// labels. No data is ever written into it.
 extern const std::string_view kRenderJs;
 
 /// A whole page: `body` (already escaped HTML), the figures as JSON, dygraphs inlined.

@@ -13,7 +13,7 @@
 
   var S = {
     status: null,      // the last /api/live status, updated from ticks
-    snapT: null,       // its run time: what ticks do not carry (mode, table, slot T) is as of then
+    slotsT: null,      // run time of the slot values shown (the tick they came with), s
     trend: [],         // [[t_h, air_c, setpoint_c], ...]
     bins: {},          // serial -> [BIN, ...] sorted by t_mid_s
     events: [],        // newest first
@@ -21,6 +21,7 @@
     runId: null,
     dirty: {temp: false, bins: false},
     charts: {},        // id -> Dygraph
+    rows: {},          // id -> the rows it draws
     loading: false,    // a /api/live read is under way: stream messages wait in `held`
     reloadAgain: false,
     held: [],
@@ -70,14 +71,43 @@
     text("station", st.station || "—");
     text("protocol", run ? run.protocol || "" : "");
     text("operator", run && run.operator ? run.operator : "—");
-    text("step-label", run ? (run.step_label || "—") : "—");
+    var step = run && run.steps ? run.steps[run.step_index] : null;
+    text("step-label", step ? stepName(step) : run ? (run.step_label || "—") : "—");
     $("recording").hidden = !(run && run.recording);
     renderSteps(run);
     renderChamber(st);
     renderSlots(st.slots || []);
-    text("slots-asof", asOf(st) ? "T, ∇T" + asOf(st) + "; bias live" : "");
+    text("slots-at", hm(S.slotsT));
     renderBanner(st);
     renderButtons(st);
+  }
+
+  // "h:mm" of a duration, "—" when unknown.
+  function duration(s) { return s === null || s === undefined ? "—" : hm(s); }
+  function signed(v) { return num(v, 1).replace("-", "\u2212"); }
+
+  // What a step does, with its target and nominal duration: "→ −40.0 °C at 60 °C/h, 1:05".
+  function stepDetail(s) {
+    if (s.kind === "set_temperature") {
+      var to = s.to_start ? "start temperature" + (s.target_c != null ? " " + signed(s.target_c) +
+        " °C" : "") : signed(s.target_c) + " °C";
+      return "→ " + to + (s.ramp_c_per_h > 0 ? " at " + s.ramp_c_per_h + " °C/h, " +
+        duration(s.duration_s) : ", as fast as the chamber goes");
+    }
+    if (s.kind === "soak") return "stable within ±" + s.tolerance_c + " °C for " +
+      duration(s.duration_s);
+    if (s.kind === "hold") return "for " + duration(s.duration_s);
+    if (s.kind === "lock_turntable") return "at " + s.position_deg + "°";
+    return "";
+  }
+
+  // A step without a label of its own is named for what it does (the parser labels it with its
+  // kind: "set_temperature" beside the kind would say nothing).
+  var KIND_NAMES = {set_temperature: "set temperature", soak: "soak", hold: "hold",
+                    record_start: "open the record window", record_stop: "close the record window",
+                    lock_turntable: "lock the turntable"};
+  function stepName(s) {
+    return s.label && s.label !== s.kind ? s.label : KIND_NAMES[s.kind] || s.kind || "step";
   }
 
   var stepsKey = null;
@@ -90,13 +120,15 @@
       while (ol.firstChild) ol.removeChild(ol.firstChild);
       steps.forEach(function (s) {
         var li = document.createElement("li");
-        li.appendChild(document.createTextNode(s.label || s.kind || "step"));
-        if (s.label && s.kind) {
-          var k = document.createElement("span");
-          k.className = "kind";
-          k.textContent = " " + s.kind;
-          li.appendChild(k);
+        li.appendChild(document.createTextNode(stepName(s)));
+        var detail = stepDetail(s);
+        if (detail) {
+          var d = document.createElement("span");
+          d.className = "detail";
+          d.textContent = " " + detail;
+          li.appendChild(d);
         }
+        li.setAttribute("data-kind", s.kind || "");
         ol.appendChild(li);
       });
     }
@@ -107,22 +139,16 @@
     }
   }
 
-  // " (at h:mm)" for what the ticks do not update, once the run has moved on since the snapshot.
-  function asOf(st) {
-    var t = st.run ? st.run.t_s : null;
-    return S.snapT !== null && t !== null && hm(t) !== hm(S.snapT) ? " (at " + hm(S.snapT) + ")"
-                                                                  : "";
-  }
-
   function renderChamber(st) {
     var ch = st.chamber || {};
-    var stale = asOf(st);
     text("air-c", num(ch.air_c, 2) + " °C");
     text("setpoint-c", num(ch.setpoint_c, 2) + " °C");
-    text("chamber-mode", (ch.mode || "—") + (ch.alarm ? " (ALARM)" : "") + stale);
+    // The protocol's target beside the setpoint a ramp moves towards it.
+    text("target-c", st.run && st.run.target_c != null ? num(st.run.target_c, 1) + " °C" : "—");
+    text("chamber-mode", (ch.mode || "—") + (ch.alarm ? " (ALARM)" : ""));
     var tb = st.table;
     text("table", tb ? num(tb.angle_deg, 1) + "°, " + num(tb.rate_dps, 2) + " °/s, " +
-         (tb.mode || "—") + (tb.locked ? ", locked" : "") + stale : "—");
+         (tb.mode || "—") + (tb.locked ? ", locked" : "") : "—");
     var sf = st.safety;
     if (!sf) { text("safety", "—"); return; }
     var parts = [];
@@ -130,7 +156,7 @@
     if (sf.estop_pressed === true) parts.push("E-STOP");
     if (sf.table_interlock_open === true) parts.push("table interlock open");
     if (sf.safe_hold) parts.push("SAFE HOLD");
-    text("safety", (parts.length ? parts.join(", ") : "ok") + stale);
+    text("safety", parts.length ? parts.join(", ") : "ok");
   }
 
   function renderSlots(slots) {
@@ -184,7 +210,7 @@
   function applyLive(live) {
     S.status = live.status || {};
     S.runId = S.status.run ? S.status.run.id : null;
-    S.snapT = S.status.run ? S.status.run.t_s : null;
+    S.slotsT = S.status.run ? S.status.run.t_s : null;
     S.trend = (live.trend || []).map(function (p) { return [p[0] / 3600, p[1], p[2]]; });
     thin(S.trend);
     S.bins = {};
@@ -243,11 +269,13 @@
     st.state = d.state;
     if (!st.safety) st.safety = {};
     st.safety.safe_hold = d.safe_hold;
-    if (!st.chamber) st.chamber = {};
-    st.chamber.air_c = d.air_c;
-    st.chamber.setpoint_c = d.setpoint_c;
+    // Each tick carries all the page shows of the rig, so every value is of the clock's time.
+    if ("chamber" in d) st.chamber = d.chamber;
+    if ("table" in d) st.table = d.table;
+    if (d.safety) st.safety = d.safety;
     if (st.run) {
       st.run.t_s = d.t_s;
+      st.run.target_c = d.target_c;
       st.run.step_index = d.step_index;
       st.run.step_label = d.step_label;
       st.run.recording = d.recording;
@@ -262,6 +290,7 @@
         if ("grad_c" in s) o.grad_c = s.grad_c;
         return o;
       });
+      S.slotsT = d.t_s;
     }
     var t_h = d.t_s / 3600;
     var last = S.trend.length ? S.trend[S.trend.length - 1][0] : -Infinity;
@@ -358,6 +387,9 @@
   }
 
   function hmAxis(v) { return hm(v * 3600); }
+  function timeAxis() {
+    return {valueFormatter: hmAxis, ticker: window.StationTicks.hours()};
+  }
 
   function plot(id, rows, opts, points) {
     var el = $(id);
@@ -377,12 +409,34 @@
       delete S.charts[id];
       g = null;
     }
+    S.rows[id] = rows;
     if (!g) {
-      S.charts[id] = new Dygraph(el, rows, opts);
+      var T = window.StationTicks;
+      opts.axes = opts.axes || {};
+      ["x", "y"].forEach(function (a) { opts.axes[a] = opts.axes[a] || {}; });
+      opts.axes.x.ticker = opts.axes.x.ticker || T.numeric(true);
+      opts.axes.y.ticker = T.numeric(false);
+      create(id, el, opts);
     } else {
       g.updateOptions({file: rows});
     }
     el.setAttribute("data-points", String(points));
+  }
+
+  // A chart whose labels need more room than they have is drawn anew with it (widths only
+  // grow, so this settles; updateOptions would leave the old plot beside the new plot area).
+  function create(id, el, opts) {
+    var T = window.StationTicks;
+    opts.drawCallback = function (g) {
+      setTimeout(function () {
+        if (S.charts[id] !== g) return;
+        var more = T.room(g, el);
+        if (!more) return;
+        g.destroy();
+        create(id, el, T.widen(opts, more));
+      }, 0);
+    };
+    S.charts[id] = new Dygraph(el, S.rows[id], opts);
   }
 
   function draw() {
@@ -390,11 +444,11 @@
     if (S.dirty.temp) {
       S.dirty.temp = false;
       plot("chart-temp", S.trend.slice(), {
-        labels: ["t (h)", "air °C", "setpoint °C"],
+        labels: ["t (h:mm)", "air °C", "setpoint °C"],
         labelsDiv: $("legend-temp"), legend: "always", labelsSeparateLines: false,
-        xlabel: "t (h)", ylabel: "°C", connectSeparatedPoints: false,
+        xlabel: "t (h:mm)", ylabel: "temperature (°C)", connectSeparatedPoints: false,
         colors: ["#1f5fbf", "#d9480f"], strokeWidth: 1.5,
-        axes: {x: {valueFormatter: hmAxis}}
+        axes: {x: timeAxis()}
       }, S.trend.length);
     }
     if (S.dirty.bins) {
@@ -402,11 +456,11 @@
       var serials = Object.keys(S.bins).sort();
       var time = binRows(serials, function (b) { return b.t_mid_s / 3600; });
       var temp = binRows(serials, function (b) { return b.temp_c; });
-      var labelsT = ["t (h)"].concat(serials), labelsC = ["T (°C)"].concat(serials);
+      var labelsT = ["t (h:mm)"].concat(serials), labelsC = ["T (°C)"].concat(serials);
       plot("chart-bias-time", time.rows, {
         labels: labelsT, labelsDiv: $("legend-bias-time"), legend: "always",
-        xlabel: "t (h)", ylabel: "bias (°/h)", drawPoints: true, pointSize: 2.5,
-        strokeWidth: 1, connectSeparatedPoints: true, xRangePad: 8, axes: {x: {valueFormatter: hmAxis}}
+        xlabel: "t (h:mm)", ylabel: "bias (°/h)", drawPoints: true, pointSize: 2.5,
+        strokeWidth: 1, connectSeparatedPoints: true, xRangePad: 8, axes: {x: timeAxis()}
       }, time.points);
       plot("chart-bias-temp", temp.rows, {
         labels: labelsC, labelsDiv: $("legend-bias-temp"), legend: "always",

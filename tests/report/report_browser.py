@@ -9,7 +9,9 @@ Exit 0 pass, 1 fail, 77 skip (Chromium, chromedriver or python3-selenium absent)
 """
 import argparse
 import json
+import math
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -152,6 +154,152 @@ def check_figures(drv, path, ramps):
                 fail(f"{path}: fig 3 has no {r} series: {series}")
 
 
+# Every drawn figure's tick labels and titles, as the browser laid them out: per axis the
+# labels' text, their text boxes (a Range over the text: what is painted, not the label's div),
+# whether the text overflows its div (dygraphs' labels clip: "1.000e+" for "1.000e+4"), and the
+# boxes of the axis titles and the figure's heading.
+TICKS_JS = """
+var out = [];
+function box(r) { return {l: r.left, t: r.top, r: r.right, b: r.bottom}; }
+function textBox(el) { var r = document.createRange(); r.selectNodeContents(el);
+  return box(r.getBoundingClientRect()); }
+var figs = JSON.parse(document.getElementById('report-figures').textContent);
+document.querySelectorAll('[data-figure][data-drawn="true"]').forEach(function (fig) {
+  var f = figs.filter(function (x) { return x.id === fig.getAttribute('data-figure'); })[0];
+  var axes = {x: [], y: [], y2: []};
+  fig.querySelectorAll('.dygraph-axis-label').forEach(function (el) {
+    if (!el.textContent.trim()) return;  // a tick with a grid line and no label
+    var a = el.classList.contains('dygraph-axis-label-x') ? 'x'
+          : el.classList.contains('dygraph-axis-label-y2') ? 'y2' : 'y';
+    axes[a].push({text: el.textContent, box: textBox(el), scroll: el.scrollWidth,
+                  client: el.clientWidth});
+  });
+  var titles = [];
+  fig.querySelectorAll('.dygraph-xlabel, .dygraph-ylabel, .dygraph-y2label, h3')
+     .forEach(function (el) { titles.push({text: el.textContent, box: textBox(el)}); });
+  out.push({id: f.id, axes: axes, titles: titles,
+            chart: box(fig.querySelector('.chart').getBoundingClientRect()),
+            log: {x: !!(f.options.axes && f.options.axes.x && f.options.axes.x.logscale),
+                  y: !!f.options.logscale, y2: !!f.options.logscale}});
+});
+return out;
+"""
+NUMBER = re.compile(r"^-?\d+(\.\d+)?(e[-+]?\d+)?$")
+
+
+def overlap(a, b, slack=0.5):
+    return (min(a["r"], b["r"]) - max(a["l"], b["l"]) > slack and
+            min(a["b"], b["b"]) - max(a["t"], b["t"]) > slack)
+
+
+def axis_problems(name, labels, log):
+    """Equal texts, incomplete or clipped numbers, and steps that are not one round 1-2-5 step
+    (linear) or 1-2-5 times a power of ten (log) in one format."""
+    out = []
+    texts = [lab["text"] for lab in labels]
+    if len(set(texts)) != len(texts):
+        out.append(f"{name}: repeated labels {texts}")
+    for lab in labels:
+        if not NUMBER.match(lab["text"]):
+            out.append(f"{name}: label {lab['text']!r} is not a complete number")
+        if lab["scroll"] > lab["client"] + 1:
+            out.append(f"{name}: label {lab['text']!r} is cut ({lab['scroll']} px of text in "
+                       f"{lab['client']} px)")
+    if out or len(labels) < 2:
+        return out + ([] if len(labels) >= 2 else [f"{name}: {len(labels)} labels"])
+    vals = sorted(float(t) for t in texts)
+    if log:
+        for v in vals:
+            m = v / 10 ** math.floor(math.log10(v) + 1e-9)
+            if min(abs(m - k) for k in (1, 2, 3, 5)) > 1e-6:
+                out.append(f"{name}: log tick {v} is not 1, 2 or 5 times a power of ten")
+        return out
+    steps = [b - a for a, b in zip(vals, vals[1:])]
+    step = steps[0]
+    if max(abs(s - step) for s in steps) > 1e-6 * step:
+        out.append(f"{name}: uneven steps {texts}")
+    m = step / 10 ** math.floor(math.log10(step) + 1e-9)
+    if min(abs(m - k) for k in (1, 2, 5, 10)) > 1e-6:
+        out.append(f"{name}: step {step} is not 1, 2 or 5 times a power of ten: {texts}")
+    if len({len(t.split("e")[0].partition(".")[2]) for t in texts}) != 1:
+        out.append(f"{name}: labels in different formats {texts}")
+    return out
+
+
+def check_ticks(drv, path, expect):
+    """Every figure in `expect` drawn with readable axes: per axis, round steps in one format,
+    no repeated, cut or incomplete label; no label over another, over an axis title or over the
+    figure's heading, and none outside its chart."""
+    figs = drv.execute_script(TICKS_JS)
+    found = {f["id"] for f in figs}
+    if not set(expect) <= found:
+        fail(f"{path}: figures {sorted(set(expect) - found)} not drawn")
+    problems = []
+    for f in figs:
+        labels = []
+        for axis in ("x", "y", "y2"):
+            if f["axes"][axis] or axis != "y2":
+                problems += axis_problems(f"fig {f['id']} {axis}", f["axes"][axis],
+                                          f["log"][axis])
+            labels += [(axis, lab) for lab in f["axes"][axis]]
+        c = f["chart"]
+        for axis, lab in labels:
+            b = lab["box"]
+            if b["l"] < c["l"] - 1 or b["r"] > c["r"] + 1 or b["t"] < c["t"] - 1:
+                problems.append(f"fig {f['id']} {axis}: {lab['text']!r} outside the chart")
+            for t in f["titles"]:
+                if overlap(b, t["box"]):
+                    problems.append(f"fig {f['id']} {axis}: {lab['text']!r} overlaps the title "
+                                    f"{t['text']!r}")
+        for i, (a1, l1) in enumerate(labels):
+            for a2, l2 in labels[i + 1:]:
+                if overlap(l1["box"], l2["box"]):
+                    problems.append(f"fig {f['id']}: {a1} {l1['text']!r} overlaps {a2} "
+                                    f"{l2['text']!r}")
+        print(f"fig {f['id']} ticks: " + "; ".join(
+            f"{a} " + " ".join(lab["text"] for lab in f["axes"][a]) for a in ("x", "y", "y2")
+            if f["axes"][a]))
+    if problems:
+        fail(f"{path}: tick labels:\n  " + "\n  ".join(problems))
+
+
+# A number in a table cell ("1.5", "-2.3e-04", "1.2e-03 ± 2e-05"): its column or row heading
+# must name its unit in parentheses; ids and counts that have none are listed here.
+CELL_NUMBER = re.compile(r"^-?\d+(\.\d+)?(e[-+]?\d+)?( ± .*)?$")
+NO_UNIT = {"serial", "slot", "fit applied", "run", "simulation seed"}
+UNITS_JS = """
+var out = [];
+document.querySelectorAll('table').forEach(function (t) {
+  var head = Array.prototype.map.call(t.rows[0].cells, function (c) {
+    return c.tagName === 'TH' ? c.textContent : ''; });
+  Array.prototype.forEach.call(t.rows, function (tr, i) {
+    if (i === 0 && tr.cells[0].tagName === 'TH' && tr.cells[0].scope !== 'row') return;
+    var rowHead = tr.cells[0].tagName === 'TH' ? tr.cells[0].textContent : '';
+    Array.prototype.forEach.call(tr.cells, function (c, j) {
+      if (c.tagName === 'TD') out.push({text: c.textContent.trim(), col: head[j] || '',
+                                         row: rowHead});
+    });
+  });
+});
+return out;
+"""
+
+
+def check_units(drv, path):
+    """Every number in every table has a heading naming its unit."""
+    bad = []
+    for c in drv.execute_script(UNITS_JS):
+        if not CELL_NUMBER.match(c["text"]):
+            continue
+        heads = [h for h in (c["row"], c["col"]) if h]
+        if any(h in NO_UNIT or re.search(r"\(.+\)", h) for h in heads):
+            continue
+        bad.append(f"{c['text']!r} under {heads}")
+    if bad:
+        fail(f"{path}: numbers without a unit in their heading: {bad[:10]}")
+    print(f"{path}: every table number has a unit in its heading")
+
+
 def check_pdf(bin_path, db, run_id, out_dir, gyros):
     """--pdf: every page printed by headless Chromium to a PDF file."""
     shutil.rmtree(out_dir, ignore_errors=True)
@@ -200,20 +348,26 @@ def main():
         if len(links) != a.gyros:
             fail(f"{index}: {len(links)} serial links, expected {a.gyros}")
         check_clean(drv, index)
+        check_units(drv, index)
         load(drv, pages[0])
         check_figures(drv, pages[0], a.ramps)
         check_clean(drv, pages[0])
+        check_units(drv, pages[0])
         shot = os.path.join(a.artifacts, name + ".png")
         drv.save_screenshot(shot)
-        # The figures alone (docs/report.png is one of these).
+        # The figures alone (docs/report.png is one of these); kept before the tick check, so a
+        # failing check leaves the picture of what failed.
         figures = os.path.join(a.artifacts, name + "-figures.png")
         drv.find_element(By.CSS_SELECTOR, ".figures").screenshot(figures)
         print(f"screenshots {shot} {figures}")
+        check_ticks(drv, pages[0], [f for f in FIGURES if a.ramps or f != "3"])
         if a.verify:
             fig6 = check_verification(drv, index, pages[0], report)
             verification = os.path.join(a.artifacts, name + "-verification.png")
             drv.find_element(By.CSS_SELECTOR, "section.verification").screenshot(verification)
             print(f"screenshot {verification}")
+            check_units(drv, pages[0])
+            check_ticks(drv, pages[0], ["6"])
             # The calibration run's page: its fit is the released one.
             cal_dir = out_dir + "-calibration"
             shutil.rmtree(cal_dir, ignore_errors=True)

@@ -94,6 +94,7 @@ class BoardServer {
       sim::BoardConfig b;  // as SimWorld::add_boards builds them
       b.node = gyros_[i].node;
       b.gyro.coefficients = gyros_[i].truth;
+      b.gyro.thermal = sim::sim_thermal(wc_.preset);
       b.gyro.thermal.initial_c = wc_.initial_c;
       b.gyro.earth_rate_dph = wc_.earth_rate_dph;
       b.gyro.pulse_weight_arcsec = gyros_[i].pulse_weight_arcsec;

@@ -168,6 +168,92 @@ def set_prompt(drv, answer):
         "window.confirm = function () { return true; };", answer)
 
 
+STEP_DETAIL = {
+    # kind -> what its line must show: target and nominal duration (h:mm)
+    "set_temperature": re.compile(r"→ (start temperature )?−?\d+\.\d °C at [\d.]+ °C/h, \d+:\d\d"
+                                  r"|→ .*°C, as fast as the chamber goes"),
+    "soak": re.compile(r"stable within ±[\d.]+ °C for \d+:\d\d"),
+    "hold": re.compile(r"for \d+:\d\d"),
+}
+
+
+def check_steps(drv):
+    """Each step shows what it does: a set_temperature step its target, rate and duration
+    (never its kind twice), a to_start step the start temperature once known."""
+    steps = drv.execute_script(
+        "return Array.prototype.map.call(document.querySelectorAll('#steps li'), function (li) {"
+        " return {kind: li.getAttribute('data-kind'), text: li.textContent.trim()}; });")
+    for s in steps:
+        if s["kind"] in s["text"]:
+            fail(f"step {s['text']!r} shows its kind's code name, not what it does")
+        want = STEP_DETAIL.get(s["kind"])
+        if want and not want.search(s["text"]):
+            fail(f"step {s['text']!r} does not show its target and duration ({want.pattern})")
+    if not any("start temperature" in s["text"] and "°C" in s["text"] for s in steps):
+        fail(f"no step shows the start temperature it returns to: {steps}")
+    print("steps: " + "; ".join(s["text"] for s in steps))
+
+
+def check_target(drv, target):
+    """While a ramp moves the setpoint, the step's target shows beside it."""
+    def seen():
+        t = text(drv, "target-c")
+        sp = text(drv, "setpoint-c")
+        return (t, sp) if t == f"{target:.1f} °C" and sp != f"{target:.2f} °C" and sp != "— °C" \
+            else None
+    t, sp = wait_for(f"#target-c {target:.1f} °C beside a moving setpoint", seen, 30, 0.1)
+    print(f"setpoint {sp}, target {t}")
+
+
+def check_clock(drv):
+    """The slot values' time is the clock's: both from the tick they came with."""
+    for _ in range(20):
+        clock, at = drv.execute_script(
+            "return [document.getElementById('t-s').textContent,"
+            " document.getElementById('slots-at').textContent];")
+        if clock != at:
+            fail(f"slot values labelled at {at!r} while the clock reads {clock!r}")
+        time.sleep(0.2)
+    print(f"slot values at the clock's time ({clock})")
+
+
+AXES_JS = """
+var out = [];
+['chart-temp', 'chart-bias-time', 'chart-bias-temp'].forEach(function (id) {
+  var el = document.getElementById(id);
+  ['x', 'y'].forEach(function (a) {
+    var labs = Array.prototype.map.call(
+      el.querySelectorAll('.dygraph-axis-label-' + a), function (l) {
+        var r = document.createRange(); r.selectNodeContents(l);
+        var b = r.getBoundingClientRect();
+        return {text: l.textContent, l: b.left, r: b.right, t: b.top, b: b.bottom,
+                cut: l.scrollWidth > l.clientWidth + 1};
+      });
+    out.push({chart: id, axis: a, labels: labs});
+  });
+});
+return out;
+"""
+
+
+def check_axes(drv):
+    """Every chart's tick labels: none repeated, cut or over another."""
+    for ax in drv.execute_script(AXES_JS):
+        texts = [lab["text"] for lab in ax["labels"]]
+        name = f"#{ax['chart']} {ax['axis']}"
+        if len(set(texts)) != len(texts):
+            fail(f"{name}: repeated tick labels {texts}")
+        if any(lab["cut"] for lab in ax["labels"]):
+            fail(f"{name}: cut tick labels {texts}")
+        labs = ax["labels"]
+        for i, a in enumerate(labs):
+            for b in labs[i + 1:]:
+                if min(a["r"], b["r"]) - max(a["l"], b["l"]) > 0.5 and \
+                        min(a["b"], b["b"]) - max(a["t"], b["t"]) > 0.5:
+                    fail(f"{name}: {a['text']!r} overlaps {b['text']!r}")
+        print(f"{name}: {' '.join(texts)}")
+
+
 def run_checks(drv, st, url, token, artifacts):
     console = Console(drv)
     drv.get(url)
@@ -189,6 +275,9 @@ def run_checks(drv, st, url, token, artifacts):
     if drv.execute_script("return !document.getElementById('banner').hidden;"):
         fail(f"a banner is shown while running normally: {text(drv, 'banner')!r}")
 
+    check_steps(drv)
+    check_clock(drv)
+
     # The page follows the run by itself (no reload): t changes, the trend grows.
     t0, p0 = text(drv, "t-s"), points(drv, "chart-temp")
     wait_for(f"#t-s changing from {t0}", lambda: text(drv, "t-s") != t0, 10)
@@ -209,6 +298,9 @@ def run_checks(drv, st, url, token, artifacts):
     if not cur or cur == "MANY" or label not in cur:
         fail(f"#steps li.current is {cur!r}, #step-label {label!r}")
     print(f"step '{step0}' -> '{label}' (li.current '{cur}')")
+    # Heating to +70 C at 10 C/h: the setpoint moves, the target stays.
+    check_target(drv, 70.0)
+    check_clock(drv)
     # A few more bins for the screenshot (2 s wall each at speed 300).
     n = points(drv, "chart-bias-time")
     try:
@@ -222,6 +314,7 @@ def run_checks(drv, st, url, token, artifacts):
             fail(f"#{id_} holds {points(drv, id_)} points (more than 2000)")
     shot = os.path.join(artifacts, "live_page.png")
     drv.save_screenshot(shot)
+    check_axes(drv)
     print(f"screenshot {shot} (chart-temp {points(drv, 'chart-temp')},"
           f" bias/time {points(drv, 'chart-bias-time')},"
           f" bias/T {points(drv, 'chart-bias-temp')} points)")
