@@ -69,6 +69,7 @@
     text("speed", st.speed != null ? "×" + st.speed : "—");
     text("sim", st.sim === true ? "yes" : st.sim === false ? "no" : "—");
     text("station", st.station || "—");
+    renderFleet(st.fleet);
     text("protocol", run ? run.protocol || "" : "");
     text("operator", run && run.operator ? run.operator : "—");
     var step = run && run.steps ? run.steps[run.step_index] : null;
@@ -250,6 +251,19 @@
     });
   }
 
+  // The forwarder to the fleet's PostgreSQL ([fleet]; absent: the box stays hidden): its state
+  // and what it has still to send; the last failure as the tooltip.
+  function renderFleet(f) {
+    $("fleet-box").hidden = !f;
+    if (!f) return;
+    var pending = f.pending_rows > 0 ? ", " + f.pending_rows + " rows pending" : ", up to date";
+    var held = f.held_items > 0 ? ", " + f.held_items + " held" : "";
+    text("fleet", f.state + (f.state === "backing off" ? " " + f.backoff_s + " s" : "") +
+         pending + held);
+    $("fleet").className = "fleet " + f.state.replace(/ /g, "-");
+    $("fleet").title = f.last_error || "";
+  }
+
   function dispatch(type, id, data) {
     if (S.loading) { S.held.push({type: type, id: id, data: data}); return; }
     if (id !== null && id <= S.seq) return;
@@ -258,6 +272,7 @@
     else if (type === "bin") onBin(data);
     else if (type === "event") onEvent(data);
     else if (type === "run") onRun(data);
+    else if (type === "fleet") { (S.status || (S.status = {})).fleet = data; renderFleet(data); }
     else if (type === "resync") reload();
   }
 
@@ -513,7 +528,7 @@
   var es = null, retryMs = 5000, triedSnapshot = false;
   function openStream() {
     es = new EventSource("/api/events/stream");
-    ["tick", "bin", "event", "run", "resync"].forEach(function (type) {
+    ["tick", "bin", "event", "run", "fleet", "resync"].forEach(function (type) {
       es.addEventListener(type, function (m) {
         var id = m.lastEventId ? parseInt(m.lastEventId, 10) : null;
         var data;

@@ -2,10 +2,11 @@
 """`station serve` with [fleet] on simrig, forwarding to a throw-away PostgreSQL 15 while a run
 goes on at 1 Hz on the wall clock; PostgreSQL stopped in the middle of the run and started again.
 
-  fleet_serve_test.py STATION SIMRIG
+  fleet_serve_test.py STATION SIMRIG [ARTIFACT_DIR]
 
 Checks: the forwarder reports itself in /api/status and /metrics; while the server is down it
-backs off, the backlog grows and the run goes on; when the server returns the backlog drains;
+backs off, the backlog grows and the run goes on, and the live page (headless Chromium) shows
+it; when the server returns the backlog drains;
 after the run every sample and event of the run is in PostgreSQL exactly once and the run's
 central state is its final one; no tick was slowed (the tick histogram has no tick over 0.25 s
 and no tick was missed). Exit 0 ok, 1 failure, 77 skip (no PostgreSQL 15 server binaries).
@@ -34,6 +35,32 @@ def metric(base, name):
     return values
 
 
+def page_shows_fleet(base, artifacts):
+    """The live page in headless Chromium shows the forwarder backing off (skipped, with a
+    message, without a browser)."""
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__))))
+    from fleet_page_browser import browser
+    driver, why = browser()
+    if driver is None:
+        print("SKIP (live page part):", why)
+        return
+    try:
+        from selenium.webdriver.support.ui import WebDriverWait
+        driver.get(base + "/")
+        shown = WebDriverWait(driver, 20).until(lambda d: d.execute_script(
+            "var e = document.getElementById('fleet'); return e && "
+            "!document.getElementById('fleet-box').hidden && e.textContent.indexOf('backing off') "
+            "=== 0 ? e.textContent : null"))
+        check(shown and "rows pending" in shown, "the live page shows the backlog: %r" % shown)
+        tip = driver.execute_script("return document.getElementById('fleet').title")
+        check("PostgreSQL" in tip, "the last error as the tooltip: %r" % tip)
+        if artifacts:
+            os.makedirs(artifacts, exist_ok=True)
+            driver.save_screenshot(os.path.join(artifacts, "live_page_fleet.png"))
+    finally:
+        driver.quit()
+
+
 def local(work, sql, *args):
     db = sqlite3.connect(os.path.join(work, "s.db"))
     try:
@@ -48,6 +75,7 @@ def main():
         print("SKIP:", why)
         return 77
     station, simrig = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
+    artifacts = os.path.abspath(sys.argv[3]) if len(sys.argv) > 3 else None
     work = tempfile.mkdtemp(prefix="fleet-serve-")
     pg = pg_server.Postgres()
     rig_cfg = open(os.path.join(work, "rig.toml"), "w")
@@ -87,6 +115,7 @@ def main():
               % (ticks_down, st["ticks"]))
         check(st["fleet"]["pending_rows"] > 0, "a backlog while down: %s" % st["fleet"])
         check(st["fleet"]["backoff_s"] >= 1.0, "the back-off grew: %s" % st["fleet"])
+        page_shows_fleet(base, artifacts)
         m = metric(base, "station_fleet_pending_rows")
         check(m and max(m.values()) > 0, "backlog in /metrics: %s" % m)
         errors = metric(base, "station_fleet_errors_total")
