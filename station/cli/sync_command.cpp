@@ -76,11 +76,7 @@ int run_sync(const SyncOptions& o) {
   fleet::PassResult total;
   for (;;) {
     const auto p = fwd.pass();
-    total.items += p.items;
-    total.rows += p.rows;
-    total.appended += p.appended;
-    total.failed += p.failed;
-    if (!p.last_error.empty()) total.last_error = p.last_error;
+    total += p;
     if (!p.more || (p.items == 0 && p.rows == 0)) break;
   }
   const auto left = fwd.backlog();

@@ -101,6 +101,7 @@ json metric_json(const Metric& m, const std::vector<const FleetPoint*>& points, 
                   {"outside_station", out_station}});
     if (out_all || out_station) {
       outside.push_back({{"metric", m.name},
+                         {"unit", unit_of(m)},
                          {"fleet_id", p->fleet_id},
                          {"station", p->station},
                          {"serial", p->serial},

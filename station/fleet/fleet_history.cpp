@@ -7,14 +7,6 @@ namespace {
 
 using nlohmann::json;
 
-std::vector<std::pair<std::string, double>> keyed(const std::string& text) {
-  std::vector<std::pair<std::string, double>> out;
-  const json j = json::parse(text);
-  for (const auto& [k, v] : j.items())
-    if (v.is_number()) out.emplace_back(k, v.get<double>());
-  return out;
-}
-
 std::vector<SerialRun> runs_of(PgConnection& pg, const std::string& serial) {
   auto r = pg.exec(
       "SELECT r.fleet_id, r.started_utc, coalesce(r.ended_utc, ''), r.state, r.protocol_name, "
@@ -55,8 +47,8 @@ std::vector<SerialFitRow> fits_of(PgConnection& pg, const std::string& serial) {
     f.created_utc = r.text(i, 1);
     f.terms = r.text(i, 2);
     f.runs = json::parse(r.text(i, 3)).get<std::vector<std::int64_t>>();
-    f.coefficients = keyed(r.text(i, 4));
-    f.std_errors = keyed(r.text(i, 5));
+    f.coefficients = values_by_name(r.text(i, 4));
+    f.std_errors = values_by_name(r.text(i, 5));
     f.n_bins = r.integer(i, 6);
     if (!r.is_null(i, 7)) f.std_ratio = r.number(i, 7);
     f.std_after_dph = r.number(i, 8);

@@ -102,8 +102,8 @@ std::int64_t count_diverged(PgConnection& pg, const FleetTable& t) {
   std::string on;
   for (const auto& k : key) on += fmt::format("{0}s.{1} = c.{1}", on.empty() ? "" : " AND ", k);
   const auto rest = non_key(t);
-  const std::string differs = fmt::format("({}) IS DISTINCT FROM ({})", prefixed(rest, "s."),
-                                          prefixed(rest, "c."));
+  const std::string differs =
+      fmt::format("({}) IS DISTINCT FROM ({})", prefixed(rest, "s."), prefixed(rest, "c."));
   const auto cols = split_columns(t.columns);
   const bool has_rev = std::find(cols.begin(), cols.end(), "rev") != cols.end();
   const std::string when =

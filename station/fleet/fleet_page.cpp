@@ -59,11 +59,11 @@ report::Figure metric_figure(const json& chart, std::size_t part_index) {
 }
 
 std::string station_table(const json& part) {
-  std::string t =
-      "<table class=\"stations\">\n" +
-      cells({"station", "calibrations", "pass", "fail", "no verdict", "k1 centre (deg/h/C)",
-             "k0 centre (deg/h/C)", "B0 centre (deg/h)", "std ratio centre"},
-            "th");
+  std::string t = "<table class=\"stations\">\n" +
+                  cells({"station", "calibrations (count)", "pass (count)", "fail (count)",
+                         "no verdict (count)", "k1 centre (deg/h/C)", "k0 centre (deg/h/C)",
+                         "B0 centre (deg/h)", "std ratio centre (after / before)"},
+                        "th");
   for (const auto& [station, n] : part["stations"].items()) {
     const auto& v = part["verdicts"][station];
     std::vector<std::string> centres;
@@ -82,16 +82,17 @@ std::string station_table(const json& part) {
 std::string outside_table(const json& part) {
   if (part["outside"].empty())
     return "<p class=\"outside-none\">No point beyond a control limit.</p>\n";
-  std::string t =
-      "<table class=\"outside\">\n" +
-      cells({"metric", "station", "serial", "fit (fleet id)", "created", "value", "chart", "limit"},
-            "th");
+  std::string t = "<table class=\"outside\">\n" +
+                  cells({"metric", "station", "serial", "fit (fleet id)", "created (UTC)",
+                         "value (the metric's unit)", "chart", "limit"},
+                        "th");
   for (const auto& o : part["outside"])
     t += cells(
         {html_escape(o["metric"].get<std::string>()), html_escape(o["station"].get<std::string>()),
          html_escape(o["serial"].get<std::string>()),
          std::to_string(o["fleet_id"].get<long long>()),
-         html_escape(o["created_utc"].get<std::string>()), num(o["value"]),
+         html_escape(o["created_utc"].get<std::string>()),
+         num(o["value"]) + " " + html_escape(o["unit"].get<std::string>()),
          html_escape(o["chart"].get<std::string>()), html_escape(o["limit"].get<std::string>())});
   return t + "</table>\n";
 }
@@ -118,7 +119,10 @@ std::string fleet_html(const json& charts, const std::string& filter_text,
     for (const auto& c : part["charts"]) {
       const auto f = metric_figure(c, i);
       body += report::figure_html(f);
-      figures.push_back(report::figure_json(f));
+      auto j = report::figure_json(f);
+      // The first and last calibrations off the corners, where the x and y labels meet.
+      j["options"]["xRangePad"] = 24;
+      figures.push_back(std::move(j));
     }
     body += "<h3>Points beyond a limit</h3>\n" + outside_table(part) + "</section>\n";
     ++i;

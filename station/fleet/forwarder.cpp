@@ -86,6 +86,16 @@ std::int64_t item_order(std::string_view item) {
 
 }  // namespace
 
+PassResult& PassResult::operator+=(const PassResult& o) {
+  items += o.items;
+  rows += o.rows;
+  appended += o.appended;
+  failed += o.failed;
+  more = o.more;
+  if (!o.last_error.empty()) last_error = o.last_error;
+  return *this;
+}
+
 Forwarder::Forwarder(std::string db_path, PgTarget target, ForwardOptions options)
     : db_path_(std::move(db_path)), target_(std::move(target)), options_(std::move(options)) {}
 

@@ -53,6 +53,8 @@ struct PassResult {
   std::int64_t failed = 0;    ///< items the server refused (their outbox row holds why)
   bool more = false;          ///< more to send right away (a batch limit was reached)
   std::string last_error;     ///< the last refusal, empty when none
+  /// Adds another pass's counts (`more` is the other's; the last error the latest).
+  PassResult& operator+=(const PassResult& o);
 };
 
 class Forwarder {

@@ -15,19 +15,19 @@ std::optional<double> lookup(const std::vector<std::pair<std::string, double>>& 
   return std::nullopt;
 }
 
-std::vector<std::pair<std::string, double>> keyed(const std::string& text) {
-  std::vector<std::pair<std::string, double>> out;
-  const json j = json::parse(text);  // items() of a temporary would dangle
-  for (const auto& [k, v] : j.items())
-    if (v.is_number()) out.emplace_back(k, v.get<double>());
-  return out;
-}
-
 std::optional<std::string> opt_text(const StatementLease& st, int c) {
   return st->column_is_null(c) ? std::nullopt : std::optional(st->column_text(c));
 }
 
 }  // namespace
+
+std::vector<std::pair<std::string, double>> values_by_name(const std::string& json_text) {
+  std::vector<std::pair<std::string, double>> out;
+  const json j = json::parse(json_text);  // items() of a temporary would dangle
+  for (const auto& [k, v] : j.items())
+    if (v.is_number()) out.emplace_back(k, v.get<double>());
+  return out;
+}
 
 std::optional<double> SerialFitRow::coefficient(const std::string& name) const {
   return lookup(coefficients, name);
@@ -80,8 +80,8 @@ std::vector<SerialFitRow> serial_fits(Store& store, const std::string& serial) {
     f.created_utc = st->column_text(1);
     f.terms = st->column_text(2);
     f.runs = json::parse(st->column_text(3)).get<std::vector<std::int64_t>>();
-    f.coefficients = keyed(st->column_text(4));
-    f.std_errors = keyed(st->column_text(5));
+    f.coefficients = values_by_name(st->column_text(4));
+    f.std_errors = values_by_name(st->column_text(5));
     f.n_bins = st->column_int(6);
     if (!st->column_is_null(7)) f.std_ratio = st->column_double(7);
     f.std_after_dph = st->column_double(8);

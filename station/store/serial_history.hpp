@@ -10,6 +10,10 @@
 
 namespace station {
 
+/// A fit's coefficients or standard errors JSON ({"B0": x, "k1": y, ...}) as (name, value) pairs;
+/// entries that are not numbers are left out.
+std::vector<std::pair<std::string, double>> values_by_name(const std::string& json_text);
+
 /// Every serial any run recorded, sorted.
 std::vector<std::string> all_serials(Store& store);
 

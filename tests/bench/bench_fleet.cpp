@@ -67,8 +67,7 @@ fleet::PassResult forward_all(const std::string& db, const fleet::PgTarget& t, b
   fleet::PassResult total;
   for (;;) {
     const auto p = f.pass();
-    total.items += p.items;
-    total.appended += p.appended;
+    total += p;
     if (!p.more) break;
   }
   return total;

@@ -59,11 +59,7 @@ class FleetTest : public ::testing::Test {
     fleet::PassResult total;
     for (int i = 0; i < 10'000; ++i) {
       const auto p = f.pass();
-      total.items += p.items;
-      total.rows += p.rows;
-      total.appended += p.appended;
-      total.failed += p.failed;
-      if (!p.last_error.empty()) total.last_error = p.last_error;
+      total += p;
       if (!p.more) break;
     }
     return total;

@@ -20,7 +20,9 @@ import sys
 import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "report"))
 import pg_server  # noqa: E402
+import report_browser  # noqa: E402  (the report's tick and unit checks: one rule for both)
 
 FAILURES = []
 
@@ -56,39 +58,6 @@ def browser():
         opts.add_argument(a)
     opts.set_capability("goog:loggingPrefs", {"browser": "ALL"})
     return webdriver.Chrome(service=Service(executable_path=driver), options=opts), None
-
-
-# Every tick label of every drawn figure: text and box, grouped by figure and axis.
-TICKS_JS = """
-return Array.from(document.querySelectorAll('[data-figure]')).map(function (box) {
-  return {id: box.getAttribute('data-figure'), drawn: box.getAttribute('data-drawn'),
-    labels: Array.from(box.querySelectorAll('.dygraph-axis-label')).map(function (e) {
-      var r = e.getBoundingClientRect();
-      var axis = e.className.match(/dygraph-axis-label-(x|y2|y)/);
-      return {axis: axis ? axis[1] : '?', text: e.textContent, left: r.left, right: r.right,
-              top: r.top, bottom: r.bottom, cut: e.scrollWidth > e.clientWidth + 1};
-    })};
-});
-"""
-
-
-def overlap(a, b):
-    return a["left"] < b["right"] - 0.5 and b["left"] < a["right"] - 0.5 and \
-        a["top"] < b["bottom"] - 0.5 and b["top"] < a["bottom"] - 0.5
-
-
-def check_ticks(figures):
-    for f in figures:
-        check(f["drawn"] == "true", "figure %s drawn" % f["id"])
-        for axis in ("x", "y"):
-            labels = [x for x in f["labels"] if x["axis"] == axis and x["text"].strip()]
-            texts = [x["text"] for x in labels]
-            check(len(texts) == len(set(texts)), "fig %s %s ticks unique: %s" % (f["id"], axis, texts))
-            check(not any(x["cut"] for x in labels), "fig %s %s ticks not cut: %s" % (f["id"], axis, texts))
-            for i in range(len(labels)):
-                for j in range(i + 1, len(labels)):
-                    check(not overlap(labels[i], labels[j]), "fig %s %s ticks %r and %r overlap"
-                          % (f["id"], axis, labels[i]["text"], labels[j]["text"]))
 
 
 def main():
@@ -142,9 +111,13 @@ def main():
             WebDriverWait(driver, 20).until(lambda d: d.execute_script(
                 "return document.querySelectorAll('[data-figure]').length > 0 && "
                 "document.querySelectorAll('[data-figure]:not([data-drawn])').length === 0"))
-            figures = driver.execute_script(TICKS_JS)
-            check(len(figures) == 4 * len(charts["parts"]), "a figure per chart: %d" % len(figures))
-            check_ticks(figures)
+            ids = ["%s-%d" % (m, i + 1) for i in range(len(charts["parts"]))
+                   for m in ("k1", "k0", "B0", "std_ratio")]
+            try:
+                report_browser.check_ticks(driver, "fleet.html", ids)
+                report_browser.check_units(driver, "fleet.html")
+            except SystemExit:  # report_browser.fail printed what failed
+                check(False, "fleet.html: the report's tick or unit checks")
             severe = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
             check(not severe, "no console error: %s" % severe)
             os.makedirs(artifacts, exist_ok=True)
