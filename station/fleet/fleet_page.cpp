@@ -103,9 +103,11 @@ std::string fleet_html(const json& charts, const std::string& filter_text,
                        const report::Assets& assets) {
   std::string body = fmt::format(
       "<h1>Fleet control charts</h1>\n<p class=\"filter\">{}</p>\n"
-      "<p>Individuals charts (ISO 7870-2): centre X\u0304, \u03c3\u0302 = MR\u0304 / 1.128 from "
-      "the moving range of consecutive calibrations, limits X\u0304 \u00b1 3\u03c3\u0302 over the "
-      "whole fleet; each station's own limits are in the JSON (--json).</p>\n",
+      "<p>Individuals charts (ISO 7870-2), one colour per station: centre X\u0304 over the whole "
+      "fleet, \u03c3\u0302 = MR\u0304 / 1.128 from the moving ranges between consecutive "
+      "calibrations of one station (so an offset between stations shows beyond the limits "
+      "instead of widening them), limits X\u0304 \u00b1 3\u03c3\u0302; each station's own "
+      "chart is in the JSON (--json).</p>\n",
       html_escape(filter_text));
   json figures = json::array();
   std::size_t i = 0;
