@@ -227,6 +227,10 @@ remove_and_purge_with_data() {
 
 echo "== install, from the installed files only"
 lintian_check
+# The fleet's server is the user's: the package needs PostgreSQL's client library only.
+DEPENDS=$(dpkg-deb -f "$DEB" Depends)
+check '[[ $DEPENDS == *libpq5* && $DEPENDS != *postgresql* ]]' \
+  "depends on libpq5, the PostgreSQL client library, and on no server: $DEPENDS"
 install_checks
 check 'systemd-analyze verify /usr/lib/systemd/system/gyro-station.service /usr/lib/systemd/system/gyro-station-simrig.service >"$WORK/verify.log" 2>&1 && ! [[ -s $WORK/verify.log ]]' \
   "systemd-analyze verify on the installed units: $(cat "$WORK/verify.log" 2>/dev/null)"
