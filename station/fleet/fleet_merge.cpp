@@ -23,6 +23,12 @@ std::vector<std::string_view> non_key(const FleetTable& t) {
   return out;
 }
 
+/// An item's own row: it carries the station's revision of the item (`rev`).
+bool has_rev(const FleetTable& t) {
+  const auto cols = split_columns(t.columns);
+  return std::find(cols.begin(), cols.end(), "rev") != cols.end();
+}
+
 // INSERT ... ON CONFLICT (postgresql.org/docs/15/sql-insert.html): DO NOTHING for appended rows;
 // DO UPDATE only WHERE the stored row IS DISTINCT FROM the incoming one, so an identical resend
 // writes nothing.
@@ -33,11 +39,10 @@ std::string merge_sql(const FleetTable& t) {
   const auto rest = non_key(t);
   // An item's row carries its revision: only a higher one replaces it (an older file, restored
   // from a backup, never writes over a newer state). Its children: replaced when they differ.
-  const auto cols = split_columns(t.columns);
-  const bool has_rev = std::find(cols.begin(), cols.end(), "rev") != cols.end();
-  const std::string when = has_rev ? std::string("EXCLUDED.rev > t.rev")
-                                   : fmt::format("({}) IS DISTINCT FROM ({})", prefixed(rest, "t."),
-                                                 prefixed(rest, "EXCLUDED."));
+  const std::string when = has_rev(t)
+                               ? std::string("EXCLUDED.rev > t.rev")
+                               : fmt::format("({}) IS DISTINCT FROM ({})", prefixed(rest, "t."),
+                                             prefixed(rest, "EXCLUDED."));
   return insert + fmt::format("ON CONFLICT ({}) DO UPDATE SET ({}) = ROW({}) WHERE {}", t.key,
                               prefixed(rest, ""), prefixed(rest, "EXCLUDED."), when);
 }
@@ -104,10 +109,8 @@ std::int64_t count_diverged(PgConnection& pg, const FleetTable& t) {
   const auto rest = non_key(t);
   const std::string differs =
       fmt::format("({}) IS DISTINCT FROM ({})", prefixed(rest, "s."), prefixed(rest, "c."));
-  const auto cols = split_columns(t.columns);
-  const bool has_rev = std::find(cols.begin(), cols.end(), "rev") != cols.end();
   const std::string when =
-      has_rev ? fmt::format("c.rev > s.rev OR (c.rev = s.rev AND {})", differs) : differs;
+      has_rev(t) ? fmt::format("c.rev > s.rev OR (c.rev = s.rev AND {})", differs) : differs;
   return pg
       .exec(fmt::format("SELECT count(*) FROM stage_{0} AS s JOIN {0} AS c ON {1} WHERE {2}",
                         t.name, on, when))

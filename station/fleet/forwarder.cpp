@@ -4,10 +4,10 @@
 
 #include <chrono>
 #include <cmath>
-#include <ctime>
 
 #include "station/fleet/fleet_merge.hpp"
 #include "station/fleet/fleet_schema.hpp"
+#include "station/store/store.hpp"
 
 namespace station::fleet {
 namespace {
@@ -41,19 +41,6 @@ void bind_named(Statement& st, const char* name, double v) {
 }
 void bind_named(Statement& st, const char* name, std::string_view v) {
   if (int i = st.parameter_index(name); i > 0) st.bind(i, v);
-}
-
-std::string utc_now() {
-  const std::time_t now = std::time(nullptr);
-  std::tm utc{};
-  gmtime_r(&now, &utc);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &utc);
-  return buf;
-}
-
-double unix_now_s() {
-  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
 
 /// An item the server will not take now: refused (retried after a back-off) or held (the server
@@ -98,6 +85,10 @@ PassResult& PassResult::operator+=(const PassResult& o) {
 
 Forwarder::Forwarder(std::string db_path, PgTarget target, ForwardOptions options)
     : db_path_(std::move(db_path)), target_(std::move(target)), options_(std::move(options)) {}
+
+double unix_now_s() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
 
 double next_backoff_s(double previous_s) {
   return previous_s <= 0 ? 0.5 : std::min(60.0, previous_s * 2);
@@ -297,7 +288,7 @@ void Forwarder::acknowledge(Item item, std::int64_t local_id, std::int64_t chang
       "acked_utc = ?3, events_acked_id = coalesce(?4, events_acked_id), "
       "samples_acked_t_s = coalesce(?5, samples_acked_t_s), last_error = NULL, refusals = 0, "
       "retry_after_unix = NULL WHERE item = ?6 AND local_id = ?7");
-  st.bind(1, sent.complete ? 1 : 0).bind(2, changes).bind(3, utc_now());
+  st.bind(1, sent.complete ? 1 : 0).bind(2, changes).bind(3, utc_now_iso());
   if (sent.events_after)
     st.bind(4, *sent.events_after);
   else
@@ -307,15 +298,20 @@ void Forwarder::acknowledge(Item item, std::int64_t local_id, std::int64_t chang
   st.step();
 }
 
-// A refused item waits 0.5 s doubling to 60 s before its next attempt (so one the server keeps
-// refusing neither spins nor blocks the items behind it); a held one waits for a person.
+// A refused item waits before its next attempt as a failing link does (next_backoff_s, once per
+// refusal in a row), so one the server keeps refusing neither spins nor blocks the items behind
+// it; a held one waits for a person.
 void Forwarder::record_error(Item item, std::int64_t local_id, const std::string& error,
                              bool hold) {
+  auto n = write_->prepare("SELECT refusals FROM fleet_outbox WHERE item = ? AND local_id = ?");
+  n.bind(1, item_name(item)).bind(2, local_id);
+  double wait_s = 0;
+  for (std::int64_t k = n.step() ? n.column_int(0) : 0; k >= 0 && wait_s < 60; --k)
+    wait_s = next_backoff_s(wait_s);
   auto st = write_->prepare(
-      "UPDATE fleet_outbox SET last_error = ?1, refusals = refusals + 1, retry_after_unix = ?2 + "
-      "min(60.0, 0.5 * (1 << min(refusals, 7))), held_reason = CASE WHEN ?3 THEN ?1 END "
-      "WHERE item = ?4 AND local_id = ?5");
-  st.bind(1, error).bind(2, unix_now_s()).bind(3, hold ? 1 : 0);
+      "UPDATE fleet_outbox SET last_error = ?1, refusals = refusals + 1, retry_after_unix = ?2, "
+      "held_reason = CASE WHEN ?3 THEN ?1 END WHERE item = ?4 AND local_id = ?5");
+  st.bind(1, error).bind(2, unix_now_s() + wait_s).bind(3, hold ? 1 : 0);
   st.bind(4, item_name(item)).bind(5, local_id);
   st.step();
 }

@@ -41,6 +41,9 @@ struct Backlog {
   std::int64_t held = 0;   ///< items held: the server has a newer state (a restored file)
 };
 
+/// Wall-clock now, Unix seconds (retry times in the outbox, the last success).
+double unix_now_s();
+
 /// The pause after a failure that followed a pause of `previous_s` (0: the first failure):
 /// 0.5 s, doubling, at most 60 s (issue 24). For the link and for each refused item.
 double next_backoff_s(double previous_s);

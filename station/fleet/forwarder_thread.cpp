@@ -6,13 +6,6 @@
 #include "station/common/logging.hpp"
 
 namespace station::fleet {
-namespace {
-
-double unix_now_s() {
-  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
-}
-
-}  // namespace
 
 nlohmann::json ForwarderStatus::to_json() const {
   return {{"state", state},
