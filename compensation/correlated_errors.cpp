@@ -3,10 +3,13 @@
 #include "compensation/correlated_errors.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <utility>
 #include <vector>
+
+#include "compensation/reml_filter.hpp"
 
 namespace station::compensation {
 namespace {
@@ -18,12 +21,6 @@ constexpr int kRefinements = 3;     // 3 rounds of 3 x 3 x 3 around the best poi
 // kMinWeight of the best's likelihood.
 constexpr std::size_t kMaxComponents = 32;
 constexpr double kMinWeight = 1e-3;
-// The filter's columns: y and up to 9 regressors (B0 and the eight terms of fit.hpp).
-constexpr int kMaxColumns = 10;
-using SmallMatrix =
-    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxColumns, kMaxColumns>;
-using SmallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxColumns, 1>;
-
 bool same_run(std::span<const int> segment, Eigen::Index i, Eigen::Index j) {
   return segment.empty() ||
          segment[static_cast<std::size_t>(i)] == segment[static_cast<std::size_t>(j)];
@@ -54,82 +51,6 @@ void step_hours(std::vector<double>& dt_h, std::span<const double> t_s,
   }
 }
 
-struct Profile {
-  double minus2_loglik = std::numeric_limits<double>::infinity();
-  double sigma2 = 0;
-};
-
-/// The variance parameters, in units of s^2: white 1 - q, Gauss-Markov q, random walk w per hour.
-struct Params {
-  double q = 0, w_per_h = 0;
-};
-
-/// -2 x restricted log-likelihood (constants dropped) of (tau, q, w) with b and s^2 concentrated
-/// out. A two-state Kalman filter (Gauss-Markov g, random walk r; observed g + r + white) runs on
-/// y and on every column of X with the same gains (Harvey 1989, 3.4.2): innovations v, their
-/// variances f (in units of s^2); GLS normal equations from v/sqrt(f). The walk starts at 0 in
-/// each run (its level there is the constant's, and different runs are independent).
-/// `z` holds the rows [y_i, x_i] (n x (p+1), row-major); plain loops: it runs ~300 times a fit.
-Profile reml_profile(
-    const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>& z,
-    const std::vector<double>& phi, const std::vector<double>& dt_h, Params pr) {
-  const Eigen::Index n = z.rows(), k = z.cols(), p = k - 1;
-  // [y X]' F^-1 [y X] of the innovations; sizes bounded by kMaxColumns, so nothing is allocated.
-  SmallMatrix m = SmallMatrix::Zero(k, k);
-  std::array<double, kMaxColumns> g{}, r{}, v{};
-  // f >= 1 - q >= 0.01, so the product of up to ~100 bins' f stays far from underflow; one log
-  // per 64 bins instead of one per bin (the log was most of the cost).
-  double sum_log_f = 0, prod_f = 1, pgg = 0, pgr = 0, prr = 0;
-  const double q = pr.q;
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const auto iu = static_cast<std::size_t>(i);
-    const double ph = phi[iu], dt = dt_h[iu];
-    if (dt < 0) {  // a run starts: the walk at 0, the Gauss-Markov part stationary
-      std::fill(g.begin(), g.end(), 0.0);
-      std::fill(r.begin(), r.end(), 0.0);
-      pgg = q;
-      pgr = prr = 0;
-    } else {
-      pgg = ph * ph * pgg + q * (1.0 - ph * ph);
-      pgr = ph * pgr;
-      prr = prr + pr.w_per_h * dt;
-      for (Eigen::Index c = 0; c < k; ++c) g[static_cast<std::size_t>(c)] *= ph;
-    }
-    const double f = pgg + 2 * pgr + prr + (1.0 - q);
-    const double kg = (pgg + pgr) / f, kr = (pgr + prr) / f;
-    for (Eigen::Index c = 0; c < k; ++c) {
-      const auto cu = static_cast<std::size_t>(c);
-      v[cu] = z(i, c) - g[cu] - r[cu];
-      g[cu] += kg * v[cu];
-      r[cu] += kr * v[cu];
-    }
-    // P <- P - K f K' (the Joseph form is not needed: f >= 1 - q keeps it well conditioned).
-    pgg -= kg * kg * f;
-    pgr -= kg * kr * f;
-    prr -= kr * kr * f;
-    prod_f *= f;
-    if ((i & 63) == 63) {
-      sum_log_f += std::log(prod_f);
-      prod_f = 1;
-    }
-    for (Eigen::Index a = 0; a < k; ++a) {
-      const double va = v[static_cast<std::size_t>(a)] / f;
-      for (Eigen::Index b = a; b < k; ++b) m(a, b) += va * v[static_cast<std::size_t>(b)];
-    }
-  }
-  sum_log_f += std::log(prod_f);
-  const SmallMatrix mxx = m.bottomRightCorner(p, p).selfadjointView<Eigen::Upper>();
-  const SmallVector mxy = m.row(0).tail(p).transpose();
-  const Eigen::LDLT<SmallMatrix> ldlt(mxx);
-  const double rss = m(0, 0) - mxy.dot(ldlt.solve(mxy));
-  Profile out;
-  const auto dof = static_cast<double>(n - p);
-  if (!(rss > 0) || ldlt.info() != Eigen::Success) return out;
-  out.sigma2 = rss / dof;
-  out.minus2_loglik = sum_log_f + ldlt.vectorD().array().log().sum() + dof * std::log(out.sigma2);
-  return out;
-}
-
 /// Median spacing of neighbouring bins of one run, s (1 when times are not given).
 double bin_spacing_s(std::span<const double> t_s, std::span<const int> segment) {
   std::vector<double> gaps;
@@ -141,9 +62,15 @@ double bin_spacing_s(std::span<const double> t_s, std::span<const int> segment) 
   return std::max(gaps[gaps.size() / 2], 1e-9);
 }
 
+using reml::Profile;
+
 struct Point {
   double log_tau = 0, q = 0, u = 0;  // u: log10 of the walk's variance over a run, in s^2
   Profile profile;
+  /// Two grid points are one error model when q, the walk and (where q > 0) tau agree.
+  bool same_model(const Point& o) const {
+    return q == o.q && u == o.u && (q == 0 || log_tau == o.log_tau);
+  }
 };
 
 /// What the search needs: the rows [y X], the bin times and runs.
@@ -152,8 +79,15 @@ struct Problem {
   std::span<const double> t_s;
   std::span<const int> segment;
   double span_h = 1;
-  std::vector<double> phi, dt_h;  // scratch
+  std::vector<double> dt_h;
+  std::map<double, std::vector<double>> phi;  // step correlations by log tau, made once each
   std::vector<Point>* record = nullptr;
+
+  const std::vector<double>& phi_at(double log_tau) {
+    auto [it, added] = phi.try_emplace(log_tau);
+    if (added) step_corrs(it->second, t_s, segment, z.rows(), std::exp(log_tau));
+    return it->second;
+  }
 };
 
 // The walk's size: log10 of its variance over the longest run in units of s^2, from 1e-3 (read
@@ -171,20 +105,36 @@ double at(double lo, double hi, int i, int steps) {
   return lo + (hi - lo) * i / (steps - 1);
 }
 
-/// Grid search over the box, `steps` points each way.
+/// Grid search over the box, `steps` points each way, in grid order (the first of equally likely
+/// points wins). A model the grid repeats (q = 0 at every tau, a clamped edge, the best point so
+/// far) is evaluated once; the others go reml::kLanes to a pass.
 void search(Point& best, Problem& pb, const Box& b, int steps) {
-  for (int a = 0; a < steps; ++a) {
-    const double log_tau = at(b.tau_lo, b.tau_hi, a, steps);
-    step_corrs(pb.phi, pb.t_s, pb.segment, pb.z.rows(), std::exp(log_tau));
-    for (int c = 0; c < steps; ++c) {
-      const double q = std::clamp(at(b.q_lo, b.q_hi, c, steps), 0.0, kMaxShare);
-      for (int d = 0; d < steps; ++d) {
-        const double u = std::clamp(at(b.u_lo, b.u_hi, d, steps), kWalkLo, kWalkHi);
-        const Profile pr = reml_profile(pb.z, pb.phi, pb.dt_h, {q, walk_per_h(pb, u)});
-        if (pb.record) pb.record->push_back({log_tau, q, u, pr});
-        if (pr.minus2_loglik < best.profile.minus2_loglik) best = {log_tau, q, u, pr};
-      }
-    }
+  std::vector<Point> pts;
+  for (int a = 0; a < steps; ++a)
+    for (int c = 0; c < steps; ++c)
+      for (int d = 0; d < steps; ++d)
+        pts.push_back({at(b.tau_lo, b.tau_hi, a, steps),
+                       std::clamp(at(b.q_lo, b.q_hi, c, steps), 0.0, kMaxShare),
+                       std::clamp(at(b.u_lo, b.u_hi, d, steps), kWalkLo, kWalkHi),
+                       {}});
+  std::vector<Point> unique{best};
+  std::vector<std::size_t> which(pts.size());
+  std::vector<reml::Model> models;
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    const auto it = std::find_if(unique.begin(), unique.end(),
+                                 [&](const Point& e) { return e.same_model(pts[i]); });
+    which[i] = static_cast<std::size_t>(it - unique.begin());
+    if (it != unique.end()) continue;
+    unique.push_back(pts[i]);
+    models.push_back({&pb.phi_at(pts[i].log_tau), pts[i].q, walk_per_h(pb, pts[i].u)});
+  }
+  std::vector<Profile> found(models.size());
+  reml::profiles(pb.z, pb.dt_h, models, found);
+  for (std::size_t j = 0; j < found.size(); ++j) unique[j + 1].profile = found[j];
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    pts[i].profile = unique[which[i]].profile;
+    if (pb.record) pb.record->push_back(pts[i]);
+    if (pts[i].profile.minus2_loglik < best.profile.minus2_loglik) best = pts[i];
   }
 }
 
@@ -229,7 +179,7 @@ ErrorModel estimate_error_model(const Eigen::MatrixXd& x, const Eigen::VectorXd&
                                 std::span<const double> t_s, std::span<const int> segment) {
   const Eigen::Index n = x.rows(), p = x.cols();
   ErrorModel model;
-  if (n < p + 5 || p + 1 > kMaxColumns) {  // too few bins to estimate three more parameters
+  if (n < p + 5 || p + 1 > reml::kMaxColumns) {  // too few bins to estimate three more parameters
     const Eigen::VectorXd b = x.colPivHouseholderQr().solve(y);
     model.sigma_dph = std::sqrt((y - x * b).squaredNorm() / static_cast<double>(n - p));
     return model;
@@ -247,8 +197,8 @@ ErrorModel estimate_error_model(const Eigen::MatrixXd& x, const Eigen::VectorXd&
   Point best;
   best.log_tau = lo;
   best.u = kWalkLo;  // q = 0 and no walk: independent bins
-  step_corrs(pb.phi, t_s, segment, n, std::exp(lo));
-  best.profile = reml_profile(pb.z, pb.phi, pb.dt_h, {});  // iid
+  const reml::Model iid{&pb.phi_at(lo), 0, 0};
+  reml::profiles(pb.z, pb.dt_h, {&iid, 1}, {&best.profile, 1});
   std::vector<Point> grid;
   pb.record = &grid;
   search(best, pb, {lo, hi, 0.0, kMaxShare, kWalkLo, kWalkHi}, kCoarseSteps);
@@ -290,73 +240,101 @@ ErrorModel estimate_error_model(const Eigen::MatrixXd& x, const Eigen::VectorXd&
 }
 
 namespace {
-Eigen::VectorXd variances_one(const ErrorModel& model, const Eigen::MatrixXd& q_basis,
-                              const Eigen::MatrixXd& r_inv, std::span<const double> t_s,
-                              std::span<const int> segment);
+
+/// A row of the design basis, on the stack (at most reml::kMaxColumns terms).
+using RowVec = Eigen::Matrix<double, 1, Eigen::Dynamic, Eigen::RowMajor, 1, reml::kMaxColumns>;
+
+/// The pieces of Q' C Q for one design basis, each in units of s^2: Q'Q (white), Q' W Q / w (the
+/// walk, per unit w) and Q' P Q per correlation time (Gauss-Markov). A mixture's models share
+/// them: the walk's piece is one matrix, and its models take at most kCoarseSteps values of tau.
+class Meats {
+ public:
+  Meats(const Eigen::MatrixXd& q_basis, std::span<const double> t_s, std::span<const int> segment)
+      : q_(q_basis), t_s_(t_s), segment_(segment), white_(q_basis.transpose() * q_basis) {
+    step_hours(dt_h_, t_s, segment, q_basis.rows());
+  }
+  const Eigen::MatrixXd& white() const { return white_; }
+
+  /// Q' W Q / w with W_ij = min(h_i, h_j), h the hours since the run's first bin: as
+  /// min(h_i, h_j) = sum of dh_k over k <= min(i, j) in the run, v' W v = sum_k dh_k (suffix sum
+  /// of v from k)^2, one backward pass with no n x n matrix.
+  const Eigen::MatrixXd& walk() {
+    if (walk_.size() > 0) return walk_;
+    const Eigen::Index n = q_.rows();
+    walk_ = Eigen::MatrixXd::Zero(q_.cols(), q_.cols());
+    RowVec suffix = RowVec::Zero(q_.cols());  // within a run: the sum of rows i..(run's end)
+    for (Eigen::Index i = n - 1; i >= 0; --i) {
+      suffix += q_.row(i);
+      const double dt = dt_h_[static_cast<std::size_t>(i)];
+      if (dt < 0) {  // bin i starts its run
+        suffix.setZero();
+        continue;
+      }
+      walk_.selfadjointView<Eigen::Upper>().rankUpdate(suffix.transpose(), dt);
+    }
+    walk_ = walk_.selfadjointView<Eigen::Upper>();
+    return walk_;
+  }
+
+  /// Q' P Q with P_ij = exp(-|t_i - t_j| / tau) within a run: P = L + L' - I with L the lower
+  /// triangle, L v the forward recursion f_i = v_i + phi_i f_(i-1), so Q' P Q = S + S' - Q'Q with
+  /// S = Q' L Q = sum_i Q_i' f_i, one pass over the rows.
+  const Eigen::MatrixXd& gauss_markov(double tau_s) {
+    for (const auto& [tau, m] : gm_)
+      if (tau == tau_s) return m;
+    const Eigen::Index n = q_.rows();
+    step_corrs(phi_, t_s_, segment_, n, tau_s);
+    Eigen::MatrixXd s = Eigen::MatrixXd::Zero(q_.cols(), q_.cols());
+    RowVec f = RowVec::Zero(q_.cols());
+    for (Eigen::Index i = 0; i < n; ++i) {
+      f = q_.row(i) + phi_[static_cast<std::size_t>(i)] * f;
+      s.noalias() += q_.row(i).transpose() * f;
+    }
+    gm_.emplace_back(tau_s, s + s.transpose() - white_);
+    return gm_.back().second;
+  }
+
+ private:
+  const Eigen::MatrixXd& q_;
+  std::span<const double> t_s_;
+  std::span<const int> segment_;
+  Eigen::MatrixXd white_, walk_;
+  std::vector<double> dt_h_, phi_;
+  std::vector<std::pair<double, Eigen::MatrixXd>> gm_;
+};
+
+/// Var(b) = s^2 (X'X)^-1 X' C X (X'X)^-1 = s^2 R^-1 (Q' C Q) R^-T with X = Q R, for one model:
+/// formed from the orthonormal Q, it does not cancel as the product with (X'X)^-1 does when X is
+/// ill conditioned.
+Eigen::VectorXd variances_one(const ErrorModel::Component& c, Meats& meats,
+                              const Eigen::MatrixXd& r_inv) {
+  if (!(c.sigma_dph > 0)) return Eigen::VectorXd::Zero(r_inv.rows());
+  const double q = c.corr_time_s > 0 ? c.correlated_share : 0.0;
+  Eigen::MatrixXd meat = (1 - q) * meats.white();
+  if (q > 0) meat += q * meats.gauss_markov(c.corr_time_s);
+  if (c.rrw_dph_per_sqrt_h > 0)
+    meat += std::pow(c.rrw_dph_per_sqrt_h / c.sigma_dph, 2) * meats.walk();
+  return (r_inv * meat * r_inv.transpose()).diagonal() * (c.sigma_dph * c.sigma_dph);
 }
+
+}  // namespace
 
 Eigen::VectorXd ols_variances_under(const ErrorModel& model, const Eigen::MatrixXd& q_basis,
                                     const Eigen::MatrixXd& r_inv, std::span<const double> t_s,
                                     std::span<const int> segment) {
-  if (model.mixture.empty()) return variances_one(model, q_basis, r_inv, t_s, segment);
+  Meats meats(q_basis, t_s, segment);
+  if (model.mixture.empty()) {
+    return variances_one(
+        {model.corr_time_s, model.correlated_share, model.sigma_dph, model.rrw_dph_per_sqrt_h, 1.0},
+        meats, r_inv);
+  }
   Eigen::VectorXd sum = Eigen::VectorXd::Zero(q_basis.cols());
   double weights = 0;
   for (const auto& c : model.mixture) {
-    ErrorModel one;
-    one.corr_time_s = c.corr_time_s;
-    one.correlated_share = c.correlated_share;
-    one.sigma_dph = c.sigma_dph;
-    one.rrw_dph_per_sqrt_h = c.rrw_dph_per_sqrt_h;
-    sum += c.weight * variances_one(one, q_basis, r_inv, t_s, segment).array().log().matrix();
+    sum += c.weight * variances_one(c, meats, r_inv).array().log().matrix();
     weights += c.weight;
   }
   return (sum / weights).array().exp().matrix();
 }
-
-namespace {
-Eigen::VectorXd variances_one(const ErrorModel& model, const Eigen::MatrixXd& q_basis,
-                              const Eigen::MatrixXd& r_inv, std::span<const double> t_s,
-                              std::span<const int> segment) {
-  const Eigen::Index n = q_basis.rows();
-  const double q = model.correlated_share, tau_s = model.corr_time_s;
-  if (!(model.sigma_dph > 0)) return Eigen::VectorXd::Zero(q_basis.cols());
-  // C Q with C = (1 - q) I + q P, P_ij = exp(-|t_i - t_j| / tau) (0 across runs), in O(n p):
-  // P v = f + b - v with f_i = v_i + phi_i f_(i-1) and b_i = v_i + phi_(i+1) b_(i+1), as
-  // exp(-|t_i - t_j| / tau) is the product of the step correlations between them. No n x n
-  // matrix is formed: a fit over thousands of bins needs no more memory than its data.
-  Eigen::MatrixXd cq = q_basis;
-  if (model.rrw_dph_per_sqrt_h > 0) {
-    // Walk part, in units of s^2: W_ij = w min(h_i, h_j), h the hours since the run's first bin,
-    // applied in O(n p) as W v = prefix sums of dh_k times suffix sums of v from k on.
-    const double w_per_h = std::pow(model.rrw_dph_per_sqrt_h / model.sigma_dph, 2);
-    std::vector<double> dt_h;
-    step_hours(dt_h, t_s, segment, n);
-    Eigen::MatrixXd suffix = q_basis;
-    for (Eigen::Index i = n - 2; i >= 0; --i)
-      if (dt_h[static_cast<std::size_t>(i + 1)] >= 0) suffix.row(i) += suffix.row(i + 1);
-    Eigen::MatrixXd walk = Eigen::MatrixXd::Zero(n, q_basis.cols());
-    for (Eigen::Index i = 1; i < n; ++i) {
-      const double dt = dt_h[static_cast<std::size_t>(i)];
-      if (dt >= 0) walk.row(i) = walk.row(i - 1) + dt * suffix.row(i);
-    }
-    cq += w_per_h * walk;
-  }
-  if (q > 0 && tau_s > 0) {
-    std::vector<double> phi;
-    step_corrs(phi, t_s, segment, n, tau_s);
-    Eigen::MatrixXd fwd = q_basis, bwd = q_basis;
-    for (Eigen::Index i = 1; i < n; ++i)
-      fwd.row(i) += phi[static_cast<std::size_t>(i)] * fwd.row(i - 1);
-    for (Eigen::Index i = n - 2; i >= 0; --i)
-      bwd.row(i) += phi[static_cast<std::size_t>(i + 1)] * bwd.row(i + 1);
-    cq += q * (fwd + bwd - 2 * q_basis);
-  }
-  // Var(b) = s^2 (X'X)^-1 X' C X (X'X)^-1 = s^2 R^-1 (Q' C Q) R^-T with X = Q R: formed from the
-  // orthonormal Q, it does not cancel as the product with (X'X)^-1 does when X is ill conditioned.
-  const Eigen::MatrixXd meat = q_basis.transpose() * cq;
-  return (r_inv * meat * r_inv.transpose()).diagonal() * (model.sigma_dph * model.sigma_dph);
-}
-
-}  // namespace
 
 }  // namespace station::compensation

@@ -1,0 +1,140 @@
+// The restricted likelihood by a Kalman filter, kLanes error models per pass (see the header).
+//
+// Harvey, "Forecasting, structural time series models and the Kalman filter" (1989): one filter
+// (Gauss-Markov state g, random-walk state r; observed g + r + white) runs on y and on every
+// column of X with the same gains (sec. 3.4.2, "augmented" filter); the innovations v and their
+// variances f give the GLS normal equations [y X]' F^-1 [y X]; with b and s^2 concentrated out
+// the restricted likelihood is (sec. 3.4 and 5.2; Harville 1977, JASA 72:320)
+//   -2 l_R = sum log f + log |X' F^-1 X| + (n - p) log s^2,  s^2 = RSS_GLS / (n - p).
+// The walk starts at 0 in each run (its level there is the constant's, and runs are independent).
+#include "compensation/reml_filter.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <utility>
+
+namespace station::compensation::reml {
+namespace {
+
+constexpr int L = kLanes;
+using SmallMatrix =
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxColumns, kMaxColumns>;
+using SmallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxColumns, 1>;
+
+/// What a pass gathers per lane: [y X]' F^-1 [y X] (upper triangle) and sum log f.
+struct Gathered {
+  std::array<SmallMatrix, L> m;
+  std::array<double, L> sum_log_f{};
+};
+
+/// The lanes' covariance of the two states (units of s^2) and their gains at one bin.
+struct Riccati {
+  double pgg[L], pgr[L], prr[L], f[L], inv_f[L], kg[L], kr[L];
+};
+
+/// One pass over the bins for L models at once, K columns fixed at compile time. Every loop's
+/// innermost index is the lane, so the compiler vectorizes across models.
+template <int K>
+Gathered pass(const double* z, Eigen::Index n, const std::vector<double>& dt_h,
+              const std::array<Model, L>& md) {
+  double m[K * K][L] = {}, g[K][L] = {}, r[K][L] = {}, v[K][L];
+  double q[L], w[L], ph[L], sum_log_f[L] = {}, prod_f[L];
+  Riccati p{};
+  for (int l = 0; l < L; ++l) q[l] = md[l].q, w[l] = md[l].w_per_h, prod_f[l] = 1;
+  for (Eigen::Index i = 0; i < n; ++i, z += K) {
+    const auto iu = static_cast<std::size_t>(i);
+    const double dt = dt_h[iu];
+    for (int l = 0; l < L; ++l) ph[l] = (*md[l].phi)[iu];
+    if (dt < 0) {  // a run starts: the walk at 0, the Gauss-Markov part stationary
+      for (int l = 0; l < L; ++l) p.pgg[l] = q[l], p.pgr[l] = p.prr[l] = 0;
+      for (int c = 0; c < K; ++c)
+        for (int l = 0; l < L; ++l) g[c][l] = r[c][l] = 0;
+    } else {
+      for (int l = 0; l < L; ++l) {
+        p.pgg[l] = ph[l] * ph[l] * p.pgg[l] + q[l] * (1.0 - ph[l] * ph[l]);
+        p.pgr[l] = ph[l] * p.pgr[l];
+        p.prr[l] = p.prr[l] + w[l] * dt;
+      }
+      for (int c = 0; c < K; ++c)
+        for (int l = 0; l < L; ++l) g[c][l] *= ph[l];
+    }
+    for (int l = 0; l < L; ++l) {
+      p.f[l] = p.pgg[l] + 2 * p.pgr[l] + p.prr[l] + (1.0 - q[l]);
+      p.inv_f[l] = 1.0 / p.f[l];
+      p.kg[l] = (p.pgg[l] + p.pgr[l]) * p.inv_f[l];
+      p.kr[l] = (p.pgr[l] + p.prr[l]) * p.inv_f[l];
+    }
+    for (int c = 0; c < K; ++c)
+      for (int l = 0; l < L; ++l) {
+        v[c][l] = z[c] - g[c][l] - r[c][l];
+        g[c][l] += p.kg[l] * v[c][l];
+        r[c][l] += p.kr[l] * v[c][l];
+      }
+    // P <- P - K f K' (the Joseph form is not needed: f >= 1 - q keeps it well conditioned).
+    for (int l = 0; l < L; ++l) {
+      p.pgg[l] -= p.kg[l] * p.kg[l] * p.f[l];
+      p.pgr[l] -= p.kg[l] * p.kr[l] * p.f[l];
+      p.prr[l] -= p.kr[l] * p.kr[l] * p.f[l];
+      prod_f[l] *= p.f[l];
+    }
+    // f >= 1 - q >= 0.01, so the product of 64 bins' f stays far from underflow: one log per 64
+    // bins instead of one per bin (the log was most of the cost).
+    if ((i & 63) == 63)
+      for (int l = 0; l < L; ++l) sum_log_f[l] += std::log(prod_f[l]), prod_f[l] = 1;
+    for (int a = 0; a < K; ++a) {
+      double va[L];
+      for (int l = 0; l < L; ++l) va[l] = v[a][l] * p.inv_f[l];
+      for (int b = a; b < K; ++b)
+        for (int l = 0; l < L; ++l) m[a * K + b][l] += va[l] * v[b][l];
+    }
+  }
+  Gathered out;
+  for (int l = 0; l < L; ++l) {
+    out.sum_log_f[l] = sum_log_f[l] + std::log(prod_f[l]);
+    out.m[l].resize(K, K);
+    for (int a = 0; a < K; ++a)
+      for (int b = 0; b < K; ++b) out.m[l](a, b) = m[a * K + b][l];
+  }
+  return out;
+}
+
+template <int... Ks>
+Gathered pass_for(int k, const double* z, Eigen::Index n, const std::vector<double>& dt_h,
+                  const std::array<Model, L>& md, std::integer_sequence<int, Ks...>) {
+  Gathered out;
+  ((k == Ks + 2 ? (out = pass<Ks + 2>(z, n, dt_h, md), true) : false) || ...);
+  return out;
+}
+
+/// The likelihood from what one lane gathered.
+Profile finish(const SmallMatrix& m, double sum_log_f, Eigen::Index n) {
+  const Eigen::Index p = m.rows() - 1;
+  const SmallMatrix mxx = m.bottomRightCorner(p, p).selfadjointView<Eigen::Upper>();
+  const SmallVector mxy = m.row(0).tail(p).transpose();
+  const Eigen::LDLT<SmallMatrix> ldlt(mxx);
+  const double rss = m(0, 0) - mxy.dot(ldlt.solve(mxy));
+  Profile out;
+  const auto dof = static_cast<double>(n - p);
+  if (!(rss > 0) || ldlt.info() != Eigen::Success) return out;
+  out.sigma2 = rss / dof;
+  out.minus2_loglik = sum_log_f + ldlt.vectorD().array().log().sum() + dof * std::log(out.sigma2);
+  return out;
+}
+
+}  // namespace
+
+void profiles(const RowMajor& z, const std::vector<double>& dt_h, std::span<const Model> models,
+              std::span<Profile> out) {
+  for (std::size_t first = 0; first < models.size(); first += L) {
+    const std::size_t lanes = std::min<std::size_t>(L, models.size() - first);
+    std::array<Model, L> md;
+    for (std::size_t l = 0; l < L; ++l) md[l] = models[first + std::min(l, lanes - 1)];
+    const Gathered g = pass_for(static_cast<int>(z.cols()), z.data(), z.rows(), dt_h, md,
+                                std::make_integer_sequence<int, kMaxColumns - 1>{});
+    for (std::size_t l = 0; l < lanes; ++l)
+      out[first + l] = finish(g.m[l], g.sum_log_f[l], z.rows());
+  }
+}
+
+}  // namespace station::compensation::reml
