@@ -8,9 +8,11 @@
 
 #include "station/cli/commands.hpp"
 #include "station/cli/csv_table.hpp"
+#include "station/common/allocator.hpp"
 #include "station/store/sqlite.hpp"
 
 int main(int argc, char** argv) {
+  station::keep_freed_memory_for_reuse();
   // A file size limit (RLIMIT_FSIZE, `prlimit --fsize`) must not kill the daemon silently: with
   // SIGXFSZ ignored the write fails with EFBIG, SQLite reports it, and it is handled like a full
   // disk (setrlimit(2), signal(7)).
