@@ -90,7 +90,9 @@ void check(const char* protocol, const std::vector<Protocol>& ps, std::uint64_t 
       if (known_shortfall && k1 != 0) {
         // Issue 22, still open: under a strong rate random walk (K = 0.003 deg/h/sqrt h, far
         // above an RLG's) the k1 errors are optimistic: 0.50 / 0.78 on the paper cycle, 0.54 /
-        // 0.87 on the ramp pair (docs/UNCERTAINTY.md). Held here so that it cannot get worse.
+        // 0.87 on the ramp pair. The bins cannot tell such a walk from none (test
+        // WalkIdentifiability; docs/UNCERTAINTY.md, "What the bins cannot tell"). Held here so
+        // that it cannot get worse.
         EXPECT_GE(s1, 0.45);
         EXPECT_GE(s2, 0.72);
         continue;
