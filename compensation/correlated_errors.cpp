@@ -179,7 +179,7 @@ ErrorModel estimate_error_model(const Eigen::MatrixXd& x, const Eigen::VectorXd&
                                 std::span<const double> t_s, std::span<const int> segment) {
   const Eigen::Index n = x.rows(), p = x.cols();
   ErrorModel model;
-  if (n < p + 5 || p < 1 ||
+  if (n < p + kMinBinsForErrorModelExtra || p < 1 ||
       p + 1 > reml::kMaxColumns) {  // too few bins to estimate three more parameters
     const Eigen::VectorXd b = x.colPivHouseholderQr().solve(y);
     model.sigma_dph = std::sqrt((y - x * b).squaredNorm() / static_cast<double>(n - p));

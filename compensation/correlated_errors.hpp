@@ -58,12 +58,16 @@ struct ErrorModel {
   std::vector<Component> mixture;
 };
 
+/// Bins beyond the p coefficients the error model needs to estimate anything: with fewer it is
+/// "iid" (the OLS errors) and the fit says so.
+inline constexpr long kMinBinsForErrorModelExtra = 5;
+
 /// Estimates the error model of y = X b + e by REML: the most likely point, and the mixture of
 /// the models the bins cannot rule out. `x` should be well conditioned (pass the
 /// orthonormal Q of X = Q R: the likelihood depends only on the column space of X). `t_s` are the
 /// bin times (increasing within a segment), `segment` the run each bin came from (bins of different
-/// runs are independent; empty: one run). Needs at least p + 5 bins; with fewer the model is "iid"
-/// with s^2 = RSS/(n-p).
+/// runs are independent; empty: one run). Needs at least p + kMinBinsForErrorModelExtra bins; with
+/// fewer the model is "iid" with s^2 = RSS/(n-p).
 ErrorModel estimate_error_model(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
                                 std::span<const double> t_s, std::span<const int> segment);
 

@@ -353,6 +353,13 @@ FitResult fit_impl(const ModelInput& in, const ModelSpec& spec, const ErrorModel
                            std::to_string(static_cast<int>(kCollinearCondition)) +
                            " (Belsley); coefficients are poorly separated");
   }
+  if (fixed == nullptr &&
+      static_cast<long>(n) < static_cast<long>(p) + kMinBinsForErrorModelExtra) {
+    res.warnings.push_back("only " + std::to_string(n) + " bins: too few to estimate their " +
+                           "correlated noise (needs " +
+                           std::to_string(static_cast<long>(p) + kMinBinsForErrorModelExtra) +
+                           "); the errors assume independent bins and may be too small");
+  }
   if (res.error_model.on_search_boundary) {
     res.warnings.push_back(
         "the bins' correlated noise looks like a drift (error model at the edge of its search: " +

@@ -1,6 +1,8 @@
 // Thermal bias model fit: exact recovery, recovery within standard errors, diagnostics.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
 #include <random>
 #include <vector>
@@ -120,6 +122,21 @@ TEST(Fit, RejectsTooFewPointsAndDependentTerms) {
     three.grad_c.push_back(d.grad_c[i]);
   }
   EXPECT_THROW(sc::fit_model(three.view(), sc::ModelSpec{}), std::invalid_argument);
+  // Six bins fit three coefficients, but their correlated noise cannot be estimated (it needs
+  // 3 + 5): the fit says its errors assume independent bins; with all bins it does not.
+  auto has_warning = [](const sc::FitResult& f) {
+    return std::any_of(f.warnings.begin(), f.warnings.end(), [](const std::string& w) {
+      return w.find("too few to estimate their correlated noise (needs 8)") != std::string::npos;
+    });
+  };
+  sc::ModelData six;
+  for (int i = 0; i < 6; ++i) {
+    six.bias_dph.push_back(d.bias_dph[i * 10]);
+    six.temp_c.push_back(d.temp_c[i * 10]);
+    six.grad_c.push_back(d.grad_c[i * 10]);
+  }
+  EXPECT_TRUE(has_warning(sc::fit_model(six.view(), sc::ModelSpec{})));
+  EXPECT_FALSE(has_warning(sc::fit_model(d.view(), sc::ModelSpec{})));
   sc::ModelSpec rate_only;
   rate_only.terms = {sc::Term::dTdt};  // constant 10 C/h: same column as B0
   EXPECT_THROW(sc::fit_model(d.view(), rate_only), std::invalid_argument);
