@@ -11,6 +11,7 @@
 #include "compensation/chi_squared.hpp"
 #include "compensation/limits.hpp"
 #include "compensation/noise_edf.hpp"
+#include "compensation/noise_id.hpp"
 
 namespace station::compensation {
 namespace {
@@ -49,6 +50,76 @@ double third_difference_sum(const double* theta, std::size_t m, std::size_t n_te
     s += d * d;
   }
   return s;
+}
+
+void check_adev_inputs(std::span<const double> rate, double rate_hz, double confidence) {
+  if (!(rate_hz > 0.0) || !std::isfinite(rate_hz) || !(confidence > 0.0 && confidence < 1.0)) {
+    throw DataError("overlapping_adev: need rate_hz > 0 and 0 < confidence < 1, got " +
+                    std::to_string(rate_hz) + ", " + std::to_string(confidence));
+  }
+  for (std::size_t i = 0; i < rate.size(); ++i) {
+    if (!std::isfinite(rate[i]))
+      throw DataError("overlapping_adev: sample " + std::to_string(i) + ": " +
+                      finite_problem(rate[i]));
+  }
+}
+
+// Integrated angle in units of (rate unit) x (sample interval): theta_0 = 0,
+// theta_k = sum_{i<k} (y_i - mean), N = M + 1 points for M samples. Working in sample units,
+// tau0 cancels out of AVAR. The mean rate is removed first: AVAR is invariant to a constant rate
+// offset (it only adds a linear ramp to theta, which the second difference annihilates), and it
+// keeps the cumulative sum a zero-mean random walk, small enough for 1e7 samples not to lose
+// precision.
+std::vector<double> integrated_angle(std::span<const double> rate) {
+  double mean = 0;
+  for (double y : rate) mean += y;
+  mean /= static_cast<double>(rate.size());
+  std::vector<double> theta(rate.size() + 1);
+  theta[0] = 0.0;
+  for (std::size_t i = 0; i < rate.size(); ++i) theta[i + 1] = theta[i] + (rate[i] - mean);
+  return theta;
+}
+
+// One point of the curve, its interval still to come. NIST SP 1065 §5.2.4, overlapping AVAR from
+// phase data: AVAR(m tau0) = 1 / (2 tau^2 (N - 2m)) sum_k (x_{k+2m} - 2 x_{k+m} + x_k)^2, and
+// §5.2.8, overlapping HVAR: 1 / (6 tau^2 (N - 3m)) sum_k (third difference)^2, with
+// x = tau0 * theta and tau = m tau0, so tau0^2 cancels.
+AdevPoint deviation_point(const std::vector<double>& theta, std::size_t m, double tau0_s,
+                          bool hadamard) {
+  const std::size_t n_terms = theta.size() - (hadamard ? 3 : 2) * m;
+  const double sum = hadamard ? third_difference_sum(theta.data(), m, n_terms)
+                              : second_difference_sum(theta.data(), m, n_terms);
+  const double md = static_cast<double>(m);
+  AdevPoint p;
+  p.m = m;
+  p.tau_s = md * tau0_s;
+  p.n = n_terms;
+  p.adev = std::sqrt(sum / ((hadamard ? 6.0 : 2.0) * md * md * static_cast<double>(n_terms)));
+  if (!std::isfinite(p.adev)) {
+    throw DataError("overlapping_adev: the Allan deviation at m = " + std::to_string(m) +
+                    " overflows: the values are too large");
+  }
+  return p;
+}
+
+// The noise at this tau decides the interval (Greenhall & Riley 2003). Identified as Stable32
+// does (NIST SP 1065 §5.6; noise_id.hpp): by the lag-1 autocorrelation where 30 averages remain,
+// by the B1 ratio down to 8; below that carried from the largest tau where it was identified,
+// and white FM (the gyro's angle random walk) when the series is too short to identify anything.
+void assign_noise(AdevPoint& p, std::span<const double> rate, int order,
+                  std::optional<int>& last_alpha) {
+  if (const auto id = identify_noise(rate, p.m, order)) {
+    p.alpha = id->alpha;
+    p.noise_id = NoiseIdMethod::lag1;
+  } else if (const auto b1 = identify_noise_b1(rate, p.m)) {
+    p.alpha = b1->alpha;
+    p.noise_id = NoiseIdMethod::b1;
+  } else {
+    p.alpha = last_alpha.value_or(0);
+    p.noise_id = NoiseIdMethod::none;
+    return;
+  }
+  last_alpha = p.alpha;
 }
 
 // Reading noise terms off the curve (IEEE Std 952-1997 Annex C, Table C.2). A term whose ADEV
@@ -135,62 +206,19 @@ std::pair<double, double> chi_squared_interval(double dev, double edf, double co
 std::vector<AdevPoint> overlapping_adev(std::span<const double> rate, double rate_hz,
                                         std::span<const std::size_t> m_list, double confidence,
                                         DeviationKind kind) {
-  if (!(rate_hz > 0.0) || !std::isfinite(rate_hz) || !(confidence > 0.0 && confidence < 1.0)) {
-    throw DataError("overlapping_adev: need rate_hz > 0 and 0 < confidence < 1, got " +
-                    std::to_string(rate_hz) + ", " + std::to_string(confidence));
-  }
-  for (std::size_t i = 0; i < rate.size(); ++i) {
-    if (!std::isfinite(rate[i]))
-      throw DataError("overlapping_adev: sample " + std::to_string(i) + ": " +
-                      finite_problem(rate[i]));
-  }
+  check_adev_inputs(rate, rate_hz, confidence);
   std::vector<AdevPoint> out;
   if (rate.empty()) return out;
-  // Integrated angle in units of (rate unit) x (sample interval): theta_0 = 0,
-  // theta_k = sum_{i<k} (y_i - mean). Working in sample units, tau0 cancels out of AVAR below.
-  // The mean rate is removed first: AVAR is invariant to a constant rate offset (it only adds a
-  // linear ramp to theta, which the second difference annihilates), and it keeps the cumulative
-  // sum a zero-mean random walk, small enough for 1e7 samples not to lose precision.
-  double mean = 0;
-  for (double y : rate) mean += y;
-  mean /= static_cast<double>(rate.size());
-  const std::size_t n_angle = rate.size() + 1;  // N = M + 1 angle points
-  std::vector<double> theta(n_angle);
-  theta[0] = 0.0;
-  for (std::size_t i = 0; i < rate.size(); ++i) theta[i + 1] = theta[i] + (rate[i] - mean);
-
-  const double tau0_s = 1.0 / rate_hz;
+  const std::vector<double> theta = integrated_angle(rate);
   const bool hadamard = kind == DeviationKind::hdev;
-  const std::size_t order = hadamard ? 3 : 2;  // the difference the variance takes of the angle
+  const int order = hadamard ? 3 : 2;  // the difference the variance takes of the angle
   std::optional<int> last_alpha;
   for (std::size_t m : m_list) {
-    if (m == 0 || order * m >= n_angle) continue;  // fewer than 1 term
-    const std::size_t n_terms = n_angle - order * m;
-    // NIST SP 1065 §5.2.4, overlapping AVAR from phase data:
-    //   AVAR(m tau0) = 1 / (2 tau^2 (N - 2m)) sum_{k} (x_{k+2m} - 2 x_{k+m} + x_k)^2,
-    // and §5.2.8, overlapping HVAR: 1 / (6 tau^2 (N - 3m)) sum_k (third difference)^2,
-    // with x = tau0 * theta and tau = m tau0, so tau0^2 cancels.
-    const double sum = hadamard ? third_difference_sum(theta.data(), m, n_terms)
-                                : second_difference_sum(theta.data(), m, n_terms);
-    const double md = static_cast<double>(m);
-    AdevPoint p;
-    p.m = m;
-    p.tau_s = md * tau0_s;
-    p.n = n_terms;
-    p.adev = std::sqrt(sum / ((hadamard ? 6.0 : 2.0) * md * md * static_cast<double>(n_terms)));
-    if (!std::isfinite(p.adev)) {
-      throw DataError("overlapping_adev: the Allan deviation at m = " + std::to_string(m) +
-                      " overflows: the values are too large");
-    }
-    // The noise at this tau decides the interval (Greenhall & Riley 2003): identified where 30
-    // averages remain, else carried from the largest tau where it was; white FM (the gyro's
-    // angle random walk) when the series is too short to identify anything.
-    if (const auto id = identify_noise(rate, m, static_cast<int>(order))) {
-      last_alpha = id->alpha;
-      p.alpha_identified = true;
-    }
-    p.alpha = last_alpha.value_or(0);
-    p.edf = greenhall_edf(p.alpha, static_cast<int>(order), md, static_cast<double>(n_angle), true);
+    if (m == 0 || static_cast<std::size_t>(order) * m >= theta.size()) continue;  // no term
+    AdevPoint p = deviation_point(theta, m, 1.0 / rate_hz, hadamard);
+    assign_noise(p, rate, order, last_alpha);
+    p.edf = greenhall_edf(p.alpha, order, static_cast<double>(m), static_cast<double>(theta.size()),
+                          true);
     std::tie(p.ci_low, p.ci_high) = chi_squared_interval(p.adev, p.edf, confidence);
     out.push_back(p);
   }

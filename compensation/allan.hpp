@@ -9,6 +9,8 @@
 #include <utility>
 #include <vector>
 
+#include "compensation/noise_id.hpp"
+
 namespace station::compensation {
 
 /// How averaging factors m (tau = m * tau0) are chosen.
@@ -31,11 +33,13 @@ struct AdevPoint {
   double ci_high = 0;  ///< upper bound
   std::size_t n = 0;   ///< number of terms in the overlapping sum (N - 2m, N angle points)
   double edf = 0;      ///< equivalent degrees of freedom used for the interval
-  /// Power-law exponent of the noise the interval assumes (noise_edf.hpp: +2 white PM .. -2
-  /// random-walk FM), identified at this tau by the lag-1 method, or carried from the largest
-  /// tau where it could be (fewer than 30 averages left: `alpha_identified` false).
+  /// Power-law exponent of the noise the interval assumes (noise_id.hpp: +2 white PM .. -2
+  /// random-walk FM), identified at this tau (`noise_id` says how) or, with fewer than
+  /// kMinB1Averages averages left, carried from the largest tau where it was (white FM when none).
   int alpha = 0;
-  bool alpha_identified = false;
+  /// How alpha was found: lag-1 autocorrelation (30 averages or more), B1 ratio (8 to 29) or
+  /// none (carried).
+  NoiseIdMethod noise_id = NoiseIdMethod::none;
 };
 
 /// Which deviation: Allan (second difference of the angle) or Hadamard (third difference:
@@ -45,7 +49,7 @@ enum class DeviationKind { adev, hdev };
 /// Overlapping ADEV (or HDEV) of `rate` (any rate unit, sampled at rate_hz) at each factor in
 /// `m_list` (increasing), computed from the integrated angle in O(N) per tau; interval at
 /// `confidence` (two-sided) from the chi-squared distribution with the equivalent degrees of
-/// freedom of Greenhall & Riley for the noise identified at that tau (noise_edf.hpp). Factors
+/// freedom of Greenhall & Riley for the noise identified at that tau (noise_id.hpp). Factors
 /// with fewer than 1 term are skipped. Throws DataError unless rate_hz > 0 is finite,
 /// 0 < confidence < 1 and every sample is finite, or when the result overflows. Pure.
 std::vector<AdevPoint> overlapping_adev(std::span<const double> rate, double rate_hz,

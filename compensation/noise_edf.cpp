@@ -4,44 +4,12 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
-#include <vector>
 
 namespace station::compensation {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kJMax = 100;  // Greenhall & Riley: exact sums up to J = 100 terms
-
-/// y minus its least-squares line.
-std::vector<double> detrended(std::vector<double> y) {
-  const double n = static_cast<double>(y.size());
-  double st = 0, sy = 0, stt = 0, sty = 0;
-  for (std::size_t i = 0; i < y.size(); ++i) {
-    const double t = static_cast<double>(i);
-    st += t;
-    sy += y[i];
-    stt += t * t;
-    sty += t * y[i];
-  }
-  const double den = n * stt - st * st;
-  const double slope = den != 0 ? (n * sty - st * sy) / den : 0.0;
-  const double icpt = (sy - slope * st) / n;
-  for (std::size_t i = 0; i < y.size(); ++i) y[i] -= icpt + slope * static_cast<double>(i);
-  return y;
-}
-
-/// Lag-1 autocorrelation about the mean (Riley & Greenhall 2004, eq. 2).
-double lag1(const std::vector<double>& x) {
-  double mean = 0;
-  for (const double v : x) mean += v;
-  mean /= static_cast<double>(x.size());
-  double num = 0, den = 0;
-  for (std::size_t i = 0; i < x.size(); ++i) {
-    den += (x[i] - mean) * (x[i] - mean);
-    if (i + 1 < x.size()) num += (x[i] - mean) * (x[i + 1] - mean);
-  }
-  return den > 0 ? num / den : 0.0;
-}
 
 // Greenhall & Riley 2003, eq. (7): the generalized autocovariance kernel sw(t) of phase noise
 // with exponent alpha (a polynomial or t^k ln|t| per alpha).
@@ -121,34 +89,6 @@ A01 table3(int d) {
 }
 
 }  // namespace
-
-std::optional<NoiseId> identify_noise(std::span<const double> rate, std::size_t m, int d_max) {
-  if (m == 0) return std::nullopt;
-  const std::size_t blocks = rate.size() / m;
-  if (blocks < kMinNoiseIdPoints) return std::nullopt;
-  std::vector<double> x(blocks);
-  for (std::size_t b = 0; b < blocks; ++b) {
-    double s = 0;
-    for (std::size_t i = 0; i < m; ++i) s += rate[b * m + i];
-    x[b] = s / static_cast<double>(m);
-  }
-  x = detrended(std::move(x));
-  for (int d = 0;; ++d) {
-    const double r1 = lag1(x);
-    const double delta = r1 / (1 + r1);
-    if (delta < 0.25 || d >= d_max) {
-      NoiseId id;
-      id.differences = d;
-      id.alpha_est = -2 * (delta + d);
-      id.alpha = static_cast<int>(-std::lround(2 * delta)) - 2 * d;
-      // The variance of order d_max converges for alpha > 1 - 2 d_max; white PM (+2) at most.
-      id.alpha = std::clamp(id.alpha, 2 - 2 * d_max, 2);
-      return id;
-    }
-    for (std::size_t i = 0; i + 1 < x.size(); ++i) x[i] = x[i + 1] - x[i];
-    x.pop_back();
-  }
-}
 
 double greenhall_edf(int alpha, int d, double m, double n_phase, bool overlapping) {
   if (alpha + 2 * d <= 1 || alpha > 2)

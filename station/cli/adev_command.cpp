@@ -5,6 +5,7 @@
 #include <cmath>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <span>
 
 #include "compensation/allan.hpp"
 #include "compensation/limits.hpp"
@@ -76,21 +77,64 @@ nlohmann::json noise_json(const sc::NoiseTerms& nt) {
           {"chi2_per_dof", opt(nt.fit_chi2_per_dof)}};
 }
 
+/// The deviation curve the options ask for; bad data is one line naming the file and column.
+std::vector<sc::AdevPoint> curve_of(const AdevOptions& o, std::span<const double> rate) {
+  const auto ms = factors_from(o, rate.size());
+  try {
+    return sc::overlapping_adev(
+        rate, o.rate_hz, ms, 0.683,
+        o.kind == "hdev" ? sc::DeviationKind::hdev : sc::DeviationKind::adev);
+  } catch (const sc::DataError& e) {
+    throw InputError(fmt::format("{}: column '{}': {}", o.file, o.col, e.what()));
+  }
+}
+
+/// One object per tau: the point, its interval, the noise it assumes and how that was found
+/// (`alpha_identified` is kept for readers of the earlier output: noise_id is not "none").
+nlohmann::json rows_json(const std::vector<sc::AdevPoint>& pts) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (const auto& p : pts) {
+    rows.push_back({{"tau_s", p.tau_s},
+                    {"m", p.m},
+                    {"adev", p.adev},
+                    {"ci_low", p.ci_low},
+                    {"ci_high", p.ci_high},
+                    {"n", p.n},
+                    {"alpha", p.alpha},
+                    {"noise_id", std::string(sc::noise_id_method_name(p.noise_id))},
+                    {"alpha_identified", p.noise_id != sc::NoiseIdMethod::none},
+                    {"edf", p.edf}});
+  }
+  return rows;
+}
+
+/// The table's mark after alpha: blank for the lag-1 method, b for the B1 ratio, * carried.
+const char* method_mark(sc::NoiseIdMethod method) {
+  switch (method) {
+    case sc::NoiseIdMethod::lag1:
+      return " ";
+    case sc::NoiseIdMethod::b1:
+      return "b";
+    case sc::NoiseIdMethod::none:
+      break;
+  }
+  return "*";
+}
+
 void print_table(const AdevOptions& o, std::size_t n, const std::vector<sc::AdevPoint>& pts,
                  const sc::NoiseTerms& nt) {
   const bool h = o.kind == "hdev";
   fmt::print(
       "{}: column '{}', {} samples at {:g} Hz, overlapping {} (IEEE 952 / NIST SP 1065); 68.3 % "
       "intervals with Greenhall's edf for the noise identified at each tau (alpha: +2 white PM, "
-      "0 white FM = ARW, -1 flicker FM = bias instability, -2 random-walk FM = RRW; * carried "
-      "from a shorter tau)\n\n",
+      "0 white FM = ARW, -1 flicker FM = bias instability, -2 random-walk FM = RRW; unmarked: "
+      "lag-1 autocorrelation, b: B1 ratio (8-29 averages), *: carried from a shorter tau)\n\n",
       o.file, o.col, n, o.rate_hz, h ? "Hadamard deviation" : "Allan deviation");
   fmt::print("  {:>12} {:>9} {:>13} {:>13} {:>13} {:>9} {:>6} {:>8}\n", "tau_s", "m",
              h ? "hdev" : "adev", "ci_low", "ci_high", "n", "alpha", "edf");
   for (const auto& p : pts) {
     fmt::print("  {:>12g} {:>9} {:>13.5e} {:>13.5e} {:>13.5e} {:>9} {:>5}{} {:>8.1f}\n", p.tau_s,
-               p.m, p.adev, p.ci_low, p.ci_high, p.n, p.alpha, p.alpha_identified ? " " : "*",
-               p.edf);
+               p.m, p.adev, p.ci_low, p.ci_high, p.n, p.alpha, method_mark(p.noise_id), p.edf);
   }
   auto line = [](const char* what, const std::optional<double>& v, const std::optional<double>& se,
                  const char* unit) {
@@ -132,32 +176,14 @@ void add_adev_command(CLI::App& app, CommandStatus& status) {
     if (rate.size() < 3) {
       throw InputError(fmt::format("{}: {} samples; ADEV needs at least 3", o->file, rate.size()));
     }
-    const auto ms = factors_from(*o, rate.size());
-    std::vector<sc::AdevPoint> pts;
-    try {
-      pts = sc::overlapping_adev(
-          rate, o->rate_hz, ms, 0.683,
-          o->kind == "hdev" ? sc::DeviationKind::hdev : sc::DeviationKind::adev);
-    } catch (const sc::DataError& e) {
-      throw InputError(fmt::format("{}: column '{}': {}", o->file, o->col, e.what()));
-    }
+    const auto pts = curve_of(*o, rate);
     const auto nt = sc::fit_noise_terms(pts);
     if (o->json) {
-      nlohmann::json rows = nlohmann::json::array();
-      for (const auto& p : pts) {
-        rows.push_back({{"tau_s", p.tau_s},
-                        {"m", p.m},
-                        {"adev", p.adev},
-                        {"ci_low", p.ci_low},
-                        {"ci_high", p.ci_high},
-                        {"n", p.n},
-                        {"alpha", p.alpha},
-                        {"alpha_identified", p.alpha_identified},
-                        {"edf", p.edf}});
-      }
-      std::cout
-          << nlohmann::json{{"kind", o->kind}, {"rows", rows}, {"noise", noise_json(nt)}}.dump(2)
-          << '\n';
+      std::cout << nlohmann::json{{"kind", o->kind},
+                                  {"rows", rows_json(pts)},
+                                  {"noise", noise_json(nt)}}
+                       .dump(2)
+                << '\n';
     } else {
       print_table(*o, rate.size(), pts, nt);
     }

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -125,10 +126,21 @@ TEST(Cli, AdevJsonHasRowsAndNoise) {
   ASSERT_GT(j["rows"].size(), 10u);
   EXPECT_EQ(j["rows"][0]["m"].get<int>(), 1);
   EXPECT_DOUBLE_EQ(j["rows"][1]["tau_s"].get<double>(), 2.0);
+  // At m = 1 the overlapping sum has samples - 1 terms.
+  const std::size_t rows_in_example = j["rows"][0]["n"].get<std::size_t>() + 1;
+  std::set<std::string> methods;
   for (const auto& r : j["rows"]) {
     EXPECT_LE(r["ci_low"].get<double>(), r["adev"].get<double>());
     EXPECT_GE(r["ci_high"].get<double>(), r["adev"].get<double>());
+    // How alpha was found: lag-1 (30 averages or more), B1 (8 to 29), none (carried).
+    const auto method = r["noise_id"].get<std::string>();
+    methods.insert(method);
+    const std::size_t averages = rows_in_example / r["m"].get<std::size_t>();
+    const std::string want = averages >= 30 ? "lag1" : averages >= 8 ? "b1" : "none";
+    EXPECT_EQ(method, want) << "m " << r["m"];
+    EXPECT_EQ(r["alpha_identified"].get<bool>(), method != "none");
   }
+  EXPECT_EQ(methods, (std::set<std::string>{"lag1", "b1", "none"}));
   EXPECT_TRUE(j["noise"].contains("angle_random_walk_deg_rth"));
 }
 
