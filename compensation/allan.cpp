@@ -64,22 +64,6 @@ void check_adev_inputs(std::span<const double> rate, double rate_hz, double conf
   }
 }
 
-// Integrated angle in units of (rate unit) x (sample interval): theta_0 = 0,
-// theta_k = sum_{i<k} (y_i - mean), N = M + 1 points for M samples. Working in sample units,
-// tau0 cancels out of AVAR. The mean rate is removed first: AVAR is invariant to a constant rate
-// offset (it only adds a linear ramp to theta, which the second difference annihilates), and it
-// keeps the cumulative sum a zero-mean random walk, small enough for 1e7 samples not to lose
-// precision.
-std::vector<double> integrated_angle(std::span<const double> rate) {
-  double mean = 0;
-  for (double y : rate) mean += y;
-  mean /= static_cast<double>(rate.size());
-  std::vector<double> theta(rate.size() + 1);
-  theta[0] = 0.0;
-  for (std::size_t i = 0; i < rate.size(); ++i) theta[i + 1] = theta[i] + (rate[i] - mean);
-  return theta;
-}
-
 // One point of the curve, its interval still to come. NIST SP 1065 §5.2.4, overlapping AVAR from
 // phase data: AVAR(m tau0) = 1 / (2 tau^2 (N - 2m)) sum_k (x_{k+2m} - 2 x_{k+m} + x_k)^2, and
 // §5.2.8, overlapping HVAR: 1 / (6 tau^2 (N - 3m)) sum_k (third difference)^2, with
@@ -201,6 +185,20 @@ std::pair<double, double> chi_squared_interval(double dev, double edf, double co
   const double alpha = 1.0 - confidence;
   return {dev * std::sqrt(edf / chi_squared_quantile(1.0 - alpha / 2.0, edf)),
           dev * std::sqrt(edf / chi_squared_quantile(alpha / 2.0, edf))};
+}
+
+// Working in sample units, tau0 cancels out of every variance. The mean rate is removed first: AVAR
+// is invariant to a constant rate offset (it only adds a linear ramp to theta, which the second
+// difference annihilates), and it keeps the cumulative sum a zero-mean random walk, small enough
+// for 1e7 samples not to lose precision.
+std::vector<double> integrated_angle(std::span<const double> rate) {
+  double mean = 0;
+  for (double y : rate) mean += y;
+  mean /= static_cast<double>(rate.size());
+  std::vector<double> theta(rate.size() + 1);
+  theta[0] = 0.0;
+  for (std::size_t i = 0; i < rate.size(); ++i) theta[i + 1] = theta[i] + (rate[i] - mean);
+  return theta;
 }
 
 std::vector<AdevPoint> overlapping_adev(std::span<const double> rate, double rate_hz,

@@ -46,6 +46,11 @@ struct AdevPoint {
 /// insensitive to a linear drift of the rate; NIST SP 1065 §5.2.8).
 enum class DeviationKind { adev, hdev };
 
+/// The integrated angle of `rate` in units of (rate unit) x (sample interval), its mean rate
+/// removed: theta_0 = 0, theta_k = sum_{i<k} (y_i - mean), M + 1 points for M samples (the phase
+/// x = tau0 theta of NIST SP 1065 §5.2). What every deviation is a difference of. Pure.
+std::vector<double> integrated_angle(std::span<const double> rate);
+
 /// Overlapping ADEV (or HDEV) of `rate` (any rate unit, sampled at rate_hz) at each factor in
 /// `m_list` (increasing), computed from the integrated angle in O(N) per tau; interval at
 /// `confidence` (two-sided) from the chi-squared distribution with the equivalent degrees of

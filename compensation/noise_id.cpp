@@ -5,6 +5,8 @@
 #include <numbers>
 #include <vector>
 
+#include "compensation/allan.hpp"
+
 namespace station::compensation {
 namespace {
 
@@ -77,11 +79,7 @@ double allan_variance_of_averages(const std::vector<double>& a) {
 /// N = n + 1 phase points x = tau0 theta, theta the integrated rate (tau0^2 cancels with tau).
 /// Needs n >= 3m.
 double modified_allan_variance(std::span<const double> rate, std::size_t m) {
-  double mean = 0;
-  for (const double v : rate) mean += v;
-  mean /= static_cast<double>(rate.size());
-  std::vector<double> theta(rate.size() + 1, 0.0);  // mean removed: see overlapping_adev
-  for (std::size_t i = 0; i < rate.size(); ++i) theta[i + 1] = theta[i] + (rate[i] - mean);
+  const std::vector<double> theta = integrated_angle(rate);
   const auto d2 = [&](std::size_t i) { return theta[i + 2 * m] - 2 * theta[i + m] + theta[i]; };
   const std::size_t terms = theta.size() - 3 * m + 1;
   double inner = 0;
