@@ -19,6 +19,7 @@
 #include <thread>
 #include <vector>
 
+#include "drivers/registry/dialects.hpp"
 #include "sim_devices/control_socket.hpp"
 #include "sim_devices/fault_commands.hpp"
 #include "sim_devices/sim_world.hpp"
@@ -166,10 +167,10 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 16));
   app.add_option("--seed", o.seed, "seed of coefficients and noise")->capture_default_str();
   app.add_option("--chamber", o.chamber_model,
-                 "chamber dialect: generic_plc, watlow_f4, watlow_f4t, watlow_f4t_map2, "
-                 "watlow_f4p, espec_p300")
+                 "chamber dialect: " + station::drivers::chamber_models())
       ->capture_default_str();
-  app.add_option("--turntable", o.turntable_model, "turntable dialect: generic_plc, acutrol3000")
+  app.add_option("--turntable", o.turntable_model,
+                 "turntable dialect: " + station::drivers::turntable_models())
       ->capture_default_str();
   app.add_option("--chamber-port", o.chamber_port, "chamber Modbus TCP port, 0 = ephemeral")
       ->capture_default_str()

@@ -61,7 +61,7 @@ Result<void> LineClient::connect() {
   backoff_.succeeded();
   connected_ = true;
   ++connects_;
-  consecutive_timeouts_ = 0;
+  link_.answered();
   tap(TapDirection::event, "ascii-connect", {}, to_string(endpoint_));
   return {};
 }
@@ -83,17 +83,13 @@ Result<void> LineClient::ensure_connected() {
 
 Error LineClient::fail(int err, const std::string& what) {
   Error e = translate_line_error(err, device_ + " " + what);
-  consecutive_timeouts_ = e.kind == ErrorKind::timeout ? consecutive_timeouts_ + 1 : 0;
-  // A rebooted TCP peer leaves our socket half-open (see ModbusClient::fail).
-  const bool stale_tcp = consecutive_timeouts_ >= kTimeoutsBeforeReconnect &&
-                         std::holds_alternative<LineTcp>(endpoint_);
-  if (stale_tcp)
-    e.message += fmt::format(" ({} timeouts in a row: reconnecting)", consecutive_timeouts_);
+  const bool reopen = link_.must_reopen(e.kind, std::holds_alternative<LineTcp>(endpoint_));
+  if (reopen && link_.stale_timeouts() > 0)
+    e.message += fmt::format(" ({} timeouts in a row: reconnecting)", link_.stale_timeouts());
   const auto eb = errno_bytes(err);
   tap(TapDirection::event, "ascii-error",
       std::string_view(reinterpret_cast<const char*>(eb.data()), 4), e.message);
-  if (e.kind == ErrorKind::disconnected || stale_tcp) {
-    consecutive_timeouts_ = 0;
+  if (reopen) {
     disconnect();
   } else if (connected_) {
     wire_->flush();  // a late reply must not be read as the next command's
@@ -121,14 +117,14 @@ Result<std::string> LineClient::query(std::string_view command) {
     const int err = errno;
     return fail(err, fmt::format("reply to '{}'", command));
   }
-  consecutive_timeouts_ = 0;
+  link_.answered();
   tap(TapDirection::rx, "ascii", line, {});
   return line;
 }
 
 Result<void> LineClient::send(std::string_view command) {
   if (auto t = transmit(command); !t) return t;
-  consecutive_timeouts_ = 0;
+  link_.answered();
   return {};
 }
 

@@ -15,6 +15,7 @@
 #include "drivers/ascii/line_wire.hpp"
 #include "drivers/common/backoff.hpp"
 #include "drivers/common/result.hpp"
+#include "drivers/common/stale_link.hpp"
 #include "drivers/common/tap.hpp"
 
 namespace station::drivers::ascii {
@@ -72,12 +73,9 @@ class LineClient {
   bool connected_ = false;
   std::uint64_t connects_ = 0;
   Tap* tap_ = nullptr;
-  int consecutive_timeouts_ = 0;
+  StaleLink link_;  ///< the stale-link rule (drivers/common/stale_link.hpp)
   Backoff backoff_;
   std::string last_connect_error_;
 };
-
-/// Consecutive timeouts after which a TCP client drops its connection (as ModbusClient).
-inline constexpr int kTimeoutsBeforeReconnect = 3;
 
 }  // namespace station::drivers::ascii

@@ -7,22 +7,17 @@
 #include <charconv>
 #include <stdexcept>
 
+#include "drivers/common/endpoint_field.hpp"
+
 namespace station::drivers::ascii {
 namespace {
 
 [[noreturn]] void fail(std::string_view text, const std::string& what) {
-  throw std::invalid_argument("line endpoint '" + std::string(text) + "': " + what);
+  endpoint_error("line", text, what);
 }
 
 int parse_int(std::string_view text, std::string_view key, std::string_view value, int lo, int hi) {
-  int v = 0;
-  auto [ptr, ec] = std::from_chars(value.data(), value.data() + value.size(), v);
-  if (ec != std::errc{} || ptr != value.data() + value.size() || value.empty())
-    fail(text, std::string(key) + " '" + std::string(value) + "' is not an integer");
-  if (v < lo || v > hi)
-    fail(text, std::string(key) + " " + std::to_string(v) + " not in " + std::to_string(lo) + ".." +
-                   std::to_string(hi));
-  return v;
+  return endpoint_int("line", text, key, value, lo, hi);
 }
 
 // The rates termios can set (cfsetspeed's B* constants up to 230400).

@@ -95,16 +95,11 @@ Result<void> ModbusClient::ensure_connected() {
 
 Error ModbusClient::fail(int err, const std::string& what) {
   Error e = translate_modbus_error(err, device_ + " " + what);
-  consecutive_timeouts_ = e.kind == ErrorKind::timeout ? consecutive_timeouts_ + 1 : 0;
-  // A TCP peer that rebooted leaves our socket half-open: requests vanish without an RST, so
-  // only a fresh connection recovers. A serial line has no connection to renew.
-  const bool stale_tcp = consecutive_timeouts_ >= kTimeoutsBeforeReconnect &&
-                         std::holds_alternative<TcpEndpoint>(endpoint_);
-  if (stale_tcp)
-    e.message += fmt::format(" ({} timeouts in a row: reconnecting)", consecutive_timeouts_);
+  const bool reopen = link_.must_reopen(e.kind, std::holds_alternative<TcpEndpoint>(endpoint_));
+  if (reopen && link_.stale_timeouts() > 0)
+    e.message += fmt::format(" ({} timeouts in a row: reconnecting)", link_.stale_timeouts());
   tap(TapDirection::event, "error", errno_bytes(err), e.message);
-  if (e.kind == ErrorKind::disconnected || stale_tcp) {
-    consecutive_timeouts_ = 0;
+  if (reopen) {
     disconnect();  // reconnect on the next call
   } else if (e.kind == ErrorKind::timeout || e.kind == ErrorKind::protocol) {
     // Discard late or partial bytes so the next reply is not misread as this one's.
@@ -124,7 +119,7 @@ Result<std::vector<std::uint16_t>> ModbusClient::read_registers(FunctionCode fc,
   if (rc == -1) return fail(errno, fmt::format("read fc={} addr={} count={}", code, addr, count));
   if (rc != count)
     return fail(EMBBADDATA, fmt::format("read addr={}: {} registers, wanted {}", addr, rc, count));
-  consecutive_timeouts_ = 0;
+  link_.answered();
   tap(TapDirection::rx, "modbus-read", read_reply_adu(unit, code, words),
       fmt::format("unit={} addr={}", unit, addr));
   return words;
@@ -139,7 +134,7 @@ Result<void> ModbusClient::write_registers(int unit, std::uint16_t addr,
       fmt::format("unit={} fc={} addr={} count={}", unit, code, addr, n));
   int rc = wire_->write(unit, addr, words);
   if (rc == -1) return fail(errno, fmt::format("write fc={} addr={} count={}", code, addr, n));
-  consecutive_timeouts_ = 0;
+  link_.answered();
   tap(TapDirection::rx, "modbus-write",
       n == 1 ? write_request_adu(unit, addr, words) : read_request_adu(unit, code, addr, n),
       fmt::format("unit={} addr={} ok", unit, addr));

@@ -12,6 +12,7 @@
 
 #include "drivers/common/backoff.hpp"
 #include "drivers/common/result.hpp"
+#include "drivers/common/stale_link.hpp"
 #include "drivers/common/tap.hpp"
 #include "drivers/modbus/endpoint.hpp"
 #include "drivers/modbus/modbus_wire.hpp"
@@ -84,13 +85,9 @@ class ModbusClient {
   bool connected_ = false;
   std::uint64_t connects_ = 0;
   Tap* tap_ = nullptr;
-  int consecutive_timeouts_ = 0;  ///< timeouts in a row since the last answer of any kind
-  Backoff backoff_;               ///< when the next connect attempt is due
+  StaleLink link_;   ///< the stale-link rule (drivers/common/stale_link.hpp)
+  Backoff backoff_;  ///< when the next connect attempt is due
   std::string last_connect_error_;
 };
-
-/// Consecutive timeouts after which a TCP client drops its connection (a half-open socket to a
-/// rebooted gateway never answers again); the next call reconnects. RTU only flushes.
-inline constexpr int kTimeoutsBeforeReconnect = 3;
 
 }  // namespace station::drivers::modbus

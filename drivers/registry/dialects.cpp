@@ -80,41 +80,44 @@ const auto kPlcTableMap =
 
 const std::vector<ChamberDialect> kChambers{
     {"generic_plc", Transport::modbus,
-     "the station's own Modbus map for a PLC-run chamber (docs/DEVICES.md)", kPlcChamberMap,
+     "the station's own Modbus map for a PLC-run chamber (docs/DEVICES.md)", "default", false,
+     kPlcChamberMap,
      [](const DeviceSpec& s, const LinkOptions& o) -> std::unique_ptr<Chamber> {
        return hooked(std::make_unique<ModbusChamber>(s.name, modbus_ep(s), kPlcChamberMap(s),
                                                      s.timeout_s, modbus_wire(s, o)),
                      s, o);
      }},
-    {"watlow_f4", Transport::modbus, "Watlow Series F4, Modbus RTU/TCP, int16 with decimals",
-     kF4Map,
+    {"watlow_f4", Transport::modbus, "Watlow Series F4, Modbus RTU/TCP, int16 with decimals", "",
+     true, kF4Map,
      [](const DeviceSpec& s, const LinkOptions& o) -> std::unique_ptr<Chamber> {
        return hooked(std::make_unique<WatlowF4Chamber>(s.name, "watlow_f4", modbus_ep(s), kF4Map(s),
                                                        s.timeout_s, modbus_wire(s, o)),
                      s, o);
      }},
-    {"watlow_f4t", Transport::modbus, "Watlow F4T, Modbus Data Map 1, float CDAB", kF4tMap,
+    {"watlow_f4t", Transport::modbus, "Watlow F4T, Modbus Data Map 1, float CDAB", "f4t", true,
+     kF4tMap,
      [](const DeviceSpec& s, const LinkOptions& o) -> std::unique_ptr<Chamber> {
        return hooked(std::make_unique<WatlowF4tChamber>(s.name, modbus_ep(s), kF4tMap(s),
                                                         s.timeout_s, modbus_wire(s, o)),
                      s, o);
      }},
     {"watlow_f4t_map2", Transport::modbus, "Watlow F4T in F4-compatibility map (the F4 registers)",
-     kF4tMap2Map,
+     "", true, kF4tMap2Map,
      [](const DeviceSpec& s, const LinkOptions& o) -> std::unique_ptr<Chamber> {
        return hooked(
            std::make_unique<WatlowF4Chamber>(s.name, "watlow_f4t_map2", modbus_ep(s),
                                              kF4tMap2Map(s), s.timeout_s, modbus_wire(s, o)),
            s, o);
      }},
-    {"watlow_f4p", Transport::modbus, "Watlow Series F4P, Modbus RTU, int16 with decimals", kF4pMap,
+    {"watlow_f4p", Transport::modbus, "Watlow Series F4P, Modbus RTU, int16 with decimals", "",
+     false, kF4pMap,
      [](const DeviceSpec& s, const LinkOptions& o) -> std::unique_ptr<Chamber> {
        return hooked(std::make_unique<WatlowF4pChamber>(s.name, modbus_ep(s), kF4pMap(s),
                                                         s.timeout_s, modbus_wire(s, o)),
                      s, o);
      }},
-    {"espec_p300", Transport::ascii, "ESPEC P300 / SCP-220, ASCII over TCP 10001 or serial",
-     nullptr,
+    {"espec_p300", Transport::ascii, "ESPEC P300 / SCP-220, ASCII over TCP 10001 or serial", "",
+     false, nullptr,
      [](const DeviceSpec& s, const LinkOptions& o) -> std::unique_ptr<Chamber> {
        return hooked_line(std::make_unique<EspecP300Chamber>(s.name, line_ep(s), s.unit_id,
                                                              s.timeout_s, line_wire(s, o)),
@@ -124,15 +127,16 @@ const std::vector<ChamberDialect> kChambers{
 
 const std::vector<TurntableDialect> kTables{
     {"generic_plc", Transport::modbus,
-     "the station's own Modbus map for a PLC-fronted table (docs/DEVICES.md)", kPlcTableMap,
+     "the station's own Modbus map for a PLC-fronted table (docs/DEVICES.md)", "default", false,
+     kPlcTableMap,
      [](const DeviceSpec& s, const LinkOptions& o) -> std::unique_ptr<Turntable> {
        return hooked(
            std::make_unique<ModbusTurntable>(s.name, modbus_ep(s), kPlcTableMap(s),
                                              TurntableLimits{}, s.timeout_s, modbus_wire(s, o)),
            s, o);
      }},
-    {"acutrol3000", Transport::ascii, "Acutronic ACUTROL3000, ASCII over TCP 9878 or serial",
-     nullptr,
+    {"acutrol3000", Transport::ascii, "Acutronic ACUTROL3000, ASCII over TCP 9878 or serial", "",
+     false, nullptr,
      [](const DeviceSpec& s, const LinkOptions& o) -> std::unique_ptr<Turntable> {
        return hooked_line(
            std::make_unique<Acutrol3000Table>(s.name, line_ep(s), s.timeout_s, line_wire(s, o)), s,
@@ -140,11 +144,14 @@ const std::vector<TurntableDialect> kTables{
      }},
 };
 
-// Names accepted for compatibility: the old presets' names.
-std::string_view canonical(std::string_view model) {
-  if (model == "f4t") return "watlow_f4t";
-  if (model == "default") return "generic_plc";
-  return model;
+// Whether `model` is one of the row's comma-separated aliases.
+bool is_alias(std::string_view aliases, std::string_view model) {
+  while (!aliases.empty()) {
+    const auto comma = aliases.find(',');
+    if (aliases.substr(0, comma) == model) return true;
+    aliases = comma == std::string_view::npos ? "" : aliases.substr(comma + 1);
+  }
+  return false;
 }
 
 template <typename D>
@@ -157,7 +164,7 @@ std::string names(std::span<const Dialect<D>> all) {
 template <typename D>
 const Dialect<D>& find(std::span<const Dialect<D>> all, std::string_view model, const char* what) {
   for (const auto& d : all)
-    if (d.model == canonical(model)) return d;
+    if (d.model == model || is_alias(d.aliases, model)) return d;
   throw std::invalid_argument(
       fmt::format("unknown {} model '{}' (known: {})", what, model, names(all)));
 }
@@ -185,13 +192,13 @@ std::string turntable_models() {
 
 template <typename Device>
 void validate(const Dialect<Device>& dialect, const DeviceSpec& spec) {
-  const bool has_events = dialect.model == "watlow_f4" || dialect.model == "watlow_f4t" ||
-                          dialect.model == "watlow_f4t_map2";
-  if (spec.run_event != 1 && !has_events)
-    throw std::invalid_argument(
-        fmt::format("run_event: model '{}' has no event outputs (only watlow_f4, watlow_f4t, "
-                    "watlow_f4t_map2 do)",
-                    dialect.model));
+  if (spec.run_event != 1 && !dialect.event_outputs) {
+    std::string with;
+    for (const auto& d : chamber_dialects())
+      if (d.event_outputs) with += (with.empty() ? "" : ", ") + std::string(d.model);
+    throw std::invalid_argument(fmt::format(
+        "run_event: model '{}' has no event outputs (only {} do)", dialect.model, with));
+  }
   if (dialect.transport == Transport::modbus) {
     (void)modbus::parse_endpoint(spec.endpoint);
     if (spec.run_event < 1 || spec.run_event > 8)

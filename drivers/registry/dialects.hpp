@@ -60,6 +60,10 @@ struct Dialect {
   std::string_view model;  ///< config name, e.g. "watlow_f4t"
   Transport transport;
   std::string_view summary;  ///< one line for `--help` and errors
+  /// Other names the configuration accepts for it (old preset names), comma-separated.
+  std::string_view aliases;
+  /// Whether the controller has event outputs (Watlow F4/F4T): `run_event` is then allowed.
+  bool event_outputs;
   /// The wire map a Modbus dialect's overrides apply to (empty for ASCII dialects).
   std::function<modbus::RegisterMap(const DeviceSpec&)> map;
   /// Builds the driver; no I/O. Throws std::invalid_argument on a bad spec.

@@ -5,6 +5,7 @@
 
 #include <stdexcept>
 
+#include "drivers/registry/dialects.hpp"
 #include "sim_devices/faces/ascii_faces.hpp"
 #include "sim_devices/servers/line_server.hpp"
 #include "sim_devices/servers/modbus_server.hpp"
@@ -34,8 +35,10 @@ ServedDevice lines(std::unique_ptr<Face> face, int port) {
 
 }  // namespace
 
-ServedDevice serve_chamber(std::string_view model, ChamberSim& chamber, const WatlowPanel& panel,
+ServedDevice serve_chamber(std::string_view name, ChamberSim& chamber, const WatlowPanel& panel,
                            int port) {
+  // The registry names the dialects (and their old names); this table gives each its face.
+  const std::string_view model = drivers::chamber_dialect(name).model;
   if (model == "generic_plc") {
     auto server = std::make_unique<ModbusServer>(chamber, 1);
     server->start_tcp(port);
@@ -49,13 +52,12 @@ ServedDevice serve_chamber(std::string_view model, ChamberSim& chamber, const Wa
   if (model == "watlow_f4t") return modbus(std::make_unique<F4tFace>(chamber, panel), port);
   if (model == "watlow_f4p") return modbus(std::make_unique<F4pFace>(chamber, panel), port);
   if (model == "espec_p300") return lines(std::make_unique<P300Face>(chamber, 1), port);
-  throw std::invalid_argument(fmt::format(
-      "no simulated chamber '{}' (known: generic_plc, watlow_f4, watlow_f4t, watlow_f4t_map2, "
-      "watlow_f4p, espec_p300)",
-      model));
+  throw std::invalid_argument(
+      fmt::format("no simulated chamber '{}' (known: {})", model, drivers::chamber_models()));
 }
 
-ServedDevice serve_turntable(std::string_view model, TurntableSim& table, int port) {
+ServedDevice serve_turntable(std::string_view name, TurntableSim& table, int port) {
+  const std::string_view model = drivers::turntable_dialect(name).model;
   if (model == "generic_plc") {
     auto server = std::make_unique<ModbusServer>(table, 1);
     server->start_tcp(port);
@@ -65,15 +67,14 @@ ServedDevice serve_turntable(std::string_view model, TurntableSim& table, int po
   }
   if (model == "acutrol3000") return lines(std::make_unique<AcutrolFace>(table), port);
   throw std::invalid_argument(
-      fmt::format("no simulated turntable '{}' (known: generic_plc, acutrol3000)", model));
+      fmt::format("no simulated turntable '{}' (known: {})", model, drivers::turntable_models()));
 }
 
 std::string device_toml(const char* section, std::string_view model, const std::string& endpoint,
                         const WatlowPanel* panel) {
   std::string out =
       fmt::format("[{}]\nmodel = \"{}\"\nendpoint = \"{}\"\n", section, model, endpoint);
-  if (panel != nullptr && panel->run_event != 1 &&
-      (model == "watlow_f4" || model == "watlow_f4t" || model == "watlow_f4t_map2"))
+  if (panel != nullptr && panel->run_event != 1 && drivers::chamber_dialect(model).event_outputs)
     out += fmt::format("run_event = {}\n", panel->run_event);
   return out;
 }

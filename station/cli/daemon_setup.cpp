@@ -5,7 +5,6 @@
 
 #include <csignal>
 #include <cstdlib>
-#include <filesystem>
 
 #include "station/cli/device_identity.hpp"
 #include "station/common/logging.hpp"
@@ -49,14 +48,6 @@ std::vector<ProcessLock> lock_db_and_devices(const std::string& db, const Statio
     }
   }
   return locks;
-}
-
-// Whether `db` exists and holds a run to resume (read-only peek: nothing is created or written).
-bool has_unfinished_run(const std::string& db) {
-  std::error_code ec;
-  if (!std::filesystem::exists(db, ec) || std::filesystem::file_size(db, ec) == 0) return false;
-  Store peek(db, OpenMode::read_only);
-  return peek.find_unfinished_run().has_value();
 }
 
 /// Each slot's fit and verdict of run `run_id`, one line per slot.

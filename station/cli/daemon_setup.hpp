@@ -23,8 +23,6 @@ void on_stop_signals(void (*handler)(int));
 void setup_daemon_logging(spdlog::level::level_enum console_level, const std::string& log_file);
 /// One daemon per database (and, on a real rig, per device): held until the process ends.
 std::vector<ProcessLock> lock_db_and_devices(const std::string& db, const StationConfig* config);
-/// Whether `db` exists and holds a run to resume (read-only peek: nothing is created or written).
-bool has_unfinished_run(const std::string& db);
 /// Each slot's fit and verdict of run `run_id`, one line per slot on stdout.
 void print_verdicts(Store& store, std::int64_t run_id);
 

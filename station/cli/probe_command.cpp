@@ -2,6 +2,7 @@
 // SYNC, GPIO inputs) and prints what it got; a device that fails is one typed error line.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -11,6 +12,7 @@
 #include "station/cli/commands.hpp"
 #include "station/cli/exit_status.hpp"
 #include "station/cli/probe.hpp"
+#include "station/daemon/rig_reading.hpp"
 
 namespace station {
 namespace {
@@ -62,13 +64,12 @@ json finite_or_null(double v) {
 
 // What the controller says it is (dialect, identity, units, decimals, limits) before its values:
 // a unit the dialect cannot read correctly fails here with the dialect's one line.
-DeviceReport probe_chamber(dr::Chamber& chamber, const StationConfig& c) {
+DeviceReport chamber_report(const dr::Result<dr::ChamberIdentity>& id, const RigReading& in,
+                            const StationConfig& c) {
   const std::string& where = c.chamber.endpoint;
-  auto id = chamber.identify();
   if (!id) return failed("chamber", where, with_model(c.chamber.model, id.error()));
-  auto r = chamber.read();
-  if (!r) return failed("chamber", where, r.error());
-  const dr::ChamberState& s = r.value();
+  if (!in.chamber) return failed("chamber", where, *in.chamber_error);
+  const dr::ChamberState& s = *in.chamber;
   const dr::ChamberIdentity& i = id.value();
   DeviceReport d{"chamber", where, {}, {}, json::object()};
   d.summary = fmt::format(
@@ -95,13 +96,12 @@ DeviceReport probe_chamber(dr::Chamber& chamber, const StationConfig& c) {
   return d;
 }
 
-DeviceReport probe_turntable(dr::Turntable& table, const StationConfig& c) {
+DeviceReport table_report(const dr::Result<std::string>& id, const RigReading& in,
+                          const StationConfig& c) {
   const std::string& where = c.turntable->endpoint;
-  auto id = table.identify();
   if (!id) return failed("turntable", where, with_model(c.turntable->model, id.error()));
-  auto r = table.read();
-  if (!r) return failed("turntable", where, r.error());
-  const dr::TurntableState& s = r.value();
+  if (!in.table) return failed("turntable", where, *in.table_error);
+  const dr::TurntableState& s = *in.table;
   DeviceReport d{"turntable", where, {}, {}, json::object()};
   d.summary = fmt::format(
       "mode {}, angle {:.4f} deg, rate {:.4f} deg/s, in_position {}, at_rate {}, fault {}, "
@@ -167,11 +167,9 @@ DeviceReport slot_report(std::size_t index, const dc::CounterReading& r, std::ui
   return d;
 }
 
-std::vector<DeviceReport> probe_counters(dc::CounterBoards& boards, const StationConfig& c) {
-  constexpr std::uint8_t kSeq = 1;
-  auto tick = boards.tick(kSeq);
-  if (!tick) return {failed("can", c.can_transport, tick.error())};
-  const dc::TickResult& t = tick.value();
+std::vector<DeviceReport> counter_reports(const RigReading& in, const StationConfig& c) {
+  if (!in.counters) return {failed("can", c.can_transport, *in.counters_error)};
+  const dc::TickResult& t = *in.counters;
   std::vector<DeviceReport> out;
   DeviceReport bus{"can", c.can_transport, {}, {}, json::object()};
   std::size_t answered = 0;
@@ -189,26 +187,29 @@ std::vector<DeviceReport> probe_counters(dc::CounterBoards& boards, const Statio
   return out;
 }
 
-/// Reads every input line once. Opening drives outputs to their safe levels (as the daemon does).
-std::vector<DeviceReport> probe_gpio(dr::gpio::GpioBank& bank) {
-  if (auto ok = bank.open(); !ok)
-    return {failed("gpio", bank.config().lines.empty() ? "gpio" : bank.config().lines[0].chip,
-                   ok.error())};
+/// Each input line of the bank as the reading found it (the bank's order).
+std::vector<DeviceReport> gpio_reports(const dr::gpio::GpioConfig& bank, const RigReading& in) {
   std::vector<DeviceReport> out;
-  for (const auto& line : bank.config().lines) {
+  for (const auto& line : bank.lines) {
     if (line.direction != dr::gpio::GpioDirection::input) continue;
     const std::string device = "gpio " + line.role;
-    auto v = bank.read(line.role);
-    if (!v) {
-      out.push_back(failed(device, line.where(), v.error()));
+    const auto error = std::find_if(in.gpio_errors.begin(), in.gpio_errors.end(),
+                                    [&line](const auto& e) { return e.first == line.role; });
+    const std::optional<bool> value = line.role == dr::gpio::roles::interlock ? in.door_closed
+                                      : line.role == dr::gpio::roles::estop   ? in.estop_pressed
+                                                                              : std::nullopt;
+    if (error != in.gpio_errors.end() || !value) {
+      out.push_back(failed(device, line.where(),
+                           error != in.gpio_errors.end()
+                               ? error->second
+                               : dr::Error{dr::ErrorKind::io, "not an input the station reads"}));
       continue;
     }
     DeviceReport d{device, line.where(), {}, {}, json::object()};
-    d.summary = v.value() ? "active" : "inactive";
-    d.fields = {{"active", v.value()}};
+    d.summary = *value ? "active" : "inactive";
+    d.fields = {{"active", *value}};
     out.push_back(std::move(d));
   }
-  bank.close();
   return out;
 }
 
@@ -245,14 +246,29 @@ void print_json(std::ostream& out, const StationConfig& c, const std::vector<Dev
       << '\n';
 }
 
+/// What the devices say they are, then one reading of the rig (read_rig, the daemon's own),
+/// with one SYNC of the counter boards; a device that did not say what it is is not read again
+/// (one timeout per dead device). Opening the GPIO bank drives outputs to their safe levels (as
+/// the daemon does); it is closed again after.
 std::vector<DeviceReport> probe_all(const StationConfig& config, Rig& rig) {
-  std::vector<DeviceReport> reports;
-  reports.push_back(probe_chamber(*rig.chamber, config));
-  if (rig.turntable) reports.push_back(probe_turntable(*rig.turntable, config));
-  for (auto& r : probe_counters(*rig.counters, config)) reports.push_back(std::move(r));
+  constexpr std::uint8_t kSeq = 1;
+  const auto chamber_id = rig.chamber->identify();
+  const auto table_id = rig.turntable ? rig.turntable->identify() : dr::Result<std::string>("");
+  std::optional<dr::Error> gpio_open;
+  if (rig.gpio)
+    if (auto ok = rig.gpio->open(); !ok) gpio_open = ok.error();
+  const RigReading in = read_rig(rig, RigReadPlan{kSeq, chamber_id.ok(), table_id.ok(), false});
   rig.counters->forget_latches();  // the probe's latch is no baseline for a run
-  if (rig.gpio) {
-    for (auto& r : probe_gpio(*rig.gpio)) reports.push_back(std::move(r));
+  std::vector<DeviceReport> reports{chamber_report(chamber_id, in, config)};
+  if (rig.turntable) reports.push_back(table_report(table_id, in, config));
+  for (auto& r : counter_reports(in, config)) reports.push_back(std::move(r));
+  if (!rig.gpio) return reports;
+  const auto& bank = rig.gpio->config();
+  if (gpio_open) {
+    reports.push_back(failed("gpio", bank.lines.empty() ? "gpio" : bank.lines[0].chip, *gpio_open));
+  } else {
+    for (auto& r : gpio_reports(bank, in)) reports.push_back(std::move(r));
+    rig.gpio->close();
   }
   return reports;
 }

@@ -26,9 +26,8 @@
 #include "station/cli/progress_display.hpp"
 #include "station/common/logging.hpp"
 #include "station/common/process_lock.hpp"
-#include "station/daemon/resume.hpp"
+#include "station/daemon/host.hpp"
 #include "station/daemon/rig.hpp"
-#include "station/daemon/sequencer.hpp"
 #include "station/parts/judged_fit.hpp"
 #include "station/session/session_recording.hpp"
 #include "station/sim/sim_run.hpp"
@@ -87,75 +86,80 @@ struct DeferredTap final : drivers::Tap {
   }
 };
 
-int run_real(const RunOptions& o) {
-  const StationConfig config = load_station_config(o.config);
-  if (!o.part.empty()) throw InputError("--part is for --sim; a rig's slots name their part");
-  auto part_limits = slot_part_limits(config, o.parts);  // a bad part file stops here
-  Protocol protocol = load_protocol(o.protocol);
-  const auto locks = lock_db_and_devices(o.db, &config);
-  // Every device must answer before anything moves or the database is touched.
-  DeferredTap tap;
-  RigOptions ro;
-  ro.tap = &tap;
-  Rig rig = build_rig(config, ro);
-  if (const auto bad = unreachable_devices(config, rig); !bad.empty()) {
-    // A new run starts only on a whole rig. A run a killed daemon left unfinished goes on: the
-    // device's outage (already open in the run's events, or starting now) is recorded and it
-    // rejoins when it answers; refusing would lose every other device's data as well.
-    if (o.fresh || !has_unfinished_run(o.db)) throw InputError::lines(bad);
-    for (const auto& line : bad) log("seq")->warn("resuming without: {}", line);
-  }
-  Store store(o.db);
-  const ResumeDecision resume_decision = decide_resume(store, config, o.fresh, false);
-  const std::optional<RunRecord>& resume = resume_decision.run;
-  if (resume_decision.protocol) {
-    if (resume_decision.protocol->text != protocol.text) {
-      log("seq")->warn("run {} continues with the protocol stored with it, not {}", resume->id,
-                       o.protocol);
-    }
-    protocol = *resume_decision.protocol;
-  }
+/// `run --config`: the CAN log or session recording, attached after the start check (the
+/// probe's exchanges are no part of the run).
+struct Recording {
   std::ofstream can_log;
   std::optional<drivers::can::CandumpTap> can_tap;
   std::optional<SessionRecording> session;
-  if (!o.record.empty()) {
-    // The probe above is not part of the session: the logs start with the run's first tick.
-    session.emplace(o.record);
-    tap.target = &session->tap();
-    session->start(config, protocol, false, std::nullopt);
-  } else if (!o.record_can.empty()) {
-    can_log.open(o.record_can, std::ios::app);
-    if (!can_log) throw InputError(fmt::format("{}: cannot write the CAN log", o.record_can));
-    tap.target = &can_tap.emplace(can_log, "can0");
+  void start(const RunOptions& o, DeferredTap& tap, const StationConfig& config,
+             const Protocol& protocol) {
+    if (!o.record.empty()) {
+      session.emplace(o.record);
+      tap.target = &session->tap();
+      session->start(config, protocol, false, std::nullopt);
+    } else if (!o.record_can.empty()) {
+      can_log.open(o.record_can, std::ios::app);
+      if (!can_log) throw InputError(fmt::format("{}: cannot write the CAN log", o.record_can));
+      tap.target = &can_tap.emplace(can_log, "can0");
+    }
   }
-  drivers::MonotonicClock clock;
+  void hook(SequencerOptions& so) {
+    if (!session) return;
+    so.on_tick = [this](const TickReport&) { session->after_tick(); };
+    so.on_resume = [this](double last_s, double next_s) { session->resumed(last_s, next_s); };
+  }
+};
+
+/// The hooks of a run on the rig: the operator, Ctrl-C, part limits, the watchdog, the
+/// recording and the live page.
+SequencerOptions real_hooks(const RunOptions& o, std::map<std::string, PartLimits> part_limits,
+                            Recording& rec, LiveService& live) {
   SequencerOptions so;
   so.operator_name = o.operator_name;
   so.stop = &g_stop;
   so.part_limits = std::move(part_limits);
   std::uint64_t watchdog_usec = 0;
-  if (sd_watchdog_enabled(0, &watchdog_usec) > 0) {
-    so.watchdog = [] { sd_notify(0, "WATCHDOG=1"); };
-  }
-  if (session) {
-    so.on_tick = [&session](const TickReport&) { session->after_tick(); };
-    so.on_resume = [&session](double last_s, double next_s) { session->resumed(last_s, next_s); };
-  }
+  if (sd_watchdog_enabled(0, &watchdog_usec) > 0) so.watchdog = [] { sd_notify(0, "WATCHDOG=1"); };
+  rec.hook(so);
+  attach_live(live, so);
+  return so;
+}
+
+// The real rig on the wall clock: the start check, the one start rule, the one host's run.
+int run_real(const RunOptions& o) {
+  const StationConfig config = load_station_config(o.config);
+  if (!o.part.empty()) throw InputError("--part is for --sim; a rig's slots name their part");
+  auto part_limits = slot_part_limits(config, o.parts);  // a bad part file stops here
+  const auto locks = lock_db_and_devices(o.db, &config);
+  DeferredTap tap;
+  Recording rec;  // before the rig: closing the rig's GPIO still writes through the tap
+  RigOptions ro;
+  ro.tap = &tap;
+  Rig rig = build_rig(config, ro);
+  // The start check: every device read once before anything moves or the database is touched.
+  const StartRequest request{load_protocol(o.protocol), o.fresh, std::nullopt,
+                             unreachable_devices(config, rig)};
+  refuse_broken_rig(o.db, request);
+  Store store(o.db);
+  drivers::MonotonicClock clock;
+  Host host(config, rig, store, clock);
+  const StartPlan plan = host.start(request);
+  rec.start(o, tap, config, plan.protocol);
   OneRunControl control(g_stop, g_abort);
   LiveService live(live_options(o, o.db, config.name, false), control);
-  attach_live(live, so);
+  SequencerOptions so = real_hooks(o, std::move(part_limits), rec, live);
   // Progress: a redrawn line on a terminal, a line every 5 minutes of run time in a log, and
   // systemd's status line under a service.
   ProgressDisplay progress(stderr, ::isatty(STDERR_FILENO) != 0, 300.0, config.bin_s,
                            notify_status);
   attach_progress(so, progress);
-  Sequencer seq(config, protocol, rig, store, clock, so);
   sd_notify(0, "READY=1");
-  const RunOutcome out = seq.run(resume);
+  const RunOutcome out = host.run(plan, std::move(so));
   progress.finish();
   live.hub().run_ended(out.run_id, std::string(to_string(out.state)));
   live.shutdown();
-  if (session) session->finish(store, out.run_id);
+  if (rec.session) rec.session->finish(store, out.run_id);
   sd_notify(0, "STOPPING=1");
   fmt::print("run {} {} at t = {:.0f} s after {} ticks\n", out.run_id, to_string(out.state),
              out.t_s, out.ticks);
@@ -164,13 +168,27 @@ int run_real(const RunOptions& o) {
   return 0;
 }
 
-int run_sim(const RunOptions& o) {
-  const std::string db = o.db.empty() ? "station-sim.db" : o.db;
+/// --fault TICK:COMMAND, each checked for its form.
+std::vector<std::pair<double, std::string>> parse_faults(const std::vector<std::string>& faults) {
+  std::vector<std::pair<double, std::string>> out;
+  for (const auto& f : faults) {
+    const auto colon = f.find(':');
+    double at_s = -1;
+    try {
+      at_s = colon == std::string::npos ? -1 : std::stod(f.substr(0, colon));
+    } catch (const std::exception&) {
+    }
+    if (!(at_s >= 0) || std::floor(at_s) != at_s || colon + 1 >= f.size())
+      throw InputError(fmt::format("--fault '{}': expected TICK:COMMAND, e.g. 3000:door open", f));
+    out.emplace_back(at_s, f.substr(colon + 1));
+  }
+  return out;
+}
+
+SimRunOptions sim_options(const RunOptions& o, const std::string& db) {
   SimRunOptions so;
   so.parts_path = o.parts;
   so.part_number = o.part;
-  sim_part_number(so);  // a bad part file stops here, before the database is locked
-  const auto locks = lock_db_and_devices(db, nullptr);
   so.gyros = o.gyros;
   so.seed = o.seed;
   so.gyro_preset = o.gyro_preset;
@@ -183,18 +201,17 @@ int run_sim(const RunOptions& o) {
   so.stop = &g_stop;
   so.record_can_path = o.record_can;
   so.record_dir = o.record;
-  for (const auto& f : o.faults) {
-    const auto colon = f.find(':');
-    double at_s = -1;
-    try {
-      at_s = colon == std::string::npos ? -1 : std::stod(f.substr(0, colon));
-    } catch (const std::exception&) {
-    }
-    if (!(at_s >= 0) || std::floor(at_s) != at_s || colon + 1 >= f.size())
-      throw InputError(fmt::format("--fault '{}': expected TICK:COMMAND, e.g. 3000:door open", f));
-    so.faults.emplace_back(at_s, f.substr(colon + 1));
-  }
+  so.faults = parse_faults(o.faults);
   so.speed = o.speed;
+  return so;
+}
+
+// The deterministic simulation (sim/sim_run.hpp) with the live page and the report.
+int run_sim(const RunOptions& o) {
+  const std::string db = o.db.empty() ? "station-sim.db" : o.db;
+  SimRunOptions so = sim_options(o, db);
+  sim_part_number(so);  // a bad part file stops here, before the database is locked
+  const auto locks = lock_db_and_devices(db, nullptr);
   OneRunControl control(g_stop, g_abort);
   LiveService live(live_options(o, db, "simulated-rig", true), control);
   so.extend = [&live](SequencerOptions& s) { attach_live(live, s); };
@@ -218,6 +235,31 @@ int run_sim(const RunOptions& o) {
   return 0;
 }
 
+/// The simulated world's options of `run --sim`: gyros, seed, dialects, preset, latitude.
+void add_sim_world_options(CLI::App* cmd, RunOptions& o) {
+  cmd->add_option("--gyros", o.gyros, "simulated gyros")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 16));
+  cmd->add_option("--seed", o.seed, "simulation seed")
+      ->check(unsigned_integer())
+      ->capture_default_str();
+  cmd->add_option(
+         "--chamber", o.chamber_model,
+         "--sim: the dialect the simulated chamber speaks (" + drivers::chamber_models() + ")")
+      ->capture_default_str();
+  cmd->add_option(
+         "--turntable", o.turntable_model,
+         "--sim: the dialect the simulated table speaks (" + drivers::turntable_models() + ")")
+      ->capture_default_str();
+  cmd->add_option("--gyro-preset", o.gyro_preset,
+                  "simulated gyros: station (strong thermal effect) or paper (the paper's "
+                  "proportions: std ratio ~0.13)")
+      ->check(CLI::IsMember({"station", "paper"}))
+      ->capture_default_str();
+  cmd->add_option("--latitude", o.latitude_deg, "simulated site latitude, deg")
+      ->capture_default_str();
+}
+
 }  // namespace
 
 void add_run_command(CLI::App& app, CommandStatus& status) {
@@ -235,27 +277,7 @@ void add_run_command(CLI::App& app, CommandStatus& status) {
   cmd->add_option("--db", o->db, "SQLite database (default with --sim: station-sim.db)");
   cmd->add_option("--operator", o->operator_name, "operator recorded with the run");
   cmd->add_flag("--new", o->fresh, "start a new run even if one was left unfinished");
-  cmd->add_option("--gyros", o->gyros, "simulated gyros")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 16));
-  cmd->add_option("--seed", o->seed, "simulation seed")
-      ->check(unsigned_integer())
-      ->capture_default_str();
-  cmd->add_option(
-         "--chamber", o->chamber_model,
-         "--sim: the dialect the simulated chamber speaks (" + drivers::chamber_models() + ")")
-      ->capture_default_str();
-  cmd->add_option(
-         "--turntable", o->turntable_model,
-         "--sim: the dialect the simulated table speaks (" + drivers::turntable_models() + ")")
-      ->capture_default_str();
-  cmd->add_option("--gyro-preset", o->gyro_preset,
-                  "simulated gyros: station (strong thermal effect) or paper (the paper's "
-                  "proportions: std ratio ~0.13)")
-      ->check(CLI::IsMember({"station", "paper"}))
-      ->capture_default_str();
-  cmd->add_option("--latitude", o->latitude_deg, "simulated site latitude, deg")
-      ->capture_default_str();
+  add_sim_world_options(cmd, *o);
   cmd->add_option("--log-file", o->log_file, "rotating log file");
   auto* record =
       cmd->add_option("--record", o->record,

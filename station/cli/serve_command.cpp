@@ -16,6 +16,7 @@
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
 
 #include "drivers/common/clock.hpp"
 #include "station/cli/commands.hpp"
@@ -24,11 +25,10 @@
 #include "station/cli/live_service.hpp"
 #include "station/cli/progress_display.hpp"
 #include "station/cli/serve_control.hpp"
+#include "station/common/input_error.hpp"
 #include "station/common/logging.hpp"
-#include "station/daemon/idle_watch.hpp"
-#include "station/daemon/resume.hpp"
+#include "station/daemon/host.hpp"
 #include "station/daemon/rig.hpp"
-#include "station/daemon/sequencer.hpp"
 #include "station/fleet/forwarder_thread.hpp"
 #include "station/parts/judged_fit.hpp"
 
@@ -71,7 +71,7 @@ struct UnclosedRun {
 /// Everything a serve process holds.
 struct Service {
   const StationConfig& config;
-  Rig& rig;
+  Host& host;
   Store& store;
   LiveService& live;
   ServeControl& control;
@@ -111,10 +111,10 @@ void run_failed(Service& s, std::optional<std::int64_t> id, const std::string& w
   if (!close_failed_run(s, u)) s.unclosed = std::move(u);
 }
 
-/// Runs one protocol (or resumes one); a failure is recorded, never fatal to the service.
-void run_one(Service& s, const Protocol& protocol, const std::optional<RunRecord>& resume,
-             const std::string& operator_name) {
-  drivers::MonotonicClock clock;
+/// The sequencer's hooks of a run under serve: the API's stop, abort and hand-over, the
+/// watchdog, the live page, systemd's status line; `run_id` is set once the run exists.
+SequencerOptions serve_hooks(Service& s, const std::string& operator_name,
+                             std::optional<std::int64_t>& run_id, ProgressDisplay& progress) {
   SequencerOptions so;
   so.operator_name = operator_name;
   so.stop = &g_run_stop;
@@ -122,26 +122,31 @@ void run_one(Service& s, const Protocol& protocol, const std::optional<RunRecord
   so.detach = &g_detach;
   so.part_limits = s.part_limits;
   if (s.watchdog) so.watchdog = [] { sd_notify(0, "WATCHDOG=1"); };
-  // The run this call made or resumed (not the hub's last one: a run that cannot even be
-  // created must not close an earlier run).
-  std::optional<std::int64_t> run_id;
-  if (resume) run_id = resume->id;
   so.on_run_start = [&s, &run_id](std::int64_t id, const Protocol&, const std::vector<RunSlot>&) {
     run_id = id;
     s.control.started(id);
   };
   live::attach(s.live.hub(), so);
-  // systemd's status line (`systemctl status`): the run's progress each tick.
-  ProgressDisplay progress(nullptr, false, 0.0, s.config.bin_s, notify_status);
   attach_progress(so, progress);
   so.http_url = s.live.url();
+  return so;
+}
+
+/// Runs a started run (a new one, or the one a killed daemon left) to its end; a failure is
+/// recorded, never fatal to the service.
+void run_one(Service& s, const StartPlan& plan, const std::string& operator_name) {
+  // The run this call made or resumed (not the hub's last one: a run that cannot even be
+  // created must not close an earlier run).
+  std::optional<std::int64_t> run_id;
+  // systemd's status line (`systemctl status`): the run's progress each tick.
+  ProgressDisplay progress(nullptr, false, 0.0, s.config.bin_s, notify_status);
   s.control.set_busy(true);
   // A stop or abort meant for an earlier run must not end this one.
   if (!g_stop.load()) g_run_stop.store(false);
   g_run_abort.store(false);
+  if (plan.resume) run_id = plan.resume->id;
   try {
-    Sequencer seq(s.config, protocol, s.rig, s.store, clock, so);
-    const RunOutcome out = seq.run(resume);
+    const RunOutcome out = s.host.run(plan, serve_hooks(s, operator_name, run_id, progress));
     s.live.hub().run_ended(out.run_id, std::string(to_string(out.state)));
     notify_status(fmt::format("idle; run {} {}", out.run_id, to_string(out.state)));
     log("serve")->info("run {} {} at t = {:.0f} s after {} ticks", out.run_id, to_string(out.state),
@@ -169,20 +174,69 @@ std::string service_fault(Service& s, const IdleReading& r) {
 }
 
 void idle_until_stopped(Service& s) {
-  IdleWatch idle(s.rig, s.store, [&s](const RunEvent& e) { s.live.hub().event(e); });
   while (!g_stop.load()) {
-    IdleReading r = idle.look();
+    IdleReading r = s.host.look();
     r.fault = service_fault(s, r);
     s.live.hub().idle(r);
     s.control.set_fault(r.fault);
     if (s.watchdog) sd_notify(0, "WATCHDOG=1");
-    if (auto req = s.control.next(std::chrono::milliseconds(1000))) {
-      run_one(s, req->protocol, std::nullopt, req->operator_name);
-      idle.run_ended();
+    // The control refuses a start while the last look found a fault (the start check of a new
+    // run); the one start rule (run_start.hpp) decides the rest.
+    const auto req = s.control.next(std::chrono::milliseconds(1000));
+    if (!req) continue;
+    // An API start never touches another run: one left unfinished (a failed close) is refused.
+    std::optional<StartPlan> plan;
+    try {
+      plan = s.host.start(StartRequest{req->protocol, false, std::nullopt, {}});
+      if (plan->resume)
+        throw InputError(
+            fmt::format("run {} is unfinished: it must be closed first", plan->resume->id));
+    } catch (const std::exception& e) {
+      run_failed(s, std::nullopt, e.what());
+      s.control.set_busy(false);
+      continue;
     }
+    run_one(s, *plan, req->operator_name);
   }
 }
 
+LiveServiceOptions live_options(const ServeOptions& o, const StationConfig& config) {
+  LiveServiceOptions lo;
+  lo.listen = o.http.empty() ? config.http.listen : o.http;
+  lo.token_file = o.token_file.empty() ? config.http.token_file : o.token_file;
+  lo.db_path = o.db;
+  lo.info.station = config.name;
+  lo.info.bin_s = config.bin_s;
+  return lo;
+}
+
+/// Store and forward ([fleet]): its own thread and connections; stopped before the hub goes.
+std::unique_ptr<fleet::ForwarderThread> start_forwarder(const ServeOptions& o,
+                                                        const StationConfig& config,
+                                                        LiveService& live) {
+  if (!config.fleet) return nullptr;
+  return std::make_unique<fleet::ForwarderThread>(
+      o.db, fleet::fleet_target(*config.fleet),
+      fleet::ForwardOptions{config.fleet->samples, 50'000, config.name}, config.fleet->interval_s,
+      [&live](const fleet::ForwarderStatus& f) {
+        live.hub().fleet(f.to_json());
+        live.hub().metrics().fleet(f.backlog.runs, f.backlog.rows, f.last_success_unix_s,
+                                   f.errors_total);
+      });
+}
+
+/// SIGUSR1's hand-over. Everything is committed (each tick is its own transaction). Leave now,
+/// as a kill would: no destructors, so the GPIO lines keep their levels (the gyros stay powered
+/// and the lamps as they are) until the new process takes the rig over a few seconds later.
+[[noreturn]] void exit_for_restart() {
+  log("serve")->info("SIGUSR1: exiting {} for a restart (a running run resumes)", kExitRestart);
+  std::fflush(stdout);
+  std::fflush(stderr);
+  spdlog::shutdown();
+  std::_Exit(kExitRestart);
+}
+
+// The real rig on the wall clock, runs started over the API; the run is the one host's.
 int serve(const ServeOptions& o) {
   const StationConfig config = load_station_config(o.config);
   auto part_limits = slot_part_limits(config, o.parts);  // a bad part file stops here
@@ -192,51 +246,32 @@ int serve(const ServeOptions& o) {
     if (auto r = rig.gpio->open(); !r) log("serve")->warn("gpio: {}", r.error().message);
   }
   Store store(o.db);
+  drivers::MonotonicClock clock;
   ServeControl control(config.http.protocol_dir, g_run_stop, g_run_abort);
-  LiveServiceOptions lo;
-  lo.listen = o.http.empty() ? config.http.listen : o.http;
-  lo.token_file = o.token_file.empty() ? config.http.token_file : o.token_file;
-  lo.db_path = o.db;
-  lo.info.station = config.name;
-  lo.info.bin_s = config.bin_s;
-  LiveService live(lo, control);
+  LiveService live(live_options(o, config), control);
+  Host host(config, rig, store, clock, [&live](const RunEvent& e) { live.hub().event(e); });
   std::uint64_t watchdog_usec = 0;
   Service s{config,
-            rig,
+            host,
             store,
             live,
             control,
             std::move(part_limits),
             sd_watchdog_enabled(0, &watchdog_usec) > 0,
             std::nullopt};
-  // Store and forward ([fleet]): its own thread and connections; stopped before the hub goes.
-  std::optional<fleet::ForwarderThread> forwarder;
-  if (config.fleet)
-    forwarder.emplace(o.db, fleet::fleet_target(*config.fleet),
-                      fleet::ForwardOptions{config.fleet->samples, 50'000, config.name},
-                      config.fleet->interval_s, [&live](const fleet::ForwarderStatus& f) {
-                        live.hub().fleet(f.to_json());
-                        live.hub().metrics().fleet(f.backlog.runs, f.backlog.rows,
-                                                   f.last_success_unix_s, f.errors_total);
-                      });
+  auto forwarder = start_forwarder(o, config, live);
   sd_notify(0, "READY=1");
-  // A run a killed daemon left unfinished goes on first, exactly as `station run` resumes it.
-  const ResumeDecision rd = decide_resume(store, config, false, false);
-  if (rd.run) run_one(s, *rd.protocol, rd.run, rd.run->operator_name);
+  // A run a killed daemon left unfinished goes on first, by the one start rule; one that no
+  // longer fits the configuration is refused (exit 2, the run untouched: README, upgrades).
+  StartRequest resume_only;
+  resume_only.resume_only = true;
+  if (const StartPlan plan = host.start(resume_only); plan.resume)
+    run_one(s, plan, plan.resume->operator_name);
   idle_until_stopped(s);
   sd_notify(0, "STOPPING=1");
   forwarder.reset();
   live.shutdown();
-  if (g_detach.load()) {
-    // Everything is committed (each tick is its own transaction). Leave now, as a kill would:
-    // no destructors, so the GPIO lines keep their levels (the gyros stay powered and the
-    // lamps as they are) until the new process takes the rig over a few seconds later.
-    log("serve")->info("SIGUSR1: exiting {} for a restart (a running run resumes)", kExitRestart);
-    std::fflush(stdout);
-    std::fflush(stderr);
-    spdlog::shutdown();
-    std::_Exit(kExitRestart);
-  }
+  if (g_detach.load()) exit_for_restart();
   live.exit_if_abandoned(0);
   return 0;
 }

@@ -53,7 +53,7 @@ http::ControlReply ServeControl::start(const std::string& protocol,
   std::unique_lock lock(mu_);
   if (busy_ || pending_) return {409, "a run is going on; stop it first"};
   if (!fault_.empty()) return {409, fmt::format("the rig is not ready: {}", fault_)};
-  pending_ = StartRequest{std::move(p), operator_name};
+  pending_ = ApiStart{std::move(p), operator_name};
   const std::uint64_t mine = ++requests_;
   cv_.notify_all();
   // Answer with the run's id once the serve loop created it (it does so before any device I/O),
@@ -72,11 +72,11 @@ http::ControlReply ServeControl::stop(std::int64_t run_id, bool abort) {
                            abort ? "aborted: no bins, no fit" : "stopped: binned and fitted")};
 }
 
-std::optional<StartRequest> ServeControl::next(std::chrono::milliseconds timeout) {
+std::optional<ApiStart> ServeControl::next(std::chrono::milliseconds timeout) {
   std::unique_lock lock(mu_);
   cv_.wait_for(lock, timeout, [this] { return pending_.has_value() || woken_; });
   woken_ = false;
-  std::optional<StartRequest> r;
+  std::optional<ApiStart> r;
   r.swap(pending_);
   if (r) busy_ = true;
   return r;

@@ -15,8 +15,8 @@
 
 namespace station {
 
-/// A run the API asked for.
-struct StartRequest {
+/// A run the API asked for (the serve loop makes it a StartRequest, run_start.hpp).
+struct ApiStart {
   Protocol protocol;
   std::string operator_name;
 };
@@ -29,7 +29,7 @@ class ServeControl final : public http::RunControl {
   http::ControlReply stop(std::int64_t run_id, bool abort) override;
 
   /// The serve loop: the next start request, waiting up to `timeout` (or until woken).
-  std::optional<StartRequest> next(std::chrono::milliseconds timeout);
+  std::optional<ApiStart> next(std::chrono::milliseconds timeout);
   /// The serve loop: a run is going on (start requests are refused meanwhile).
   void set_busy(bool busy);
   /// The serve loop: why the idle rig cannot start a run (empty: it can).
@@ -50,7 +50,7 @@ class ServeControl final : public http::RunControl {
   std::atomic<bool>& run_abort_;
   std::mutex mu_;
   std::condition_variable cv_;
-  std::optional<StartRequest> pending_;
+  std::optional<ApiStart> pending_;
   bool busy_ = false, woken_ = false;
   std::uint64_t requests_ = 0, answered_ = 0;  ///< start requests taken / whose run exists
   std::int64_t started_id_ = 0;

@@ -9,18 +9,17 @@
 #include <string>
 #include <vector>
 
+#include "station/daemon/outputs.hpp"
 #include "station/daemon/rig.hpp"
+#include "station/daemon/rig_reading.hpp"
 #include "station/daemon/sequencer.hpp"
 #include "station/store/store.hpp"
 
 namespace station {
 
-/// One idle look at the rig.
+/// One idle look at the rig: the reading (rig_reading.hpp) and what rig_faults() found in it.
 struct IdleReading {
-  std::optional<drivers::ChamberState> chamber;
-  std::optional<drivers::TurntableState> table;
-  std::optional<bool> door_closed, estop_pressed;
-  std::vector<IoError> io_errors;
+  RigReading in;
   std::string fault;      ///< empty: every device answered and nothing is alarming
   std::string fault_key;  ///< the same as stable names (device: error kind), for change detection
   std::string storage_error;  ///< this look's event could not be stored (empty: stored or none)
@@ -31,21 +30,23 @@ class IdleWatch {
  public:
   /// `on_event` is told each event stored (the live page's event list); may be empty.
   IdleWatch(Rig& rig, Store& store, std::function<void(const RunEvent&)> on_event = {})
-      : rig_(rig), store_(store), on_event_(std::move(on_event)) {}
-  /// Reads every device once, drives the lamps, stores an event when the fault text changes.
+      : rig_(rig), store_(store), on_event_(std::move(on_event)), outputs_(rig.gpio.get(), 0) {}
+  /// Reads every device once (read_rig), drives the lamps, stores an event when the faults
+  /// (rig_faults) change.
   IdleReading look();
   /// Forget the lamps written (a run drove them meanwhile): the next look writes them again.
-  void run_ended() { lamps_written_ = false; }
+  void run_ended() { outputs_.forget(); }
 
  private:
-  void drive_lamps(bool red);
+  /// Stores (and tells) the event of a change of the faults; a store failure goes into
+  /// `r.storage_error`.
+  void note_change(IdleReading& r);
 
   Rig& rig_;
   Store& store_;
   std::function<void(const RunEvent&)> on_event_;
   std::string last_key_;  ///< what is wrong, without the messages' changing details
-  bool lamps_written_ = false;
-  bool red_ = false;
+  RigOutputs outputs_;    ///< the lamps (idle_outputs); the relays are the runs' to drive
 };
 
 }  // namespace station

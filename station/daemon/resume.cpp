@@ -1,5 +1,4 @@
-// Resume decisions: same meaning of every sample, stored protocol, explicit abort of superseded
-// runs.
+// The meaning of a run's samples, and the one-line difference between two meanings.
 #include "station/daemon/resume.hpp"
 
 #include <fmt/format.h>
@@ -22,12 +21,6 @@ std::vector<RunSlot> run_slots_of(const StationConfig& c) {
 namespace {
 
 using nlohmann::json;
-
-void abort_run(Store& store, const RunRecord& run, const std::string& why) {
-  store.add_event(run.id, run.last_tick_s.value_or(0), Severity::warn, "seq", EventKind::aborted,
-                  why);
-  store.finish_run(run.id, RunState::aborted);
-}
 
 json meaning_of(const StationConfig& c) {
   json slots = json::array();
@@ -98,31 +91,6 @@ std::string resume_mismatch(Store& store, const RunRecord& run, const StationCon
   if (patch.empty()) return {};
   return fmt::format("run {} was started with a different meaning of its samples: {}", run.id,
                      describe_patch(then, patch));
-}
-
-ResumeDecision decide_resume(Store& store, const StationConfig& config, bool fresh,
-                             bool abort_mismatch) {
-  ResumeDecision d;
-  auto run = store.find_unfinished_run();
-  if (!run) return d;
-  if (fresh) {
-    abort_run(store, *run, "superseded by a new run (--new)");
-    return d;
-  }
-  if (const auto why = resume_mismatch(store, *run, config); !why.empty()) {
-    if (!abort_mismatch) {
-      throw InputError(
-          fmt::format("{}: {}; start a new run with --new (the old one is then "
-                      "marked aborted)",
-                      store.db().path(), why));
-    }
-    abort_run(store, *run, why);
-    return d;
-  }
-  d.protocol = parse_protocol(run->protocol_text,
-                              fmt::format("{}:run {} protocol", store.db().path(), run->id));
-  d.run = std::move(run);
-  return d;
 }
 
 }  // namespace station

@@ -68,6 +68,10 @@ Protocol Safety::clamp_protocol(const Protocol& p, std::vector<std::string>& not
   return out;
 }
 
+SafetyInputs safety_inputs(const RigReading& in, std::optional<double> air_c) {
+  return {in.chamber, in.table_interlock_open, in.door_closed, in.estop_pressed, air_c};
+}
+
 std::vector<std::string> Safety::judge(const std::optional<drivers::ChamberState>& chamber) const {
   std::vector<std::string> out;
   if (!chamber) return out;
@@ -99,9 +103,9 @@ struct CauseWords {
 };
 constexpr CauseWords kCauseWords[] = {
     {&SafetyCauses::chamber_high_limit, "chamber high-limit trip", "chamber high-limit trip reset"},
-    {&SafetyCauses::gpio_estop_pressed, "e-stop pressed", "e-stop released"},
+    {&SafetyCauses::estop_pressed, "e-stop pressed", "e-stop released"},
     {&SafetyCauses::chamber_door_open, "chamber door open", "chamber door closed"},
-    {&SafetyCauses::gpio_interlock_open, "interlock open", "interlock closed"},
+    {&SafetyCauses::door_open, "interlock open", "interlock closed"},
     {&SafetyCauses::table_interlock_open, "turntable interlock open", "turntable interlock closed"},
     {&SafetyCauses::inputs_unreadable, "interlock / e-stop unreadable",
      "interlock / e-stop readable again"},
@@ -143,8 +147,7 @@ std::optional<std::string> Safety::update(SafetyCauses causes) {
 
 bool Safety::blind(const SafetyInputs& in) const {
   return (sources_.table && !in.table_interlock_open) ||
-         (sources_.gpio_interlock && !in.gpio_interlock_closed) ||
-         (sources_.gpio_estop && !in.gpio_estop_pressed);
+         (sources_.gpio_interlock && !in.door_closed) || (sources_.gpio_estop && !in.estop_pressed);
 }
 
 SafetyDecision Safety::decide(const SafetyInputs& in) {
@@ -160,8 +163,8 @@ SafetyDecision Safety::decide(const SafetyInputs& in) {
   // interlock, its high-limit trip as an e-stop.
   SafetyCauses c = causes_;
   if (in.table_interlock_open) c.table_interlock_open = *in.table_interlock_open;
-  if (in.gpio_interlock_closed) c.gpio_interlock_open = !*in.gpio_interlock_closed;
-  if (in.gpio_estop_pressed) c.gpio_estop_pressed = *in.gpio_estop_pressed;
+  if (in.door_closed) c.door_open = !*in.door_closed;
+  if (in.estop_pressed) c.estop_pressed = *in.estop_pressed;
   if (in.chamber) {
     c.chamber_door_open = in.chamber->alarms.door_open;
     c.chamber_high_limit = in.chamber->alarms.high_limit_trip;
@@ -174,12 +177,12 @@ SafetyDecision Safety::decide(const SafetyInputs& in) {
   return d;
 }
 
-SafetyDecision Safety::decide_between_ticks(std::optional<bool> gpio_interlock_closed,
-                                            std::optional<bool> gpio_estop_pressed,
+SafetyDecision Safety::decide_between_ticks(std::optional<bool> door_closed,
+                                            std::optional<bool> estop_pressed,
                                             std::optional<double> air_c) {
   SafetyDecision d;
-  const bool open = gpio_interlock_closed && !*gpio_interlock_closed;
-  const bool pressed = gpio_estop_pressed.value_or(false);
+  const bool open = door_closed && !*door_closed;
+  const bool pressed = estop_pressed.value_or(false);
   if (holding_ || !(open || pressed)) {
     d.holding = holding_;
     d.outputs = outputs();
@@ -187,8 +190,8 @@ SafetyDecision Safety::decide_between_ticks(std::optional<bool> gpio_interlock_c
   }
   // An edge only adds a cause; readings out of limits are judged at the ticks.
   SafetyCauses c = causes_;
-  c.gpio_interlock_open = c.gpio_interlock_open || open;
-  c.gpio_estop_pressed = c.gpio_estop_pressed || pressed;
+  c.door_open = c.door_open || open;
+  c.estop_pressed = c.estop_pressed || pressed;
   const bool was = holding_;
   auto change = update(std::move(c));
   if (change) *change += " (between ticks)";
@@ -232,6 +235,13 @@ void Safety::finish(SafetyDecision& d, bool was, const std::optional<std::string
 void Safety::acknowledge(bool chamber_hold_ok, bool table_stop_ok) {
   hold_acknowledged_ = hold_acknowledged_ || chamber_hold_ok;
   table_stopped_ = table_stopped_ || table_stop_ok;
+}
+
+SafetyOutputs idle_outputs(bool fault) {
+  SafetyOutputs o;
+  o.red = fault;
+  o.amber = !fault;  // amber: idle, ready for a run
+  return o;
 }
 
 SafetyOutputs Safety::outputs() const {

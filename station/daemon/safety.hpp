@@ -10,6 +10,7 @@
 #include "drivers/chamber/chamber.hpp"
 #include "station/config/config.hpp"
 #include "station/config/protocol.hpp"
+#include "station/daemon/rig_reading.hpp"
 #include "station/store/events.hpp"
 
 namespace station {
@@ -25,10 +26,13 @@ struct SafetySources {
 struct SafetyInputs {
   std::optional<drivers::ChamberState> chamber;  ///< also its door and high-limit alarms
   std::optional<bool> table_interlock_open;
-  std::optional<bool> gpio_interlock_closed;
-  std::optional<bool> gpio_estop_pressed;
-  std::optional<double> air_c;  ///< last finite air reading (where a hold keeps the chamber)
+  std::optional<bool> door_closed;    ///< the GPIO interlock line (closed = safe)
+  std::optional<bool> estop_pressed;  ///< the GPIO e-stop line
+  std::optional<double> air_c;        ///< last finite air reading (where a hold keeps the chamber)
 };
+
+/// The safety inputs of one rig reading (`air_c`: the last finite air reading).
+SafetyInputs safety_inputs(const RigReading& in, std::optional<double> air_c);
 
 /// The outputs the safety state asks for (tower lamps, gyro power relays).
 struct SafetyOutputs {
@@ -37,20 +41,23 @@ struct SafetyOutputs {
   bool operator==(const SafetyOutputs&) const = default;
 };
 
+/// The outputs between runs (serve's idle rig): amber, red while `fault`; gyros unpowered.
+SafetyOutputs idle_outputs(bool fault);
+
 /// Why the rig holds: each input's own last known state (a source that cannot be read keeps its
 /// own last reading, never another source's), so a hold clears once every cause read clear.
 struct SafetyCauses {
   bool table_interlock_open = false;       ///< the turntable's interlock input
-  bool gpio_interlock_open = false;        ///< the GPIO door interlock line
+  bool door_open = false;                  ///< the GPIO door interlock line
   bool chamber_door_open = false;          ///< the chamber's own door alarm
-  bool gpio_estop_pressed = false;         ///< the GPIO e-stop line
+  bool estop_pressed = false;              ///< the GPIO e-stop line
   bool chamber_high_limit = false;         ///< the chamber's high-limit (over-temperature) trip
   bool inputs_unreadable = false;          ///< interlock / e-stop unreadable for kBlindTicks
   std::vector<std::string> out_of_limits;  ///< the chamber's readings outside the limits
   bool interlock_open() const {
-    return table_interlock_open || gpio_interlock_open || chamber_door_open || inputs_unreadable;
+    return table_interlock_open || door_open || chamber_door_open || inputs_unreadable;
   }
-  bool estop() const { return gpio_estop_pressed || chamber_high_limit; }
+  bool estop() const { return estop_pressed || chamber_high_limit; }
   bool any() const { return interlock_open() || estop() || !out_of_limits.empty(); }
   /// The active causes in words ("chamber high-limit trip; GPIO e-stop pressed"), or "none".
   std::string text() const;
@@ -104,8 +111,8 @@ class Safety {
   /// row it counts as open (fail safe); a hold clears only on positive readings.
   SafetyDecision decide(const SafetyInputs& in);
   /// Between ticks (a GPIO edge): may enter the hold, never clears it.
-  SafetyDecision decide_between_ticks(std::optional<bool> gpio_interlock_closed,
-                                      std::optional<bool> gpio_estop_pressed,
+  SafetyDecision decide_between_ticks(std::optional<bool> door_closed,
+                                      std::optional<bool> estop_pressed,
                                       std::optional<double> air_c);
   /// What the devices said to this tick's hold commands; a refused one is sent again next tick.
   void acknowledge(bool chamber_hold_ok, bool table_stop_ok);

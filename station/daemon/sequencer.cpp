@@ -10,27 +10,13 @@
 #include "drivers/gpio/gpio_bank.hpp"
 #include "station/common/logging.hpp"
 #include "station/daemon/sample.hpp"
+#include "station/daemon/stopwatch.hpp"
 
 namespace station {
 
 namespace dr = station::drivers;
 
 namespace {
-
-/// Adds the wall time of its scope to a phase total.
-class PhaseTimer {
- public:
-  explicit PhaseTimer(double& total) : total_(total), start_(std::chrono::steady_clock::now()) {}
-  ~PhaseTimer() {
-    total_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-  }
-  PhaseTimer(const PhaseTimer&) = delete;
-  PhaseTimer& operator=(const PhaseTimer&) = delete;
-
- private:
-  double& total_;
-  std::chrono::steady_clock::time_point start_;
-};
 
 // Which safety inputs the rig has: each one configured must be readable every tick.
 SafetySources sources_of(const Rig& rig) {
@@ -51,7 +37,8 @@ Sequencer::Sequencer(const StationConfig& config, const Protocol& protocol, Rig&
       store_(store),
       clock_(clock),
       options_(std::move(options)),
-      safety_(config.limits, sources_of(rig)) {}
+      safety_(config.limits, sources_of(rig)),
+      outputs_(rig.gpio.get(), config.slots.size()) {}
 
 void Sequencer::emit(double t_s, Severity severity, const std::string& source, EventKind kind,
                      const std::string& message, const nlohmann::json& data) {
@@ -79,37 +66,14 @@ void Sequencer::connect_devices() {
 }
 
 void Sequencer::read_devices(double t_s, TickData& d) {
-  // SYNC and collect before the Modbus reads. (Overlapping the boards' answers with the Modbus
-  // reads measured slower on 2 cores: the simulators' threads compete for them.)
-  std::optional<PhaseTimer> timer(std::in_place, phase_s_.can);
-  auto counts = rig_.counters->tick(latch_seq_++);
-  if (counts) {
-    d.counts = std::move(counts).value();
-  } else {
-    d.io_errors.push_back({"can", dr::to_string(counts.error().kind)});
-  }
-  note_counters(t_s, d, counts ? std::string() : counts.error().message);
-  timer.emplace(phase_s_.chamber);
-  auto chamber = rig_.chamber->read();
-  if (chamber) {
-    d.chamber = chamber.value();
-  } else {
-    d.io_errors.push_back({"chamber", dr::to_string(chamber.error().kind)});
-  }
-  note_link(t_s, "chamber", chamber.ok(), chamber ? std::string() : chamber.error().message);
-  timer.emplace(phase_s_.table);
-  if (rig_.turntable) {
-    auto table = rig_.turntable->read();
-    if (table) {
-      d.table = table.value();
-      d.table_interlock_open = d.table->interlock_open;
-    } else {
-      d.io_errors.push_back({"turntable", dr::to_string(table.error().kind)});
-    }
-    note_link(t_s, "turntable", table.ok(), table ? std::string() : table.error().message);
-  }
-  timer.emplace(phase_s_.gpio);
-  read_gpio(t_s, d);
+  d.in = read_rig(rig_, RigReadPlan{latch_seq_++}, &phase_s_.rig);
+  note_counters(t_s, d, d.in.counters_error ? d.in.counters_error->message : std::string());
+  note_link(t_s, "chamber", d.in.chamber.has_value(),
+            d.in.chamber_error ? d.in.chamber_error->message : std::string());
+  if (d.in.has_table)
+    note_link(t_s, "turntable", d.in.table.has_value(),
+              d.in.table_error ? d.in.table_error->message : std::string());
+  note_edges(t_s, d.in);
 }
 
 void Sequencer::note_link(double t_s, const std::string& device, std::optional<bool> answered,
@@ -133,13 +97,14 @@ void Sequencer::note_link(double t_s, const std::string& device, std::optional<b
 
 void Sequencer::note_counters(double t_s, const TickData& d, const std::string& error) {
   bool any = false;
-  if (d.counts)
-    for (const auto& r : d.counts->readings) any = any || r.answered;
-  note_link(t_s, "can", any, d.counts ? "no counter board answered" : error);
+  const auto& counts = d.in.counters;
+  if (counts)
+    for (const auto& r : counts->readings) any = any || r.answered;
+  note_link(t_s, "can", any, counts ? "no counter board answered" : error);
   for (std::size_t i = 0; i < config_.slots.size(); ++i) {
     const std::string device = fmt::format("can node {}", config_.slots[i].node);
     // Behind a lost bus a board has no news of its own: the bus outage covers it.
-    const auto* r = any ? &d.counts->readings[i] : nullptr;
+    const auto* r = any ? &counts->readings[i] : nullptr;
     note_link(t_s, device, r ? std::optional<bool>(r->answered) : std::nullopt,
               "no complete answer to the latch");
     if (r == nullptr || !r->answered) continue;
@@ -188,31 +153,11 @@ std::map<std::string, std::string> Sequencer::close_outages(double t_s) {
   return out;
 }
 
-void Sequencer::read_gpio(double t_s, TickData& d) {
-  if (!rig_.gpio) return;
-  if (auto ev = rig_.gpio->read_events(); ev) {
-    for (const auto& e : ev.value()) {
-      emit(t_s, Severity::info, "gpio", EventKind::edge,
-           fmt::format("{} {}", e.role, e.rising ? "rising" : "falling"),
-           {{"role", e.role}, {"rising", e.rising}});
-    }
-  }
-  const auto has = [this](std::string_view role) {
-    return dr::gpio::find_role(rig_.gpio->config(), role) != nullptr;
-  };
-  if (has(dr::gpio::roles::interlock)) {
-    if (auto closed = rig_.gpio->read(dr::gpio::roles::interlock); closed) {
-      d.gpio_interlock_closed = closed.value();
-    } else {
-      d.io_errors.push_back({"gpio", dr::to_string(closed.error().kind)});
-    }
-  }
-  if (has(dr::gpio::roles::estop)) {
-    if (auto pressed = rig_.gpio->read(dr::gpio::roles::estop); pressed) {
-      d.gpio_estop_pressed = pressed.value();
-    } else {
-      d.io_errors.push_back({"gpio", dr::to_string(pressed.error().kind)});
-    }
+void Sequencer::note_edges(double t_s, const RigReading& in) {
+  for (const auto& e : in.edges) {
+    emit(t_s, Severity::info, "gpio", EventKind::edge,
+         fmt::format("{} {}", e.role, e.rising ? "rising" : "falling"),
+         {{"role", e.role}, {"rising", e.rising}});
   }
 }
 
@@ -220,12 +165,14 @@ void Sequencer::assemble_samples(double t_s, TickData& d) {
   const bool recording = runner_->progress().recording;
   d.obs.t_s = t_s;
   d.obs.has_turntable = rig_.turntable != nullptr;
-  if (d.table) {
-    d.obs.table_in_position = d.table->in_position;
-    d.obs.table_angle_deg = d.table->angle_deg;
-    d.obs.table_locked = d.table->locked;
+  const auto& table = d.in.table;
+  const auto& chamber = d.in.chamber;
+  if (table) {
+    d.obs.table_in_position = table->in_position;
+    d.obs.table_angle_deg = table->angle_deg;
+    d.obs.table_locked = table->locked;
   }
-  if (d.chamber && std::isfinite(d.chamber->air_c)) d.obs.air_c = d.chamber->air_c;
+  d.obs.air_c = d.in.air_c();
   if (d.obs.air_c) last_air_c_ = d.obs.air_c;
   for (const auto& slot : config_.slots) {
     SampleRow r;
@@ -233,11 +180,11 @@ void Sequencer::assemble_samples(double t_s, TickData& d) {
     r.t_s = t_s;
     r.recording = recording;
     r.air_c = d.obs.air_c;
-    if (d.chamber) r.setpoint_c = d.chamber->setpoint_c;
-    r.flags = (d.chamber ? 0 : kChamberMissing) | (safety_.holding() ? kSafeHold : 0);
+    if (chamber) r.setpoint_c = chamber->setpoint_c;
+    r.flags = (chamber ? 0 : kChamberMissing) | (safety_.holding() ? kSafeHold : 0);
     const dr::counters::CounterReading* rd = nullptr;
-    if (d.counts) {
-      for (const auto& x : d.counts->readings) rd = x.serial == slot.serial ? &x : rd;
+    if (d.in.counters) {
+      for (const auto& x : d.in.counters->readings) rd = x.serial == slot.serial ? &x : rd;
     }
     apply_reading(rd, r);
     if (r.temp_c) d.obs.gyro_temps_c.push_back(*r.temp_c);
@@ -246,13 +193,7 @@ void Sequencer::assemble_samples(double t_s, TickData& d) {
 }
 
 void Sequencer::apply_safety(double t_s, TickData& d) {
-  SafetyInputs in;
-  in.chamber = d.chamber;
-  in.table_interlock_open = d.table_interlock_open;
-  in.gpio_interlock_closed = d.gpio_interlock_closed;
-  in.gpio_estop_pressed = d.gpio_estop_pressed;
-  in.air_c = d.obs.air_c;
-  const auto decision = safety_.decide(in);
+  const auto decision = safety_.decide(safety_inputs(d.in, d.obs.air_c));
   act_on_safety(t_s, decision);
   if (decision.cleared) runner_->reenter(decision.hold_air_c);
 }
@@ -262,10 +203,9 @@ void Sequencer::watch_inputs_until(double deadline_s, double t_s) {
   // Between ticks the loop waits on the GPIO bank's event fd: an interlock opening or an e-stop
   // puts the rig in safe hold at once, not at the next tick. Clearing waits for a tick.
   while (fd >= 0 && clock_.wait_readable(fd, deadline_s)) {
-    TickData d;
-    read_gpio(t_s, d);
-    act_on_safety(t_s, safety_.decide_between_ticks(d.gpio_interlock_closed, d.gpio_estop_pressed,
-                                                    last_air_c_));
+    const RigReading in = read_rig(rig_, RigReadPlan{std::nullopt, false, false});
+    note_edges(t_s, in);
+    act_on_safety(t_s, safety_.decide_between_ticks(in.door_closed, in.estop_pressed, last_air_c_));
   }
   clock_.sleep_until(deadline_s);
 }
@@ -294,24 +234,9 @@ void Sequencer::act_on_safety(double t_s, const SafetyDecision& d) {
 }
 
 void Sequencer::drive_outputs(double t_s, const SafetyOutputs& o) {
-  if (!rig_.gpio) return;
-  std::vector<std::pair<std::string, bool>> lines{
-      {std::string(dr::gpio::roles::tower_red), o.red},
-      {std::string(dr::gpio::roles::tower_amber), o.amber},
-      {std::string(dr::gpio::roles::tower_green), o.green}};
-  for (std::size_t i = 0; i < config_.slots.size(); ++i)
-    lines.emplace_back(dr::gpio::roles::relay(static_cast<int>(i + 1)), o.gyro_power);
-  for (const auto& [role, on] : lines) {
-    const auto it = outputs_.find(role);
-    if ((it != outputs_.end() && it->second == on) ||
-        dr::gpio::find_role(rig_.gpio->config(), role) == nullptr)
-      continue;
-    if (auto r = rig_.gpio->write(role, on); r) {
-      outputs_[role] = on;
-    } else if (command_failures_++ % 60 == 0) {
-      emit(t_s, Severity::warn, "gpio", EventKind::output_failed, r.error().message);
-    }
-  }
+  for (const auto& failure : outputs_.write(o))
+    if (command_failures_++ % 60 == 0)
+      emit(t_s, Severity::warn, "gpio", EventKind::output_failed, failure);
 }
 
 void Sequencer::apply_actions(double t_s, const Actions& a) {
@@ -353,13 +278,13 @@ TickReport Sequencer::report(double t_s, const TickData& d) const {
   r.safe_hold = safety_.holding();
   r.air_c = d.obs.air_c;
   r.run_id = run_id_;
-  r.chamber = d.chamber;
-  r.table = d.table;
-  r.door_closed = d.gpio_interlock_closed;
-  r.estop_pressed = d.gpio_estop_pressed;
-  r.table_interlock_open = d.table_interlock_open;
+  r.chamber = d.in.chamber;
+  r.table = d.in.table;
+  r.door_closed = d.in.door_closed;
+  r.estop_pressed = d.in.estop_pressed;
+  r.table_interlock_open = d.in.table_interlock_open;
   r.rows = &d.rows;
-  r.io_errors = d.io_errors;
+  r.io_errors = d.in.io_errors;
   r.replaying = replaying_;
   return r;
 }
@@ -372,7 +297,7 @@ void Sequencer::tick(double t_s, TickData& d) {
   if (!safety_.holding()) a = runner_->tick(d.obs);
   apply_actions(t_s, a);
   if (!replaying_) {
-    PhaseTimer timer(phase_s_.store);
+    Stopwatch timer(&phase_s_.store);
     store_.append_tick(run_id_, t_s, d.rows, runner_->progress());
   }
 }

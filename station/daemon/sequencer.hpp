@@ -16,20 +16,16 @@
 #include "station/config/config.hpp"
 #include "station/config/protocol.hpp"
 #include "station/daemon/outages.hpp"
+#include "station/daemon/outputs.hpp"
 #include "station/daemon/protocol_runner.hpp"
 #include "station/daemon/rig.hpp"
+#include "station/daemon/rig_reading.hpp"
 #include "station/daemon/safety.hpp"
 #include "station/parts/part_file.hpp"
 #include "station/store/calibration.hpp"
 #include "station/store/store.hpp"
 
 namespace station {
-
-/// One device I/O failure of a tick (metrics): device ("chamber", "turntable", "can", "gpio")
-/// and drivers::ErrorKind by name.
-struct IoError {
-  std::string device, kind;
-};
 
 /// One tick's summary for progress lines, the live page and metrics.
 struct TickReport {
@@ -121,16 +117,11 @@ class Sequencer {
   RunOutcome run(const std::optional<RunRecord>& resume = std::nullopt);
 
  private:
-  /// Everything one tick read.
+  /// Everything one tick read, and what the sequencer made of it.
   struct TickData {
-    std::optional<drivers::counters::TickResult> counts;
-    std::optional<drivers::ChamberState> chamber;
-    std::optional<drivers::TurntableState> table;
-    // Safety inputs as read this tick (empty: not readable this tick).
-    std::optional<bool> table_interlock_open, gpio_interlock_closed, gpio_estop_pressed;
+    RigReading in;  ///< the rig, read once (rig_reading.hpp)
     std::vector<SampleRow> rows;
     Observation obs;
-    std::vector<IoError> io_errors;
   };
   /// The tick's summary for SequencerOptions::on_tick.
   TickReport report(double t_s, const TickData& d) const;
@@ -148,7 +139,8 @@ class Sequencer {
   void tick(double t_s, TickData& d);
   void read_devices(double t_s, TickData& d);
   void apply_safety(double t_s, TickData& d);
-  void read_gpio(double t_s, TickData& d);
+  /// Stores an event per GPIO edge of a reading.
+  void note_edges(double t_s, const RigReading& in);
   void watch_inputs_until(double deadline_s, double t_s);
   /// Carries out a safety decision: its events, hold commands (acknowledged back), outputs.
   void act_on_safety(double t_s, const SafetyDecision& d);
@@ -193,12 +185,13 @@ class Sequencer {
   std::uint8_t latch_seq_ = 0;
   bool replaying_ = false;
   int command_failures_ = 0;
-  OutageTracker outages_;                ///< link outages per device
-  std::optional<double> last_air_c_;     ///< last chamber air reading
-  std::map<std::string, bool> outputs_;  ///< output role -> level as last written
+  OutageTracker outages_;             ///< link outages per device
+  std::optional<double> last_air_c_;  ///< last chamber air reading
+  RigOutputs outputs_;                ///< lamps and relays, written where they change
   /// Time spent per tick phase (wall seconds, summed), logged at the end of a run.
   struct PhaseTimes {
-    double world = 0, can = 0, chamber = 0, table = 0, gpio = 0, store = 0;
+    double world = 0, store = 0;
+    RigReadTimes rig;
   } phase_s_;
   std::optional<drivers::ChamberCommand> pending_chamber_;
   std::optional<drivers::TurntableCommand> pending_table_;

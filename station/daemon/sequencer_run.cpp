@@ -11,6 +11,7 @@
 #include "station/common/logging.hpp"
 #include "station/daemon/resume.hpp"
 #include "station/daemon/sequencer.hpp"
+#include "station/daemon/stopwatch.hpp"
 #include "station/parts/judged_fit.hpp"
 #include "station/store/calibration.hpp"
 #include "station/store/fit_json.hpp"
@@ -218,10 +219,8 @@ RunOutcome Sequencer::tick_loop(double t_first) {
     replaying_ = options_.replay_until_t_s && t_s <= *options_.replay_until_t_s;
     if (skipped > 0) note_tick_gap(t_s, skipped);
     if (options_.before_tick) {
-      const auto w0 = std::chrono::steady_clock::now();
+      Stopwatch timer(&phase_s_.world);
       options_.before_tick(t_s);
-      phase_s_.world +=
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
     }
     TickData d;
     const auto w0 = std::chrono::steady_clock::now();
@@ -253,8 +252,8 @@ std::optional<RunOutcome> Sequencer::end_of_run(double t_s, std::int64_t ticks) 
   log("seq")->info(
       "tick phases, mean us: world {:.0f} can {:.0f} chamber {:.0f} table {:.0f} gpio {:.0f} "
       "store {:.0f}",
-      phase_s_.world / n, phase_s_.can / n, phase_s_.chamber / n, phase_s_.table / n,
-      phase_s_.gpio / n, phase_s_.store / n);
+      phase_s_.world / n, phase_s_.rig.can / n, phase_s_.rig.chamber / n, phase_s_.rig.table / n,
+      phase_s_.rig.gpio / n, phase_s_.store / n);
   return RunOutcome{run_id_, finish(state, t_s), t_s, ticks};
 }
 

@@ -222,8 +222,8 @@ void LiveHub::run_ended(std::int64_t run_id, const std::string& state) {
 
 void LiveHub::idle(const IdleReading& r) {
   std::lock_guard lock(mu_);
-  metrics_.io_errors(r.io_errors);
-  if (r.chamber) metrics_.chamber(*r.chamber);
+  metrics_.io_errors(r.in.io_errors);
+  if (r.in.chamber) metrics_.chamber(*r.in.chamber);
   idle_ = r;
   fault_ = r.fault;
   publish_state(last_run_id_.value_or(0));
@@ -262,22 +262,22 @@ nlohmann::json LiveHub::status_locked() const {
       {"http", http_url_},
       {"run", run},
       {"chamber", chamber_json(live    ? last_->chamber
-                               : idle_ ? idle_->chamber
+                               : idle_ ? idle_->in.chamber
                                        : std::nullopt)},
       {"table", table_json(live    ? last_->table
-                           : idle_ ? idle_->table
+                           : idle_ ? idle_->in.table
                                    : std::nullopt)},
       {"slots", slots},
       {"safety", safety_json(live && last_->safe_hold,
                              live    ? last_->door_closed
-                             : idle_ ? idle_->door_closed
+                             : idle_ ? idle_->in.door_closed
                                      : std::nullopt,
                              live    ? last_->estop_pressed
-                             : idle_ ? idle_->estop_pressed
+                             : idle_ ? idle_->in.estop_pressed
                                      : std::nullopt,
-                             live                    ? last_->table_interlock_open
-                             : idle_ && idle_->table ? std::optional(idle_->table->interlock_open)
-                                                     : std::nullopt)},
+                             live    ? last_->table_interlock_open
+                             : idle_ ? idle_->in.table_interlock_open
+                                     : std::nullopt)},
       {"ticks", ticks_},
       {"last_tick_ms", last_ ? nlohmann::json(last_->tick_wall_s * 1e3) : nlohmann::json(nullptr)},
       {"last_run_id", last_run_id_ ? nlohmann::json(*last_run_id_) : nlohmann::json(nullptr)},

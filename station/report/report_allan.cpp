@@ -4,6 +4,7 @@
 #include <algorithm>
 
 #include "compensation/binning.hpp"
+#include "station/store/sample_series.hpp"
 
 namespace station::report {
 
@@ -35,15 +36,10 @@ std::vector<double> per_sample_dtdt(const std::vector<double>& t_s,
 
 OneHzRecord one_hz_record(const std::vector<SampleRow>& rows, double earth_rate_dph,
                           const sc::FitResult& fit, double bin_s) {
-  std::vector<double> t, temp, grad;
+  const SampleSeries s = sample_series(rows);
+  const std::vector<double>&t = s.t_s, &temp = s.temp_c, &grad = s.grad_c;
   OneHzRecord r;
-  for (const auto& s : rows) {
-    if (!sample_goes_into_bins(s)) continue;
-    t.push_back(s.t_s);
-    r.bias_dph.push_back(*s.rate_dph - earth_rate_dph);
-    temp.push_back(*s.temp_c);
-    grad.push_back(*gradient_c(s));
-  }
+  for (double rate : s.rate_dph) r.bias_dph.push_back(rate - earth_rate_dph);
   if (r.bias_dph.empty()) return r;
   std::vector<double> dtdt, channel;
   if (has_coefficient(fit, "kr")) dtdt = per_sample_dtdt(t, temp, bin_s);

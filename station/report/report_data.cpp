@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "compensation/binning.hpp"
+#include "station/store/sample_series.hpp"
 
 namespace station::report {
 
@@ -62,21 +63,14 @@ std::size_t Figure::points() const {
 
 std::vector<RunBin> whole_run_bins(const std::vector<SampleRow>& rows, double bin_s,
                                    double earth_rate_dph) {
-  std::vector<double> t, rate, temp, grad;
-  for (const auto& s : rows) {
-    if (!sample_is_usable(s)) continue;
-    t.push_back(s.t_s);
-    rate.push_back(*s.rate_dph);
-    temp.push_back(*s.temp_c);
-    grad.push_back(*gradient_c(s));
-  }
+  const SampleSeries s = sample_series(rows, SampleRule::usable);
   sc::BinConfig cfg;
   cfg.width_s = bin_s;
   cfg.sample_period_s = 1.0;  // the sequencer's tick
   std::vector<RunBin> out;
-  if (t.size() < 2) return out;
+  if (s.t_s.size() < 2) return out;
   std::size_t air_from = 0;
-  for (const auto& b : sc::make_bins({t, rate, temp, grad, {}}, cfg)) {
+  for (const auto& b : sc::make_bins(s.bin_input(), cfg)) {
     if (!b.complete) continue;
     out.push_back({b.t_mid_s, b.rate_dph - earth_rate_dph, b.temp_c,
                    mean_air(rows, air_from, b.t_start_s, b.t_start_s + bin_s), b.dtdt_c_per_h});

@@ -16,9 +16,8 @@
 #include "sim_devices/sim_world.hpp"
 #include "station/common/logging.hpp"
 #include "station/config/protocol.hpp"
-#include "station/daemon/resume.hpp"
+#include "station/daemon/host.hpp"
 #include "station/daemon/rig.hpp"
-#include "station/daemon/sequencer.hpp"
 #include "station/parts/judged_fit.hpp"
 #include "station/session/session_recording.hpp"
 #include "station/sim/paced_clock.hpp"
@@ -112,10 +111,9 @@ void check_fault_commands(const SimRunOptions& o, const sim::SimWorldConfig& wc)
 
 }  // namespace
 
-nlohmann::json run_simulated(const SimRunOptions& o) {
-  const auto wall_start = std::chrono::steady_clock::now();
-  const auto part = sim_part_number(o);
-  const Protocol protocol = load_protocol(o.protocol);
+namespace {
+
+sim::SimWorldConfig world_config(const SimRunOptions& o) {
   sim::SimWorldConfig wc;
   wc.gyros = o.gyros;
   wc.seed = o.seed;
@@ -128,69 +126,63 @@ nlohmann::json run_simulated(const SimRunOptions& o) {
   wc.chamber_model = o.chamber_model;
   wc.turntable_model = o.turntable_model;
   wc.earth_rate_dph = compensation::earth_rate_along_axis_dph(o.latitude_deg, {0, 0, 1});
-  check_fault_commands(o, wc);
-  sim::SimWorld world(wc);
-  const StationConfig config =
-      parse_station_config(sim_config_text(world, o, part), "sim:station.toml");
-  RigOptions ro;
+  return wc;
+}
+
+/// Where a simulation's time comes from: the simulated clock, paced to the wall (--speed), or
+/// the wall itself; logs are stamped on the run's clock (`now_s`): the simulated one starts at
+/// the wall time the simulation started, so a simulated session reads like a recorded one (13 h
+/// of traffic spans 13 h of time stamps, not the seconds the simulation took).
+struct SimTime {
+  explicit SimTime(const SimRunOptions& o)
+      : paced(sim_clock, o.speed > 0 ? o.speed : 1.0),
+        clock(o.wall_clock  ? static_cast<drivers::Clock&>(wall_clock)
+              : o.speed > 0 ? static_cast<drivers::Clock&>(paced)
+                            : sim_clock),
+        now_s([this, wall = o.wall_clock, t0_epoch_s = drivers::tap_wall_time_s()] {
+          return wall ? drivers::tap_wall_time_s() : t0_epoch_s + sim_clock.now_s();
+        }) {}
   sim::SimClock sim_clock;
   drivers::MonotonicClock wall_clock;
-  PacedClock paced(sim_clock, o.speed > 0 ? o.speed : 1.0);
-  drivers::Clock& clock = o.wall_clock  ? static_cast<drivers::Clock&>(wall_clock)
-                          : o.speed > 0 ? static_cast<drivers::Clock&>(paced)
-                                        : sim_clock;
-  // Logs are stamped on the run's clock: the simulated one starts at the wall time the
-  // simulation started, so a simulated session reads like a recorded one (13 h of traffic
-  // spans 13 h of time stamps, not the seconds the simulation took).
-  const double t0_epoch_s = drivers::tap_wall_time_s();
-  const std::function<double()> run_now_s = [&, t0_epoch_s] {
-    return o.wall_clock ? drivers::tap_wall_time_s() : t0_epoch_s + sim_clock.now_s();
-  };
+  PacedClock paced;
+  drivers::Clock& clock;
+  std::function<double()> now_s;
+};
+
+/// What a simulation records: a whole session (--record) or the CAN log alone (--record-can).
+struct SimRecording {
+  SimRecording(const SimRunOptions& o, const std::function<double()>& now_s) {
+    if (!o.record_dir.empty()) {
+      session.emplace(o.record_dir, [now_s](const drivers::TapRecord&) { return now_s(); });
+      tap = &session->tap();
+    } else if (!o.record_can_path.empty()) {
+      can_log.open(o.record_can_path);
+      if (!can_log)
+        throw InputError(fmt::format("{}: cannot write the CAN log", o.record_can_path));
+      tap = &can_tap.emplace(can_log, "can0", now_s);
+    }
+  }
   std::ofstream can_log;
   std::optional<drivers::can::CandumpTap> can_tap;
   std::optional<SessionRecording> session;
-  if (!o.record_dir.empty()) {
-    session.emplace(o.record_dir, [run_now_s](const drivers::TapRecord&) { return run_now_s(); });
-    ro.tap = &session->tap();
-  } else if (!o.record_can_path.empty()) {
-    can_log.open(o.record_can_path);
-    if (!can_log) throw InputError(fmt::format("{}: cannot write the CAN log", o.record_can_path));
-    ro.tap = &can_tap.emplace(can_log, "can0", run_now_s);
-  }
-  // The links' reconnect back-off runs on the run's clock: a replay makes the same decisions.
-  ro.clock = &clock;
-  auto chips = world.gpio_chips();
-  ro.gpio_factory = [chips](const drivers::gpio::GpioConfig& g) {
-    return std::make_unique<sim::GpioSimBank>(g, chips);
-  };
-  Rig rig = build_rig(config, ro);
-  Store store(o.db_path.empty() ? "station-sim.db" : o.db_path);
-  // One commit per simulated minute: a commit costs more than a simulated tick, and a killed
-  // simulation resumes by deterministic replay anyway. Real rigs commit every tick.
-  // A paced simulation (--speed, watched live) holds a write transaction at most ~20 ms of wall
-  // time: another writer on the same file (a release over the API) waits in its busy handler
-  // for a gap between batches, and a batch held across the whole pace starves it.
-  store.set_ticks_per_commit(o.wall_clock  ? 1
-                             : o.speed > 0 ? std::max(1, static_cast<int>(o.speed * 0.02))
-                                           : 60);
-  // A simulation continues only the same simulation: same slots, seed and protocol text.
-  ResumeDecision rd = decide_resume(store, config, o.fresh, true);
-  std::optional<RunRecord> resume = rd.run;
-  if (resume && (resume->sim_seed != static_cast<std::int64_t>(o.seed) ||
-                 rd.protocol->text != protocol.text)) {
-    store.add_event(resume->id, resume->last_tick_s.value_or(0), Severity::warn, "seq",
-                    EventKind::aborted, "superseded by a simulation with another seed or protocol");
-    store.finish_run(resume->id, RunState::aborted);
-    resume.reset();
-  }
-  SequencerOptions so;
-  so.part_limits = slot_part_limits(config, o.parts_path);
-  so.sim_seed = static_cast<std::int64_t>(o.seed);
-  so.stop = o.stop;
-  // Resuming a simulation replays it deterministically from t = 0 up to the last stored tick.
-  if (resume) so.replay_until_t_s = resume->last_tick_s.value_or(-1.0);
-  so.before_tick = [&world, &o, &session, replay_until = so.replay_until_t_s](double t_s) {
-    if (session) session->tap().pause(replay_until && t_s <= *replay_until);
+  drivers::Tap* tap = nullptr;
+};
+
+/// One commit per simulated minute: a commit costs more than a simulated tick, and a killed
+/// simulation resumes by deterministic replay anyway. Real rigs commit every tick. A paced
+/// simulation (--speed, watched live) holds a write transaction at most ~20 ms of wall time:
+/// another writer on the same file (a release over the API) waits in its busy handler for a gap
+/// between batches, and a batch held across the whole pace starves it.
+int ticks_per_commit(const SimRunOptions& o) {
+  return o.wall_clock ? 1 : o.speed > 0 ? std::max(1, static_cast<int>(o.speed * 0.02)) : 60;
+}
+
+/// Before each tick: the world advances, the --fault commands of that second run, and a resumed
+/// session's recording stays paused until the replay passes the last stored tick.
+std::function<void(double)> world_tick(const SimRunOptions& o, sim::SimWorld& world,
+                                       SimRecording& rec, std::optional<double> replay_until) {
+  return [&world, &o, &rec, replay_until](double t_s) {
+    if (rec.session) rec.session->tap().pause(replay_until && t_s <= *replay_until);
     world.advance_to(t_s);
     for (const auto& [at_s, command] : o.faults) {
       if (at_s != t_s) continue;
@@ -206,27 +198,35 @@ nlohmann::json run_simulated(const SimRunOptions& o) {
     }
     if (o.on_world_tick) o.on_world_tick(t_s, world);
   };
-  const double nominal_s = protocol.nominal_duration_s(wc.initial_c);
-  double next_report_s = 0;
-  if (session) {
-    session->start(config, protocol, true, static_cast<std::int64_t>(o.seed));
-    so.on_resume = [&session](double last_s, double next_s) { session->resumed(last_s, next_s); };
-    // A resumed simulation connects and recomputes its stored ticks first: all of that is in
-    // the logs already (before_tick lifts the pause after the last stored tick).
-    if (resume) session->tap().pause(true);
-  }
-  so.on_tick = [&](const TickReport& r) {
-    if (session) session->after_tick();
+}
+
+/// After each tick: the session's bookkeeping and, with --progress, a line every 30 min.
+std::function<void(const TickReport&)> progress_tick(const SimRunOptions& o, SimRecording& rec,
+                                                     double nominal_s) {
+  return [&o, &rec, nominal_s, next_report_s = 0.0](const TickReport& r) mutable {
+    if (rec.session) rec.session->after_tick();
     if (!o.progress || r.t_s < next_report_s) return;
     next_report_s = r.t_s + 1800.0;
     fmt::print(stderr, "sim {:5.1f} h of ~{:.1f} h  step {}/{}  air {:6.1f} C{}{}\n",
                r.t_s / 3600.0, nominal_s / 3600.0, r.step_index + 1, r.steps, r.air_c.value_or(NAN),
                r.recording ? "  recording" : "", r.safe_hold ? "  SAFE HOLD" : "");
   };
-  if (o.extend) o.extend(so);
-  Sequencer seq(config, protocol, rig, store, clock, so);
-  const RunOutcome out = seq.run(resume);
-  if (session) session->finish(store, out.run_id);
+}
+
+/// The simulated rig's links: recorded when asked, their reconnect back-off on the run's clock
+/// (a replay decides the same), GPIO from the world's chips.
+RigOptions sim_rig_options(sim::SimWorld& world, const SimRecording& rec, SimTime& time) {
+  RigOptions ro;
+  ro.tap = rec.tap;
+  ro.clock = &time.clock;
+  ro.gpio_factory = [chips = world.gpio_chips()](const drivers::gpio::GpioConfig& g) {
+    return std::make_unique<sim::GpioSimBank>(g, chips);
+  };
+  return ro;
+}
+
+nlohmann::json sim_report(Store& store, const RunOutcome& out, const sim::SimWorld& world,
+                          std::chrono::steady_clock::time_point wall_start) {
   nlohmann::json report{
       {"run_id", out.run_id},
       {"state", to_string(out.state)},
@@ -236,6 +236,47 @@ nlohmann::json run_simulated(const SimRunOptions& o) {
       {"gyros", nlohmann::json::array()}};
   for (const auto& g : world.gyros()) report["gyros"].push_back(gyro_report(store, out.run_id, g));
   return report;
+}
+
+}  // namespace
+
+// The deterministic simulation: a simulated world on loopback, its clock, the recording; the
+// run itself is the one host's (daemon/host.hpp), started by the one start rule (run_start.hpp):
+// a simulation continues only the same simulation, with its stored protocol, replayed from 0.
+nlohmann::json run_simulated(const SimRunOptions& o) {
+  const auto wall_start = std::chrono::steady_clock::now();
+  const auto part = sim_part_number(o);
+  const Protocol protocol = load_protocol(o.protocol);
+  const sim::SimWorldConfig wc = world_config(o);
+  check_fault_commands(o, wc);
+  sim::SimWorld world(wc);
+  const StationConfig config =
+      parse_station_config(sim_config_text(world, o, part), "sim:station.toml");
+  SimTime time(o);
+  SimRecording rec(o, time.now_s);
+  Rig rig = build_rig(config, sim_rig_options(world, rec, time));
+  Store store(o.db_path.empty() ? "station-sim.db" : o.db_path);
+  store.set_ticks_per_commit(ticks_per_commit(o));
+  const auto seed = static_cast<std::int64_t>(o.seed);
+  Host host(config, rig, store, time.clock);
+  const StartPlan plan = host.start({protocol, o.fresh, seed, {}});
+  SequencerOptions so;
+  so.part_limits = slot_part_limits(config, o.parts_path);
+  so.sim_seed = seed;
+  so.stop = o.stop;
+  so.before_tick = world_tick(o, world, rec, plan.replay_until_t_s);
+  so.on_tick = progress_tick(o, rec, plan.protocol.nominal_duration_s(wc.initial_c));
+  if (rec.session) {
+    rec.session->start(config, plan.protocol, true, seed);
+    so.on_resume = [&rec](double last_s, double next_s) { rec.session->resumed(last_s, next_s); };
+    // A resumed simulation connects and recomputes its stored ticks first: all of that is in
+    // the logs already (world_tick lifts the pause after the last stored tick).
+    if (plan.resume) rec.session->tap().pause(true);
+  }
+  if (o.extend) o.extend(so);
+  const RunOutcome out = host.run(plan, std::move(so));
+  if (rec.session) rec.session->finish(store, out.run_id);
+  return sim_report(store, out, world, wall_start);
 }
 
 namespace {

@@ -8,6 +8,7 @@
 
 #include "compensation/binning.hpp"
 #include "station/common/input_error.hpp"
+#include "station/store/sample_series.hpp"
 
 namespace station {
 
@@ -17,14 +18,12 @@ sc::ModelData record_model_data(Store& store, std::int64_t run_id, const std::st
   double earth_rate_dph = 0;
   for (const auto& s : store.run_slots(run_id))
     if (s.serial == serial) earth_rate_dph = s.earth_rate_dph;
+  SampleSeries s = sample_series(store.samples(run_id, serial, true));
   sc::ModelData d;
-  for (const auto& s : store.samples(run_id, serial, true)) {
-    if (!sample_goes_into_bins(s)) continue;
-    d.bias_dph.push_back(*s.rate_dph - earth_rate_dph);
-    d.temp_c.push_back(*s.temp_c);
-    d.grad_c.push_back(*gradient_c(s));
-    d.t_mid_s.push_back(s.t_s);
-  }
+  for (double r : s.rate_dph) d.bias_dph.push_back(r - earth_rate_dph);
+  d.temp_c = std::move(s.temp_c);
+  d.grad_c = std::move(s.grad_c);
+  d.t_mid_s = std::move(s.t_s);
   return d;
 }
 
@@ -53,18 +52,11 @@ sc::ModelData fitted_record_model_data(Store& store, std::int64_t run_id,
 }
 
 std::vector<sc::Bin> bin_samples(const std::vector<SampleRow>& rows, double bin_s) {
-  std::vector<double> t, rate, temp, grad;
-  for (const auto& s : rows) {
-    if (!sample_goes_into_bins(s)) continue;
-    t.push_back(s.t_s);
-    rate.push_back(*s.rate_dph);
-    temp.push_back(*s.temp_c);
-    grad.push_back(*gradient_c(s));
-  }
+  const SampleSeries s = sample_series(rows);
   sc::BinConfig cfg;
   cfg.width_s = bin_s;
   cfg.sample_period_s = 1.0;  // the sequencer's tick
-  return sc::make_bins({t, rate, temp, grad, {}}, cfg);
+  return sc::make_bins(s.bin_input(), cfg);
 }
 
 void bin_run(Store& store, std::int64_t run_id, double bin_s) {

@@ -162,14 +162,15 @@ TEST_F(ModbusClientTest, RepeatedTimeoutsOnTcpReconnect) {
   RecordingTap tap;
   client->set_tap(&tap);
   ASSERT_TRUE(client->connect());
-  server.inject_timeouts(mb::kTimeoutsBeforeReconnect);
-  for (int i = 1; i <= mb::kTimeoutsBeforeReconnect; ++i) {
+  server.inject_timeouts(station::drivers::kTimeoutsBeforeReconnect);
+  for (int i = 1; i <= station::drivers::kTimeoutsBeforeReconnect; ++i) {
     auto v = client->read(map.at(cm::kAir));
     ASSERT_FALSE(v);
     EXPECT_EQ(v.error().kind, ErrorKind::timeout) << v.error().message;
     // Connected until the last timeout of the run, then dropped.
-    EXPECT_EQ(client->connected(), i < mb::kTimeoutsBeforeReconnect) << "after timeout " << i;
-    if (i == mb::kTimeoutsBeforeReconnect) {
+    EXPECT_EQ(client->connected(), i < station::drivers::kTimeoutsBeforeReconnect)
+        << "after timeout " << i;
+    if (i == station::drivers::kTimeoutsBeforeReconnect) {
       EXPECT_NE(v.error().message.find("reconnecting"), std::string::npos) << v.error().message;
     }
   }
@@ -186,8 +187,8 @@ TEST_F(ModbusClientTest, AnAnswerResetsTheTimeoutRun) {
   RecordingTap tap;
   client->set_tap(&tap);
   ASSERT_TRUE(client->connect());
-  server.inject_timeouts(mb::kTimeoutsBeforeReconnect - 1);
-  for (int i = 1; i < mb::kTimeoutsBeforeReconnect; ++i)
+  server.inject_timeouts(station::drivers::kTimeoutsBeforeReconnect - 1);
+  for (int i = 1; i < station::drivers::kTimeoutsBeforeReconnect; ++i)
     ASSERT_FALSE(client->read(map.at(cm::kAir)));
   ASSERT_TRUE(client->read(map.at(cm::kAir)));
   server.inject_timeouts(1);
@@ -204,8 +205,8 @@ TEST(ModbusClientRtu, RepeatedTimeoutsKeepTheLineOpen) {
   server.start_rtu_pty();
   mb::ModbusClient rtu("chamber-rtu", mb::parse_endpoint(server.endpoint()), 0.2);
   ASSERT_TRUE(rtu.connect()) << server.endpoint();
-  server.inject_timeouts(mb::kTimeoutsBeforeReconnect);
-  for (int i = 0; i < mb::kTimeoutsBeforeReconnect; ++i) {
+  server.inject_timeouts(station::drivers::kTimeoutsBeforeReconnect);
+  for (int i = 0; i < station::drivers::kTimeoutsBeforeReconnect; ++i) {
     auto v = rtu.read(map.at(cm::kAir));
     ASSERT_FALSE(v);
     EXPECT_EQ(v.error().kind, ErrorKind::timeout) << v.error().message;

@@ -67,8 +67,8 @@ station::SafetyInputs inputs(double setpoint_c, double air_c) {
   station::SafetyInputs in;
   in.chamber = chamber(setpoint_c, air_c);
   in.air_c = air_c;
-  in.gpio_interlock_closed = true;
-  in.gpio_estop_pressed = false;
+  in.door_closed = true;
+  in.estop_pressed = false;
   return in;
 }
 
@@ -119,7 +119,7 @@ TEST(Safety, ReadingsOutOfLimitsHoldUntilTheyAreBackInside) {
 TEST(Safety, AFaultDuringAnInterlockHoldKeepsTheHoldAfterTheInterlockCloses) {
   station::Safety s(limits(), kGpio);
   auto open = inputs(20.0, 25.0);
-  open.gpio_interlock_closed = false;
+  open.door_closed = false;
   auto d = s.decide(open);
   ASSERT_TRUE(d.entered);
   EXPECT_EQ(d.outputs, (station::SafetyOutputs{false, true, false, false}));  // amber
@@ -156,13 +156,13 @@ TEST(Safety, HoldCommandsAreRetriedUntilAcknowledged) {
 TEST(Safety, AHoldWithoutAnAirReadingTakesTheFirstOne) {
   station::Safety s(limits(), kGpio);
   station::SafetyInputs in;
-  in.gpio_interlock_closed = false;
-  in.gpio_estop_pressed = false;
+  in.door_closed = false;
+  in.estop_pressed = false;
   auto d = s.decide(in);
   ASSERT_TRUE(d.entered);
   EXPECT_FALSE(d.chamber);
   in = inputs(20.0, -12.5);
-  in.gpio_interlock_closed = false;
+  in.door_closed = false;
   d = s.decide(in);
   ASSERT_TRUE(d.chamber);
   EXPECT_DOUBLE_EQ(*d.chamber->setpoint_c, -12.5);
@@ -191,10 +191,10 @@ TEST(Safety, BlindInputsKeepTheirLastValueThenFailSafe) {
   EXPECT_TRUE(d.cleared);
   // An e-stop pressed, then unreadable: still pressed.
   auto pressed = inputs(20.0, 25.0);
-  pressed.gpio_estop_pressed = true;
+  pressed.estop_pressed = true;
   EXPECT_TRUE(s.decide(pressed).entered);
   auto unknown = inputs(20.0, 25.0);
-  unknown.gpio_estop_pressed.reset();
+  unknown.estop_pressed.reset();
   EXPECT_TRUE(s.decide(unknown).holding);
   EXPECT_TRUE(s.decide(inputs(20.0, 25.0)).cleared);
 }
@@ -302,9 +302,9 @@ TEST(Safety, EveryInputTrippedThenClearedHoldsThenClears) {
       {"air", "out of limits: chamber air", false, false,
        [](station::SafetyInputs& in) { in.chamber->air_c = 99.0; }},
       {"gpio e-stop", "e-stop pressed", true, false,
-       [](station::SafetyInputs& in) { in.gpio_estop_pressed = true; }},
+       [](station::SafetyInputs& in) { in.estop_pressed = true; }},
       {"gpio interlock", "interlock open", true, false,
-       [](station::SafetyInputs& in) { in.gpio_interlock_closed = false; }},
+       [](station::SafetyInputs& in) { in.door_closed = false; }},
       {"table interlock", "turntable interlock open", false, true,
        [](station::SafetyInputs& in) { in.table_interlock_open = true; }},
   };
@@ -318,8 +318,8 @@ TEST(Safety, EveryInputTrippedThenClearedHoldsThenClears) {
                                         << ", table " << sources.table);
       station::Safety s(limits(), sources);
       auto clear = inputs(20.0, 25.0);
-      if (!sources.gpio_estop) clear.gpio_estop_pressed.reset();
-      if (!sources.gpio_interlock) clear.gpio_interlock_closed.reset();
+      if (!sources.gpio_estop) clear.estop_pressed.reset();
+      if (!sources.gpio_interlock) clear.door_closed.reset();
       if (sources.table) clear.table_interlock_open = false;
       ASSERT_FALSE(s.decide(clear).holding);
       auto tripped = clear;
@@ -344,8 +344,8 @@ TEST(Safety, EveryInputTrippedThenClearedHoldsThenClears) {
 TEST(Safety, AnUnreadChamberKeepsItsOwnTripUntilItReadsClear) {
   station::Safety s(limits());
   auto clear = inputs(20.0, 25.0);
-  clear.gpio_estop_pressed.reset();
-  clear.gpio_interlock_closed.reset();
+  clear.estop_pressed.reset();
+  clear.door_closed.reset();
   auto trip = clear;
   trip.chamber->alarms.high_limit_trip = true;
   ASSERT_TRUE(s.decide(trip).entered);

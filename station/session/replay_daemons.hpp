@@ -1,0 +1,33 @@
+// The recorded daemons of a session replayed through the one host (daemon/host.hpp): the first
+// makes the run, each restarted one ([[resume]] in session.toml) continues it by the one start
+// rule (daemon/run_start.hpp), with every device answered from the session's logs.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "station/config/config.hpp"
+#include "station/config/protocol.hpp"
+#include "station/session/session_files.hpp"
+#include "station/session/session_replay.hpp"
+#include "station/store/store.hpp"
+
+namespace station {
+
+/// What session.toml says the run was.
+struct RecordedSession {
+  StationConfig config;
+  Protocol protocol;
+  std::optional<std::int64_t> sim_seed;
+  SessionEnd end;
+};
+
+/// Replays the session in `dir` into `store`; returns the run's id, or 0 when a divergence ended
+/// it (then `report` says where: same = false, first_difference, notes, ticks). Throws
+/// InputError when the recording cannot be replayed (a resume without its keys, a recording
+/// that starts mid-run, a run that ended before its recorded kill).
+std::int64_t replay_daemons(const std::string& dir, const RecordedSession& session, Store& store,
+                            ReplayReport& report);
+
+}  // namespace station
