@@ -175,15 +175,42 @@ void add_mixture(ErrorModel& model, std::vector<Point>& grid, const Point& best,
 
 }  // namespace
 
+namespace {
+
+/// Independent bins: sigma from the OLS residuals (RSS / (n - p)).
+ErrorModel ols_only(const Eigen::MatrixXd& x, const Eigen::VectorXd& y) {
+  ErrorModel model;
+  const Eigen::VectorXd b = x.colPivHouseholderQr().solve(y);
+  model.sigma_dph = std::sqrt((y - x * b).squaredNorm() / static_cast<double>(x.rows() - x.cols()));
+  return model;
+}
+
+/// Finer searches around the best point so far, each on a grid half as wide.
+void refine(Point& best, Problem& pb, double lo, double hi) {
+  double half_tau = (hi - lo) / (kCoarseSteps - 1), half_q = kMaxShare / (kCoarseSteps - 1);
+  double half_u = (kWalkHi - kWalkLo) / (kCoarseSteps - 1);
+  for (int round = 0; round < kRefinements; ++round) {
+    const Point c = best;
+    search(best, pb,
+           {std::max(c.log_tau - half_tau, lo), std::min(c.log_tau + half_tau, hi),
+            std::max(c.q - half_q, 0.0), std::min(c.q + half_q, kMaxShare),
+            std::max(c.u - half_u, kWalkLo), std::min(c.u + half_u, kWalkHi)},
+           3);
+    half_tau /= 2;
+    half_q /= 2;
+    half_u /= 2;
+  }
+}
+
+}  // namespace
+
 ErrorModel estimate_error_model(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
                                 std::span<const double> t_s, std::span<const int> segment) {
   const Eigen::Index n = x.rows(), p = x.cols();
   ErrorModel model;
   if (n < p + kMinBinsForErrorModelExtra || p < 1 ||
       p + 1 > reml::kMaxColumns) {  // too few bins to estimate three more parameters
-    const Eigen::VectorXd b = x.colPivHouseholderQr().solve(y);
-    model.sigma_dph = std::sqrt((y - x * b).squaredNorm() / static_cast<double>(n - p));
-    return model;
+    return ols_only(x, y);
   }
   const double spacing_s = bin_spacing_s(t_s, segment);
   const double span_s = std::max(longest_run_s(t_s, segment, n), spacing_s);
@@ -204,25 +231,10 @@ ErrorModel estimate_error_model(const Eigen::MatrixXd& x, const Eigen::VectorXd&
   pb.record = &grid;
   search(best, pb, {lo, hi, 0.0, kMaxShare, kWalkLo, kWalkHi}, kCoarseSteps);
   pb.record = nullptr;
-  // Finer searches around the best point so far, each on a grid half as wide.
-  double half_tau = (hi - lo) / (kCoarseSteps - 1), half_q = kMaxShare / (kCoarseSteps - 1);
-  double half_u = (kWalkHi - kWalkLo) / (kCoarseSteps - 1);
-  for (int round = 0; round < kRefinements; ++round) {
-    const Point c = best;
-    search(best, pb,
-           {std::max(c.log_tau - half_tau, lo), std::min(c.log_tau + half_tau, hi),
-            std::max(c.q - half_q, 0.0), std::min(c.q + half_q, kMaxShare),
-            std::max(c.u - half_u, kWalkLo), std::min(c.u + half_u, kWalkHi)},
-           3);
-    half_tau /= 2;
-    half_q /= 2;
-    half_u /= 2;
-  }
+  refine(best, pb, lo, hi);
   if (!std::isfinite(best.profile.minus2_loglik) || !(best.profile.sigma2 > 0)) {
     // No error model fits (a noise-free or constant bias): the OLS errors, as with too few bins.
-    const Eigen::VectorXd b = x.colPivHouseholderQr().solve(y);
-    model.sigma_dph = std::sqrt((y - x * b).squaredNorm() / static_cast<double>(n - p));
-    return model;
+    return ols_only(x, y);
   }
   model.sigma_dph = std::sqrt(best.profile.sigma2);
   add_mixture(model, grid, best, pb);

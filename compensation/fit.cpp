@@ -270,6 +270,80 @@ ModelData model_data_from_bins(std::span<const Bin> bins, double earth_rate_dph)
 
 namespace {
 
+/// Scales each column of `x` to unit norm (better conditioned QR and a meaningful condition
+/// number); returns the scales. A column that is zero everywhere is refused naming its term.
+Eigen::VectorXd scale_columns(Eigen::MatrixXd& x, const ModelSpec& spec) {
+  Eigen::VectorXd scale = x.colwise().norm().transpose();
+  for (Eigen::Index j = 0; j < scale.size(); ++j) {
+    if (!(scale(j) > 0)) {
+      throw DataError("fit: term " + std::string(info(spec.terms[j - 1]).option) +
+                      " is zero at every point");
+    }
+  }
+  x = x * scale.cwiseInverse().asDiagonal();
+  return scale;
+}
+
+/// The fit's warnings: collinear terms (Belsley), too few bins for the error model, an error
+/// model at the edge of its search.
+void add_fit_warnings(FitResult& res, std::size_t n, std::size_t p, bool fixed_error_model) {
+  if (res.condition_number > kCollinearCondition) {
+    res.warnings.push_back("terms nearly collinear: condition number " +
+                           std::to_string(res.condition_number) + " > " +
+                           std::to_string(static_cast<int>(kCollinearCondition)) +
+                           " (Belsley); coefficients are poorly separated");
+  }
+  if (!fixed_error_model &&
+      static_cast<long>(n) < static_cast<long>(p) + kMinBinsForErrorModelExtra) {
+    res.warnings.push_back("only " + std::to_string(n) + " bins: too few to estimate their " +
+                           "correlated noise (needs " +
+                           std::to_string(static_cast<long>(p) + kMinBinsForErrorModelExtra) +
+                           "); the errors assume independent bins and may be too small");
+  }
+  if (res.error_model.on_search_boundary) {
+    res.warnings.push_back(
+        "the bins' correlated noise looks like a drift (error model at the edge of its search: " +
+        std::to_string(100 * res.error_model.correlated_share) + " % correlated, tau " +
+        number_text(res.error_model.corr_time_s) + " s, rate random walk " +
+        number_text(res.error_model.rrw_dph_per_sqrt_h) +
+        " deg/h/sqrt(h)); the uncertainties are less certain");
+  }
+}
+
+/// The coefficients and their three kinds of standard error, back in the columns' own units.
+void set_coefficients(FitResult& res, const ModelSpec& spec, const Eigen::VectorXd& beta_scaled,
+                      const Eigen::VectorXd& scale, const Eigen::VectorXd& var_model,
+                      const Eigen::VectorXd& var_ols, const Eigen::VectorXd& var_hac) {
+  res.names.emplace_back("B0");
+  for (Term t : spec.terms) res.names.emplace_back(info(t).coefficient);
+  for (Eigen::Index j = 0; j < beta_scaled.size(); ++j) {
+    res.coefficients.push_back(beta_scaled(j) / scale(j));
+    res.std_errors.push_back(std::sqrt(var_model(j)) / scale(j));  // NaN if < 0: refused later
+    res.std_errors_ols.push_back(std::sqrt(var_ols(j)) / scale(j));
+    res.std_errors_hac.push_back(std::sqrt(std::max(var_hac(j), 0.0)) / scale(j));
+  }
+}
+
+/// The scaled design's condition number from R's singular values (those of X: X = QR, Q with
+/// orthonormal columns); a singular design is refused.
+double condition_number(const Eigen::MatrixXd& r) {
+  const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(r).singularValues();
+  const double c = sv(sv.size() - 1) > 0 ? sv(0) / sv(sv.size() - 1) : INFINITY;
+  if (!(c < kSingularCondition)) {
+    throw DataError("fit: the terms are linearly dependent (condition number " + number_text(c) +
+                    ")");
+  }
+  return c;
+}
+
+/// R² and the residual RMS from the bias and the residual sum of squares.
+void set_goodness(FitResult& res, const Eigen::Ref<const Eigen::VectorXd>& y, double rss) {
+  const double mean_y = y.mean();
+  const double tss = (y.array() - mean_y).square().sum();
+  res.r2 = tss > 0 ? 1.0 - rss / tss : (rss == 0 ? 1.0 : 0.0);
+  res.residual_rms_dph = std::sqrt(rss / static_cast<double>(y.size()));
+}
+
 FitResult fit_impl(const ModelInput& in, const ModelSpec& spec, const ErrorModel* fixed) {
   const std::size_t p = spec.terms.size() + 1;
   const std::size_t n = in.bias_dph.size();
@@ -282,29 +356,15 @@ FitResult fit_impl(const ModelInput& in, const ModelSpec& spec, const ErrorModel
   const Eigen::Map<const Eigen::VectorXd> y(in.bias_dph.data(), static_cast<Eigen::Index>(n));
   std::vector<double> vif = variance_inflation(x);
 
-  // Scale each column to unit norm: better conditioned QR and a meaningful condition number.
-  Eigen::VectorXd scale = x.colwise().norm().transpose();
-  for (Eigen::Index j = 0; j < scale.size(); ++j) {
-    if (!(scale(j) > 0)) {
-      throw DataError("fit: term " + std::string(info(spec.terms[j - 1]).option) +
-                      " is zero at every point");
-    }
-  }
-  x = x * scale.cwiseInverse().asDiagonal();
+  const Eigen::VectorXd scale = scale_columns(x, spec);
 
   const Eigen::HouseholderQR<Eigen::MatrixXd> qr(x);
   const auto pi = static_cast<Eigen::Index>(p);
   const Eigen::MatrixXd r = qr.matrixQR().topLeftCorner(pi, pi).triangularView<Eigen::Upper>();
-  // Singular values of X equal those of R (X = QR, Q orthonormal columns).
-  const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(r).singularValues();
   FitResult res;
   res.spec = spec;
   res.vif = std::move(vif);
-  res.condition_number = sv(sv.size() - 1) > 0 ? sv(0) / sv(sv.size() - 1) : INFINITY;
-  if (!(res.condition_number < kSingularCondition)) {
-    throw DataError("fit: the terms are linearly dependent (condition number " +
-                    number_text(res.condition_number) + ")");
-  }
+  res.condition_number = condition_number(r);
   const Eigen::VectorXd beta_scaled = qr.solve(y);
   const Eigen::VectorXd resid = y - x * beta_scaled;
   const double rss = resid.squaredNorm();
@@ -335,39 +395,9 @@ FitResult fit_impl(const ModelInput& in, const ModelSpec& spec, const ErrorModel
   // Newey-West pass over the bins for them.
   const Eigen::VectorXd var_hac =
       fixed != nullptr ? Eigen::VectorXd::Zero(pi) : hac_variances(x, resid, r_inv, res.hac_lag);
-  res.names.emplace_back("B0");
-  for (Term t : spec.terms) res.names.emplace_back(info(t).coefficient);
-  for (Eigen::Index j = 0; j < pi; ++j) {
-    res.coefficients.push_back(beta_scaled(j) / scale(j));
-    res.std_errors.push_back(std::sqrt(var_model(j)) / scale(j));  // NaN if < 0: refused below
-    res.std_errors_ols.push_back(std::sqrt(var_scaled(j)) / scale(j));
-    res.std_errors_hac.push_back(std::sqrt(std::max(var_hac(j), 0.0)) / scale(j));
-  }
-  const double mean_y = y.mean();
-  const double tss = (y.array() - mean_y).square().sum();
-  res.r2 = tss > 0 ? 1.0 - rss / tss : (rss == 0 ? 1.0 : 0.0);
-  res.residual_rms_dph = std::sqrt(rss / static_cast<double>(n));
-  if (res.condition_number > kCollinearCondition) {
-    res.warnings.push_back("terms nearly collinear: condition number " +
-                           std::to_string(res.condition_number) + " > " +
-                           std::to_string(static_cast<int>(kCollinearCondition)) +
-                           " (Belsley); coefficients are poorly separated");
-  }
-  if (fixed == nullptr &&
-      static_cast<long>(n) < static_cast<long>(p) + kMinBinsForErrorModelExtra) {
-    res.warnings.push_back("only " + std::to_string(n) + " bins: too few to estimate their " +
-                           "correlated noise (needs " +
-                           std::to_string(static_cast<long>(p) + kMinBinsForErrorModelExtra) +
-                           "); the errors assume independent bins and may be too small");
-  }
-  if (res.error_model.on_search_boundary) {
-    res.warnings.push_back(
-        "the bins' correlated noise looks like a drift (error model at the edge of its search: " +
-        std::to_string(100 * res.error_model.correlated_share) + " % correlated, tau " +
-        number_text(res.error_model.corr_time_s) + " s, rate random walk " +
-        number_text(res.error_model.rrw_dph_per_sqrt_h) +
-        " deg/h/sqrt(h)); the uncertainties are less certain");
-  }
+  set_coefficients(res, spec, beta_scaled, scale, var_model, var_scaled, var_hac);
+  set_goodness(res, y, rss);
+  add_fit_warnings(res, n, p, fixed != nullptr);
   check_result(res);
   return res;
 }

@@ -157,11 +157,7 @@ int send_commands(const Options& o) {
   return ok ? 0 : 1;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  CLI::App app{"Simulated gyro test rig: chamber, turntable, counter boards on the wall clock"};
-  Options o;
+void add_options(CLI::App& app, Options& o) {
   app.add_option("--gyros", o.gyros, "simulated gyros, nodes 1..N")
       ->capture_default_str()
       ->check(CLI::Range(1, 16));
@@ -190,6 +186,27 @@ int main(int argc, char** argv) {
   app.footer(
       "Fault commands (--control; e.g. simrig --control /tmp/simrig.ctl --send 'door open'):\n" +
       sim::fault_command_help() + "Details: docs/SIMRIG.md");
+}
+
+sim::SimWorldConfig world_config(const Options& o) {
+  sim::SimWorldConfig c;
+  c.chamber_model = o.chamber_model;
+  c.turntable_model = o.turntable_model;
+  c.gyros = o.gyros;
+  c.seed = o.seed;
+  c.chamber_port = o.chamber_port;
+  c.turntable_port = o.turntable_port;
+  c.can_unix_path = o.can_socket;
+  c.earth_rate_dph = earth_rate_up_dph(o.latitude_deg);
+  return c;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Simulated gyro test rig: chamber, turntable, counter boards on the wall clock"};
+  Options o;
+  add_options(app, o);
   CLI11_PARSE(app, argc, argv);
   if (!o.send.empty()) {
     try {
@@ -210,16 +227,7 @@ int main(int argc, char** argv) {
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
   try {
-    sim::SimWorldConfig c;
-    c.chamber_model = o.chamber_model;
-    c.turntable_model = o.turntable_model;
-    c.gyros = o.gyros;
-    c.seed = o.seed;
-    c.chamber_port = o.chamber_port;
-    c.turntable_port = o.turntable_port;
-    c.can_unix_path = o.can_socket;
-    c.earth_rate_dph = earth_rate_up_dph(o.latitude_deg);
-    sim::SimWorld world(c);
+    sim::SimWorld world(world_config(o));
     std::unique_ptr<sim::ControlSocket> control;
     if (!o.control.empty()) {
       control = std::make_unique<sim::ControlSocket>(o.control, [&world](std::string_view line) {

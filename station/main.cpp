@@ -5,11 +5,30 @@
 #include <CLI/CLI.hpp>
 #include <csignal>
 #include <cstdio>
+#include <string>
 
 #include "station/cli/commands.hpp"
 #include "station/cli/csv_table.hpp"
 #include "station/common/allocator.hpp"
 #include "station/store/sqlite.hpp"
+
+namespace {
+
+/// CLI11 would say only "A subcommand is required": names the word and the known commands.
+/// False (after printing so) when argv[1] is a word that is no subcommand.
+bool known_subcommand(CLI::App& app, const char* word) {
+  std::string known;
+  bool found = false;
+  for (const CLI::App* sub : app.get_subcommands({})) {
+    found = found || sub->check_name(word);
+    known += (known.empty() ? "" : ", ") + sub->get_name();
+  }
+  if (!found)
+    fmt::print(stderr, "station: unknown subcommand '{}'; known: {} (see --help)\n", word, known);
+  return found;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   station::keep_freed_memory_for_reuse();
@@ -37,20 +56,7 @@ int main(int argc, char** argv) {
   station::add_fleet_command(app, status);
   station::add_replay_command(app, status);
   station::add_report_command(app, status);
-  if (argc > 1 && argv[1][0] != '-') {
-    // CLI11 would say only "A subcommand is required": name the word and the known commands.
-    std::string known;
-    bool found = false;
-    for (const CLI::App* sub : app.get_subcommands({})) {
-      found = found || sub->check_name(argv[1]);
-      known += (known.empty() ? "" : ", ") + sub->get_name();
-    }
-    if (!found) {
-      fmt::print(stderr, "station: unknown subcommand '{}'; known: {} (see --help)\n", argv[1],
-                 known);
-      return 2;
-    }
-  }
+  if (argc > 1 && argv[1][0] != '-' && !known_subcommand(app, argv[1])) return 2;
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -260,6 +260,30 @@ void add_sim_world_options(CLI::App* cmd, RunOptions& o) {
       ->capture_default_str();
 }
 
+/// What a run records and the simulation's fault script and parts.
+void add_record_and_fault_options(CLI::App* cmd, RunOptions& o) {
+  auto* record =
+      cmd->add_option("--record", o.record,
+                      "record the session in this directory: session.toml, can.log, modbus.log, "
+                      "gpio.log, result.json (schemas/session.md)");
+  cmd->add_option("--record-can", o.record_can,
+                  "write only the CAN frames, in can-utils' candump format, to this file")
+      ->excludes(record);
+  cmd->add_option(
+      "--fault", o.faults,
+      "--sim: at tick T (s) inject a simrig fault command, T:COMMAND "
+      "(docs/SIMRIG.md), e.g. '3000:door open', or T:kill (the daemon SIGKILLs "
+      "itself before tick T, to record a killed and resumed run) or T:sigint (it raises SIGINT "
+      "after tick T: the operator's stop); repeatable");
+  cmd->add_option("--parts", o.parts,
+                  "part file (TOML, schemas/parts.schema.json): each fit gets a verdict against "
+                  "its slot's part (overrides [station] parts; with --sim: applied to every "
+                  "simulated gyro)");
+  cmd->add_option("--part", o.part,
+                  "--sim: the simulated gyros' part number (default: the part file's first, in "
+                  "sort order)");
+}
+
 }  // namespace
 
 void add_run_command(CLI::App& app, CommandStatus& status) {
@@ -279,26 +303,7 @@ void add_run_command(CLI::App& app, CommandStatus& status) {
   cmd->add_flag("--new", o->fresh, "start a new run even if one was left unfinished");
   add_sim_world_options(cmd, *o);
   cmd->add_option("--log-file", o->log_file, "rotating log file");
-  auto* record =
-      cmd->add_option("--record", o->record,
-                      "record the session in this directory: session.toml, can.log, modbus.log, "
-                      "gpio.log, result.json (schemas/session.md)");
-  cmd->add_option("--record-can", o->record_can,
-                  "write only the CAN frames, in can-utils' candump format, to this file")
-      ->excludes(record);
-  cmd->add_option(
-      "--fault", o->faults,
-      "--sim: at tick T (s) inject a simrig fault command, T:COMMAND "
-      "(docs/SIMRIG.md), e.g. '3000:door open', or T:kill (the daemon SIGKILLs "
-      "itself before tick T, to record a killed and resumed run) or T:sigint (it raises SIGINT "
-      "after tick T: the operator's stop); repeatable");
-  cmd->add_option("--parts", o->parts,
-                  "part file (TOML, schemas/parts.schema.json): each fit gets a verdict against "
-                  "its slot's part (overrides [station] parts; with --sim: applied to every "
-                  "simulated gyro)");
-  cmd->add_option("--part", o->part,
-                  "--sim: the simulated gyros' part number (default: the part file's first, in "
-                  "sort order)");
+  add_record_and_fault_options(cmd, *o);
   cmd->add_flag("--json", o->json, "print one JSON object at the end (--sim)");
   cmd->add_flag("--verify", o->verify,
                 "--sim: release each passing fit, then run the same gyros again (independent "

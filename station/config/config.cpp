@@ -176,65 +176,51 @@ void check_slots_unique(const TomlView& root, const std::vector<SlotConfig>& slo
   }
 }
 
-}  // namespace
+/// [station]: name, latitude, T_ref, bin length, the lost-tick share, the part file.
+void read_station_table(const TomlView& root, const std::string& path, StationConfig& c) {
+  auto st = root.opt_table("station");
+  if (!st) throw root.error("station", "missing [station] table (latitude_deg is required)");
+  st->allow_only({"name", "latitude_deg", "ref_temp_c", "bin_s", "max_lost_share", "parts"});
+  c.name = st->opt_string("name").value_or(c.name);
+  c.latitude_deg = st->get_number("latitude_deg");
+  if (c.latitude_deg < -90 || c.latitude_deg > 90)
+    throw st->error("latitude_deg", "must be -90..90");
+  c.ref_temp_c =
+      st->opt_number_in("ref_temp_c", compensation::kMinTempC, compensation::kMaxTempC, "C")
+          .value_or(c.ref_temp_c);
+  // A bin of more than a day would average over a whole thermal cycle.
+  c.bin_s = st->opt_number_in("bin_s", 1.0, 86400.0, "s").value_or(c.bin_s);
+  c.max_lost_share = st->opt_number("max_lost_share").value_or(c.max_lost_share);
+  if (!(c.max_lost_share >= 0 && c.max_lost_share <= 1))
+    throw st->error("max_lost_share", "must be 0..1 (a share of the record window's ticks)");
+  if (auto parts = st->opt_string("parts")) {
+    if (parts->empty()) throw st->error("parts", "must not be empty");
+    // Relative to the configuration file, so a station's files travel together.
+    c.parts_path = (std::filesystem::path(path).parent_path() / *parts).string();
+  }
+}
 
-StationConfig parse_station_config(const std::string& text, const std::string& path) {
-  const toml::table tbl = TomlView::parse_text(text, path);
-  const TomlView root(tbl, path);
-  root.allow_only(
-      {"station", "limits", "chamber", "turntable", "can", "gpio", "slot", "http", "fleet"});
-  StationConfig c;
-  c.path = path;
-  c.text = text;
-  if (auto st = root.opt_table("station")) {
-    st->allow_only({"name", "latitude_deg", "ref_temp_c", "bin_s", "max_lost_share", "parts"});
-    c.name = st->opt_string("name").value_or(c.name);
-    c.latitude_deg = st->get_number("latitude_deg");
-    if (c.latitude_deg < -90 || c.latitude_deg > 90)
-      throw st->error("latitude_deg", "must be -90..90");
-    c.ref_temp_c =
-        st->opt_number_in("ref_temp_c", compensation::kMinTempC, compensation::kMaxTempC, "C")
-            .value_or(c.ref_temp_c);
-    // A bin of more than a day would average over a whole thermal cycle.
-    c.bin_s = st->opt_number_in("bin_s", 1.0, 86400.0, "s").value_or(c.bin_s);
-    c.max_lost_share = st->opt_number("max_lost_share").value_or(c.max_lost_share);
-    if (!(c.max_lost_share >= 0 && c.max_lost_share <= 1))
-      throw st->error("max_lost_share", "must be 0..1 (a share of the record window's ticks)");
-    if (auto parts = st->opt_string("parts")) {
-      if (parts->empty()) throw st->error("parts", "must not be empty");
-      // Relative to the configuration file, so a station's files travel together.
-      c.parts_path = (std::filesystem::path(path).parent_path() / *parts).string();
-    }
-  } else {
-    throw root.error("station", "missing [station] table (latitude_deg is required)");
+/// [http]: where the service listens, its token file and its protocol folder (relative paths
+/// are beside the configuration file).
+void read_http_table(const TomlView& h, const std::string& path, HttpConfig& http) {
+  h.allow_only({"listen", "token_file", "protocol_dir"});
+  const auto beside = [&path](const std::string& p) {
+    return (std::filesystem::path(path).parent_path() / p).string();
+  };
+  http.listen = h.opt_string("listen").value_or(http.listen);
+  if (http.listen.empty()) throw h.error("listen", "must not be empty (HOST:PORT)");
+  if (auto t = h.opt_string("token_file")) {
+    if (t->empty()) throw h.error("token_file", "must not be empty");
+    http.token_file = beside(*t);
   }
-  if (auto l = root.opt_table("limits")) c.limits = read_limits(*l);
-  if (auto h = root.opt_table("http")) {
-    h->allow_only({"listen", "token_file", "protocol_dir"});
-    const auto beside = [&path](const std::string& p) {
-      return (std::filesystem::path(path).parent_path() / p).string();
-    };
-    c.http.listen = h->opt_string("listen").value_or(c.http.listen);
-    if (c.http.listen.empty()) throw h->error("listen", "must not be empty (HOST:PORT)");
-    if (auto t = h->opt_string("token_file")) {
-      if (t->empty()) throw h->error("token_file", "must not be empty");
-      c.http.token_file = beside(*t);
-    }
-    if (auto d = h->opt_string("protocol_dir")) {
-      if (d->empty()) throw h->error("protocol_dir", "must not be empty");
-      c.http.protocol_dir = beside(*d);
-    }
+  if (auto d = h.opt_string("protocol_dir")) {
+    if (d->empty()) throw h.error("protocol_dir", "must not be empty");
+    http.protocol_dir = beside(*d);
   }
-  if (auto f = root.opt_table("fleet")) {
-    // Central rows name the station that recorded them: every station of a line needs its own.
-    if (!root.opt_table("station")->opt_string("name"))
-      throw f->error("pg", "[fleet] needs [station] name, a name unique in the fleet");
-    c.fleet = read_fleet_config(*f, path);
-  }
-  auto chamber = root.opt_table("chamber");
-  if (!chamber) throw root.error("chamber", "missing [chamber] table");
-  c.chamber = read_device(*chamber, true);
-  if (auto t = root.opt_table("turntable")) c.turntable = read_device(*t, false);
+}
+
+/// [can]: the transport and the tick's deadline for the boards' answers.
+void read_can_table(const TomlView& root, StationConfig& c) {
   auto can = root.opt_table("can");
   if (!can) throw root.error("can", "missing [can] table");
   can->allow_only({"transport", "tick_timeout_ms"});
@@ -245,6 +231,32 @@ StationConfig parse_station_config(const std::string& text, const std::string& p
     throw can->error("tick_timeout_ms", "must be 10..900 ms (it must fit in the 1 s tick)");
   }
   c.can_tick_timeout_ms = static_cast<int>(tick_ms);
+}
+
+}  // namespace
+
+StationConfig parse_station_config(const std::string& text, const std::string& path) {
+  const toml::table tbl = TomlView::parse_text(text, path);
+  const TomlView root(tbl, path);
+  root.allow_only(
+      {"station", "limits", "chamber", "turntable", "can", "gpio", "slot", "http", "fleet"});
+  StationConfig c;
+  c.path = path;
+  c.text = text;
+  read_station_table(root, path, c);
+  if (auto l = root.opt_table("limits")) c.limits = read_limits(*l);
+  if (auto h = root.opt_table("http")) read_http_table(*h, path, c.http);
+  if (auto f = root.opt_table("fleet")) {
+    // Central rows name the station that recorded them: every station of a line needs its own.
+    if (!root.opt_table("station")->opt_string("name"))
+      throw f->error("pg", "[fleet] needs [station] name, a name unique in the fleet");
+    c.fleet = read_fleet_config(*f, path);
+  }
+  auto chamber = root.opt_table("chamber");
+  if (!chamber) throw root.error("chamber", "missing [chamber] table");
+  c.chamber = read_device(*chamber, true);
+  if (auto t = root.opt_table("turntable")) c.turntable = read_device(*t, false);
+  read_can_table(root, c);
   for (const auto& s : root.table_array("slot")) c.slots.push_back(read_slot(s));
   if (c.slots.empty()) throw root.error("slot", "no [[slot]] entries: the rig has no gyros");
   check_slots_unique(root, c.slots);
