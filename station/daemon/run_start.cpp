@@ -31,6 +31,11 @@ std::string mismatch(Store& store, const RunRecord& run, const StationConfig& co
   return resume_mismatch(store, run, config);
 }
 
+/// Rule 4: a rig whose devices do not all answer refuses a new run, never a resume.
+bool rig_refuses(const StartRequest& request, bool unfinished_run) {
+  return !request.rig_problems.empty() && (request.fresh || !unfinished_run);
+}
+
 }  // namespace
 
 bool has_unfinished_run(const std::string& db) {
@@ -41,8 +46,8 @@ bool has_unfinished_run(const std::string& db) {
 }
 
 void refuse_broken_rig(const std::string& db, const StartRequest& request) {
-  if (request.rig_problems.empty()) return;
-  if (request.fresh || !has_unfinished_run(db)) throw InputError::lines(request.rig_problems);
+  if (!request.rig_problems.empty() && rig_refuses(request, has_unfinished_run(db)))
+    throw InputError::lines(request.rig_problems);
 }
 
 StartPlan start_run(Store& store, const StationConfig& config, const StartRequest& request) {
@@ -50,8 +55,7 @@ StartPlan start_run(Store& store, const StationConfig& config, const StartReques
   auto run = store.find_unfinished_run();
   if (!run && request.resume_only) return plan;
   // Rule 4 first: a refused start changes nothing, not even the run --new would supersede.
-  if (!request.rig_problems.empty() && (request.fresh || !run))
-    throw InputError::lines(request.rig_problems);
+  if (rig_refuses(request, run.has_value())) throw InputError::lines(request.rig_problems);
   if (run && request.fresh) {
     abort_run(store, *run, "superseded by a new run (--new)");
     run.reset();
