@@ -15,6 +15,7 @@ namespace {
 struct Sums {
   std::size_t n = 0;
   double t = 0, tt = 0, rate = 0, temp = 0, t_temp = 0, grad = 0, extra = 0;
+  double temp_min = 0, temp_max = 0, grad_min = 0, grad_max = 0;
 };
 
 // A bin index is an exact integer in a double only up to 2^53 (the binary64 significand).
@@ -53,6 +54,15 @@ void check_input(const BinInput& in, const BinConfig& cfg) {
 }
 
 void add(Sums& s, const BinInput& in, std::size_t i, double t_rel_s) {
+  const double g = in.grad_c.empty() ? 0.0 : in.grad_c[i];
+  if (s.n == 0) {
+    s.temp_min = s.temp_max = in.temp_c[i];
+    s.grad_min = s.grad_max = g;
+  }
+  s.temp_min = std::min(s.temp_min, in.temp_c[i]);
+  s.temp_max = std::max(s.temp_max, in.temp_c[i]);
+  s.grad_min = std::min(s.grad_min, g);
+  s.grad_max = std::max(s.grad_max, g);
   ++s.n;
   s.t += t_rel_s;
   s.tt += t_rel_s * t_rel_s;
@@ -75,6 +85,10 @@ Bin finish(const Sums& s, double t_start_s, double expected, double min_fill) {
   b.temp_c = s.temp / n;
   b.grad_c = s.grad / n;
   b.extra = s.extra / n;
+  b.temp_min_c = s.temp_min;
+  b.temp_max_c = s.temp_max;
+  b.grad_min_c = s.grad_min;
+  b.grad_max_c = s.grad_max;
   // Ordinary least-squares slope: S_tT / S_tt with centred sums.
   const double s_tt = s.tt - s.t * s.t / n;
   const double s_tT = s.t_temp - s.t * s.temp / n;

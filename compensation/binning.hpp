@@ -34,6 +34,8 @@ struct Bin {
   double grad_c = 0;        ///< mean gradient (0 when no gradient series)
   double dtdt_c_per_h = 0;  ///< least-squares slope of temperature against time, deg C / h
   double extra = 0;         ///< mean of the extra channel (0 when none)
+  double temp_min_c = 0, temp_max_c = 0;  ///< range of the bin's sample temperatures
+  double grad_min_c = 0, grad_max_c = 0;  ///< range of its gradients (0 when no series)
   bool complete = false;    ///< n >= min_fill * expected: usable in fits
 };
 

@@ -31,6 +31,33 @@ struct Gathered {
 /// The lanes' covariance of the two states (units of s^2) and their gains at one bin.
 struct Riccati {
   double pgg[L], pgr[L], prr[L], f[L], inv_f[L], kg[L], kr[L];
+
+  /// Time update over dt hours (Harvey sec. 3.2.1): the Gauss-Markov part decays by phi towards
+  /// its stationary variance q, the walk's variance grows by w dt.
+  void predict(const double* q, const double* w, const double* ph, double dt) {
+    for (int l = 0; l < L; ++l) {
+      pgg[l] = ph[l] * ph[l] * pgg[l] + q[l] * (1.0 - ph[l] * ph[l]);
+      pgr[l] = ph[l] * pgr[l];
+      prr[l] = prr[l] + w[l] * dt;
+    }
+  }
+  /// The innovation variance f (states plus white, 1 - q) and the two gains.
+  void gains(const double* q) {
+    for (int l = 0; l < L; ++l) {
+      f[l] = pgg[l] + 2 * pgr[l] + prr[l] + (1.0 - q[l]);
+      inv_f[l] = 1.0 / f[l];
+      kg[l] = (pgg[l] + pgr[l]) * inv_f[l];
+      kr[l] = (pgr[l] + prr[l]) * inv_f[l];
+    }
+  }
+  /// P <- P - K f K' (the Joseph form is not needed: f >= 1 - q keeps it well conditioned).
+  void update() {
+    for (int l = 0; l < L; ++l) {
+      pgg[l] -= kg[l] * kg[l] * f[l];
+      pgr[l] -= kg[l] * kr[l] * f[l];
+      prr[l] -= kr[l] * kr[l] * f[l];
+    }
+  }
 };
 
 /// One pass over the bins for L models at once, K columns fixed at compile time. Every loop's
@@ -51,33 +78,19 @@ Gathered pass(const double* z, Eigen::Index n, const std::vector<double>& dt_h,
       for (int c = 0; c < K; ++c)
         for (int l = 0; l < L; ++l) g[c][l] = r[c][l] = 0;
     } else {
-      for (int l = 0; l < L; ++l) {
-        p.pgg[l] = ph[l] * ph[l] * p.pgg[l] + q[l] * (1.0 - ph[l] * ph[l]);
-        p.pgr[l] = ph[l] * p.pgr[l];
-        p.prr[l] = p.prr[l] + w[l] * dt;
-      }
+      p.predict(q, w, ph, dt);
       for (int c = 0; c < K; ++c)
         for (int l = 0; l < L; ++l) g[c][l] *= ph[l];
     }
-    for (int l = 0; l < L; ++l) {
-      p.f[l] = p.pgg[l] + 2 * p.pgr[l] + p.prr[l] + (1.0 - q[l]);
-      p.inv_f[l] = 1.0 / p.f[l];
-      p.kg[l] = (p.pgg[l] + p.pgr[l]) * p.inv_f[l];
-      p.kr[l] = (p.pgr[l] + p.prr[l]) * p.inv_f[l];
-    }
+    p.gains(q);
     for (int c = 0; c < K; ++c)
       for (int l = 0; l < L; ++l) {
         v[c][l] = z[c] - g[c][l] - r[c][l];
         g[c][l] += p.kg[l] * v[c][l];
         r[c][l] += p.kr[l] * v[c][l];
       }
-    // P <- P - K f K' (the Joseph form is not needed: f >= 1 - q keeps it well conditioned).
-    for (int l = 0; l < L; ++l) {
-      p.pgg[l] -= p.kg[l] * p.kg[l] * p.f[l];
-      p.pgr[l] -= p.kg[l] * p.kr[l] * p.f[l];
-      p.prr[l] -= p.kr[l] * p.kr[l] * p.f[l];
-      prod_f[l] *= p.f[l];
-    }
+    p.update();
+    for (int l = 0; l < L; ++l) prod_f[l] *= p.f[l];
     // f >= 1 - q >= 0.01, so the product of 64 bins' f stays far from underflow: one log per 64
     // bins instead of one per bin (the log was most of the cost).
     if ((i & 63) == 63)

@@ -10,8 +10,7 @@
 #include <vector>
 
 #include "drivers/ascii/number_field.hpp"
-#include "drivers/chamber/espec_p300/p300_wire.hpp"
-#include "drivers/turntable/acutrol3000/acutrol_wire.hpp"
+#include "sim_devices/sources/espec_p300_sources.hpp"
 
 namespace station::sim {
 namespace {
@@ -63,17 +62,17 @@ std::string P300Face::alarm_codes() const {
 
 std::string P300Face::set_temp(std::string_view args) {
   // "TEMP, S<sp>" (CCL write_temp:1037): comma, space, S, value.
-  if (args.substr(0, 2) != " S") return "NA:PARA ERR";
+  if (args.substr(0, 2) != sources::p300::kTempSetPrefix.substr(5)) return "NA:PARA ERR";
   auto v = num(args.substr(2));
   if (!v) return "NA:PARA ERR";
   const auto& cfg = chamber_.config();
   if (*v < cfg.setpoint_low_c || *v > cfg.setpoint_high_c) return "NA:DATA OUT OF RANGE";
   chamber_.set_setpoint_c(*v);
-  return fmt::format("OK:TEMP, S{:.1f}", *v);
+  return fmt::format("{}{}{:.1f}", sources::p300::kOk, sources::p300::kTempSetPrefix, *v);
 }
 
 std::string P300Face::answer(std::string_view c) {
-  namespace p3 = drivers::espec_p300;
+  namespace p3 = sources::p300;
   const auto& cfg = chamber_.config();
   const auto mode = [&] { return chamber_.run() ? "CONSTANT" : "STANDBY"; };
   const double pv = chamber_.air_sensor_failed() ? cfg.broken_sensor_c : chamber_.air_c();
@@ -92,13 +91,13 @@ std::string P300Face::answer(std::string_view c) {
   if (c == p3::kRomQuery) return "P300 SIM 1.00";
   if (c == p3::kModeConstant || c == p3::kPowerOn) {
     chamber_.set_run(true);
-    return "OK:" + std::string(c);
+    return std::string(p3::kOk) + std::string(c);
   }
-  if (c == p3::kModeStandby || c == p3::kModeOff || upper(c) == "POWER,OFF") {
+  if (c == p3::kModeStandby || c == p3::kModeOff || upper(c) == p3::kPowerOff) {
     chamber_.set_run(false);
-    return "OK:" + std::string(c);
+    return std::string(p3::kOk) + std::string(c);
   }
-  if (c.substr(0, 5) == "TEMP,") return set_temp(c.substr(5));
+  if (c.substr(0, 5) == p3::kTempSetPrefix.substr(0, 5)) return set_temp(c.substr(5));
   return "NA:CMD ERR";
 }
 
@@ -135,7 +134,6 @@ std::string AcutrolFace::error_reply(std::string_view, int) const {
 }
 
 std::optional<std::string> AcutrolFace::one(const std::string& path, std::string_view args) {
-  namespace ac = drivers::acutrol3000;
   const bool axis1 = args.substr(0, 1) == "1";
   const auto value = [&]() -> std::optional<double> {
     const auto c = args.find(',');
@@ -183,7 +181,6 @@ std::optional<std::string> AcutrolFace::one(const std::string& path, std::string
     if (!interlock_closed_) return std::string("Error: interlock open");
     return table_.set_mode(mode) ? std::string{} : std::string("Error: interlock open");
   }
-  (void)ac::kAxis;
   return std::nullopt;
 }
 

@@ -3,18 +3,14 @@
 
 #include <cmath>
 
-#include "drivers/chamber/watlow_f4/f4_map.hpp"
-#include "drivers/chamber/watlow_f4p/f4p_map.hpp"
-#include "drivers/chamber/watlow_f4t/f4t_map.hpp"
+#include "sim_devices/sources/watlow_sources.hpp"
 
 namespace station::sim {
-namespace f4 = drivers::watlow_f4;
-namespace f4t = drivers::watlow_f4t;
-namespace f4p = drivers::watlow_f4p;
+namespace f4 = sources::f4;
+namespace f4t = sources::f4t;
+namespace f4p = sources::f4p;
 
 namespace {
-// Value an input shows on an open sensor: over range (F4P p. 2.5: "SEnhi", error 3).
-constexpr int kOverRange = 3;
 // The part number the simulated F4T reports: character 6 'D' = profiles, 6 alarms; character
 // 11 '2' = two loops (CCL watlowf4t.py process_controller:861-921). Synthetic.
 constexpr const char* kF4tPartNumber = "F4T1L2DAA0A2AAA";
@@ -24,18 +20,21 @@ constexpr int kAlarmHigh = 7;
 }  // namespace
 
 double WatlowFace::raw_temp(double c) const {
-  const drivers::TemperatureScale s{panel_.decimals, panel_.fahrenheit};
-  return s.to_raw(s.from_c(c)).value_or(c > 0 ? 32767 : -32768);
+  return sources::watlow_raw(c, panel_.decimals, panel_.fahrenheit);
 }
 
 double WatlowFace::c_of_raw(double raw) const {
-  const drivers::TemperatureScale s{panel_.decimals, panel_.fahrenheit};
-  return s.c_from_raw(static_cast<std::int16_t>(raw));
+  return sources::watlow_c_of_raw(static_cast<std::int16_t>(raw), panel_.decimals,
+                                  panel_.fahrenheit);
 }
+
+double WatlowFace::unit(double c) const { return sources::watlow_unit(c, panel_.fahrenheit); }
+double WatlowFace::c_of_unit(double v) const { return sources::watlow_c(v, panel_.fahrenheit); }
 
 // ---------------------------------------------------------------------------------- F4
 F4Face::F4Face(ChamberSim& chamber, WatlowPanel panel, int unit_id, const char* name)
-    : WatlowFace(chamber, f4::map(unit_id, panel.run_event, name), panel) {}
+    : WatlowFace(chamber,
+                 sources::register_map(name, unit_id, f4::points(panel.run_event)), panel) {}
 
 std::uint8_t F4Face::check_write(const RegisterWrite& write) const {
   const auto ev = write.value_of(map_.at(f4::kRunEvent));
@@ -46,16 +45,17 @@ std::uint8_t F4Face::check_write(const RegisterWrite& write) const {
 void F4Face::publish(modbus_mapping_t& regs) {
   const bool broken = chamber_.air_sensor_failed();
   put(regs, f4::kAir, broken ? 32767 : raw_temp(chamber_.air_c()));
-  put(regs, f4::kAirError, broken ? kOverRange : 0);
+  put(regs, f4::kAirError, broken ? f4::kInputOverRange : 0);
   put(regs, f4::kProduct, raw_temp(chamber_.product_c()));
   put(regs, f4::kProductError, 0);
-  put(regs, f4::kStatus, chamber_.status() == 3 ? f4::kProfilePaused : f4::kConstant1);
+  put(regs, f4::kStatus,
+      chamber_.status() == 3 ? f4::kStatusProfilePaused : f4::kStatusConstant);
   put(regs, f4::kSetpoint, raw_temp(chamber_.setpoint_c()));
   put(regs, f4::kSetpointLow, raw_temp(chamber_.config().setpoint_low_c));
   put(regs, f4::kSetpointHigh, raw_temp(chamber_.config().setpoint_high_c));
   put(regs, f4::kDecimals, panel_.decimals);
   put(regs, f4::kDecimals2, panel_.decimals);
-  put(regs, f4::kUnits, panel_.fahrenheit ? f4::kUnitsFahrenheit : 1);
+  put(regs, f4::kUnits, panel_.fahrenheit ? f4::kUnitsFahrenheit : f4::kUnitsCelsius);
   put(regs, f4::kRunEvent, chamber_.run() ? f4::kEventOn : f4::kEventOff);
 }
 
@@ -68,14 +68,16 @@ void F4Face::on_write(const modbus_mapping_t& regs, std::uint16_t pdu_address, i
 
 // --------------------------------------------------------------------------------- F4T
 F4tFace::F4tFace(ChamberSim& chamber, WatlowPanel panel, int unit_id, bool rtu)
-    : WatlowFace(chamber, f4t::map(unit_id, panel.run_event, rtu), panel) {}
+    : WatlowFace(chamber,
+                 sources::register_map("watlow_f4t", unit_id, f4t::points(panel.run_event, rtu)),
+                 panel) {}
 
 std::uint8_t F4tFace::check_write(const RegisterWrite& write) const {
   const auto ev = write.value_of(map_.at(f4t::kRunEvent));
   if (ev && *ev != f4t::kOn && *ev != f4t::kOff) return kIllegalDataValue;
   const auto action = write.value_of(map_.at(f4t::kRampAction));
-  if (action && *action != f4t::kOff && *action != f4t::kRampSetpoint && *action != 88 &&
-      *action != 13)
+  if (action && *action != f4t::kOff && *action != f4t::kRampSetpoint &&
+      *action != f4t::kStartup && *action != f4t::kRampBoth)
     return kIllegalDataValue;
   const auto scale = write.value_of(map_.at(f4t::kRampScale));
   if (scale && *scale != f4t::kMinutes && *scale != f4t::kHours) return kIllegalDataValue;
@@ -87,19 +89,18 @@ std::uint8_t F4tFace::check_write(const RegisterWrite& write) const {
 }
 
 void F4tFace::publish(modbus_mapping_t& regs) {
-  const drivers::TemperatureScale s{-1, panel_.fahrenheit};
-  put(regs, f4t::kAir, chamber_.air_sensor_failed() ? NAN : s.from_c(chamber_.air_c()));
-  put(regs, f4t::kProduct, s.from_c(chamber_.product_c()));
-  put(regs, f4t::kSetpoint, s.from_c(chamber_.setpoint_c()));
-  put(regs, f4t::kWorkingSetpoint, s.from_c(chamber_.effective_setpoint_c()));
-  put(regs, f4t::kSetpointLow, s.from_c(chamber_.config().setpoint_low_c));
-  put(regs, f4t::kSetpointHigh, s.from_c(chamber_.config().setpoint_high_c));
+  put(regs, f4t::kAir, chamber_.air_sensor_failed() ? NAN : unit(chamber_.air_c()));
+  put(regs, f4t::kProduct, unit(chamber_.product_c()));
+  put(regs, f4t::kSetpoint, unit(chamber_.setpoint_c()));
+  put(regs, f4t::kWorkingSetpoint, unit(chamber_.effective_setpoint_c()));
+  put(regs, f4t::kSetpointLow, unit(chamber_.config().setpoint_low_c));
+  put(regs, f4t::kSetpointHigh, unit(chamber_.config().setpoint_high_c));
   put(regs, f4t::kLoopMode, chamber_.run() ? f4t::kAuto : f4t::kOff);
   put(regs, f4t::kRampAction, ramp_action_);
   put(regs, f4t::kRampScale, ramp_scale_);
   put(regs, f4t::kRampRate, ramp_rate_);
   put(regs, f4t::kProfileState, chamber_.status() == 3 ? f4t::kProfilePaused : 0);
-  put(regs, f4t::kAlarm1, (chamber_.alarms() & 1u) != 0 ? kAlarmHigh : 61);
+  put(regs, f4t::kAlarm1, (chamber_.alarms() & 1u) != 0 ? kAlarmHigh : f4t::kAlarmNone);
   put(regs, f4t::kRunEvent, chamber_.run() ? f4t::kOn : f4t::kOff);
   put(regs, f4t::kUnits, panel_.fahrenheit ? f4t::kFahrenheit : f4t::kCelsius);
   for (int i = 0; i < f4t::kPartNumberRegisters; ++i)
@@ -107,7 +108,6 @@ void F4tFace::publish(modbus_mapping_t& regs) {
 }
 
 void F4tFace::on_write(const modbus_mapping_t& regs, std::uint16_t pdu_address, int count) {
-  const drivers::TemperatureScale s{-1, panel_.fahrenheit};
   auto written = [&](const char* name) { return point_written(map_.at(name), pdu_address, count); };
   auto value = [&](const char* name) { return get_point(regs, map_.at(name)); };
   if (written(f4t::kRampAction)) ramp_action_ = static_cast<int>(value(f4t::kRampAction));
@@ -115,25 +115,26 @@ void F4tFace::on_write(const modbus_mapping_t& regs, std::uint16_t pdu_address, 
   if (written(f4t::kRampRate)) ramp_rate_ = value(f4t::kRampRate);
   if (written(f4t::kRampAction) || written(f4t::kRampScale) || written(f4t::kRampRate)) {
     const double per_min = ramp_scale_ == f4t::kHours ? ramp_rate_ / 60.0 : ramp_rate_;
-    chamber_.set_ramp_c_per_min(ramp_action_ == f4t::kOff ? 0.0 : s.delta_to_c(per_min));
+    chamber_.set_ramp_c_per_min(
+        ramp_action_ == f4t::kOff ? 0.0 : sources::watlow_c_delta(per_min, panel_.fahrenheit));
   }
-  if (written(f4t::kSetpoint)) chamber_.set_setpoint_c(s.to_c(value(f4t::kSetpoint)));
+  if (written(f4t::kSetpoint)) chamber_.set_setpoint_c(c_of_unit(value(f4t::kSetpoint)));
   if (written(f4t::kRunEvent)) chamber_.set_run(value(f4t::kRunEvent) == f4t::kOn);
 }
 
 // --------------------------------------------------------------------------------- F4P
 F4pFace::F4pFace(ChamberSim& chamber, WatlowPanel panel, int unit_id)
-    : WatlowFace(chamber, f4p::map(unit_id), panel) {}
+    : WatlowFace(chamber, sources::register_map("watlow_f4p", unit_id, f4p::points()), panel) {}
 
 std::uint8_t F4pFace::check_write(const RegisterWrite& write) const {
   const auto op = write.value_of(map_.at(f4p::kOperation));
   if (op && *op != f4p::kAuto && *op != f4p::kManual) return kIllegalDataValue;
   const auto mode = write.value_of(map_.at(f4p::kRampMode));
-  if (mode && (*mode < 0 || *mode > 2)) return kIllegalDataValue;
+  if (mode && (*mode < f4p::kRampOff || *mode > f4p::kRampMax)) return kIllegalDataValue;
   const auto rate = write.value_of(map_.at(f4p::kRampRate));
-  if (rate && (*rate < 1 || *rate > 999)) return kIllegalDataValue;  // p. 6.8
+  if (rate && (*rate < f4p::kRampRateMin || *rate > f4p::kRampRateMax)) return kIllegalDataValue;
   const auto scale = write.value_of(map_.at(f4p::kRampScale));
-  if (scale && *scale != 0 && *scale != 1) return kIllegalDataValue;
+  if (scale && *scale != f4p::kPerMinute && *scale != f4p::kPerHour) return kIllegalDataValue;
   return 0;
 }
 
@@ -141,7 +142,7 @@ void F4pFace::publish(modbus_mapping_t& regs) {
   const bool broken = chamber_.air_sensor_failed();
   put(regs, f4p::kModel, f4p::kModelF4p);
   put(regs, f4p::kAir, broken ? 32767 : raw_temp(chamber_.air_c()));
-  put(regs, f4p::kAirError, broken ? kOverRange : 0);
+  put(regs, f4p::kAirError, broken ? f4p::kInputOverRange : 0);
   put(regs, f4p::kAlarm1, (chamber_.alarms() & 1u) != 0 ? 1 : 0);
   put(regs, f4p::kOperation, chamber_.run() ? f4p::kAuto : f4p::kManual);
   put(regs, f4p::kControlSetpoint, raw_temp(chamber_.effective_setpoint_c()));
@@ -162,9 +163,13 @@ void F4pFace::on_write(const modbus_mapping_t& regs, std::uint16_t pdu_address, 
   if (written(f4p::kRampRate)) ramp_rate_raw_ = value(f4p::kRampRate);
   if (written(f4p::kRampScale)) ramp_scale_ = static_cast<int>(value(f4p::kRampScale));
   if (written(f4p::kRampMode) || written(f4p::kRampRate) || written(f4p::kRampScale)) {
-    const drivers::TemperatureScale s{panel_.decimals, panel_.fahrenheit};
-    const double rate = s.delta_to_c(s.from_raw(static_cast<std::int16_t>(ramp_rate_raw_)));
-    chamber_.set_ramp_c_per_min(ramp_mode_ == 0 ? 0.0 : ramp_scale_ == 1 ? rate / 60.0 : rate);
+    // The rate carries the input's implied decimals (p. 6.8), a difference: no deg F offset.
+    const double per_scale =
+        static_cast<std::int16_t>(ramp_rate_raw_) * std::pow(10.0, -panel_.decimals);
+    const double rate = sources::watlow_c_delta(per_scale, panel_.fahrenheit);
+    chamber_.set_ramp_c_per_min(ramp_mode_ == f4p::kRampOff ? 0.0
+                                : ramp_scale_ == f4p::kPerHour ? rate / 60.0
+                                                               : rate);
   }
   if (written(f4p::kSetpoint)) chamber_.set_setpoint_c(c_of_raw(value(f4p::kSetpoint)));
   if (written(f4p::kOperation)) chamber_.set_run(value(f4p::kOperation) == f4p::kAuto);

@@ -1,15 +1,15 @@
 // The chamber model served as the Watlow controllers serve their registers: F4 (and an F4T in
-// F4-compatibility map), F4T Data Map 1, F4P. Written from the dialects' wire definitions
-// (drivers/chamber/watlow_*/..._map.hpp) and their sources; never from the driver classes.
+// F4-compatibility map), F4T Data Map 1, F4P. Written from the tables transcribed from the
+// makers' documents (sim_devices/sources/watlow_sources.hpp); never from a driver's map or class.
 #pragma once
 
 #include <cstdint>
 #include <string>
 
-#include "drivers/chamber/scaled_temperature.hpp"
 #include "drivers/modbus/register_map.hpp"
 #include "sim_devices/chamber_sim.hpp"
 #include "sim_devices/servers/modbus_server.hpp"
+#include "sim_devices/sources/watlow_sources.hpp"
 
 namespace station::sim {
 
@@ -35,13 +35,16 @@ class WatlowFace : public ModbusDeviceModel {
   /// A temperature as the integer the controller shows (decimals, unit).
   double raw_temp(double c) const;
   double c_of_raw(double raw) const;
+  /// A temperature in the controller's unit as a float (F4T), and back.
+  double unit(double c) const;
+  double c_of_unit(double v) const;
 
   ChamberSim& chamber_;
   drivers::modbus::RegisterMap map_;
   WatlowPanel panel_;
 };
 
-/// Watlow F4 map (f4_map.hpp): status 200 0/1 constant, 2/3 profile; run on an event output.
+/// Watlow F4 map (sources::f4): status 200 0/1 constant, 2/3 profile; run on an event output.
 class F4Face final : public WatlowFace {
  public:
   F4Face(ChamberSim& chamber, WatlowPanel panel, int unit_id = 1, const char* name = "watlow_f4");
@@ -50,7 +53,7 @@ class F4Face final : public WatlowFace {
   void on_write(const modbus_mapping_t& regs, std::uint16_t pdu_address, int count) override;
 };
 
-/// Watlow F4T Data Map 1 (f4t_map.hpp): floats CDAB, the controller's ramp, events 63/62.
+/// Watlow F4T Data Map 1 (sources::f4t): floats CDAB, the controller's ramp, events 63/62.
 class F4tFace final : public WatlowFace {
  public:
   F4tFace(ChamberSim& chamber, WatlowPanel panel, int unit_id = 1, bool rtu = false);
@@ -59,11 +62,11 @@ class F4tFace final : public WatlowFace {
   void on_write(const modbus_mapping_t& regs, std::uint16_t pdu_address, int count) override;
 
  private:
-  int ramp_action_ = 62, ramp_scale_ = 57;
+  int ramp_action_ = sources::f4t::kOff, ramp_scale_ = sources::f4t::kMinutes;
   double ramp_rate_ = 0;
 };
 
-/// Watlow F4P (f4p_map.hpp): model 5280, auto/manual, ramp to set point 1100-1102.
+/// Watlow F4P (sources::f4p): model 5280, auto/manual, ramp to set point 1100-1102.
 class F4pFace final : public WatlowFace {
  public:
   F4pFace(ChamberSim& chamber, WatlowPanel panel, int unit_id = 1);

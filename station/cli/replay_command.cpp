@@ -9,7 +9,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
-#include "drivers/can/replay_transport.hpp"
+#include "station/session/replay_can.hpp"
 #include "drivers/counters/counter_boards.hpp"
 #include "station/cli/commands.hpp"
 #include "station/cli/exit_status.hpp"
@@ -60,7 +60,7 @@ using StoredSamples = std::map<std::string, std::vector<SampleRow>>;
 StoredSamples replay_samples(const ReplayCommandOptions& o, const std::vector<RunSlot>& slots,
                              const StoredSamples& stored) {
   auto records = dr::can::read_candump_log(o.log);
-  const auto syncs = dr::can::logged_syncs(records);
+  const auto syncs = logged_syncs(records);
   const std::size_t ticks = stored.at(slots.front().serial).size();
   if (syncs.size() != ticks) {
     throw InputError(fmt::format("{}: {} SYNC frames, but run {} has {} ticks", o.log, syncs.size(),
@@ -73,7 +73,7 @@ StoredSamples replay_samples(const ReplayCommandOptions& o, const std::vector<Ru
   for (const auto& s : slots)
     cfg.slots.push_back({static_cast<std::uint8_t>(s.node), s.serial, s.pulse_weight_arcsec});
   dr::counters::CounterBoards boards(
-      std::make_unique<dr::can::ReplayCanTransport>(std::move(records)), cfg);
+      std::make_unique<ReplayCanTransport>(std::move(records)), cfg);
   StoredSamples out;
   for (std::size_t k = 0; k < ticks; ++k) {
     auto tick = boards.tick(syncs[k]);

@@ -53,7 +53,7 @@ struct Rig {
 
 /// Builds the drivers; no I/O. Every link (Modbus, CAN) opens on first use and reopens after a
 /// loss with bounded back-off, so an unreachable device is found by probing it
-/// (unreachable_devices in station/cli/probe.hpp), not here. Throws only on config errors.
+/// (unreachable_devices in station/daemon/rig_probe.hpp), not here. Throws only on config errors.
 Rig build_rig(const StationConfig& config, const RigOptions& options = {});
 
 }  // namespace station

@@ -31,7 +31,9 @@ std::optional<double> runs_bin_s(Store& store, const std::vector<std::int64_t>& 
   return bin_s;
 }
 
-void set_spans(Store& store, const FitRecord& fit, CoefficientBlock& b) {
+/// The span of a fit stored before migration 8: from the 1 Hz samples of its complete bins, as
+/// make_bins finds it for a fit stored since (the export round-trip test holds the two equal).
+FitSpan span_from_samples(Store& store, const FitRecord& fit) {
   constexpr double inf = std::numeric_limits<double>::infinity();
   double t_lo = inf, t_hi = -inf, g_lo = inf, g_hi = -inf;
   for (const auto run : fit.runs) {
@@ -48,10 +50,15 @@ void set_spans(Store& store, const FitRecord& fit, CoefficientBlock& b) {
         fmt::format("{}: fit {}: its runs {} hold no 1 Hz sample of {} in a complete "
                     "bin",
                     store.db().path(), fit.id, fmt::join(fit.runs, ","), fit.serial));
-  b.t_min_c = t_lo;
-  b.t_max_c = t_hi;
-  b.grad_min_c = g_lo;
-  b.grad_max_c = g_hi;
+  return FitSpan{t_lo, t_hi, g_lo, g_hi};
+}
+
+void set_spans(Store& store, const FitRecord& fit, CoefficientBlock& b) {
+  const FitSpan s = fit.span ? *fit.span : span_from_samples(store, fit);
+  b.t_min_c = s.temp_min_c;
+  b.t_max_c = s.temp_max_c;
+  b.grad_min_c = s.grad_min_c;
+  b.grad_max_c = s.grad_max_c;
 }
 
 /// A block with a value that is not finite is refused: "inf" in a C header does not compile, and

@@ -48,8 +48,9 @@ struct CoefficientBlock {
 };
 
 /// Builds the block of a stored fit: the spans are the min and max of T and gradT over the 1 Hz
-/// samples of the fit's complete bins (fitted_record_model_data), so every bin mean the fit used
-/// and every sample in it lies inside them. Throws ReleaseRefused for an undeliverable term, and
+/// samples of the fit's complete bins, as stored with the fit (FitRecord::span; found from the
+/// samples only for a fit stored before migration 8), so every bin mean the fit used and every
+/// sample in it lies inside them. Throws ReleaseRefused for an undeliverable term, and
 /// InputError when the fit's runs hold no such sample, a value is not finite, or the canonical
 /// text would not fit GYRO_TC_CANONICAL_MAX.
 CoefficientBlock make_block(Store& store, const FitRecord& fit,

@@ -12,7 +12,7 @@
 #include <map>
 
 #include "drivers/can/candump_log.hpp"
-#include "drivers/can/replay_transport.hpp"
+#include "station/session/replay_can.hpp"
 #include "station/common/input_error.hpp"
 #include "station/daemon/host.hpp"
 #include "station/daemon/rig.hpp"
@@ -72,7 +72,7 @@ struct ReplayRig {
   std::vector<double> sync_times_s;
   std::map<std::string, const RecordedModbusWire*> wires;
   std::map<std::string, const RecordedLineWire*> line_wires;
-  const dr::can::ReplayCanTransport* can_transport = nullptr;
+  const ReplayCanTransport* can_transport = nullptr;
   const ReplayGpioBank* gpio_bank = nullptr;
 
   ReplayRig(std::vector<SessionLogLine> modbus_lines, std::vector<SessionLogLine> ascii_lines,
@@ -105,7 +105,7 @@ struct ReplayRig {
       return w;
     };
     o.can_transport_factory = [this] {
-      auto t = std::make_unique<dr::can::ReplayCanTransport>(std::move(can));
+      auto t = std::make_unique<ReplayCanTransport>(std::move(can));
       can_transport = t.get();
       return t;
     };

@@ -94,7 +94,7 @@ SerialFit fit_serial(Store& store, const std::string& serial, std::vector<std::i
                       id));
   }
   out.fit.warnings.insert(out.fit.warnings.end(), warnings.begin(), warnings.end());
-  out.fit_id = store.save_fit(serial, runs, out.fit, out.eval);
+  out.fit_id = store.save_fit(serial, runs, out.fit, out.eval, store.bins_span(serial, runs));
   return out;
 }
 

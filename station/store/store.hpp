@@ -106,6 +106,13 @@ inline std::optional<double> gradient_c(const SampleRow& s) {
   return *s.temp2_c - *s.temp_c;
 }
 
+/// The range of temperature and gradient a fit saw: over the 1 Hz samples of its complete bins.
+struct FitSpan {
+  double temp_min_c = 0, temp_max_c = 0;
+  double grad_min_c = 0, grad_max_c = 0;
+  bool operator==(const FitSpan&) const = default;
+};
+
 /// A stored fit.
 struct FitRecord {
   std::int64_t id = 0;
@@ -113,6 +120,7 @@ struct FitRecord {
   std::vector<std::int64_t> runs;
   compensation::FitResult fit;
   compensation::Evaluation eval;
+  std::optional<FitSpan> span;  ///< empty: fitted before migration 8, or over older bins
 };
 
 /// Typed access to the station database. Not thread-safe: one writer (the sequencer).
@@ -153,8 +161,14 @@ class Store {
   /// Run ids that recorded `serial`.
   std::vector<std::int64_t> runs_of_serial(const std::string& serial);
 
+  /// The span of the complete bins of `serial` over `runs` (their stored ranges); empty when a
+  /// complete bin was stored before migration 8 or there is none.
+  std::optional<FitSpan> bins_span(const std::string& serial,
+                                   const std::vector<std::int64_t>& runs);
+
   std::int64_t save_fit(const std::string& serial, const std::vector<std::int64_t>& runs,
-                        const compensation::FitResult& fit, const compensation::Evaluation& eval);
+                        const compensation::FitResult& fit, const compensation::Evaluation& eval,
+                        const std::optional<FitSpan>& span = std::nullopt);
   std::optional<FitRecord> latest_fit(const std::string& serial);
   /// Fit `fit_id`; empty when there is none.
   std::optional<FitRecord> find_fit(std::int64_t fit_id);

@@ -51,6 +51,29 @@ TEST(Binning, MeansAndSlope) {
   double rate_sum = 0;
   for (int i = 600; i < 1200; ++i) rate_sum += i % 7;
   EXPECT_NEAR(b.rate_dph, rate_sum / 600.0, 1e-12);
+  // The range is of the bin's own samples (600 and 1199), exactly as they were given.
+  EXPECT_EQ(b.temp_min_c, s.temp[600]);
+  EXPECT_EQ(b.temp_max_c, s.temp[1199]);
+  EXPECT_EQ(bins[0].temp_max_c, s.temp[599]);
+  EXPECT_EQ(b.grad_min_c, 0.5);
+  EXPECT_EQ(b.grad_max_c, 0.5);
+}
+
+TEST(Binning, RangeOfANonMonotonicBinAndNoGradientSeries) {
+  Series s = ramp(600, 0.0, 0.0);
+  s.temp[17] = 3.25;   // a spike up
+  s.temp[400] = -55.5; // and one down, the rest at -40
+  s.grad[5] = -1.5;
+  s.grad[599] = 2.0;
+  const auto b = sc::make_bins(s.view()).at(0);
+  EXPECT_EQ(b.temp_min_c, -55.5);
+  EXPECT_EQ(b.temp_max_c, 3.25);
+  EXPECT_EQ(b.grad_min_c, -1.5);
+  EXPECT_EQ(b.grad_max_c, 2.0);
+  s.grad.clear();
+  const auto nograd = sc::make_bins(s.view()).at(0);
+  EXPECT_EQ(nograd.grad_min_c, 0.0);
+  EXPECT_EQ(nograd.grad_max_c, 0.0);
 }
 
 TEST(Binning, GapFlagsAPartialBinAndLeavesNoEmptyOnes) {

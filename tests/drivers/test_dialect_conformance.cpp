@@ -1,37 +1,41 @@
-// Issue 20: each dialect's shared wire definition (what driver AND simulator use) against a table
-// transcribed by hand from the maker's document or public client library, so a wrong address,
-// type, word order or spelling is a failing test, not a consistent error on both sides. The
-// tables below are the transcription; docs/DEVICES.md cites the same sources per point.
+// Issue 20: each dialect's wire definition (what the driver uses) against the table transcribed
+// by hand from the maker's document or public client library (sim_devices/sources/), which the
+// simulator speaks from. The driver's map and the simulator's are two readings of one document:
+// a wrong address, type, word order or code is a failing test here, and a driver-simulator run
+// that disagrees fails too. docs/DEVICES.md cites the same sources per point.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <array>
+#include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "drivers/chamber/espec_p300/p300_wire.hpp"
+#include "drivers/chamber/scaled_temperature.hpp"
 #include "drivers/chamber/watlow_f4/f4_map.hpp"
 #include "drivers/chamber/watlow_f4p/f4p_map.hpp"
 #include "drivers/chamber/watlow_f4t/f4t_map.hpp"
 #include "drivers/turntable/acutrol3000/acutrol_wire.hpp"
+#include "sim_devices/sources/espec_p300_sources.hpp"
+#include "sim_devices/sources/watlow_sources.hpp"
 
 namespace {
 
 namespace mb = station::drivers::modbus;
+namespace src = station::sim::sources;
 using mb::PointType;
 using mb::WordOrder;
 
-struct Row {
-  const char* point;
-  int address;  // 0-based PDU address, as the source gives it
-  PointType type;
-  WordOrder order;
-  bool writable;
-  const char* source;
-};
-
-void check(const mb::RegisterMap& map, const std::vector<Row>& rows) {
+/// Every source row is in the driver's map as the source gives it, and the driver's map has no
+/// point the sources do not give.
+void check(const mb::RegisterMap& map, const std::vector<src::SourcePoint>& rows) {
+  std::set<std::string> named;
   for (const auto& r : rows) {
-    SCOPED_TRACE(std::string(r.point) + " (" + r.source + ")");
-    const auto* p = map.find(r.point);
+    SCOPED_TRACE(r.name + " (" + r.source + ")");
+    named.insert(r.name);
+    const auto* p = map.find(r.name);
     ASSERT_NE(p, nullptr);
     EXPECT_EQ(p->pdu_address(), r.address);
     EXPECT_EQ(p->type, r.type);
@@ -42,93 +46,110 @@ void check(const mb::RegisterMap& map, const std::vector<Row>& rows) {
     EXPECT_EQ(p->access == mb::Access::rw, r.writable);
     EXPECT_EQ(p->scale, 1.0);  // raw on the wire; decimals/units are read from the unit
   }
+  for (const auto& [name, p] : map.points())
+    EXPECT_EQ(named.count(name), 1u) << map.device() << ": the driver's point '" << name
+                                     << "' is in no source row";
 }
-
-constexpr auto I16 = PointType::int16;
-constexpr auto U16 = PointType::uint16;
-constexpr auto F32 = PointType::float32;
-constexpr auto CDAB = WordOrder::cdab;
-constexpr auto ABCD = WordOrder::abcd;
 
 // ESPEC ChamberConnectLibrary @1d2deb8 watlowf4.py (CCL) and the Watlow F4P manual Rev E (F4P).
 TEST(Conformance, WatlowF4MatchesChamberConnectLibrary) {
-  check(station::drivers::watlow_f4::map(1, 3),
-        {{"input1_pv", 100, I16, ABCD, false, "CCL get_loop_pv:349"},
-         {"input1_err", 101, U16, ABCD, false, "F4P p. 9.6"},
-         {"input2_pv", 104, I16, ABCD, false, "CCL get_loop_pv:349 (loop 2)"},
-         {"status", 200, U16, ABCD, false, "CCL get_status:545"},
-         {"setpoint1", 300, I16, ABCD, true, "CCL get_loop_sp:329, set_loop_sp:342"},
-         {"sp_low1", 602, I16, ABCD, false, "CCL get_loop_range:354"},
-         {"sp_high1", 603, I16, ABCD, false, "CCL get_loop_range:354"},
-         {"decimals1", 606, U16, ABCD, false, "CCL __get_scalar:100"},
-         {"decimals2", 616, U16, ABCD, false, "CCL __get_scalar:100"},
-         {"units", 901, U16, ABCD, false, "CCL get_loop_units:396"},
-         {"event", 2020, U16, ABCD, true, "CCL get_event:533 (2000 + 10(n-1), n = 3)"}});
-  EXPECT_EQ(station::drivers::watlow_f4::kEventOn, 1);  // CCL set_event:539-543
-  EXPECT_EQ(station::drivers::watlow_f4::kEventOff, 0);
-  EXPECT_EQ(station::drivers::watlow_f4::kProfileRunning, 2);  // CCL get_status:545-554
-  EXPECT_EQ(station::drivers::watlow_f4::kProfilePaused, 3);
-  EXPECT_EQ(station::drivers::watlow_f4::kUnitsFahrenheit, 0);  // F4P p. 6.11
+  namespace d = station::drivers::watlow_f4;
+  for (int event = 1; event <= 8; ++event) {
+    SCOPED_TRACE("run event " + std::to_string(event));
+    check(d::map(1, event), src::f4::points(event));
+  }
+  EXPECT_EQ(src::f4::points(3).back().address, 2020);  // CCL get_event:533, n = 3
+  EXPECT_EQ(d::kEventOn, src::f4::kEventOn);
+  EXPECT_EQ(d::kEventOff, src::f4::kEventOff);
+  EXPECT_EQ(d::kProfilePaused, src::f4::kStatusProfilePaused);
+  EXPECT_EQ(d::kConstant1, src::f4::kStatusConstant);
+  EXPECT_EQ(d::kProfileRunning, 2);  // CCL get_status:545-554
+  EXPECT_EQ(d::kUnitsFahrenheit, src::f4::kUnitsFahrenheit);
 }
 
 // CCL watlowf4t.py / modbus.py; ramp registers from the TestEquity F4T manual as issue 20 quotes.
 TEST(Conformance, WatlowF4tMatchesDataMap1) {
-  check(station::drivers::watlow_f4t::map(1, 5, false, 1),
-        {{"loop1_pv", 2820, F32, CDAB, false, "CCL get_loop_pv:243; modbus.py low_word_first"},
-         {"loop2_pv", 2980, F32, CDAB, false, "CCL get_loop_pv:243 (+160 per loop)"},
-         {"loop1_sp", 2782, F32, CDAB, true, "CCL get_loop_sp:234, set_loop_sp:241"},
-         {"loop1_wsp", 2810, F32, CDAB, false, "CCL get_loop_sp:235"},
-         {"loop1_sp_min", 2774, F32, CDAB, false, "CCL get_loop_range:256"},
-         {"loop1_sp_max", 2776, F32, CDAB, false, "CCL get_loop_range:256"},
-         {"loop1_mode", 2814, U16, ABCD, false, "CCL get_loop_en:264"},
-         {"loop1_ramp_action", 2794, U16, ABCD, true, "TestEquity F4T manual (issue 20)"},
-         {"loop1_ramp_scale", 2796, U16, ABCD, true, "TestEquity F4T manual (issue 20)"},
-         {"loop1_ramp_rate", 2798, F32, CDAB, true, "TestEquity F4T manual (issue 20)"},
-         {"profile_state", 16568, U16, ABCD, false, "CCL get_status:528"},
-         {"alarm1_state", 1356, U16, ABCD, false, "CCL get_alarm_status:552"},
-         {"event", 16822, U16, ABCD, true, "CCL get_event:499 (event 5)"},
-         {"units", 6730, U16, ABCD, false, "CCL __profile_units:1003 (TCP)"},
-         {"part_number_0", 16, U16, ABCD, false, "CCL process_controller:861"}});
-  EXPECT_EQ(station::drivers::watlow_f4t::map(1, 1, true).at("units").address, 14080);  // RTU
-  EXPECT_EQ(station::drivers::watlow_f4t::map(1, 1, false, 2).at("loop1_pv").address, 2980);
   namespace t = station::drivers::watlow_f4t;
-  EXPECT_EQ(t::kOn, 63);  // CCL set_event:508-520
-  EXPECT_EQ(t::kOff, 62);
-  EXPECT_EQ(t::kAuto, 10);  // CCL set_loop_mode:294-309
-  EXPECT_EQ(t::kManual, 54);
+  for (int event = 1; event <= 8; ++event)
+    for (const bool rtu : {false, true})
+      for (int loop = 1; loop <= 3; ++loop) {
+        SCOPED_TRACE(fmt::format("event {} rtu {} loop {}", event, rtu, loop));
+        check(t::map(1, event, rtu, loop), src::f4t::points(event, rtu, loop));
+      }
+  EXPECT_EQ(t::kOn, src::f4t::kOn);
+  EXPECT_EQ(t::kOff, src::f4t::kOff);
+  EXPECT_EQ(t::kAuto, src::f4t::kAuto);
+  EXPECT_EQ(t::kManual, src::f4t::kManual);
+  EXPECT_EQ(t::kProfilePaused, src::f4t::kProfilePaused);
   EXPECT_EQ(t::kProfileRunning, 149);  // CCL get_status:528-546
-  EXPECT_EQ(t::kProfilePaused, 146);
-  EXPECT_EQ(t::kCelsius, 15);  // CCL __profile_units
-  EXPECT_EQ(t::kFahrenheit, 30);
+  EXPECT_EQ(t::kCelsius, src::f4t::kCelsius);
+  EXPECT_EQ(t::kFahrenheit, src::f4t::kFahrenheit);
+  EXPECT_EQ(t::kHours, src::f4t::kHours);
+  EXPECT_EQ(t::kMinutes, src::f4t::kMinutes);
+  EXPECT_EQ(t::kRampSetpoint, src::f4t::kRampSetpoint);
   EXPECT_EQ(t::kAlarmInactive, (std::array<int, 3>{88, 61, 12}));  // CCL get_alarm_status:552
+  EXPECT_EQ(t::kAlarmInactive[1], src::f4t::kAlarmNone);
+  EXPECT_EQ(t::kPartNumberRegisters, src::f4t::kPartNumberRegisters);
   // A float goes low word first (CCL modbus.py read_holding_float:157-173): 25.0 = 0x41C80000.
-  const auto w = mb::float_to_words(25.0f, CDAB);
+  const auto w = mb::float_to_words(25.0f, WordOrder::cdab);
   EXPECT_EQ(w[0], 0x0000);
   EXPECT_EQ(w[1], 0x41C8);
 }
 
 // Watlow Series F4P User's Manual 0600-0032-0013 Rev E, pages as printed.
 TEST(Conformance, WatlowF4pMatchesItsManual) {
-  check(station::drivers::watlow_f4p::map(1), {{"model", 0, U16, ABCD, false, "p. 6.27"},
-                                               {"input1_pv", 100, I16, ABCD, false, "p. 9.6"},
-                                               {"input1_err", 101, U16, ABCD, false, "p. 9.6"},
-                                               {"alarm1_status", 102, U16, ABCD, false, "p. 9.2"},
-                                               {"auto_manual", 200, U16, ABCD, true, "p. 9.2"},
-                                               {"control_sp", 298, I16, ABCD, false, "p. 9.4"},
-                                               {"setpoint1", 300, I16, ABCD, true, "p. 9.9"},
-                                               {"sp_low1", 602, I16, ABCD, false, "p. 6.13"},
-                                               {"sp_high1", 603, I16, ABCD, false, "p. 6.13"},
-                                               {"decimals1", 606, U16, ABCD, false, "p. 6.13"},
-                                               {"units", 901, U16, ABCD, false, "p. 6.11"},
-                                               {"ramp_mode", 1100, U16, ABCD, true, "p. 6.7"},
-                                               {"ramp_rate", 1101, I16, ABCD, true, "p. 6.8"},
-                                               {"ramp_scale", 1102, U16, ABCD, true, "p. 6.8"}});
-  EXPECT_EQ(station::drivers::watlow_f4p::kModelF4p, 5280);  // "P4 (4P) ASCII 5280 Dec"
+  namespace d = station::drivers::watlow_f4p;
+  check(d::map(1), src::f4p::points());
+  EXPECT_EQ(d::kModelF4p, src::f4p::kModelF4p);
+  EXPECT_EQ(d::kAuto, src::f4p::kAuto);
+  EXPECT_EQ(d::kManual, src::f4p::kManual);
+  EXPECT_EQ(d::kRampOff, src::f4p::kRampOff);
+  EXPECT_EQ(d::kRampStartupOrChange, src::f4p::kRampMax);
+  EXPECT_EQ(d::kPerMinute, src::f4p::kPerMinute);
+  EXPECT_EQ(d::kPerHour, src::f4p::kPerHour);
+  EXPECT_EQ(d::kUnitsFahrenheit, src::f4p::kUnitsFahrenheit);
+  EXPECT_EQ(d::kUnitsCelsius, src::f4p::kUnitsCelsius);
+}
+
+// The simulator's scaling of a Watlow integer (F4P p. 6.11, 6.13) against the driver's codec:
+// two readings of the same pages, over every decimal setting and both units.
+TEST(Conformance, WatlowScalingAgreesWithTheDriversCodec) {
+  for (int decimals = 0; decimals <= 3; ++decimals)
+    for (const bool f : {false, true})
+      for (const double c : {-73.3, -40.0, 0.0, 0.04, 23.45, 85.0, 150.0}) {
+        const station::drivers::TemperatureScale s{decimals, f};
+        const double raw = src::watlow_raw(c, decimals, f);
+        const auto want = s.raw_from_c(c);
+        if (!want) {
+          EXPECT_TRUE(raw == 32767 || raw == -32768) << c << " C, " << decimals;
+          continue;
+        }
+        EXPECT_EQ(raw, *want) << c << " C, " << decimals << " decimals, F " << f;
+        const auto r16 = static_cast<std::int16_t>(raw);
+        EXPECT_DOUBLE_EQ(src::watlow_c_of_raw(r16, decimals, f), s.c_from_raw(r16));
+      }
+  EXPECT_EQ(src::watlow_raw(25.0, 1, true), 770);  // 77.0 F
+  EXPECT_DOUBLE_EQ(src::watlow_c(212.0, true), 100.0);
 }
 
 // CCL p300.py / especinteract.py: spellings and the replies as the library parses them.
 TEST(Conformance, EspecP300MatchesChamberConnectLibrary) {
   namespace p = station::drivers::espec_p300;
+  namespace q = src::p300;  // what the simulator answers
+  for (const auto& [driver, source] : std::vector<std::pair<std::string_view, std::string_view>>{
+           {p::kTempQuery, q::kTempQuery},
+           {p::kMonitorQuery, q::kMonitorQuery},
+           {p::kModeQuery, q::kModeQuery},
+           {p::kAlarmQuery, q::kAlarmQuery},
+           {p::kProductQuery, q::kProductQuery},
+           {p::kRomQuery, q::kRomQuery},
+           {p::kModeConstant, q::kModeConstant},
+           {p::kModeStandby, q::kModeStandby},
+           {p::kModeOff, q::kModeOff},
+           {p::kPowerOn, q::kPowerOn},
+           {p::kErrorPrefix, q::kError}})
+    EXPECT_EQ(driver, source);
+  EXPECT_EQ(p::temp_setpoint_command(25).substr(0, q::kTempSetPrefix.size()), q::kTempSetPrefix);
   EXPECT_EQ(p::kTcpPort, 10001);                           // EspecTCP.__init__:117
   EXPECT_EQ(p::kTerminator, "\r\n");                       // EspecSerial.__init__:55
   EXPECT_EQ(p::temp_setpoint_command(25), "TEMP, S25.0");  // write_temp:1037 ("TEMP, S%0.1f")

@@ -7,6 +7,7 @@
 #include <unistd.h>
 #include <zlib.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -150,6 +151,35 @@ TEST_F(ExportRoundTrip, JsonBlockVerifiesAndReproducesTheStation) {
   // One ulp changed in a coefficient: the block no longer verifies.
   b.k_dph[0] = std::nextafter(b.k_dph[0], 1.0);
   EXPECT_EQ(gyro_tc_verify(&b), 0);
+}
+
+// Migration 8: the span is stored with the fit, from the bins' own ranges. It must be exactly the
+// range of the 1 Hz samples of the fit's complete bins (what every version before computed at
+// export), and a fit stored before (span NULL) must export the identical block.
+TEST_F(ExportRoundTrip, StoredSpanIsTheSamplesSpanAndOlderFitsExportTheSame) {
+  ASSERT_TRUE(fit_.span);
+  double t_lo = 1e300, t_hi = -1e300, g_lo = 1e300, g_hi = -1e300;
+  std::size_t n = 0;
+  for (const auto run : fit_.runs) {
+    const auto d = station::fitted_record_model_data(*store_, run, fit_.serial);
+    for (std::size_t i = 0; i < d.temp_c.size(); ++i, ++n) {
+      t_lo = std::min(t_lo, d.temp_c[i]);
+      t_hi = std::max(t_hi, d.temp_c[i]);
+      g_lo = std::min(g_lo, d.grad_c[i]);
+      g_hi = std::max(g_hi, d.grad_c[i]);
+    }
+  }
+  ASSERT_GT(n, 1000u);
+  EXPECT_EQ(*fit_.span, (station::FitSpan{t_lo, t_hi, g_lo, g_hi}));
+  EXPECT_LT(t_lo, t_hi);
+  EXPECT_LT(g_lo, g_hi);
+  store_->db().exec("UPDATE fits SET temp_min_c = NULL, temp_max_c = NULL, grad_min_c = NULL, "
+                    "grad_max_c = NULL WHERE id = " + std::to_string(fit_.id));
+  const auto old = *store_->find_fit(fit_.id);
+  EXPECT_FALSE(old.span);
+  const auto again = station::make_block(*store_, old, rel_);
+  EXPECT_EQ(again.canonical, block_.canonical);
+  EXPECT_EQ(again.crc32, block_.crc32);
 }
 
 TEST_F(ExportRoundTrip, CsvRowsReproduceTheStation) {

@@ -21,7 +21,7 @@
 #include "compensation/earth_rate.hpp"
 #include "sim_devices/sim_clock.hpp"
 #include "sim_devices/sim_world.hpp"
-#include "station/cli/probe.hpp"
+#include "station/daemon/rig_probe.hpp"
 #include "station/daemon/sequencer.hpp"
 #include "station/store/calibration.hpp"
 #include "tests/station/temp_db.hpp"

@@ -13,7 +13,7 @@
 
 #include "sim_devices/gpio_sim.hpp"
 #include "sim_devices/sim_world.hpp"
-#include "station/cli/probe.hpp"
+#include "station/daemon/rig_probe.hpp"
 #include "station/config/config.hpp"
 
 namespace {

@@ -12,7 +12,7 @@
 #include <iterator>
 #include <set>
 
-#include "station/cli/device_identity.hpp"
+#include "station/daemon/device_identity.hpp"
 #include "station/store/store.hpp"
 #include "tests/station/rig_process.hpp"
 

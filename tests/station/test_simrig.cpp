@@ -12,7 +12,7 @@
 #include <string>
 #include <thread>
 
-#include "station/cli/probe.hpp"
+#include "station/daemon/rig_probe.hpp"
 #include "station/config/config.hpp"
 
 namespace {

@@ -1,5 +1,5 @@
 // Live service start-up: token file, bind, the address line.
-#include "station/cli/live_service.hpp"
+#include "station/http/live_service.hpp"
 
 #include <fmt/format.h>
 

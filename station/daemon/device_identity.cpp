@@ -1,5 +1,5 @@
 // Device endpoints resolved to what they reach (device locks).
-#include "station/cli/device_identity.hpp"
+#include "station/daemon/device_identity.hpp"
 
 #include <arpa/inet.h>
 #include <fmt/format.h>

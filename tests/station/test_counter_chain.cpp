@@ -8,7 +8,7 @@
 #include <cmath>
 #include <thread>
 
-#include "drivers/can/replay_transport.hpp"
+#include "station/session/replay_can.hpp"
 #include "drivers/counters/counter_boards.hpp"
 #include "drivers/counters/counter_frames.hpp"
 
@@ -165,11 +165,11 @@ std::vector<can::CandumpRecord> latch_log(int n) {
 // Rates of every latch replayed through the driver, configured as `station replay` does.
 std::vector<double> replay_rates(std::chrono::milliseconds stall) {
   auto log = latch_log(8);
-  const auto syncs = can::logged_syncs(log);
+  const auto syncs = station::logged_syncs(log);
   c::CounterBoardsConfig cfg{{{1, "A", 1.5}, {2, "B", 1.5}}, 1ms, 1.0};
   cfg.wall_clock_deadline = false;  // what replay_command sets
   c::CounterBoards boards(
-      std::make_unique<Stalling>(std::make_unique<can::ReplayCanTransport>(std::move(log)), stall),
+      std::make_unique<Stalling>(std::make_unique<station::ReplayCanTransport>(std::move(log)), stall),
       cfg);
   std::vector<double> rates;
   for (const auto seq : syncs) {

@@ -1,5 +1,5 @@
 // Serve control: validation on the HTTP thread, hand-over to the serve loop under a lock.
-#include "station/cli/serve_control.hpp"
+#include "station/http/serve_control.hpp"
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>

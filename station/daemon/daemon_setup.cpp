@@ -1,12 +1,12 @@
 // Shared daemon set-up.
-#include "station/cli/daemon_setup.hpp"
+#include "station/daemon/daemon_setup.hpp"
 
 #include <fmt/format.h>
 
 #include <csignal>
 #include <cstdlib>
 
-#include "station/cli/device_identity.hpp"
+#include "station/daemon/device_identity.hpp"
 #include "station/common/logging.hpp"
 #include "station/parts/judged_fit.hpp"
 

@@ -1,9 +1,13 @@
 // Replay of candump logs as a CAN transport.
-#include "drivers/can/replay_transport.hpp"
+#include "station/session/replay_can.hpp"
 
 #include <fmt/format.h>
 
-namespace station::drivers::can {
+namespace station {
+using drivers::ErrorKind;
+using drivers::make_error;
+using drivers::Result;
+using drivers::can::CandumpRecord;
 namespace {
 
 constexpr canid_t kSyncId = 0x080;  // schemas/can_frames.md
@@ -47,4 +51,4 @@ std::vector<std::uint8_t> logged_syncs(const std::vector<CandumpRecord>& records
   return out;
 }
 
-}  // namespace station::drivers::can
+}  // namespace station

@@ -1,0 +1,103 @@
+// The Watlow controllers' registers and codes as their makers' documents give them, transcribed
+// by hand: the simulated F4, F4T and F4P speak from these tables, and the conformance test
+// (tests/drivers/test_dialect_conformance.cpp) holds each driver's own map against them, so the
+// driver's map and the simulator's are two readings of one document and a driver-simulator run
+// is a conformance check. Nothing here comes from drivers/chamber/ (docs/DEVICES.md).
+//
+// [CCL] ESPEC North America ChamberConnectLibrary (MIT) @1d2deb8, chamberconnectlibrary/
+// watlowf4.py, watlowf4t.py, modbus.py. [F4P] Watlow Series F4P User's Manual 0600-0032-0013
+// Rev E, pages as printed. [TE] TestEquity F4T controller manual, as issue 20 quotes it.
+// Addresses are 0-based PDU addresses (CCL modbus.py _make_packet:325-333; F4P p. 9.2).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "drivers/modbus/register_map.hpp"
+
+namespace station::sim::sources {
+
+/// One holding register (or float pair) as a document gives it.
+struct SourcePoint {
+  std::string name;  ///< the station's name for it (the drivers' maps use the same names)
+  std::uint16_t address = 0;
+  drivers::modbus::PointType type = drivers::modbus::PointType::uint16;
+  drivers::modbus::WordOrder order = drivers::modbus::WordOrder::abcd;
+  bool writable = false;
+  std::string source;  ///< document and page, or file:line
+};
+
+/// The rows as a register map of unit `unit_id` (holding registers, raw values: scale 1).
+drivers::modbus::RegisterMap register_map(const std::string& device, int unit_id,
+                                          const std::vector<SourcePoint>& rows);
+
+/// A temperature as a Watlow integer register holds it: deg C or deg F (F4P p. 6.11, register
+/// 901), times 10^decimals (F4P p. 6.13, register 606: 0 -> "0", 1 -> "0.0" ...), rounded,
+/// clipped to 16 bits signed. c_of_raw is the inverse.
+double watlow_raw(double c, int decimals, bool fahrenheit);
+double watlow_c_of_raw(std::int16_t raw, int decimals, bool fahrenheit);
+/// deg C in the controller's unit (floats of the F4T: [CCL] __profile_units), and back; a rate
+/// per unit time scales without the offset.
+double watlow_unit(double c, bool fahrenheit);
+double watlow_c(double unit, bool fahrenheit);
+double watlow_c_delta(double unit_delta, bool fahrenheit);
+
+/// Series F4 ([CCL] watlowf4.py; [F4P] where CCL is silent).
+namespace f4 {
+std::vector<SourcePoint> points(int run_event);
+inline constexpr const char *kAir = "input1_pv", *kAirError = "input1_err",
+                            *kProduct = "input2_pv", *kProductError = "input2_err",
+                            *kStatus = "status", *kSetpoint = "setpoint1",
+                            *kSetpointLow = "sp_low1", *kSetpointHigh = "sp_high1",
+                            *kDecimals = "decimals1", *kDecimals2 = "decimals2", *kUnits = "units",
+                            *kRunEvent = "event";
+inline constexpr int kEventOff = 0, kEventOn = 1;                     // CCL set_event:539-543
+inline constexpr int kStatusConstant = 1, kStatusProfilePaused = 3;  // CCL get_status:545-554
+inline constexpr int kUnitsFahrenheit = 0, kUnitsCelsius = 1;        // F4P p. 6.11
+inline constexpr int kInputOverRange = 3;  // F4P p. 2.5: "SEnhi", input error 3
+}  // namespace f4
+
+/// F4T Data Map 1 ([CCL] watlowf4t.py, modbus.py; [TE] for the ramp registers).
+namespace f4t {
+/// `loop` is the air loop (1..4), `rtu` picks the units register of a serial link.
+std::vector<SourcePoint> points(int run_event, bool rtu, int loop = 1);
+inline constexpr const char *kAir = "loop1_pv", *kProduct = "loop2_pv", *kSetpoint = "loop1_sp",
+                            *kWorkingSetpoint = "loop1_wsp", *kSetpointLow = "loop1_sp_min",
+                            *kSetpointHigh = "loop1_sp_max", *kLoopMode = "loop1_mode",
+                            *kRampAction = "loop1_ramp_action", *kRampScale = "loop1_ramp_scale",
+                            *kRampRate = "loop1_ramp_rate", *kProfileState = "profile_state",
+                            *kAlarm1 = "alarm1_state", *kRunEvent = "event", *kUnits = "units";
+/// Part number, one character per register from 16 (CCL process_controller:861-921).
+inline constexpr int kPartNumberRegisters = 15;
+std::string part_number_point(int i);
+// Watlow enumeration codes (CCL watlowf4t.py __init__:78-121 and the functions named).
+inline constexpr int kAuto = 10, kManual = 54;             // CCL set_loop_mode:294-309
+inline constexpr int kOff = 62, kOn = 63;                  // CCL set_event:508-520 (#62=off)
+inline constexpr int kCelsius = 15, kFahrenheit = 30;      // CCL __profile_units:990-1007
+inline constexpr int kHours = 39, kMinutes = 57;           // CCL dictionary; [TE] the register
+inline constexpr int kRampSetpoint = 85;                   // CCL dictionary "setpoint"
+inline constexpr int kStartup = 88, kRampBoth = 13;        // CCL dictionary ("startup", "both")
+inline constexpr int kProfilePaused = 146;                 // CCL get_status:528-546
+inline constexpr int kAlarmNone = 61;                      // CCL get_alarm_status:552 (inactive)
+}  // namespace f4t
+
+/// Series F4P ([F4P] chapter 9 and the parameter tables of chapter 6).
+namespace f4p {
+std::vector<SourcePoint> points();
+inline constexpr const char *kModel = "model", *kAir = "input1_pv", *kAirError = "input1_err",
+                            *kAlarm1 = "alarm1_status", *kOperation = "auto_manual",
+                            *kControlSetpoint = "control_sp", *kSetpoint = "setpoint1",
+                            *kSetpointLow = "sp_low1", *kSetpointHigh = "sp_high1",
+                            *kDecimals = "decimals1", *kUnits = "units", *kRampMode = "ramp_mode",
+                            *kRampRate = "ramp_rate", *kRampScale = "ramp_scale";
+inline constexpr int kModelF4p = 5280;            // p. 6.27: "P4 (4P) ASCII 5280 Dec"
+inline constexpr int kAuto = 1, kManual = 2;      // register 200, p. 9.2
+inline constexpr int kRampOff = 0, kRampMax = 2;  // register 1100: off, startup, startup/change
+inline constexpr int kRampRateMin = 1, kRampRateMax = 999;  // register 1101, p. 6.8
+inline constexpr int kPerMinute = 0, kPerHour = 1;          // register 1102, p. 6.8
+inline constexpr int kUnitsFahrenheit = 0, kUnitsCelsius = 1;  // register 901, p. 6.11
+inline constexpr int kInputOverRange = 3;                      // p. 2.5
+}  // namespace f4p
+
+}  // namespace station::sim::sources
