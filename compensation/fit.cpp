@@ -8,6 +8,7 @@
 #include <numeric>
 #include <string>
 
+#include "compensation/earth_rate.hpp"
 #include "compensation/fit_diagnostics.hpp"
 #include "compensation/limits.hpp"
 
@@ -258,7 +259,7 @@ ModelData model_data_from_bins(std::span<const Bin> bins, double earth_rate_dph)
   ModelData d;
   for (const Bin& b : bins) {
     if (!b.complete) continue;
-    d.bias_dph.push_back(b.rate_dph - earth_rate_dph);
+    d.bias_dph.push_back(bias_dph(b.rate_dph, earth_rate_dph));
     d.temp_c.push_back(b.temp_c);
     d.grad_c.push_back(b.grad_c);
     d.dtdt_c_per_h.push_back(b.dtdt_c_per_h);

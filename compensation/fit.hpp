@@ -60,7 +60,7 @@ struct ModelData {
   }
 };
 
-/// Complete bins only, bias = bin mean rate - earth_rate_dph.
+/// Complete bins only, each bias the bias_dph() of its mean rate (earth_rate.hpp).
 ModelData model_data_from_bins(std::span<const Bin> bins, double earth_rate_dph);
 
 /// A fitted model with its statistics. coefficients[0] is B0; names[i] labels coefficients[i].

@@ -28,7 +28,7 @@ struct AnalyzeOptions {
   std::string file;
   std::string time_col = "time_s", rate_col = "rate_dph", temp_col = "temp_c";
   std::string grad_col, temp2_col;
-  double bin_s = 600.0;
+  double bin_s = sc::kPaperBinS;
   double ref_temp_c = 25.0;
   std::string terms = "dT,gradT";
   std::optional<double> earth_rate_dph, latitude_deg;

@@ -6,6 +6,7 @@
 #include <functional>
 #include <string>
 
+#include "compensation/binning.hpp"
 #include "station/daemon/sequencer.hpp"
 
 namespace station {
@@ -23,7 +24,7 @@ class ProgressDisplay {
   void finish();
 
   /// The progress text of a tick: step, its label, run time, air and setpoint, bins so far.
-  static std::string text(const TickReport& r, long bins, double bin_s = 600.0);
+  static std::string text(const TickReport& r, long bins, double bin_s = compensation::kPaperBinS);
 
  private:
   std::FILE* out_;

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "compensation/binning.hpp"
 #include "compensation/earth_rate.hpp"
 #include "drivers/gpio/gpio_bank.hpp"
 #include "drivers/modbus/map_overrides.hpp"
@@ -57,7 +58,7 @@ struct StationConfig {
   std::string name = "station";
   double latitude_deg = 0;   ///< geodetic latitude of the site, deg
   double ref_temp_c = 25.0;  ///< T_ref of the model
-  double bin_s = 600.0;      ///< bin width, s
+  double bin_s = compensation::kPaperBinS;  ///< bin width, s
   /// Largest share of a slot's record-window ticks that may lack a rate (link outages) before
   /// the run ends 'incomplete', 0..1.
   double max_lost_share = 0.05;

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "compensation/binning.hpp"
 #include "station/config/protocol.hpp"
 #include "station/daemon/idle_watch.hpp"
 #include "station/daemon/sequencer.hpp"
@@ -28,7 +29,7 @@ struct StationInfo {
   std::string station;
   bool sim = false;
   std::optional<double> speed;  ///< simulated seconds per wall second (--speed)
-  double bin_s = 600;
+  double bin_s = compensation::kPaperBinS;
 };
 
 /// One event-stream message, formatted for the wire ("id: …\nevent: …\ndata: …\n\n").

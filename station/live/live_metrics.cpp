@@ -6,6 +6,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "compensation/earth_rate.hpp"
 #include "station/store/store.hpp"
 
 namespace station::live {
@@ -101,7 +102,7 @@ void LiveMetrics::tick(const TickReport& r) {
     const auto& l = it->second.labels;
     if (row.rate_dph) {
       slot_rate_.Add(l).Set(*row.rate_dph);
-      slot_bias_.Add(l).Set(*row.rate_dph - it->second.earth_rate_dph);
+      slot_bias_.Add(l).Set(compensation::bias_dph(*row.rate_dph, it->second.earth_rate_dph));
     }
     if (row.temp_c) slot_temp_.Add(l).Set(*row.temp_c);
     if (const auto g = gradient_c(row)) slot_grad_.Add(l).Set(*g);

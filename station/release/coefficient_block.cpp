@@ -21,11 +21,8 @@ std::optional<double> runs_bin_s(Store& store, const std::vector<std::int64_t>& 
   std::optional<double> bin_s;
   for (const auto id : runs) {
     const auto run = store.find_run(id);
-    if (!run) return std::nullopt;
-    const auto j = nlohmann::json::parse(run->resolved_json, nullptr, false);
-    if (!j.is_object() || !j.contains("bin_s") || !j["bin_s"].is_number()) return std::nullopt;
-    const double b = j["bin_s"].get<double>();
-    if (bin_s && *bin_s != b) return std::nullopt;
+    const auto b = run ? recorded_bin_s(*run) : std::nullopt;
+    if (!b || (bin_s && *bin_s != *b)) return std::nullopt;
     bin_s = b;
   }
   return bin_s;

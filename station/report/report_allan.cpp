@@ -3,6 +3,7 @@
 
 #include <algorithm>
 
+#include "compensation/earth_rate.hpp"
 #include "compensation/binning.hpp"
 #include "station/store/sample_series.hpp"
 
@@ -39,7 +40,7 @@ OneHzRecord one_hz_record(const std::vector<SampleRow>& rows, double earth_rate_
   const SampleSeries s = sample_series(rows);
   const std::vector<double>&t = s.t_s, &temp = s.temp_c, &grad = s.grad_c;
   OneHzRecord r;
-  for (double rate : s.rate_dph) r.bias_dph.push_back(rate - earth_rate_dph);
+  for (double rate : s.rate_dph) r.bias_dph.push_back(compensation::bias_dph(rate, earth_rate_dph));
   if (r.bias_dph.empty()) return r;
   std::vector<double> dtdt, channel;
   if (has_coefficient(fit, "kr")) dtdt = per_sample_dtdt(t, temp, bin_s);

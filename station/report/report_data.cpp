@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 
+#include "compensation/earth_rate.hpp"
 #include "compensation/binning.hpp"
 #include "station/store/sample_series.hpp"
 
@@ -72,7 +73,7 @@ std::vector<RunBin> whole_run_bins(const std::vector<SampleRow>& rows, double bi
   std::size_t air_from = 0;
   for (const auto& b : sc::make_bins(s.bin_input(), cfg)) {
     if (!b.complete) continue;
-    out.push_back({b.t_mid_s, b.rate_dph - earth_rate_dph, b.temp_c,
+    out.push_back({b.t_mid_s, compensation::bias_dph(b.rate_dph, earth_rate_dph), b.temp_c,
                    mean_air(rows, air_from, b.t_start_s, b.t_start_s + bin_s), b.dtdt_c_per_h});
   }
   return out;

@@ -9,21 +9,12 @@
 #include <map>
 
 #include "station/common/input_error.hpp"
+#include "station/store/calibration.hpp"
 #include "station/store/fit_verdicts.hpp"
 
 namespace station::report {
 
 namespace {
-
-/// The run's bin width from its stored meaning; 600 s (the paper's) when not recorded.
-double run_bin_s(const RunRecord& run) {
-  const auto j = nlohmann::json::parse(run.resolved_json, nullptr, false);
-  if (j.is_object() && j.contains("bin_s") && j["bin_s"].is_number()) {
-    const double bin_s = j["bin_s"].get<double>();
-    if (bin_s > 0) return bin_s;
-  }
-  return 600.0;
-}
 
 /// The newest run of each ramp protocol (ramp_00/10/20) that recorded `serial` and has complete
 /// bins, in protocol order.

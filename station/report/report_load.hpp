@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "compensation/binning.hpp"
 #include "station/release/releases.hpp"
 #include "station/release/verification.hpp"
 #include "station/report/report_allan.hpp"
@@ -46,7 +47,7 @@ struct SerialReport {
 struct RunReport {
   RunRecord run;
   std::string config_sha256;  ///< SHA-256 of the stored configuration text, hex
-  double bin_s = 600.0;       ///< the run's bin width (runs.resolved_json)
+  double bin_s = compensation::kPaperBinS;  ///< the run's bin width (run_bin_s)
   std::vector<EventRow> events;
   std::vector<SerialReport> serials;
 };

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <nlohmann/json.hpp>
 
+#include "compensation/earth_rate.hpp"
 #include "compensation/binning.hpp"
 #include "station/common/input_error.hpp"
 #include "station/store/sample_series.hpp"
@@ -14,13 +15,23 @@ namespace station {
 
 namespace sc = station::compensation;
 
+std::optional<double> recorded_bin_s(const RunRecord& run) {
+  const auto j = nlohmann::json::parse(run.resolved_json, nullptr, false);
+  if (!j.is_object() || !j.contains("bin_s") || !j["bin_s"].is_number()) return std::nullopt;
+  const double bin_s = j["bin_s"].get<double>();
+  if (!(bin_s > 0)) return std::nullopt;
+  return bin_s;
+}
+
+double run_bin_s(const RunRecord& run) { return recorded_bin_s(run).value_or(sc::kPaperBinS); }
+
 sc::ModelData record_model_data(Store& store, std::int64_t run_id, const std::string& serial) {
   double earth_rate_dph = 0;
   for (const auto& s : store.run_slots(run_id))
     if (s.serial == serial) earth_rate_dph = s.earth_rate_dph;
   SampleSeries s = sample_series(store.samples(run_id, serial, true));
   sc::ModelData d;
-  for (double r : s.rate_dph) d.bias_dph.push_back(r - earth_rate_dph);
+  for (double r : s.rate_dph) d.bias_dph.push_back(sc::bias_dph(r, earth_rate_dph));
   d.temp_c = std::move(s.temp_c);
   d.grad_c = std::move(s.grad_c);
   d.t_mid_s = std::move(s.t_s);
@@ -30,12 +41,7 @@ sc::ModelData record_model_data(Store& store, std::int64_t run_id, const std::st
 sc::ModelData fitted_record_model_data(Store& store, std::int64_t run_id,
                                        const std::string& serial) {
   const auto run = store.find_run(run_id);
-  double bin_s = 600.0;  // the paper's, when the run did not record its own (before migration 2)
-  if (run) {
-    const auto j = nlohmann::json::parse(run->resolved_json, nullptr, false);
-    if (j.is_object() && j.contains("bin_s") && j["bin_s"].is_number() && j["bin_s"] > 0)
-      bin_s = j["bin_s"].get<double>();
-  }
+  const double bin_s = run ? run_bin_s(*run) : sc::kPaperBinS;
   const std::vector<double> starts = store.model_data(serial, {run_id}).t_mid_s;  // bin starts
   const sc::ModelData all = record_model_data(store, run_id, serial);
   sc::ModelData d;

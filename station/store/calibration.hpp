@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -10,6 +11,12 @@
 #include "station/store/store.hpp"
 
 namespace station {
+
+/// The bin width a run recorded (runs.resolved_json "bin_s", migration 2); empty when it did not.
+std::optional<double> recorded_bin_s(const RunRecord& run);
+/// The bin width of a run: its own, or the paper's (compensation::kPaperBinS) for a run recorded
+/// before it was kept.
+double run_bin_s(const RunRecord& run);
 
 /// One gyro's 1 Hz record in `run_id` as model input: bias (rate - the slot's Earth rate),
 /// temperature, gradient (temp2 - temp), over the samples that go into bins (gaps closed up).

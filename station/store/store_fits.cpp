@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include "station/store/fit_json.hpp"
+#include "compensation/earth_rate.hpp"
 #include "station/store/store.hpp"
 
 namespace station {
@@ -26,7 +27,7 @@ void Store::replace_bins(std::int64_t run_id, const std::string& serial,
         .bind(2, serial)
         .bind(3, b.t_start_s)
         .bind(4, static_cast<std::int64_t>(b.n));
-    ins.bind(5, b.rate_dph).bind(6, b.rate_dph - earth_rate_dph).bind(7, b.temp_c);
+    ins.bind(5, b.rate_dph).bind(6, sc::bias_dph(b.rate_dph, earth_rate_dph)).bind(7, b.temp_c);
     ins.bind(8, b.grad_c).bind(9, b.dtdt_c_per_h).bind(10, b.complete ? 1 : 0);
     ins.bind(11, b.temp_min_c).bind(12, b.temp_max_c).bind(13, b.grad_min_c);
     ins.bind(14, b.grad_max_c);
