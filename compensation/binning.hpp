@@ -39,7 +39,7 @@ struct Bin {
   double extra = 0;         ///< mean of the extra channel (0 when none)
   double temp_min_c = 0, temp_max_c = 0;  ///< range of the bin's sample temperatures
   double grad_min_c = 0, grad_max_c = 0;  ///< range of its gradients (0 when no series)
-  bool complete = false;    ///< n >= min_fill * expected: usable in fits
+  bool complete = false;                  ///< n >= min_fill * expected: usable in fits
 };
 
 /// Bin k covers [t0 + k*w, t0 + (k+1)*w), t0 the first sample's time. Only bins that hold a

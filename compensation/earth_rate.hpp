@@ -34,7 +34,9 @@ EnuAxis parse_axis(std::string_view text);
 
 /// The gyro's bias: its output minus the Earth rate along its input axis (the paper, sec. 2: the
 /// table holds still, so all a perfect gyro would sense is the Earth's rotation), deg/h.
-inline double bias_dph(double rate_dph, double earth_rate_dph) { return rate_dph - earth_rate_dph; }
+inline double bias_dph(double rate_dph, double earth_rate_dph) {
+  return rate_dph - earth_rate_dph;
+}
 
 /// Earth-rate component along `axis` at geodetic latitude `latitude_deg`, deg/h.
 /// In ENU the Earth rate is (0, W cos(phi), W sin(phi)) (Titterton & Weston, Strapdown Inertial

@@ -104,6 +104,10 @@ SimWorld::SimWorld(const SimWorldConfig& config) : config_(config) {
   chamber_ =
       serve_chamber(config_.chamber_model, *chamber_sim_, config_.panel, config_.chamber_port);
   table_ = serve_turntable(config_.turntable_model, *table_sim_, config_.turntable_port);
+  // Link faults last seconds of the world's time (simulated under run --sim, wall under simrig).
+  const auto world_s = [this] { return now_s_.load(); };
+  chamber_.server->set_time_source(world_s);
+  table_.server->set_time_source(world_s);
   gpio_ = std::make_shared<GpioSimChips>(gpio_lines(config_.gyros));
   gpio_->set_input("DOOR_SW", true);  // door closed
   gpio_->set_input("ESTOP", false);   // not pressed

@@ -3,6 +3,7 @@
 // `station run --sim`, by the daemon tests and (on the wall clock) by `simrig`.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -106,6 +107,12 @@ class SimWorld {
 
   /// Advances chamber, table and every gyro to t_s (air temperature feeds the gyros).
   void advance_to(double t_s);
+  /// Returns once the device servers have applied the link faults due now (SimServer::settle):
+  /// after advance_to and the fault commands of a tick, on the simulated clock.
+  void settle() const {
+    chamber_.server->settle();
+    table_.server->settle();
+  }
   double now_s() const { return now_s_; }
 
   const std::vector<SimGyro>& gyros() const { return gyros_; }
@@ -128,7 +135,7 @@ class SimWorld {
   std::shared_ptr<GpioSimChips> gpio_;
   std::string can_transport_;
   int listen_fd_ = -1;
-  double now_s_ = 0;
+  std::atomic<double> now_s_ = 0;  // read by the servers' threads (link-fault durations)
   bool door_open_ = false, estop_ = false;
   BusFaultRates can_rates_;
   std::map<std::uint8_t, int> failed_temp_;  // node -> channel

@@ -54,31 +54,23 @@ Result<void> LineClient::connect() {
     const auto eb = errno_bytes(err);
     tap(TapDirection::event, "ascii-error",
         std::string_view(reinterpret_cast<const char*>(eb.data()), 4), e.message);
-    backoff_.failed();
-    last_connect_error_ = e.message;
+    state_.connect_failed(e.message);
     return e;
   }
-  backoff_.succeeded();
-  connected_ = true;
-  ++connects_;
+  state_.connect_succeeded();
   link_.answered();
   tap(TapDirection::event, "ascii-connect", {}, to_string(endpoint_));
   return {};
 }
 
 void LineClient::disconnect() {
-  if (connected_) tap(TapDirection::event, "ascii-disconnect", {}, to_string(endpoint_));
+  if (state_.connected()) tap(TapDirection::event, "ascii-disconnect", {}, to_string(endpoint_));
   wire_->close();
-  connected_ = false;
+  state_.closed();
 }
 
 Result<void> LineClient::ensure_connected() {
-  if (connected_) return {};
-  if (!backoff_.due())
-    return make_error(ErrorKind::disconnected,
-                      fmt::format("{}: not connected, next attempt in {:.1f} s ({})", device_,
-                                  backoff_.wait_s(), last_connect_error_));
-  return connect();
+  return state_.ensure(device_, [this] { return connect(); });
 }
 
 Error LineClient::fail(int err, const std::string& what) {
@@ -91,7 +83,7 @@ Error LineClient::fail(int err, const std::string& what) {
       std::string_view(reinterpret_cast<const char*>(eb.data()), 4), e.message);
   if (reopen) {
     disconnect();
-  } else if (connected_) {
+  } else if (state_.connected()) {
     wire_->flush();  // a late reply must not be read as the next command's
   }
   return e;

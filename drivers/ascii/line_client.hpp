@@ -13,7 +13,7 @@
 
 #include "drivers/ascii/line_endpoint.hpp"
 #include "drivers/ascii/line_wire.hpp"
-#include "drivers/common/backoff.hpp"
+#include "drivers/common/link_state.hpp"
 #include "drivers/common/result.hpp"
 #include "drivers/common/stale_link.hpp"
 #include "drivers/common/tap.hpp"
@@ -40,14 +40,14 @@ class LineClient {
   /// Sets the tap every exchange passes (nullptr: none). Not owned.
   void set_tap(Tap* tap) { tap_ = tap; }
   /// Sets the time source of the reconnect back-off (nullptr: steady clock). Not owned.
-  void set_clock(const Clock* clock) { backoff_.set_clock(clock); }
+  void set_clock(const Clock* clock) { state_.set_clock(clock); }
   /// Opens the link now, whatever the back-off says; blocks up to the timeout.
   Result<void> connect();
   /// Closes the link; the next call reconnects.
   void disconnect();
-  bool connected() const { return connected_; }
+  bool connected() const { return state_.connected(); }
   /// Successful connects so far (a change tells a driver the device may have restarted).
-  std::uint64_t connects() const { return connects_; }
+  std::uint64_t connects() const { return state_.connects(); }
 
   /// Sends `command` and returns the one reply line (terminator removed). Unread input is
   /// discarded first, so a late reply to an earlier command is never taken for this one's.
@@ -70,12 +70,9 @@ class LineClient {
   LineFraming framing_;
   double timeout_s_;
   std::unique_ptr<LineWire> wire_;
-  bool connected_ = false;
-  std::uint64_t connects_ = 0;
   Tap* tap_ = nullptr;
-  StaleLink link_;  ///< the stale-link rule (drivers/common/stale_link.hpp)
-  Backoff backoff_;
-  std::string last_connect_error_;
+  StaleLink link_;   ///< the stale-link rule (drivers/common/stale_link.hpp)
+  LinkState state_;  ///< open or not, and when the next connect attempt is due
 };
 
 }  // namespace station::drivers::ascii

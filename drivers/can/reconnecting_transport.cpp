@@ -22,36 +22,26 @@ std::string spec_text(const CanSpec& spec) {
 }  // namespace
 
 ReconnectingCanTransport::ReconnectingCanTransport(CanSpec spec, CanOpenOptions options)
-    : spec_(std::move(spec)),
-      options_(std::move(options)),
-      name_(spec_text(spec_)),
-      backoff_(options_.clock) {}
+    : spec_(std::move(spec)), options_(std::move(options)), name_(spec_text(spec_)) {
+  state_.set_clock(options_.clock);
+}
 
 Result<void> ReconnectingCanTransport::open() {
   if (link_) return {};
   auto t = open_can_transport(spec_, options_);
   if (!t) {
-    backoff_.failed();
-    last_error_ = t.error().message;
-    tap_event("error", last_error_);
-    return make_error(ErrorKind::disconnected, last_error_);
+    state_.connect_failed(t.error().message);
+    tap_event("error", state_.last_error());
+    return make_error(ErrorKind::disconnected, state_.last_error());
   }
   link_ = std::move(t).value();
-  backoff_.succeeded();
-  if (opened_once_) ++reconnects_;
-  opened_once_ = true;
+  state_.connect_succeeded();
   tap_event("connect", name_);
   return {};
 }
 
 Result<void> ReconnectingCanTransport::ensure_open() {
-  if (link_) return {};
-  if (!backoff_.due()) {
-    return make_error(ErrorKind::disconnected,
-                      fmt::format("{}: link down, next reconnect attempt in {:.1f} s ({})", name_,
-                                  backoff_.wait_s(), last_error_));
-  }
-  return open();
+  return state_.ensure(name_, [this] { return open(); });
 }
 
 Error ReconnectingCanTransport::lost(Error e) {
@@ -61,7 +51,7 @@ Error ReconnectingCanTransport::lost(Error e) {
     e.message += "; an inherited fd cannot be reopened, it is read again on every tick";
     return e;
   }
-  last_error_ = e.message;
+  state_.lost(e.message);
   link_.reset();
   tap_event("disconnect", e.message);
   e.message += "; reconnecting";

@@ -6,7 +6,7 @@
 #include <string>
 
 #include "drivers/can/can_transport.hpp"
-#include "drivers/common/backoff.hpp"
+#include "drivers/common/link_state.hpp"
 
 namespace station::drivers::can {
 
@@ -31,7 +31,9 @@ class ReconnectingCanTransport final : public CanTransport {
   /// Whether a link is open now.
   bool link_up() const { return link_ != nullptr; }
   /// Times the link was reopened after a loss.
-  int reconnects() const { return reconnects_; }
+  int reconnects() const {
+    return state_.connects() > 0 ? static_cast<int>(state_.connects() - 1) : 0;
+  }
   /// The spec as text (`unix:PATH`, ...).
   const std::string& name() const { return name_; }
 
@@ -44,10 +46,7 @@ class ReconnectingCanTransport final : public CanTransport {
   CanOpenOptions options_;
   std::string name_;
   std::unique_ptr<CanTransport> link_;
-  Backoff backoff_;
-  std::string last_error_;
-  bool opened_once_ = false;
-  int reconnects_ = 0;
+  LinkState state_;  ///< open or not (mirrors link_), and when the next attempt is due
   double last_rx_time_s_ = 0;
 };
 

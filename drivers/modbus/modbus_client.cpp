@@ -56,9 +56,8 @@ Result<void> ModbusClient::connect() {
   try {
     rc = wire_->open(timeout_s_);
   } catch (const std::exception& e) {
-    backoff_.failed();
-    last_connect_error_ = device_ + ": " + e.what();
-    return make_error(ErrorKind::io, last_connect_error_);
+    state_.connect_failed(device_ + ": " + e.what());
+    return make_error(ErrorKind::io, state_.last_error());
   }
   if (rc == -1) {
     int err = errno;
@@ -66,31 +65,22 @@ Result<void> ModbusClient::connect() {
     auto e = translate_modbus_error(err, device_ + " connect " + to_string(endpoint_));
     if (e.kind != ErrorKind::timeout) e.kind = ErrorKind::disconnected;
     tap(TapDirection::event, "error", errno_bytes(err), e.message);
-    backoff_.failed();
-    last_connect_error_ = e.message;
+    state_.connect_failed(e.message);
     return e;
   }
-  backoff_.succeeded();
-  connected_ = true;
-  ++connects_;
+  state_.connect_succeeded();
   tap(TapDirection::event, "connect", {}, to_string(endpoint_));
   return {};
 }
 
 void ModbusClient::disconnect() {
-  if (connected_) tap(TapDirection::event, "disconnect", {}, to_string(endpoint_));
+  if (state_.connected()) tap(TapDirection::event, "disconnect", {}, to_string(endpoint_));
   wire_->close();
-  connected_ = false;
+  state_.closed();
 }
 
 Result<void> ModbusClient::ensure_connected() {
-  if (connected_) return {};
-  if (!backoff_.due()) {
-    return make_error(ErrorKind::disconnected,
-                      fmt::format("{}: not connected, next attempt in {:.1f} s ({})", device_,
-                                  backoff_.wait_s(), last_connect_error_));
-  }
-  return connect();
+  return state_.ensure(device_, [this] { return connect(); });
 }
 
 Error ModbusClient::fail(int err, const std::string& what) {
@@ -103,7 +93,7 @@ Error ModbusClient::fail(int err, const std::string& what) {
     disconnect();  // reconnect on the next call
   } else if (e.kind == ErrorKind::timeout || e.kind == ErrorKind::protocol) {
     // Discard late or partial bytes so the next reply is not misread as this one's.
-    if (connected_) wire_->flush();
+    if (state_.connected()) wire_->flush();
   }
   return e;
 }

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "drivers/common/backoff.hpp"
+#include "drivers/common/link_state.hpp"
 #include "drivers/common/result.hpp"
 #include "drivers/common/stale_link.hpp"
 #include "drivers/common/tap.hpp"
@@ -40,16 +40,16 @@ class ModbusClient {
   /// Sets the tap every exchange passes (nullptr: none). Not owned.
   void set_tap(Tap* tap) { tap_ = tap; }
   /// Sets the time source of the reconnect back-off (nullptr: steady clock). Not owned.
-  void set_clock(const Clock* clock) { backoff_.set_clock(clock); }
+  void set_clock(const Clock* clock) { state_.set_clock(clock); }
   /// Opens the transport (TCP connect / open the serial line) now, whatever the back-off says;
   /// blocks up to the timeout.
   Result<void> connect();
   /// Closes the transport; the next read/write reconnects.
   void disconnect();
   /// True while the transport is open.
-  bool connected() const { return connected_; }
+  bool connected() const { return state_.connected(); }
   /// Successful connects so far (a change tells a driver the device may have restarted).
-  std::uint64_t connects() const { return connects_; }
+  std::uint64_t connects() const { return state_.connects(); }
 
   /// Every read and write below first reopens a lost transport: at once after the loss, then
   /// after 0.5, 1, 2, 4, 8, 8 ... s of failed attempts (Backoff); while no attempt is due they
@@ -82,12 +82,9 @@ class ModbusClient {
   Endpoint endpoint_;
   double timeout_s_;
   std::unique_ptr<ModbusWire> wire_;
-  bool connected_ = false;
-  std::uint64_t connects_ = 0;
   Tap* tap_ = nullptr;
   StaleLink link_;   ///< the stale-link rule (drivers/common/stale_link.hpp)
-  Backoff backoff_;  ///< when the next connect attempt is due
-  std::string last_connect_error_;
+  LinkState state_;  ///< open or not, and when the next connect attempt is due
 };
 
 }  // namespace station::drivers::modbus

@@ -28,13 +28,17 @@ double WatlowFace::c_of_raw(double raw) const {
                                   panel_.fahrenheit);
 }
 
-double WatlowFace::unit(double c) const { return sources::watlow_unit(c, panel_.fahrenheit); }
-double WatlowFace::c_of_unit(double v) const { return sources::watlow_c(v, panel_.fahrenheit); }
+double WatlowFace::unit(double c) const {
+  return sources::watlow_unit(c, panel_.fahrenheit);
+}
+double WatlowFace::c_of_unit(double v) const {
+  return sources::watlow_c(v, panel_.fahrenheit);
+}
 
 // ---------------------------------------------------------------------------------- F4
 F4Face::F4Face(ChamberSim& chamber, WatlowPanel panel, int unit_id, const char* name)
-    : WatlowFace(chamber,
-                 sources::register_map(name, unit_id, f4::points(panel.run_event)), panel) {}
+    : WatlowFace(chamber, sources::register_map(name, unit_id, f4::points(panel.run_event)),
+                 panel) {}
 
 std::uint8_t F4Face::check_write(const RegisterWrite& write) const {
   const auto ev = write.value_of(map_.at(f4::kRunEvent));
@@ -48,8 +52,7 @@ void F4Face::publish(modbus_mapping_t& regs) {
   put(regs, f4::kAirError, broken ? f4::kInputOverRange : 0);
   put(regs, f4::kProduct, raw_temp(chamber_.product_c()));
   put(regs, f4::kProductError, 0);
-  put(regs, f4::kStatus,
-      chamber_.status() == 3 ? f4::kStatusProfilePaused : f4::kStatusConstant);
+  put(regs, f4::kStatus, chamber_.status() == 3 ? f4::kStatusProfilePaused : f4::kStatusConstant);
   put(regs, f4::kSetpoint, raw_temp(chamber_.setpoint_c()));
   put(regs, f4::kSetpointLow, raw_temp(chamber_.config().setpoint_low_c));
   put(regs, f4::kSetpointHigh, raw_temp(chamber_.config().setpoint_high_c));
@@ -76,8 +79,8 @@ std::uint8_t F4tFace::check_write(const RegisterWrite& write) const {
   const auto ev = write.value_of(map_.at(f4t::kRunEvent));
   if (ev && *ev != f4t::kOn && *ev != f4t::kOff) return kIllegalDataValue;
   const auto action = write.value_of(map_.at(f4t::kRampAction));
-  if (action && *action != f4t::kOff && *action != f4t::kRampSetpoint &&
-      *action != f4t::kStartup && *action != f4t::kRampBoth)
+  if (action && *action != f4t::kOff && *action != f4t::kRampSetpoint && *action != f4t::kStartup &&
+      *action != f4t::kRampBoth)
     return kIllegalDataValue;
   const auto scale = write.value_of(map_.at(f4t::kRampScale));
   if (scale && *scale != f4t::kMinutes && *scale != f4t::kHours) return kIllegalDataValue;
@@ -167,7 +170,7 @@ void F4pFace::on_write(const modbus_mapping_t& regs, std::uint16_t pdu_address, 
     const double per_scale =
         static_cast<std::int16_t>(ramp_rate_raw_) * std::pow(10.0, -panel_.decimals);
     const double rate = sources::watlow_c_delta(per_scale, panel_.fahrenheit);
-    chamber_.set_ramp_c_per_min(ramp_mode_ == f4p::kRampOff ? 0.0
+    chamber_.set_ramp_c_per_min(ramp_mode_ == f4p::kRampOff    ? 0.0
                                 : ramp_scale_ == f4p::kPerHour ? rate / 60.0
                                                                : rate);
   }

@@ -1,10 +1,14 @@
 // The injected link faults of one simulated server (Modbus or line), decided in one place:
 // what the next request gets (no reply, the device's error, a dropped connection) and when the
 // link is down. Thread-safe: the fault commands set it, the server thread takes from it.
+// Durations run on the rig's own time: the wall clock under simrig, the simulated clock under
+// `run --sim` (set_time_source), so a fault script means the same seconds on both.
 #pragma once
 
 #include <algorithm>
 #include <chrono>
+#include <functional>
+#include <limits>
 #include <mutex>
 #include <utility>
 
@@ -13,7 +17,18 @@ namespace station::sim {
 class FaultSchedule {
  public:
   enum class Fault { none, timeout, exception, drop };
-  using SteadyTime = std::chrono::steady_clock::time_point;
+  /// Seconds on the rig's time; the default is the steady (wall) clock.
+  using TimeSource = std::function<double()>;
+
+  /// The clock durations run on; set before the server thread starts.
+  void set_time_source(TimeSource now_s) {
+    std::lock_guard lock(mutex_);
+    now_s_ = std::move(now_s);
+  }
+  double now_s() const {
+    std::lock_guard lock(mutex_);
+    return now_s_();
+  }
 
   void inject_timeouts(int n) {
     std::lock_guard lock(mutex_);
@@ -30,25 +45,25 @@ class FaultSchedule {
   }
   void stall_for(double seconds) {
     std::lock_guard lock(mutex_);
-    stall_until_ = after(seconds);
+    stall_until_s_ = after(seconds);
   }
   void disconnect_for(double seconds) {
     std::lock_guard lock(mutex_);
-    down_until_ = after(seconds);
+    down_until_s_ = after(seconds);
     kick_clients_ = true;
   }
   void clear() {
     std::lock_guard lock(mutex_);
     timeouts_ = exceptions_ = drops_ = 0;
-    stall_until_ = down_until_ = {};
+    stall_until_s_ = down_until_s_ = kNever;
     kick_clients_ = false;
   }
   /// What the request just received gets; `code` is set for an exception. While stalled or
   /// down (a serial line is silent when its device is off) nothing answers.
   Fault take(int& code) {
     std::lock_guard lock(mutex_);
-    const auto now = std::chrono::steady_clock::now();
-    if (now < stall_until_ || now < down_until_) return Fault::timeout;
+    const double now = now_s_();
+    if (now < stall_until_s_ || now < down_until_s_) return Fault::timeout;
     if (timeouts_ > 0) return --timeouts_, Fault::timeout;
     if (drops_ > 0) return --drops_, Fault::drop;
     if (exceptions_ != 0) {
@@ -58,24 +73,32 @@ class FaultSchedule {
     }
     return Fault::none;
   }
-  /// Whether a disconnect was asked since the last call (its clients are to be closed now), and
-  /// until when the link stays down.
-  bool take_kick(SteadyTime& down_until) {
+  /// Whether a disconnect is asked and not yet taken; `down_until_s` as take_kick gives it.
+  bool kick_pending(double& down_until_s) const {
     std::lock_guard lock(mutex_);
-    down_until = down_until_;
+    down_until_s = down_until_s_;
+    return kick_clients_;
+  }
+  /// Whether a disconnect was asked since the last call (its clients are to be closed now), and
+  /// until when the link stays down (on now_s()).
+  bool take_kick(double& down_until_s) {
+    std::lock_guard lock(mutex_);
+    down_until_s = down_until_s_;
     return std::exchange(kick_clients_, false);
   }
 
  private:
-  static SteadyTime after(double seconds) {
-    const std::chrono::duration<double> d(std::max(0.0, seconds));
-    return std::chrono::steady_clock::now() +
-           std::chrono::duration_cast<std::chrono::steady_clock::duration>(d);
+  static constexpr double kNever = -std::numeric_limits<double>::infinity();
+  static double steady_s() {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
+        .count();
   }
+  double after(double seconds) const { return now_s_() + std::max(0.0, seconds); }
 
-  std::mutex mutex_;
+  mutable std::mutex mutex_;
+  TimeSource now_s_ = steady_s;
   int timeouts_ = 0, exceptions_ = 0, exception_code_ = 0, drops_ = 0;
-  SteadyTime stall_until_{}, down_until_{};
+  double stall_until_s_ = kNever, down_until_s_ = kNever;
   bool kick_clients_ = false;
 };
 

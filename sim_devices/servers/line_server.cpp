@@ -65,6 +65,7 @@ void LineServer::start_tcp(int port) {
   socklen_t len = sizeof a;
   ::getsockname(listen_fd_, reinterpret_cast<sockaddr*>(&a), &len);
   port_ = ntohs(a.sin_port);
+  tcp_ = listening_ = true;
   thread_ = std::thread([this] { run(); });
 }
 
@@ -100,43 +101,26 @@ std::string LineServer::endpoint() const {
   return "tcp://127.0.0.1:" + std::to_string(port_);
 }
 
-void LineServer::inject_timeouts(int n) {
-  faults_.inject_timeouts(n);
-}
-void LineServer::inject_exception(int code, int n) {
-  faults_.inject_exception(code, n);
-}
-void LineServer::inject_drop(int n) {
-  faults_.inject_drop(n);
-}
-void LineServer::stall_for(double seconds) {
-  faults_.stall_for(seconds);
-}
-void LineServer::disconnect_for(double seconds) {
-  faults_.disconnect_for(seconds);
-}
-void LineServer::clear_faults() {
-  faults_.clear();
-}
-
 // Applies an injected disconnect (TCP): drops clients and listener, listens again on the same
 // port when the down time is over. False while down.
 bool LineServer::link_up() {
   if (pty_master_ != -1) return true;
-  FaultSchedule::SteadyTime down_until;
+  double down_until = 0;
   if (faults_.take_kick(down_until)) {
     for (auto& [fd, buf] : clients_) ::close(fd);
     clients_.clear();
     if (listen_fd_ != -1) ::close(listen_fd_);
     listen_fd_ = -1;
+    listening_ = false;
   }
   if (listen_fd_ != -1) return true;
-  if (std::chrono::steady_clock::now() < down_until) return false;
+  if (faults_.now_s() < down_until) return false;
   try {
     listen_fd_ = listen_on(port_);
   } catch (const std::runtime_error&) {
     return false;  // the port is still in TIME_WAIT somewhere: try again next turn
   }
+  listening_ = true;
   return true;
 }
 

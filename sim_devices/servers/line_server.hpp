@@ -52,13 +52,6 @@ class LineServer final : public SimServer {
   std::string endpoint() const override;
   std::uint64_t requests() const override { return requests_.load(); }
 
-  void inject_timeouts(int n) override;
-  void inject_exception(int code, int n = 1) override;
-  void inject_drop(int n = 1) override;
-  void stall_for(double seconds) override;
-  void disconnect_for(double seconds) override;
-  void clear_faults() override;
-
   /// Longest request line kept; a longer one is discarded unanswered (as a device's buffer).
   static constexpr std::size_t kMaxLine = 1024;
 
@@ -73,7 +66,6 @@ class LineServer final : public SimServer {
   std::atomic<bool> stop_{false};
   std::atomic<std::uint64_t> requests_{0};
   std::thread thread_;
-  FaultSchedule faults_;
   std::map<int, std::string> clients_;  // fd -> bytes of a partial line
 };
 

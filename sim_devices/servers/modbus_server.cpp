@@ -96,6 +96,7 @@ void ModbusServer::start_tcp(int port) {
   if (getsockname(listen_fd_, reinterpret_cast<sockaddr*>(&addr), &len) == -1)
     sys_fail("getsockname");
   port_ = ntohs(addr.sin_port);
+  tcp_ = listening_ = true;
   thread_ = std::thread([this] { run_tcp(); });
 }
 
@@ -135,25 +136,6 @@ std::string ModbusServer::endpoint() const {
   return "tcp://127.0.0.1:" + std::to_string(port_);
 }
 
-void ModbusServer::inject_timeouts(int n) {
-  faults_.inject_timeouts(n);
-}
-void ModbusServer::inject_exception(int code, int n) {
-  faults_.inject_exception(code, n);
-}
-void ModbusServer::inject_drop(int n) {
-  faults_.inject_drop(n);
-}
-void ModbusServer::stall_for(double seconds) {
-  faults_.stall_for(seconds);
-}
-void ModbusServer::disconnect_for(double seconds) {
-  faults_.disconnect_for(seconds);
-}
-void ModbusServer::clear_faults() {
-  faults_.clear();
-}
-
 void ModbusServer::accept_client(std::vector<int>& clients) {
   int fd = accept4(listen_fd_, nullptr, nullptr, SOCK_CLOEXEC);
   if (fd != -1) clients.push_back(fd);
@@ -162,7 +144,7 @@ void ModbusServer::accept_client(std::vector<int>& clients) {
 // Applies an injected disconnect: drops the clients and the listener, and listens again on the
 // same port once the down time is over. False while the link is down.
 bool ModbusServer::tcp_link_up(std::vector<int>& clients) {
-  FaultSchedule::SteadyTime down_until;
+  double down_until = 0;
   const bool kick = faults_.take_kick(down_until);
   if (kick) {
     for (int c : clients) close(c);
@@ -170,11 +152,13 @@ bool ModbusServer::tcp_link_up(std::vector<int>& clients) {
     pending_.clear();
     if (listen_fd_ != -1) close(listen_fd_);
     listen_fd_ = -1;
+    listening_ = false;
   }
   if (listen_fd_ != -1) return true;
-  if (std::chrono::steady_clock::now() < down_until) return false;
+  if (faults_.now_s() < down_until) return false;
   ctx_.reset(modbus_new_tcp("127.0.0.1", port_));
   if (ctx_) listen_fd_ = modbus_tcp_listen(ctx_.get(), 8);
+  listening_ = listen_fd_ != -1;
   return listen_fd_ != -1;
 }
 

@@ -74,23 +74,6 @@ class ModbusServer final : public SimServer {
   /// Requests received so far (including faulted ones).
   std::uint64_t requests() const override { return requests_.load(); }
 
-  /// The next `n` requests get no reply at all (the client times out).
-  void inject_timeouts(int n) override;
-  /// The next `n` requests get exception reply `code` (e.g.
-  /// MODBUS_EXCEPTION_SLAVE_OR_SERVER_FAILURE); n < 0: every request until clear_faults().
-  void inject_exception(int code, int n = 1) override;
-  /// The next `n` requests make the server close the connection without replying (TCP; on RTU
-  /// this is a missing reply).
-  void inject_drop(int n = 1) override;
-  /// Every request received in the next `seconds` (wall clock) gets no reply; 0 ends a stall.
-  void stall_for(double seconds) override;
-  /// Closes every client connection now and stops listening for `seconds` (wall clock): a
-  /// connect meanwhile is refused, as by a device that is powered off. On RTU the line is silent
-  /// for that time. Then it listens again on the same port.
-  void disconnect_for(double seconds) override;
-  /// Ends every injected fault (timeouts, exceptions, drops, stall, disconnect).
-  void clear_faults() override;
-
  private:
   struct FreeServerCtx {
     void operator()(modbus_t* c) const noexcept;
@@ -123,7 +106,6 @@ class ModbusServer final : public SimServer {
   std::atomic<bool> stop_{false};
   std::atomic<std::uint64_t> requests_{0};
   std::thread thread_;
-  FaultSchedule faults_;
   std::map<int, std::vector<std::uint8_t>> pending_;  // per TCP client: bytes of a partial frame
 };
 

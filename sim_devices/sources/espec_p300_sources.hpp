@@ -22,8 +22,8 @@ inline constexpr std::string_view kModeStandby = "MODE,STANDBY";    // write_mod
 inline constexpr std::string_view kModeOff = "MODE,OFF";            // write_mode_off:1136
 inline constexpr std::string_view kPowerOn = "POWER,ON";            // write_power:1014
 inline constexpr std::string_view kPowerOff = "POWER,OFF";          // write_power:1014
-inline constexpr std::string_view kTempSetPrefix = "TEMP, S";       // write_temp:1037 "TEMP, S%0.1f"
-inline constexpr std::string_view kError = "NA:";                   // especinteract.py interact:103
+inline constexpr std::string_view kTempSetPrefix = "TEMP, S";  // write_temp:1037 "TEMP, S%0.1f"
+inline constexpr std::string_view kError = "NA:";              // especinteract.py interact:103
 // The simulator acknowledges a write with "OK:<command>"; CCL looks only for kError.
 inline constexpr std::string_view kOk = "OK:";
 

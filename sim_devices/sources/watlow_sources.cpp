@@ -15,7 +15,9 @@ constexpr auto ABCD = mb::WordOrder::abcd;
 constexpr auto CDAB = mb::WordOrder::cdab;  // CCL modbus.py read_holding_float:157-173
 constexpr bool RO = false, RW = true;
 
-std::uint16_t u16(int v) { return static_cast<std::uint16_t>(v); }
+std::uint16_t u16(int v) {
+  return static_cast<std::uint16_t>(v);
+}
 }  // namespace
 
 mb::RegisterMap register_map(const std::string& device, int unit_id,
@@ -28,11 +30,15 @@ mb::RegisterMap register_map(const std::string& device, int unit_id,
 }
 
 // deg F = deg C x 9/5 + 32.
-double watlow_unit(double c, bool fahrenheit) { return fahrenheit ? c * 9.0 / 5.0 + 32.0 : c; }
+double watlow_unit(double c, bool fahrenheit) {
+  return fahrenheit ? c * 9.0 / 5.0 + 32.0 : c;
+}
 double watlow_c(double unit, bool fahrenheit) {
   return fahrenheit ? (unit - 32.0) * 5.0 / 9.0 : unit;
 }
-double watlow_c_delta(double d, bool fahrenheit) { return fahrenheit ? d * 5.0 / 9.0 : d; }
+double watlow_c_delta(double d, bool fahrenheit) {
+  return fahrenheit ? d * 5.0 / 9.0 : d;
+}
 
 double watlow_raw(double c, int decimals, bool fahrenheit) {
   const double r = std::nearbyint(watlow_unit(c, fahrenheit) * std::pow(10.0, decimals));
@@ -61,7 +67,9 @@ std::vector<SourcePoint> f4::points(int run_event) {
   };
 }
 
-std::string f4t::part_number_point(int i) { return "part_number_" + std::to_string(i); }
+std::string f4t::part_number_point(int i) {
+  return "part_number_" + std::to_string(i);
+}
 
 std::vector<SourcePoint> f4t::points(int run_event, bool rtu, int loop) {
   // Loop n's registers are loop 1's + 160 (n - 1) (CCL get_loop_pv:243, get_loop_sp:234 ...).

@@ -46,13 +46,12 @@ double watlow_c_delta(double unit_delta, bool fahrenheit);
 /// Series F4 ([CCL] watlowf4.py; [F4P] where CCL is silent).
 namespace f4 {
 std::vector<SourcePoint> points(int run_event);
-inline constexpr const char *kAir = "input1_pv", *kAirError = "input1_err",
-                            *kProduct = "input2_pv", *kProductError = "input2_err",
-                            *kStatus = "status", *kSetpoint = "setpoint1",
-                            *kSetpointLow = "sp_low1", *kSetpointHigh = "sp_high1",
-                            *kDecimals = "decimals1", *kDecimals2 = "decimals2", *kUnits = "units",
-                            *kRunEvent = "event";
-inline constexpr int kEventOff = 0, kEventOn = 1;                     // CCL set_event:539-543
+inline constexpr const char *kAir = "input1_pv", *kAirError = "input1_err", *kProduct = "input2_pv",
+                            *kProductError = "input2_err", *kStatus = "status",
+                            *kSetpoint = "setpoint1", *kSetpointLow = "sp_low1",
+                            *kSetpointHigh = "sp_high1", *kDecimals = "decimals1",
+                            *kDecimals2 = "decimals2", *kUnits = "units", *kRunEvent = "event";
+inline constexpr int kEventOff = 0, kEventOn = 1;                    // CCL set_event:539-543
 inline constexpr int kStatusConstant = 1, kStatusProfilePaused = 3;  // CCL get_status:545-554
 inline constexpr int kUnitsFahrenheit = 0, kUnitsCelsius = 1;        // F4P p. 6.11
 inline constexpr int kInputOverRange = 3;  // F4P p. 2.5: "SEnhi", input error 3
@@ -72,14 +71,14 @@ inline constexpr const char *kAir = "loop1_pv", *kProduct = "loop2_pv", *kSetpoi
 inline constexpr int kPartNumberRegisters = 15;
 std::string part_number_point(int i);
 // Watlow enumeration codes (CCL watlowf4t.py __init__:78-121 and the functions named).
-inline constexpr int kAuto = 10, kManual = 54;             // CCL set_loop_mode:294-309
-inline constexpr int kOff = 62, kOn = 63;                  // CCL set_event:508-520 (#62=off)
-inline constexpr int kCelsius = 15, kFahrenheit = 30;      // CCL __profile_units:990-1007
-inline constexpr int kHours = 39, kMinutes = 57;           // CCL dictionary; [TE] the register
-inline constexpr int kRampSetpoint = 85;                   // CCL dictionary "setpoint"
-inline constexpr int kStartup = 88, kRampBoth = 13;        // CCL dictionary ("startup", "both")
-inline constexpr int kProfilePaused = 146;                 // CCL get_status:528-546
-inline constexpr int kAlarmNone = 61;                      // CCL get_alarm_status:552 (inactive)
+inline constexpr int kAuto = 10, kManual = 54;         // CCL set_loop_mode:294-309
+inline constexpr int kOff = 62, kOn = 63;              // CCL set_event:508-520 (#62=off)
+inline constexpr int kCelsius = 15, kFahrenheit = 30;  // CCL __profile_units:990-1007
+inline constexpr int kHours = 39, kMinutes = 57;       // CCL dictionary; [TE] the register
+inline constexpr int kRampSetpoint = 85;               // CCL dictionary "setpoint"
+inline constexpr int kStartup = 88, kRampBoth = 13;    // CCL dictionary ("startup", "both")
+inline constexpr int kProfilePaused = 146;             // CCL get_status:528-546
+inline constexpr int kAlarmNone = 61;                  // CCL get_alarm_status:552 (inactive)
 }  // namespace f4t
 
 /// Series F4P ([F4P] chapter 9 and the parameter tables of chapter 6).
@@ -94,8 +93,8 @@ inline constexpr const char *kModel = "model", *kAir = "input1_pv", *kAirError =
 inline constexpr int kModelF4p = 5280;            // p. 6.27: "P4 (4P) ASCII 5280 Dec"
 inline constexpr int kAuto = 1, kManual = 2;      // register 200, p. 9.2
 inline constexpr int kRampOff = 0, kRampMax = 2;  // register 1100: off, startup, startup/change
-inline constexpr int kRampRateMin = 1, kRampRateMax = 999;  // register 1101, p. 6.8
-inline constexpr int kPerMinute = 0, kPerHour = 1;          // register 1102, p. 6.8
+inline constexpr int kRampRateMin = 1, kRampRateMax = 999;     // register 1101, p. 6.8
+inline constexpr int kPerMinute = 0, kPerHour = 1;             // register 1102, p. 6.8
 inline constexpr int kUnitsFahrenheit = 0, kUnitsCelsius = 1;  // register 901, p. 6.11
 inline constexpr int kInputOverRange = 3;                      // p. 2.5
 }  // namespace f4p

@@ -9,13 +9,13 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
-#include "station/session/replay_can.hpp"
 #include "drivers/counters/counter_boards.hpp"
 #include "station/cli/commands.hpp"
 #include "station/cli/exit_status.hpp"
 #include "station/common/logging.hpp"
 #include "station/config/config.hpp"
 #include "station/daemon/sample.hpp"
+#include "station/session/replay_can.hpp"
 #include "station/session/session_replay.hpp"
 #include "station/store/calibration.hpp"
 #include "station/store/fit_json.hpp"
@@ -72,8 +72,7 @@ StoredSamples replay_samples(const ReplayCommandOptions& o, const std::vector<Ru
   cfg.wall_clock_deadline = false;
   for (const auto& s : slots)
     cfg.slots.push_back({static_cast<std::uint8_t>(s.node), s.serial, s.pulse_weight_arcsec});
-  dr::counters::CounterBoards boards(
-      std::make_unique<ReplayCanTransport>(std::move(records)), cfg);
+  dr::counters::CounterBoards boards(std::make_unique<ReplayCanTransport>(std::move(records)), cfg);
   StoredSamples out;
   for (std::size_t k = 0; k < ticks; ++k) {
     auto tick = boards.tick(syncs[k]);

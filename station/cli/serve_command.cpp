@@ -20,16 +20,16 @@
 
 #include "drivers/common/clock.hpp"
 #include "station/cli/commands.hpp"
-#include "station/daemon/daemon_setup.hpp"
 #include "station/cli/exit_status.hpp"
-#include "station/http/live_service.hpp"
 #include "station/cli/progress_display.hpp"
-#include "station/http/serve_control.hpp"
 #include "station/common/input_error.hpp"
 #include "station/common/logging.hpp"
+#include "station/daemon/daemon_setup.hpp"
 #include "station/daemon/host.hpp"
 #include "station/daemon/rig.hpp"
 #include "station/fleet/forwarder_thread.hpp"
+#include "station/http/live_service.hpp"
+#include "station/http/serve_control.hpp"
 #include "station/parts/judged_fit.hpp"
 
 namespace station {

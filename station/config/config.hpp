@@ -56,8 +56,8 @@ struct StationConfig {
   std::string path;  ///< file it came from
   std::string text;  ///< its full text (snapshot stored with each run)
   std::string name = "station";
-  double latitude_deg = 0;   ///< geodetic latitude of the site, deg
-  double ref_temp_c = 25.0;  ///< T_ref of the model
+  double latitude_deg = 0;                  ///< geodetic latitude of the site, deg
+  double ref_temp_c = 25.0;                 ///< T_ref of the model
   double bin_s = compensation::kPaperBinS;  ///< bin width, s
   /// Largest share of a slot's record-window ticks that may lack a rate (link outages) before
   /// the run ends 'incomplete', 0..1.

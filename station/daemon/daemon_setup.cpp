@@ -6,8 +6,8 @@
 #include <csignal>
 #include <cstdlib>
 
-#include "station/daemon/device_identity.hpp"
 #include "station/common/logging.hpp"
+#include "station/daemon/device_identity.hpp"
 #include "station/parts/judged_fit.hpp"
 
 namespace station {

@@ -1,6 +1,8 @@
 // Probing a rig (`station probe`, and the check before a run starts): reads each configured
 // device once (chamber, turntable, one counter-board SYNC, GPIO inputs) and reports what it got;
 // a device that fails is one typed error line.
+#include "station/daemon/rig_probe.hpp"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -10,7 +12,6 @@
 #include <optional>
 
 #include "drivers/counters/counter_frames.hpp"
-#include "station/daemon/rig_probe.hpp"
 #include "station/daemon/rig_reading.hpp"
 
 namespace station {

@@ -132,6 +132,8 @@ class Sequencer {
   void connect_devices();
   /// The 1 Hz loop from `t_first` to the run's end.
   RunOutcome tick_loop(double t_first);
+  void create_run();
+  RunOutcome guarded_tick_loop(double t_first);
   /// The run's end after tick `t_s`, if this tick ends it (abort, detach, stop, protocol done).
   std::optional<RunOutcome> end_of_run(double t_s, std::int64_t ticks);
   /// `skipped` ticks before `t_s` were missed (the process was stopped or late): a tick_gap event.

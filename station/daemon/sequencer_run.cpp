@@ -128,6 +128,28 @@ void Sequencer::restore_outages(std::int64_t run_id, double last_s) {
   }
 }
 
+// A new run: the protocol's step times checked before the run exists, the run stored, its
+// parts, the start event.
+void Sequencer::create_run() {
+  // A ramp that would take longer than any step may is refused before the run exists.
+  protocol_.check_step_times(config_.limits.min_setpoint_c, config_.limits.max_setpoint_c);
+  RunInfo info{protocol_.name,
+               protocol_.text,
+               config_.text,
+               STATION_VERSION,
+               config_.name,
+               options_.operator_name,
+               options_.sim_seed,
+               drivers::tap_wall_time_s(),
+               resolved_meaning_json(config_)};
+  run_id_ = store_.create_run(info, run_slots_of(config_));
+  save_parts();
+  emit(0, Severity::info, "seq", EventKind::run_start,
+       fmt::format("run {} protocol '{}' with {} gyros", run_id_, protocol_.name,
+                   config_.slots.size()),
+       {{"protocol", protocol_.name}, {"gyros", config_.slots.size()}});
+}
+
 RunOutcome Sequencer::run(const std::optional<RunRecord>& resume) {
   // Real hardware resumes at the stored protocol position; a simulation replays from t = 0.
   RunProgress progress = resume && !options_.replay_until_t_s ? resume->progress : RunProgress{};
@@ -136,23 +158,7 @@ RunOutcome Sequencer::run(const std::optional<RunRecord>& resume) {
     run_id_ = resume->id;
     t_first = resume_first_tick(*resume);
   } else {
-    // A ramp that would take longer than any step may is refused before the run exists.
-    protocol_.check_step_times(config_.limits.min_setpoint_c, config_.limits.max_setpoint_c);
-    RunInfo info{protocol_.name,
-                 protocol_.text,
-                 config_.text,
-                 STATION_VERSION,
-                 config_.name,
-                 options_.operator_name,
-                 options_.sim_seed,
-                 drivers::tap_wall_time_s(),
-                 resolved_meaning_json(config_)};
-    run_id_ = store_.create_run(info, run_slots_of(config_));
-    save_parts();
-    emit(0, Severity::info, "seq", EventKind::run_start,
-         fmt::format("run {} protocol '{}' with {} gyros", run_id_, protocol_.name,
-                     config_.slots.size()),
-         {{"protocol", protocol_.name}, {"gyros", config_.slots.size()}});
+    create_run();
   }
   // The safety layer's limits apply to the whole protocol before anything moves.
   std::vector<std::string> notes;
@@ -166,13 +172,17 @@ RunOutcome Sequencer::run(const std::optional<RunRecord>& resume) {
     emit(t_first, Severity::info, "http", EventKind::listen,
          fmt::format("live page at {}", options_.http_url), {{"url", options_.http_url}});
   connect_devices();
+  return guarded_tick_loop(t_first);
+}
+
+// The tick loop; when the store cannot record (disk full, a file size limit, an I/O error)
+// nothing this run measures from now on would be kept, so the rig goes to the state a run's end
+// leaves it in (gyro power off, lamps dark) and the caller decides (serve closes the run once
+// writing works again; run exits and the run stays resumable).
+RunOutcome Sequencer::guarded_tick_loop(double t_first) {
   try {
     return tick_loop(t_first);
   } catch (const SqliteError& e) {
-    // The store cannot record (disk full, a file size limit, an I/O error): nothing this run
-    // measures from now on would be kept, so the rig goes to the state a run's end leaves it in
-    // (gyro power off, lamps dark) and the caller decides (serve closes the run once writing
-    // works again; run exits and the run stays resumable).
     log("seq")->error("run {}: the store failed: {}", run_id_, e.what());
     try {
       drive_outputs(last_t_s_, SafetyOutputs{});

@@ -40,10 +40,12 @@ const std::vector<FleetTable> kTables = {
      "WHERE s.run_id = :id",
      Merge::replace_set},
     {"bins", Item::run,
-     "run_uuid,serial,t_start_s,n,rate_dph,bias_dph,temp_c,grad_c,dtdt_c_per_h,complete",
+     "run_uuid,serial,t_start_s,n,rate_dph,bias_dph,temp_c,grad_c,dtdt_c_per_h,complete,"
+     "temp_min_c,temp_max_c,grad_min_c,grad_max_c",
      "run_uuid,serial,t_start_s",
      "SELECT r.uuid, b.serial, b.t_start_s, b.n, b.rate_dph, b.bias_dph, b.temp_c, b.grad_c, "
-     "b.dtdt_c_per_h, b.complete FROM bins AS b JOIN runs AS r ON r.id = b.run_id "
+     "b.dtdt_c_per_h, b.complete, b.temp_min_c, b.temp_max_c, b.grad_min_c, b.grad_max_c "
+     "FROM bins AS b JOIN runs AS r ON r.id = b.run_id "
      "WHERE b.run_id = :id",
      Merge::replace_set},
     {"events", Item::run, "run_uuid,local_id,t_s,wall_utc,severity,source,kind,message,data_json",
@@ -65,7 +67,7 @@ const std::vector<FleetTable> kTables = {
      "rev,uuid,station,local_id,serial,created_utc,runs_json,run_uuids_json,terms,ref_temp_c,"
      "coefficients_json,std_errors_json,n_bins,r2,residual_rms_dph,condition_number,"
      "std_before_dph,std_after_dph,std_ratio,warnings_json,std_errors_ols_json,error_model_json,"
-     "part_number,verdict_json,adev_floor_dph",
+     "part_number,verdict_json,adev_floor_dph,temp_min_c,temp_max_c,grad_min_c,grad_max_c",
      "uuid",
      "SELECT " STATION_REV("fit", "f.id") ", f.uuid, " STATION_FIT_STATION(
          "f") ", f.id, f.serial, f.created_utc, f.runs_json, "
@@ -77,7 +79,8 @@ const std::vector<FleetTable> kTables = {
               "f.std_ratio, "
               "f.warnings_json, f.std_errors_ols_json, f.error_model_json, f.part_number, "
               "f.verdict_json, "
-              "f.adev_floor_dph FROM fits AS f WHERE f.id = :id",
+              "f.adev_floor_dph, f.temp_min_c, f.temp_max_c, f.grad_min_c, f.grad_max_c "
+              "FROM fits AS f WHERE f.id = :id",
      Merge::upsert},
     {"releases", Item::release,
      "rev,uuid,station,local_id,fit_uuid,serial,released_utc,released_by,note,override_reason,"

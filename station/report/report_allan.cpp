@@ -3,8 +3,8 @@
 
 #include <algorithm>
 
-#include "compensation/earth_rate.hpp"
 #include "compensation/binning.hpp"
+#include "compensation/earth_rate.hpp"
 #include "station/store/sample_series.hpp"
 
 namespace station::report {

@@ -7,8 +7,8 @@
 #include <cmath>
 #include <limits>
 
-#include "compensation/earth_rate.hpp"
 #include "compensation/binning.hpp"
+#include "compensation/earth_rate.hpp"
 #include "station/store/sample_series.hpp"
 
 namespace station::report {

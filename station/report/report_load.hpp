@@ -46,7 +46,7 @@ struct SerialReport {
 /// One run and its serials.
 struct RunReport {
   RunRecord run;
-  std::string config_sha256;  ///< SHA-256 of the stored configuration text, hex
+  std::string config_sha256;                ///< SHA-256 of the stored configuration text, hex
   double bin_s = compensation::kPaperBinS;  ///< the run's bin width (run_bin_s)
   std::vector<EventRow> events;
   std::vector<SerialReport> serials;

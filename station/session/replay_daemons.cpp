@@ -12,11 +12,11 @@
 #include <map>
 
 #include "drivers/can/candump_log.hpp"
-#include "station/session/replay_can.hpp"
 #include "station/common/input_error.hpp"
 #include "station/daemon/host.hpp"
 #include "station/daemon/rig.hpp"
 #include "station/session/replay_ascii.hpp"
+#include "station/session/replay_can.hpp"
 #include "station/session/replay_clock.hpp"
 #include "station/session/replay_gpio.hpp"
 #include "station/session/replay_modbus.hpp"
@@ -255,6 +255,13 @@ class DaemonReplay {
       abort = session_.end.state == to_string(RunState::aborted);
     }
     if (!killed || t_s < resumes_[k].after_tick_s) return;
+    // A killed daemon that had committed no tick (after_tick_s = -1) left nothing for the next
+    // to pass over: its ticks are rolled back and the resumed simulation's recording starts at
+    // t = 0 with nothing replayed again.
+    if (resumes_[k].after_tick_s < 0) {
+      store_.discard();
+      throw KilledHere{};
+    }
     store_.flush();  // what the killed daemon had committed
     // A resumed simulation asks what this life replayed again, first.
     if (session_.sim_seed)

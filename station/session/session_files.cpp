@@ -214,11 +214,12 @@ std::vector<SessionResume> read_session_resumes(const std::string& path) {
   if (list == nullptr) return out;
   for (std::size_t i = 0; i < list->size(); ++i) {
     const auto* r = list->get(i)->as_table();
-    const auto number = [&](const char* key) {
+    // after_tick_s = -1: the killed daemon had committed no tick (a batch lost whole).
+    const auto number = [&](const char* key, double least = 0) {
       const auto v = r != nullptr ? (*r)[key].value<double>() : std::nullopt;
-      if (!v || *v < 0)
+      if (!v || *v < least)
         throw InputError(
-            fmt::format("{}: resume {}: key '{}': missing or negative", path, i + 1, key));
+            fmt::format("{}: resume {}: key '{}': missing or below {}", path, i + 1, key, least));
       return *v;
     };
     const auto next = r != nullptr ? (*r)["next_tick_s"].value<double>() : std::nullopt;
@@ -227,7 +228,7 @@ std::vector<SessionResume> read_session_resumes(const std::string& path) {
     const auto ascii = ascii_node != nullptr ? ascii_node->value<double>() : std::nullopt;
     if (ascii_node != nullptr && (!ascii || *ascii < 0))
       throw InputError(fmt::format("{}: resume {}: key 'ascii_lines': not a count", path, i + 1));
-    out.push_back({number("after_tick_s"), next, static_cast<std::int64_t>(number("can_lines")),
+    out.push_back({number("after_tick_s", -1), next, static_cast<std::int64_t>(number("can_lines")),
                    static_cast<std::int64_t>(number("modbus_lines")),
                    static_cast<std::int64_t>(number("gpio_lines")),
                    static_cast<std::int64_t>(ascii.value_or(0))});

@@ -196,6 +196,7 @@ std::function<void(double)> world_tick(const SimRunOptions& o, sim::SimWorld& wo
       const std::string reply = sim::run_fault_command(world, command);
       if (reply.rfind("ok", 0) != 0) throw fault_error(at_s, command, reply);
     }
+    world.settle();  // a link fault lasts the same ticks on every run of this seed
     if (o.on_world_tick) o.on_world_tick(t_s, world);
   };
 }
@@ -270,8 +271,10 @@ nlohmann::json run_simulated(const SimRunOptions& o) {
     rec.session->start(config, plan.protocol, true, seed);
     so.on_resume = [&rec](double last_s, double next_s) { rec.session->resumed(last_s, next_s); };
     // A resumed simulation connects and recomputes its stored ticks first: all of that is in
-    // the logs already (world_tick lifts the pause after the last stored tick).
-    if (plan.resume) rec.session->tap().pause(true);
+    // the logs already (world_tick lifts the pause after the last stored tick). With no tick
+    // stored (the kill came before the first commit) the resumed daemon is recorded whole.
+    const bool stored = plan.replay_until_t_s && *plan.replay_until_t_s >= 0;
+    if (plan.resume && stored) rec.session->tap().pause(true);
   }
   if (o.extend) o.extend(so);
   const RunOutcome out = host.run(plan, std::move(so));

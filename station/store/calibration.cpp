@@ -6,8 +6,8 @@
 #include <algorithm>
 #include <nlohmann/json.hpp>
 
-#include "compensation/earth_rate.hpp"
 #include "compensation/binning.hpp"
+#include "compensation/earth_rate.hpp"
 #include "station/common/input_error.hpp"
 #include "station/store/sample_series.hpp"
 
@@ -23,7 +23,9 @@ std::optional<double> recorded_bin_s(const RunRecord& run) {
   return bin_s;
 }
 
-double run_bin_s(const RunRecord& run) { return recorded_bin_s(run).value_or(sc::kPaperBinS); }
+double run_bin_s(const RunRecord& run) {
+  return recorded_bin_s(run).value_or(sc::kPaperBinS);
+}
 
 sc::ModelData record_model_data(Store& store, std::int64_t run_id, const std::string& serial) {
   double earth_rate_dph = 0;

@@ -146,6 +146,11 @@ class Store {
   void set_ticks_per_commit(int n) { ticks_per_commit_ = n < 1 ? 1 : n; }
   /// Commits an open batch of ticks.
   void flush();
+  /// Rolls an open batch of ticks back, as a kill before its commit loses it (replay).
+  void discard() {
+    batch_.reset();
+    batch_ticks_ = 0;
+  }
   ~Store();
   /// Samples of one serial in a run, by time (recording window only when asked).
   std::vector<SampleRow> samples(std::int64_t run_id, const std::string& serial,

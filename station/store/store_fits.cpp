@@ -2,8 +2,8 @@
 #include <algorithm>
 #include <nlohmann/json.hpp>
 
-#include "station/store/fit_json.hpp"
 #include "compensation/earth_rate.hpp"
+#include "station/store/fit_json.hpp"
 #include "station/store/store.hpp"
 
 namespace station {

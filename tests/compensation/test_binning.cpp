@@ -61,8 +61,8 @@ TEST(Binning, MeansAndSlope) {
 
 TEST(Binning, RangeOfANonMonotonicBinAndNoGradientSeries) {
   Series s = ramp(600, 0.0, 0.0);
-  s.temp[17] = 3.25;   // a spike up
-  s.temp[400] = -55.5; // and one down, the rest at -40
+  s.temp[17] = 3.25;    // a spike up
+  s.temp[400] = -55.5;  // and one down, the rest at -40
   s.grad[5] = -1.5;
   s.grad[599] = 2.0;
   const auto b = sc::make_bins(s.view()).at(0);

@@ -47,8 +47,8 @@ void check(const mb::RegisterMap& map, const std::vector<src::SourcePoint>& rows
     EXPECT_EQ(p->scale, 1.0);  // raw on the wire; decimals/units are read from the unit
   }
   for (const auto& [name, p] : map.points())
-    EXPECT_EQ(named.count(name), 1u) << map.device() << ": the driver's point '" << name
-                                     << "' is in no source row";
+    EXPECT_EQ(named.count(name), 1u)
+        << map.device() << ": the driver's point '" << name << "' is in no source row";
 }
 
 // ESPEC ChamberConnectLibrary @1d2deb8 watlowf4.py (CCL) and the Watlow F4P manual Rev E (F4P).

@@ -8,9 +8,9 @@
 #include <cmath>
 #include <thread>
 
-#include "station/session/replay_can.hpp"
 #include "drivers/counters/counter_boards.hpp"
 #include "drivers/counters/counter_frames.hpp"
+#include "station/session/replay_can.hpp"
 
 using namespace station::drivers;
 using namespace std::chrono_literals;
@@ -168,9 +168,9 @@ std::vector<double> replay_rates(std::chrono::milliseconds stall) {
   const auto syncs = station::logged_syncs(log);
   c::CounterBoardsConfig cfg{{{1, "A", 1.5}, {2, "B", 1.5}}, 1ms, 1.0};
   cfg.wall_clock_deadline = false;  // what replay_command sets
-  c::CounterBoards boards(
-      std::make_unique<Stalling>(std::make_unique<station::ReplayCanTransport>(std::move(log)), stall),
-      cfg);
+  c::CounterBoards boards(std::make_unique<Stalling>(
+                              std::make_unique<station::ReplayCanTransport>(std::move(log)), stall),
+                          cfg);
   std::vector<double> rates;
   for (const auto seq : syncs) {
     auto t = boards.tick(seq);

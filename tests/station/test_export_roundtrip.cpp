@@ -173,8 +173,10 @@ TEST_F(ExportRoundTrip, StoredSpanIsTheSamplesSpanAndOlderFitsExportTheSame) {
   EXPECT_EQ(*fit_.span, (station::FitSpan{t_lo, t_hi, g_lo, g_hi}));
   EXPECT_LT(t_lo, t_hi);
   EXPECT_LT(g_lo, g_hi);
-  store_->db().exec("UPDATE fits SET temp_min_c = NULL, temp_max_c = NULL, grad_min_c = NULL, "
-                    "grad_max_c = NULL WHERE id = " + std::to_string(fit_.id));
+  store_->db().exec(
+      "UPDATE fits SET temp_min_c = NULL, temp_max_c = NULL, grad_min_c = NULL, "
+      "grad_max_c = NULL WHERE id = " +
+      std::to_string(fit_.id));
   const auto old = *store_->find_fit(fit_.id);
   EXPECT_FALSE(old.span);
   const auto again = station::make_block(*store_, old, rel_);

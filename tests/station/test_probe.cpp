@@ -13,8 +13,8 @@
 
 #include "sim_devices/gpio_sim.hpp"
 #include "sim_devices/sim_world.hpp"
-#include "station/daemon/rig_probe.hpp"
 #include "station/config/config.hpp"
+#include "station/daemon/rig_probe.hpp"
 
 namespace {
 

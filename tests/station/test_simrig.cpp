@@ -12,8 +12,8 @@
 #include <string>
 #include <thread>
 
-#include "station/daemon/rig_probe.hpp"
 #include "station/config/config.hpp"
+#include "station/daemon/rig_probe.hpp"
 
 namespace {
 

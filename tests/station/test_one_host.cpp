@@ -1,0 +1,304 @@
+// Issue 31: one host, four ways in. One scripted sequence of rig faults (door, e-stop, a chamber
+// disconnect, a CAN drop, a kill and a resume) is run by `run --sim` (the simulated rig on the
+// simulated clock), by `run --config` against simrig (real loopback stacks on the wall clock) and
+// by a run started through `serve`'s API against simrig; each session is recorded and replayed.
+// All four go through daemon/host and daemon/run_start, so they must agree:
+//  * the same run state at the end and one resume;
+//  * the same fault events (kind and source), in the same order;
+//  * the same committed samples: on the simulated clock exactly (replay says "same"); between the
+//    simulated and the wall-clock runs the same share of each flag over the ticks both kept (a
+//    fault injected between two wall-clock ticks may land one tick early or late: one tick per
+//    fault edge is the tolerance), and a wall-clock rig misses only the ticks of its down time.
+// Where they are meant to differ, by the one start rule: a simulation resumes by replaying from
+// t = 0 (its first daemon's batch of ticks is recomputed), a rig at the elapsed time (a gap).
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sqlite3.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <set>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "tests/station/rig_process.hpp"
+#include "tests/station/temp_db.hpp"
+
+namespace {
+
+namespace ts = station::testing_support;
+using namespace std::chrono_literals;
+
+struct Fault {
+  double t_s;
+  std::string command;  // simrig's control language (docs/SIMRIG.md)
+};
+const std::vector<Fault> kScript{{6, "door open"},
+                                 {9, "door close"},
+                                 {13, "estop press"},
+                                 {16, "estop release"},
+                                 {20, "chamber disconnect 2"},
+                                 {25, "can drop 3"}};
+constexpr double kKillBeforeS = 29;  // the daemon is SIGKILLed before this tick, then restarted
+constexpr int kHoldS = 36;
+
+std::string write_protocol(const std::string& dir) {
+  const std::string path = dir + "/one_host.toml";
+  std::ofstream(path) << "name = \"one_host\"\n\n[[step]]\ntype = \"record_start\"\n\n[[step]]\n"
+                         "type = \"hold\"\nduration_s = "
+                      << kHoldS << "\n";
+  return path;
+}
+
+/// A rig loses the ticks of its down time (a simulation replays them): the kill's few seconds of
+/// a short run must not make it 'incomplete' (the configured share, [station] max_lost_share).
+void allow_down_time(const std::string& config_path) {
+  std::string text = ts::slurp(config_path);
+  const auto at = text.find("bin_s = ");
+  ASSERT_NE(at, std::string::npos) << text;
+  text.insert(text.find('\n', at) + 1, "max_lost_share = 0.5\n");
+  std::ofstream(config_path) << text;
+}
+
+/// Runs `sql` on `db` read-only; every row as text columns joined by '|'.
+std::vector<std::string> query(const std::string& db, const std::string& sql) {
+  std::vector<std::string> rows;
+  sqlite3* h = nullptr;
+  if (sqlite3_open_v2(db.c_str(), &h, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK) {
+    sqlite3_close(h);
+    return rows;
+  }
+  sqlite3_busy_timeout(h, 2000);
+  sqlite3_stmt* st = nullptr;
+  if (sqlite3_prepare_v2(h, sql.c_str(), -1, &st, nullptr) == SQLITE_OK) {
+    while (sqlite3_step(st) == SQLITE_ROW) {
+      std::string row;
+      for (int c = 0; c < sqlite3_column_count(st); ++c) {
+        const auto* t = sqlite3_column_text(st, c);
+        row += (c ? "|" : "") + std::string(t ? reinterpret_cast<const char*>(t) : "");
+      }
+      rows.push_back(row);
+    }
+  }
+  sqlite3_finalize(st);
+  sqlite3_close(h);
+  return rows;
+}
+
+double last_tick(const std::string& db) {
+  const auto r = query(db, "SELECT max(t_s) FROM samples");
+  return r.empty() || r[0].empty() ? -1.0 : std::stod(r[0]);
+}
+
+/// What a run left: its state, its fault events in order, its samples' flags by tick.
+struct Outcome {
+  std::vector<std::string> states;
+  std::vector<std::string> fault_events;  // "kind source"
+  int resumes = 0;
+  std::map<int, int> flags;  // tick -> flags of the first gyro
+};
+
+Outcome outcome_of(const std::string& db) {
+  Outcome o;
+  o.states = query(db, "SELECT state FROM runs ORDER BY id");
+  static const std::set<std::string> kFaultKinds{"safe_hold", "safe_hold_cleared", "outage_start",
+                                                 "outage"};
+  for (const auto& row : query(db, "SELECT kind, source FROM events ORDER BY id")) {
+    const auto bar = row.find('|');
+    const std::string kind = row.substr(0, bar), source = row.substr(bar + 1);
+    if (kind == "resume") ++o.resumes;
+    // A CAN outage is one per board: the first board's stands for the bus.
+    if (kFaultKinds.count(kind) && source.rfind("can node", 0) == 0 && source != "can node 1")
+      continue;
+    if (kFaultKinds.count(kind)) o.fault_events.push_back(kind + " " + source);
+  }
+  for (const auto& row : query(db,
+                               "SELECT CAST(t_s AS INTEGER), flags FROM samples WHERE "
+                               "serial = (SELECT min(serial) FROM samples) ORDER BY t_s")) {
+    const auto bar = row.find('|');
+    o.flags[std::stoi(row.substr(0, bar))] = std::stoi(row.substr(bar + 1));
+  }
+  return o;
+}
+
+/// Sends one line to simrig's control socket and reads its one-line answer.
+std::string control(const std::string& socket_path, const std::string& command) {
+  const int fd = socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  sockaddr_un a{};
+  a.sun_family = AF_UNIX;
+  std::snprintf(a.sun_path, sizeof a.sun_path, "%s", socket_path.c_str());
+  std::string reply;
+  if (connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0) {
+    const std::string line = command + "\n";
+    if (write(fd, line.data(), line.size()) == static_cast<ssize_t>(line.size())) {
+      char c = 0;
+      while (read(fd, &c, 1) == 1 && c != '\n') reply += c;
+    }
+  }
+  close(fd);
+  return reply;
+}
+
+/// Plays the script against a daemon on `rig`: each fault once the daemon committed the tick
+/// before it, the kill before kKillBeforeS; `restart` starts the daemon again. The daemon's pid.
+pid_t play_script(const ts::SimrigProcess& rig, const std::string& control_path,
+                  const std::string& db, pid_t daemon, const std::function<pid_t()>& restart) {
+  auto reached = [&](double t_s) {
+    return ts::wait_until([&] { return last_tick(db) >= t_s - 1; }, 60s);
+  };
+  for (const auto& f : kScript) {
+    EXPECT_TRUE(reached(f.t_s)) << "the daemon never reached t = " << f.t_s << " s";
+    EXPECT_EQ(control(control_path, f.command).rfind("ok", 0), 0u) << f.command;
+  }
+  EXPECT_TRUE(reached(kKillBeforeS));
+  kill(daemon, SIGKILL);
+  waitpid(daemon, nullptr, 0);
+  std::this_thread::sleep_for(3s);  // a rig resumes at the elapsed time: a gap
+  (void)rig;
+  return restart();
+}
+
+std::string replay(const std::string& session, const std::string& tag) {
+  const pid_t p = ts::spawn_process({ts::kStationBin, "replay", session}, tag + ".replay.out",
+                                    tag + ".replay.err");
+  const int st = ts::wait_bounded(p, 120s);
+  EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0)
+      << ts::slurp(tag + ".replay.out") << ts::slurp(tag + ".replay.err");
+  return ts::slurp(tag + ".replay.out");
+}
+
+/// Ticks of `o` with flag bit `bit`, over the ticks `other` kept too.
+int ticks_with(const Outcome& o, const Outcome& other, int bit) {
+  int n = 0;
+  for (const auto& [t, f] : o.flags)
+    if (other.flags.count(t) && (f & bit) != 0) ++n;
+  return n;
+}
+
+class OneHost : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = ::testing::TempDir() + "one-host-" + std::to_string(getpid());
+    std::filesystem::remove_all(dir_);
+    std::filesystem::create_directories(dir_);
+    protocol_ = write_protocol(dir_);
+  }
+  std::string dir_, protocol_;
+};
+
+TEST_F(OneHost, OneFaultScriptGivesTheSameRunUnderSimRigApiAndReplay) {
+  // 1. run --sim: the script as --fault options, the kill too; run again to resume.
+  const std::string sim_db = dir_ + "/sim.db", sim_session = dir_ + "/sim.session";
+  std::vector<std::string> sim{ts::kStationBin, "run",     "--sim", "--gyros", "2",
+                               "--protocol",    protocol_, "--db",  sim_db,    "--record",
+                               sim_session};
+  for (const auto& f : kScript)
+    sim.insert(sim.end(), {"--fault", fmt::format("{}:{}", f.t_s, f.command)});
+  auto killed = sim;
+  killed.insert(killed.end(), {"--fault", fmt::format("{}:kill", kKillBeforeS)});
+  int st = ts::wait_bounded(ts::spawn_process(killed, sim_db + ".a.out", sim_db + ".a.err"), 120s);
+  ASSERT_TRUE(WIFSIGNALED(st) && WTERMSIG(st) == SIGKILL) << ts::slurp(sim_db + ".a.err");
+  st = ts::wait_bounded(ts::spawn_process(sim, sim_db + ".b.out", sim_db + ".b.err"), 120s);
+  ASSERT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0) << ts::slurp(sim_db + ".b.err");
+  const Outcome want = outcome_of(sim_db);
+
+  // 2. run --config against simrig, the script through simrig's control socket.
+  const std::string ctl = dir_ + "/rig.ctl";
+  ts::SimrigProcess rig;
+  rig.extra_args = {"--control", ctl};
+  ASSERT_TRUE(rig.start("one-host-rig")) << ts::slurp(rig.err);
+  allow_down_time(rig.config_path);
+  const std::string rig_db = dir_ + "/rig.db", rig_session = dir_ + "/rig.session";
+  auto run_rig = [&, n = 0]() mutable {
+    ++n;
+    return ts::spawn_process({ts::kStationBin, "run", "--config", rig.config_path, "--protocol",
+                              protocol_, "--db", rig_db, "--record", rig_session},
+                             fmt::format("{}.{}.out", rig_db, n),
+                             fmt::format("{}.{}.err", rig_db, n));
+  };
+  pid_t daemon = play_script(rig, ctl, rig_db, run_rig(), run_rig);
+  st = ts::wait_bounded(daemon, 120s);
+  ASSERT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0) << ts::slurp(rig_db + ".2.err");
+  const Outcome rig_run = outcome_of(rig_db);
+  rig.stop();
+
+  // 3. serve, the run started by the API; the killed service resumes it at its next start.
+  ts::SimrigProcess rig2;
+  const std::string ctl2 = dir_ + "/rig2.ctl";
+  rig2.extra_args = {"--control", ctl2};
+  ASSERT_TRUE(rig2.start("one-host-api")) << ts::slurp(rig2.err);
+  allow_down_time(rig2.config_path);
+  {
+    std::ofstream(rig2.config_path, std::ios::app)
+        << "\n[http]\nprotocol_dir = \"" << dir_ << "\"\n";
+  }
+  const std::string api_db = dir_ + "/api.db";
+  auto serve = [&, n = 0]() mutable {
+    ++n;
+    return ts::spawn_process({ts::kStationBin, "serve", "--config", rig2.config_path, "--db",
+                              api_db, "--http", "127.0.0.1:0"},
+                             fmt::format("{}.{}.out", api_db, n),
+                             fmt::format("{}.{}.err", api_db, n));
+  };
+  pid_t service = serve();
+  std::string port;
+  ASSERT_TRUE(ts::wait_until(
+      [&] {
+        const std::string out = ts::slurp(api_db + ".1.out");
+        const auto at = out.find("127.0.0.1:");
+        if (at == std::string::npos) return false;
+        port = out.substr(at + 10, out.find_first_not_of("0123456789", at + 10) - at - 10);
+        return !port.empty();
+      },
+      20s))
+      << ts::slurp(api_db + ".1.err");
+  const std::string token = ts::slurp(api_db + ".token");
+  const pid_t curl = ts::spawn_process(
+      {"/usr/bin/curl", "-s", "-o", api_db + ".post", "-w", "%{http_code}", "-X", "POST", "-H",
+       "Authorization: Bearer " + token.substr(0, token.find_first_of("\r\n")), "-H",
+       "Content-Type: application/json", "-d", R"({"protocol":"one_host","operator":"t"})",
+       "http://127.0.0.1:" + port + "/api/runs"},
+      api_db + ".curl.out", api_db + ".curl.err");
+  ts::wait_bounded(curl, 20s);
+  ASSERT_EQ(ts::slurp(api_db + ".curl.out"), "202") << ts::slurp(api_db + ".post");
+  service = play_script(rig2, ctl2, api_db, service, serve);
+  ASSERT_TRUE(ts::wait_until(
+      [&] {
+        const auto s = query(api_db, "SELECT state FROM runs");
+        return !s.empty() && s[0] != "running";
+      },
+      120s));
+  kill(service, SIGTERM);
+  ts::wait_bounded(service, 20s);
+  const Outcome api_run = outcome_of(api_db);
+
+  // The same run, four ways.
+  EXPECT_EQ(want.states, (std::vector<std::string>{"completed"}));
+  EXPECT_EQ(want.resumes, 1);
+  EXPECT_EQ(want.flags.size(), static_cast<std::size_t>(kHoldS + 1)) << "sim replays from 0";
+  for (const auto* got : {&rig_run, &api_run}) {
+    SCOPED_TRACE(got == &rig_run ? "run --config on simrig" : "serve's API on simrig");
+    EXPECT_EQ(got->states, want.states);
+    EXPECT_EQ(got->resumes, 1);
+    EXPECT_EQ(got->fault_events, want.fault_events);
+    // A rig resumes at the elapsed time: the down time is missing, nothing else.
+    EXPECT_LT(got->flags.size(), want.flags.size());
+    EXPECT_GE(got->flags.size(), want.flags.size() - 6);
+    for (const int bit : {1, 2, 4, 8, 16, 32, 64, 128}) {
+      const int a = ticks_with(want, *got, bit), b = ticks_with(*got, want, bit);
+      EXPECT_LE(std::abs(a - b), 2) << "flag bit " << bit << ": sim " << a << ", rig " << b;
+    }
+  }
+  EXPECT_NE(replay(sim_session, sim_db).find(": same"), std::string::npos);
+  EXPECT_NE(replay(rig_session, rig_db).find(": same"), std::string::npos);
+}
+
+}  // namespace
