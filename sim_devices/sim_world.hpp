@@ -130,12 +130,13 @@ class SimWorld {
   std::vector<SimGyro> gyros_;
   std::unique_ptr<ChamberSim> chamber_sim_;
   std::unique_ptr<TurntableSim> table_sim_;
+  // The world's time, read by the servers' threads (link-fault durations): declared before them.
+  std::atomic<double> now_s_ = 0;
   ServedDevice chamber_, table_;  // faces and servers (destroyed before the models)
   std::unique_ptr<CounterBoardBus> bus_;
   std::shared_ptr<GpioSimChips> gpio_;
   std::string can_transport_;
   int listen_fd_ = -1;
-  std::atomic<double> now_s_ = 0;  // read by the servers' threads (link-fault durations)
   bool door_open_ = false, estop_ = false;
   BusFaultRates can_rates_;
   std::map<std::uint8_t, int> failed_temp_;  // node -> channel

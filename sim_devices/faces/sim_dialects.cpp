@@ -33,19 +33,22 @@ ServedDevice lines(std::unique_ptr<Face> face, int port) {
   return d;
 }
 
+/// A model that is its own Modbus face (the station's generic PLC layout).
+ServedDevice generic(ModbusDeviceModel& model, int port) {
+  auto server = std::make_unique<ModbusServer>(model, 1);
+  server->start_tcp(port);
+  ServedDevice d;
+  d.server = std::move(server);
+  return d;
+}
+
 }  // namespace
 
 ServedDevice serve_chamber(std::string_view name, ChamberSim& chamber, const WatlowPanel& panel,
                            int port) {
   // The registry names the dialects (and their old names); this table gives each its face.
   const std::string_view model = drivers::chamber_dialect(name).model;
-  if (model == "generic_plc") {
-    auto server = std::make_unique<ModbusServer>(chamber, 1);
-    server->start_tcp(port);
-    ServedDevice d;
-    d.server = std::move(server);
-    return d;
-  }
+  if (model == "generic_plc") return generic(chamber, port);
   if (model == "watlow_f4") return modbus(std::make_unique<F4Face>(chamber, panel), port);
   if (model == "watlow_f4t_map2")
     return modbus(std::make_unique<F4Face>(chamber, panel, 1, "watlow_f4t_map2"), port);
@@ -58,13 +61,7 @@ ServedDevice serve_chamber(std::string_view name, ChamberSim& chamber, const Wat
 
 ServedDevice serve_turntable(std::string_view name, TurntableSim& table, int port) {
   const std::string_view model = drivers::turntable_dialect(name).model;
-  if (model == "generic_plc") {
-    auto server = std::make_unique<ModbusServer>(table, 1);
-    server->start_tcp(port);
-    ServedDevice d;
-    d.server = std::move(server);
-    return d;
-  }
+  if (model == "generic_plc") return generic(table, port);
   if (model == "acutrol3000") return lines(std::make_unique<AcutrolFace>(table), port);
   throw std::invalid_argument(
       fmt::format("no simulated turntable '{}' (known: {})", model, drivers::turntable_models()));

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <functional>
 #include <limits>
 #include <mutex>
@@ -50,13 +51,12 @@ class FaultSchedule {
   void disconnect_for(double seconds) {
     std::lock_guard lock(mutex_);
     down_until_s_ = after(seconds);
-    kick_clients_ = true;
+    ++kicks_;
   }
   void clear() {
     std::lock_guard lock(mutex_);
     timeouts_ = exceptions_ = drops_ = 0;
     stall_until_s_ = down_until_s_ = kNever;
-    kick_clients_ = false;
   }
   /// What the request just received gets; `code` is set for an exception. While stalled or
   /// down (a serial line is silent when its device is off) nothing answers.
@@ -73,18 +73,12 @@ class FaultSchedule {
     }
     return Fault::none;
   }
-  /// Whether a disconnect is asked and not yet taken; `down_until_s` as take_kick gives it.
-  bool kick_pending(double& down_until_s) const {
+  /// Disconnects asked so far (a server closes its connections once per new one), and until
+  /// when the link stays down (on now_s()).
+  std::uint64_t kicks(double& down_until_s) const {
     std::lock_guard lock(mutex_);
     down_until_s = down_until_s_;
-    return kick_clients_;
-  }
-  /// Whether a disconnect was asked since the last call (its clients are to be closed now), and
-  /// until when the link stays down (on now_s()).
-  bool take_kick(double& down_until_s) {
-    std::lock_guard lock(mutex_);
-    down_until_s = down_until_s_;
-    return std::exchange(kick_clients_, false);
+    return kicks_;
   }
 
  private:
@@ -99,7 +93,7 @@ class FaultSchedule {
   TimeSource now_s_ = steady_s;
   int timeouts_ = 0, exceptions_ = 0, exception_code_ = 0, drops_ = 0;
   double stall_until_s_ = kNever, down_until_s_ = kNever;
-  bool kick_clients_ = false;
+  std::uint64_t kicks_ = 0;
 };
 
 }  // namespace station::sim

@@ -86,6 +86,7 @@ void LineServer::start_pty(int baud) {
 
 void LineServer::stop() {
   stop_ = true;
+  tcp_ = false;  // nothing to settle any more
   if (thread_.joinable()) thread_.join();
   for (auto& [fd, buf] : clients_)
     if (fd != pty_master_) ::close(fd);
@@ -106,12 +107,14 @@ std::string LineServer::endpoint() const {
 bool LineServer::link_up() {
   if (pty_master_ != -1) return true;
   double down_until = 0;
-  if (faults_.take_kick(down_until)) {
+  const std::uint64_t asked = faults_.kicks(down_until);
+  if (asked != kicks_applied_.load()) {
     for (auto& [fd, buf] : clients_) ::close(fd);
     clients_.clear();
     if (listen_fd_ != -1) ::close(listen_fd_);
     listen_fd_ = -1;
     listening_ = false;
+    kicks_applied_ = asked;
   }
   if (listen_fd_ != -1) return true;
   if (faults_.now_s() < down_until) return false;

@@ -123,6 +123,7 @@ void ModbusServer::start_rtu_pty(int baud) {
 
 void ModbusServer::stop() {
   stop_ = true;
+  tcp_ = false;  // nothing to settle any more
   if (thread_.joinable()) thread_.join();
   for (int* fd : {&listen_fd_, &pty_master_, &pty_slave_}) {
     if (*fd != -1) close(*fd);
@@ -145,14 +146,15 @@ void ModbusServer::accept_client(std::vector<int>& clients) {
 // same port once the down time is over. False while the link is down.
 bool ModbusServer::tcp_link_up(std::vector<int>& clients) {
   double down_until = 0;
-  const bool kick = faults_.take_kick(down_until);
-  if (kick) {
+  const std::uint64_t asked = faults_.kicks(down_until);
+  if (asked != kicks_applied_.load()) {
     for (int c : clients) close(c);
     clients.clear();
     pending_.clear();
     if (listen_fd_ != -1) close(listen_fd_);
     listen_fd_ = -1;
     listening_ = false;
+    kicks_applied_ = asked;
   }
   if (listen_fd_ != -1) return true;
   if (faults_.now_s() < down_until) return false;

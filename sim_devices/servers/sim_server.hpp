@@ -5,6 +5,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <cstdio>
 #include <functional>
 #include <string>
 #include <thread>
@@ -45,24 +46,28 @@ class SimServer {
   /// Ends every injected fault (timeouts, exceptions, drops, stall, disconnect).
   void clear_faults() { faults_.clear(); }
 
-  /// Returns once the server thread has done what the schedule says for now: a disconnect's
-  /// kick taken, the listener reopened when the down time is over (TCP; at most 1 s). A
-  /// simulated clock jumps between ticks faster than the thread polls: settling after each
-  /// jump makes a link fault last the same ticks on every run of a seed.
+  /// Returns once the server thread has done what the schedule says for now: every disconnect
+  /// asked applied (connections and listener closed), the listener reopened when the down time
+  /// is over (TCP; at most 1 s, then a line on stderr). A simulated clock jumps between ticks
+  /// faster than the thread polls: settling after each jump makes a link fault last the same
+  /// ticks on every run of a seed.
   void settle() const {
     using namespace std::chrono_literals;
     for (int i = 0; i < 1000 && tcp_.load(); ++i) {
       double down_until_s = 0;
-      const bool kick = faults_.kick_pending(down_until_s);
-      if (!kick && (listening_.load() || faults_.now_s() < down_until_s)) return;
+      const std::uint64_t asked = faults_.kicks(down_until_s);
+      if (asked == kicks_applied_.load() && (listening_.load() || faults_.now_s() < down_until_s))
+        return;
       std::this_thread::sleep_for(1ms);
     }
+    if (tcp_.load()) std::fputs("simulator: a server did not settle within 1 s\n", stderr);
   }
 
  protected:
   FaultSchedule faults_;
   std::atomic<bool> tcp_{false};        ///< serving TCP (a listener the faults close and reopen)
   std::atomic<bool> listening_{false};  ///< the TCP listener is open now
+  std::atomic<std::uint64_t> kicks_applied_{0};  ///< disconnects the thread has carried out
 };
 
 }  // namespace station::sim

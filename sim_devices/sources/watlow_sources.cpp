@@ -1,7 +1,6 @@
 // The Watlow tables, row by row as the documents give them (see the header for the sources).
 #include "sim_devices/sources/watlow_sources.hpp"
 
-#include <algorithm>
 #include <cmath>
 
 namespace station::sim::sources {
@@ -42,7 +41,8 @@ double watlow_c_delta(double d, bool fahrenheit) {
 
 double watlow_raw(double c, int decimals, bool fahrenheit) {
   const double r = std::nearbyint(watlow_unit(c, fahrenheit) * std::pow(10.0, decimals));
-  return std::clamp(r, -32768.0, 32767.0);
+  if (!(r >= -32768 && r <= 32767)) return c > 0 ? 32767 : -32768;  // over range (NaN: under)
+  return r;
 }
 
 double watlow_c_of_raw(std::int16_t raw, int decimals, bool fahrenheit) {

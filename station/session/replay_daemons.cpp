@@ -151,7 +151,10 @@ std::vector<SessionResume> replayable_resumes(const std::string& dir,
                       "daemon chose its first tick from the wall clock",
                       path, i + 1));
   const auto& first = resumes.front();
-  if (first.can_lines + first.modbus_lines + first.ascii_lines + first.gpio_lines == 0)
+  // Nothing logged before the first resume is a recording begun by a resumed daemon, unless
+  // the first daemon was killed before it committed anything (after_tick_s = -1).
+  if (first.after_tick_s >= 0 &&
+      first.can_lines + first.modbus_lines + first.ascii_lines + first.gpio_lines == 0)
     throw InputError(
         fmt::format("{}: the recording starts with a resumed run (after t = {:.0f} "
                     "s); its first part was not recorded",
@@ -231,6 +234,9 @@ class DaemonReplay {
     so.stop = &stop;
     so.abort = &abort;
     so.on_tick = [&](const TickReport& r) { after_tick(r.t_s, k, devices, stop, abort); };
+    // A daemon killed before it sent its first SYNC ends before its first tick here too.
+    if (killed && resumes_[k].after_tick_s < 0 && !sent_a_sync(k))
+      so.before_tick = [](double) { throw KilledHere{}; };
     try {
       const auto out = host.run(plan, std::move(so));
       if (!killed) return out.run_id;
@@ -244,6 +250,12 @@ class DaemonReplay {
     }
   }
 
+  /// Whether daemon k's part of the CAN log holds a frame (it began a tick).
+  bool sent_a_sync(std::size_t k) const {
+    const std::int64_t from = k > 0 ? resumes_[k - 1].can_lines : 0;
+    return resumes_[k].can_lines > from;
+  }
+
   /// Ends daemon k's life where the recording says: the operator's stop or abort after the
   /// tick it came, or the kill (KilledHere) after the last tick the killed daemon committed.
   void after_tick(double t_s, std::size_t k, ReplayRig& devices, std::atomic<bool>& stop,
@@ -255,9 +267,10 @@ class DaemonReplay {
       abort = session_.end.state == to_string(RunState::aborted);
     }
     if (!killed || t_s < resumes_[k].after_tick_s) return;
-    // A killed daemon that had committed no tick (after_tick_s = -1) left nothing for the next
-    // to pass over: its ticks are rolled back and the resumed simulation's recording starts at
-    // t = 0 with nothing replayed again.
+    // A killed daemon that had committed no tick (after_tick_s = -1; a simulation commits in
+    // batches) left nothing for the next to pass over: its batch is rolled back (the events of
+    // the tick before its first sample stay, as they did) and the resumed simulation's
+    // recording starts at t = 0 with nothing replayed again.
     if (resumes_[k].after_tick_s < 0) {
       store_.discard();
       throw KilledHere{};

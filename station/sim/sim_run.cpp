@@ -187,8 +187,12 @@ std::function<void(double)> world_tick(const SimRunOptions& o, sim::SimWorld& wo
     for (const auto& [at_s, command] : o.faults) {
       if (at_s != t_s) continue;
       // The daemon itself killed before the tick (what a power cut does): committed ticks stay,
-      // the rest is lost, a later `run` resumes. For recording resumed sessions.
-      if (command == "kill") ::raise(SIGKILL);
+      // the rest is lost, a later `run` resumes. For recording resumed sessions; the logs hold
+      // what came before the kill, the devices' connect too (flushed as after a tick).
+      if (command == "kill") {
+        if (rec.session) rec.session->after_tick();
+        ::raise(SIGKILL);
+      }
       if (command == "sigint") {  // the operator's Ctrl-C: the run ends 'stopped' after this tick
         ::raise(SIGINT);
         continue;

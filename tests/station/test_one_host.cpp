@@ -302,3 +302,30 @@ TEST_F(OneHost, OneFaultScriptGivesTheSameRunUnderSimRigApiAndReplay) {
 }
 
 }  // namespace
+
+namespace {
+
+// A simulation commits its ticks in batches: killed before the first commit (before its first
+// tick, or a few ticks in), it leaves a run with no tick (after_tick_s = -1 in the session). The
+// resumed run and the recording of both daemons must still replay "same".
+TEST_F(OneHost, ASimulationKilledBeforeItsFirstCommitResumesAndReplays) {
+  for (const int kill_at : {0, 5}) {
+    SCOPED_TRACE("killed before tick " + std::to_string(kill_at));
+    const std::string db = fmt::format("{}/early{}.db", dir_, kill_at);
+    const std::string session = db + ".session";
+    const std::vector<std::string> run{ts::kStationBin, "run",     "--sim", "--gyros", "1",
+                                       "--protocol",    protocol_, "--db",  db,        "--record",
+                                       session};
+    auto killed = run;
+    killed.insert(killed.end(), {"--fault", fmt::format("{}:kill", kill_at)});
+    int st = ts::wait_bounded(ts::spawn_process(killed, db + ".a.out", db + ".a.err"), 60s);
+    ASSERT_TRUE(WIFSIGNALED(st) && WTERMSIG(st) == SIGKILL) << ts::slurp(db + ".a.err");
+    EXPECT_EQ(query(db, "SELECT count(*) FROM samples"), (std::vector<std::string>{"0"}));
+    st = ts::wait_bounded(ts::spawn_process(run, db + ".b.out", db + ".b.err"), 60s);
+    ASSERT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0) << ts::slurp(db + ".b.err");
+    EXPECT_EQ(outcome_of(db).states, (std::vector<std::string>{"completed"}));
+    EXPECT_NE(replay(session, db).find(": same"), std::string::npos);
+  }
+}
+
+}  // namespace

@@ -108,19 +108,26 @@ Result<ChamberState> EspecP300Chamber::read() {
   return s;
 }
 
+Result<p3::TempReply> EspecP300Chamber::read_temp() {
+  auto temp = ask(p3::kTempQuery);
+  if (!temp) return temp.error();
+  auto t = p3::parse_temp(temp.value());
+  if (!t)
+    return make_error(ErrorKind::protocol,
+                      fmt::format("{}: TEMP? reply '{}' does not parse", name_, temp.value()));
+  return *t;
+}
+
 Result<void> EspecP300Chamber::command(const ChamberCommand& c) {
   readback_.invalidate();
   if (c.setpoint_c) {
-    auto temp = ask(p3::kTempQuery);
-    if (!temp) return temp.error();
-    auto t = p3::parse_temp(temp.value());
-    if (!t)
-      return make_error(ErrorKind::protocol,
-                        fmt::format("{}: TEMP? reply '{}' does not parse", name_, temp.value()));
-    if (!std::isfinite(*c.setpoint_c) || *c.setpoint_c < t->low_c || *c.setpoint_c > t->high_c)
+    const auto limits = read_temp();
+    if (!limits) return limits.error();
+    const p3::TempReply& t = limits.value();
+    if (!std::isfinite(*c.setpoint_c) || *c.setpoint_c < t.low_c || *c.setpoint_c > t.high_c)
       return make_error(ErrorKind::range,
                         fmt::format("{}: setpoint {} C outside the chamber limits [{}, {}] C",
-                                    name_, *c.setpoint_c, t->low_c, t->high_c));
+                                    name_, *c.setpoint_c, t.low_c, t.high_c));
     if (auto r = ask(p3::temp_setpoint_command(*c.setpoint_c)); !r) return r.error();
   }
   if (c.run) {
@@ -132,20 +139,17 @@ Result<void> EspecP300Chamber::command(const ChamberCommand& c) {
 Result<ChamberIdentity> EspecP300Chamber::identify() {
   auto rom = ask(p3::kRomQuery);
   if (!rom) return rom.error();
-  auto temp = ask(p3::kTempQuery);
+  const auto temp = read_temp();
   if (!temp) return temp.error();
-  auto t = p3::parse_temp(temp.value());
-  if (!t)
-    return make_error(ErrorKind::protocol,
-                      fmt::format("{}: TEMP? reply '{}' does not parse", name_, temp.value()));
+  const p3::TempReply& t = temp.value();
   ChamberIdentity id;
   id.model = "espec_p300";
   // CCL espec.py process_controller:666: a ROM starting "P3" is a P300, else an SCP-220.
   id.identity =
       fmt::format("ROM {} ({})", rom.value(), rom.value().rfind("P3", 0) == 0 ? "P300" : "SCP-220");
   id.units = "C";  // the P300 protocol is in deg C (CCL espec.py get_loop_units:299-305)
-  id.setpoint_low_c = t->low_c;
-  id.setpoint_high_c = t->high_c;
+  id.setpoint_low_c = t.low_c;
+  id.setpoint_high_c = t.high_c;
   id.notes = "no constant-mode ramp: the station ramps the setpoint; run = MODE,CONSTANT";
   return id;
 }

@@ -8,6 +8,7 @@
 
 #include "drivers/ascii/line_client.hpp"
 #include "drivers/chamber/chamber.hpp"
+#include "drivers/chamber/espec_p300/p300_wire.hpp"
 #include "drivers/modbus/readback.hpp"
 
 namespace station::drivers {
@@ -31,6 +32,9 @@ class EspecP300Chamber final : public Chamber {
 
  private:
   Result<std::string> ask(std::string_view command);
+  /// TEMP? parsed (pv, setpoint, high and low limit); a reply that does not parse is a
+  /// protocol error.
+  Result<espec_p300::TempReply> read_temp();
   Result<void> read_slow(ChamberState& s, int alarm_count);
 
   std::string name_;
