@@ -62,17 +62,15 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     const int rc = app.exit(e);
     return rc == 0 ? 0 : 2;
-  } catch (const station::SqliteError& e) {
-    // Names the database file; a storage fault is the user's file to look at, like bad input.
-    fmt::print(stderr, "station: {}\n", e.what());
-    return 2;
-  } catch (const station::InputError& e) {
-    fmt::print(stderr, "station: {}\n", e.what());
-    return 2;
-  } catch (const std::invalid_argument& e) {
-    fmt::print(stderr, "station: {}\n", e.what());
-    return 2;
   } catch (const std::exception& e) {
+    // Bad input, and a storage fault (it names the database file: the user's file to look at,
+    // like bad input), exit 2; anything else is unexpected.
+    if (dynamic_cast<const station::SqliteError*>(&e) != nullptr ||
+        dynamic_cast<const station::InputError*>(&e) != nullptr ||
+        dynamic_cast<const std::invalid_argument*>(&e) != nullptr) {
+      fmt::print(stderr, "station: {}\n", e.what());
+      return 2;
+    }
     fmt::print(stderr, "station: error: {}\n", e.what());
     return 1;
   }
