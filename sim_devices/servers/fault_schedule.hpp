@@ -21,7 +21,7 @@ class FaultSchedule {
   /// Seconds on the rig's time; the default is the steady (wall) clock.
   using TimeSource = std::function<double()>;
 
-  /// The clock durations run on; set before the server thread starts.
+  /// The clock durations run on (may be set while the server thread runs).
   void set_time_source(TimeSource now_s) {
     std::lock_guard lock(mutex_);
     now_s_ = std::move(now_s);

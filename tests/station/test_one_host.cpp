@@ -1,7 +1,8 @@
 // Issue 31: one host, four ways in. One scripted sequence of rig faults (door, e-stop, a chamber
 // disconnect, a CAN drop, a kill and a resume) is run by `run --sim` (the simulated rig on the
 // simulated clock), by `run --config` against simrig (real loopback stacks on the wall clock) and
-// by a run started through `serve`'s API against simrig; each session is recorded and replayed.
+// by a run started through `serve`'s API against simrig (the two wall-clock legs side by side,
+// each on its own simrig); the sim's and the rig's sessions are recorded and replayed.
 // All four go through daemon/host and daemon/run_start, so they must agree:
 //  * the same run state at the end and one resume;
 //  * the same fault events (kind and source), in the same order;
@@ -14,9 +15,6 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <signal.h>
-#include <sqlite3.h>
-#include <sys/socket.h>
-#include <sys/un.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -24,11 +22,15 @@
 #include <fstream>
 #include <functional>
 #include <map>
+#include <optional>
 #include <set>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "sim_devices/control_socket.hpp"
+#include "station/store/run_state.hpp"
+#include "station/store/store.hpp"
 #include "tests/station/rig_process.hpp"
 #include "tests/station/temp_db.hpp"
 
@@ -68,34 +70,25 @@ void allow_down_time(const std::string& config_path) {
   std::ofstream(config_path) << text;
 }
 
-/// Runs `sql` on `db` read-only; every row as text columns joined by '|'.
-std::vector<std::string> query(const std::string& db, const std::string& sql) {
-  std::vector<std::string> rows;
-  sqlite3* h = nullptr;
-  if (sqlite3_open_v2(db.c_str(), &h, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK) {
-    sqlite3_close(h);
-    return rows;
+/// The daemon's store read-only; empty while the daemon has not created it.
+std::optional<station::Store> open_store(const std::string& db) {
+  try {
+    return std::optional<station::Store>(std::in_place, db, station::OpenMode::read_only);
+  } catch (const std::exception&) {
+    return std::nullopt;
   }
-  sqlite3_busy_timeout(h, 2000);
-  sqlite3_stmt* st = nullptr;
-  if (sqlite3_prepare_v2(h, sql.c_str(), -1, &st, nullptr) == SQLITE_OK) {
-    while (sqlite3_step(st) == SQLITE_ROW) {
-      std::string row;
-      for (int c = 0; c < sqlite3_column_count(st); ++c) {
-        const auto* t = sqlite3_column_text(st, c);
-        row += (c ? "|" : "") + std::string(t ? reinterpret_cast<const char*>(t) : "");
-      }
-      rows.push_back(row);
-    }
-  }
-  sqlite3_finalize(st);
-  sqlite3_close(h);
-  return rows;
+}
+
+/// The first gyro's samples of run 1 (empty before there are any).
+std::vector<station::SampleRow> first_gyro_samples(station::Store& s) {
+  const auto slots = s.run_slots(1);
+  return slots.empty() ? std::vector<station::SampleRow>{} : s.samples(1, slots[0].serial, false);
 }
 
 double last_tick(const std::string& db) {
-  const auto r = query(db, "SELECT max(t_s) FROM samples");
-  return r.empty() || r[0].empty() ? -1.0 : std::stod(r[0]);
+  auto s = open_store(db);
+  const auto rows = s ? first_gyro_samples(*s) : std::vector<station::SampleRow>{};
+  return rows.empty() ? -1.0 : rows.back().t_s;
 }
 
 /// What a run left: its state, its fault events in order, its samples' flags by tick.
@@ -108,61 +101,40 @@ struct Outcome {
 
 Outcome outcome_of(const std::string& db) {
   Outcome o;
-  o.states = query(db, "SELECT state FROM runs ORDER BY id");
+  auto s = open_store(db);
+  if (!s) return o;
+  for (std::int64_t id = 1; const auto run = s->find_run(id); ++id)
+    o.states.emplace_back(station::to_string(run->state));
   static const std::set<std::string> kFaultKinds{"safe_hold", "safe_hold_cleared", "outage_start",
                                                  "outage"};
-  for (const auto& row : query(db, "SELECT kind, source FROM events ORDER BY id")) {
-    const auto bar = row.find('|');
-    const std::string kind = row.substr(0, bar), source = row.substr(bar + 1);
-    if (kind == "resume") ++o.resumes;
+  for (const auto& e : s->event_rows(1)) {
+    if (e.kind == "resume") ++o.resumes;
     // A CAN outage is one per board: the first board's stands for the bus.
-    if (kFaultKinds.count(kind) && source.rfind("can node", 0) == 0 && source != "can node 1")
-      continue;
-    if (kFaultKinds.count(kind)) o.fault_events.push_back(kind + " " + source);
+    const bool other_board = e.source.rfind("can node", 0) == 0 && e.source != "can node 1";
+    if (kFaultKinds.count(e.kind) && !other_board)
+      o.fault_events.push_back(e.kind + " " + e.source);
   }
-  for (const auto& row : query(db,
-                               "SELECT CAST(t_s AS INTEGER), flags FROM samples WHERE "
-                               "serial = (SELECT min(serial) FROM samples) ORDER BY t_s")) {
-    const auto bar = row.find('|');
-    o.flags[std::stoi(row.substr(0, bar))] = std::stoi(row.substr(bar + 1));
-  }
+  for (const auto& r : first_gyro_samples(*s)) o.flags[static_cast<int>(r.t_s)] = r.flags;
   return o;
-}
-
-/// Sends one line to simrig's control socket and reads its one-line answer.
-std::string control(const std::string& socket_path, const std::string& command) {
-  const int fd = socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  sockaddr_un a{};
-  a.sun_family = AF_UNIX;
-  std::snprintf(a.sun_path, sizeof a.sun_path, "%s", socket_path.c_str());
-  std::string reply;
-  if (connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0) {
-    const std::string line = command + "\n";
-    if (write(fd, line.data(), line.size()) == static_cast<ssize_t>(line.size())) {
-      char c = 0;
-      while (read(fd, &c, 1) == 1 && c != '\n') reply += c;
-    }
-  }
-  close(fd);
-  return reply;
 }
 
 /// Plays the script against a daemon on `rig`: each fault once the daemon committed the tick
 /// before it, the kill before kKillBeforeS; `restart` starts the daemon again. The daemon's pid.
-pid_t play_script(const ts::SimrigProcess& rig, const std::string& control_path,
-                  const std::string& db, pid_t daemon, const std::function<pid_t()>& restart) {
+pid_t play_script(const std::string& control_path, const std::string& db, pid_t daemon,
+                  const std::function<pid_t()>& restart) {
   auto reached = [&](double t_s) {
     return ts::wait_until([&] { return last_tick(db) >= t_s - 1; }, 60s);
   };
   for (const auto& f : kScript) {
     EXPECT_TRUE(reached(f.t_s)) << "the daemon never reached t = " << f.t_s << " s";
-    EXPECT_EQ(control(control_path, f.command).rfind("ok", 0), 0u) << f.command;
+    EXPECT_EQ(station::sim::send_control_commands(control_path, {f.command}).at(0).rfind("ok", 0),
+              0u)
+        << f.command;
   }
   EXPECT_TRUE(reached(kKillBeforeS));
   kill(daemon, SIGKILL);
   waitpid(daemon, nullptr, 0);
   std::this_thread::sleep_for(3s);  // a rig resumes at the elapsed time: a gap
-  (void)rig;
   return restart();
 }
 
@@ -191,6 +163,78 @@ class OneHost : public ::testing::Test {
     std::filesystem::create_directories(dir_);
     protocol_ = write_protocol(dir_);
   }
+  /// run --config against simrig, the script through simrig's control socket.
+  void run_on_simrig(Outcome& out) {
+    const std::string ctl = dir_ + "/rig.ctl";
+    ts::SimrigProcess rig;
+    rig.extra_args = {"--control", ctl};
+    ASSERT_TRUE(rig.start("one-host-rig")) << ts::slurp(rig.err);
+    allow_down_time(rig.config_path);
+    const std::string db = dir_ + "/rig.db";
+    int lives = 0;
+    const std::function<pid_t()> start = [&] {
+      ++lives;
+      return ts::spawn_process({ts::kStationBin, "run", "--config", rig.config_path, "--protocol",
+                                protocol_, "--db", db, "--record", dir_ + "/rig.session"},
+                               fmt::format("{}.{}.out", db, lives),
+                               fmt::format("{}.{}.err", db, lives));
+    };
+    const int st = ts::wait_bounded(play_script(ctl, db, start(), start), 120s);
+    ASSERT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0) << ts::slurp(db + ".2.err");
+    out = outcome_of(db);
+  }
+
+  /// serve, the run started by the API; the killed service resumes it at its next start.
+  void serve_through_api(Outcome& out) {
+    ts::SimrigProcess rig;
+    const std::string ctl = dir_ + "/rig2.ctl";
+    rig.extra_args = {"--control", ctl};
+    ASSERT_TRUE(rig.start("one-host-api")) << ts::slurp(rig.err);
+    allow_down_time(rig.config_path);
+    std::ofstream(rig.config_path, std::ios::app)
+        << "\n[http]\nprotocol_dir = \"" << dir_ << "\"\n";
+    const std::string db = dir_ + "/api.db";
+    int lives = 0;
+    const std::function<pid_t()> start = [&] {
+      ++lives;
+      return ts::spawn_process({ts::kStationBin, "serve", "--config", rig.config_path, "--db", db,
+                                "--http", "127.0.0.1:0"},
+                               fmt::format("{}.{}.out", db, lives),
+                               fmt::format("{}.{}.err", db, lives));
+    };
+    pid_t service = start();
+    std::string port;
+    ASSERT_TRUE(ts::wait_until(
+        [&] {
+          const std::string text = ts::slurp(db + ".1.out");
+          const auto at = text.find("127.0.0.1:");
+          if (at == std::string::npos) return false;
+          port = text.substr(at + 10, text.find_first_not_of("0123456789", at + 10) - at - 10);
+          return !port.empty();
+        },
+        20s))
+        << ts::slurp(db + ".1.err");
+    const std::string token = ts::slurp(db + ".token");
+    const pid_t curl = ts::spawn_process(
+        {"/usr/bin/curl", "-s", "-o", db + ".post", "-w", "%{http_code}", "-X", "POST", "-H",
+         "Authorization: Bearer " + token.substr(0, token.find_first_of("\r\n")), "-H",
+         "Content-Type: application/json", "-d", R"({"protocol":"one_host","operator":"t"})",
+         "http://127.0.0.1:" + port + "/api/runs"},
+        db + ".curl.out", db + ".curl.err");
+    ts::wait_bounded(curl, 20s);
+    ASSERT_EQ(ts::slurp(db + ".curl.out"), "202") << ts::slurp(db + ".post");
+    service = play_script(ctl, db, service, start);
+    EXPECT_TRUE(ts::wait_until(
+        [&] {
+          const auto states = outcome_of(db).states;
+          return !states.empty() && states[0] != "running";
+        },
+        120s));
+    kill(service, SIGTERM);
+    ts::wait_bounded(service, 20s);
+    out = outcome_of(db);
+  }
+
   std::string dir_, protocol_;
 };
 
@@ -210,75 +254,11 @@ TEST_F(OneHost, OneFaultScriptGivesTheSameRunUnderSimRigApiAndReplay) {
   ASSERT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0) << ts::slurp(sim_db + ".b.err");
   const Outcome want = outcome_of(sim_db);
 
-  // 2. run --config against simrig, the script through simrig's control socket.
-  const std::string ctl = dir_ + "/rig.ctl";
-  ts::SimrigProcess rig;
-  rig.extra_args = {"--control", ctl};
-  ASSERT_TRUE(rig.start("one-host-rig")) << ts::slurp(rig.err);
-  allow_down_time(rig.config_path);
-  const std::string rig_db = dir_ + "/rig.db", rig_session = dir_ + "/rig.session";
-  auto run_rig = [&, n = 0]() mutable {
-    ++n;
-    return ts::spawn_process({ts::kStationBin, "run", "--config", rig.config_path, "--protocol",
-                              protocol_, "--db", rig_db, "--record", rig_session},
-                             fmt::format("{}.{}.out", rig_db, n),
-                             fmt::format("{}.{}.err", rig_db, n));
-  };
-  pid_t daemon = play_script(rig, ctl, rig_db, run_rig(), run_rig);
-  st = ts::wait_bounded(daemon, 120s);
-  ASSERT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0) << ts::slurp(rig_db + ".2.err");
-  const Outcome rig_run = outcome_of(rig_db);
-  rig.stop();
-
-  // 3. serve, the run started by the API; the killed service resumes it at its next start.
-  ts::SimrigProcess rig2;
-  const std::string ctl2 = dir_ + "/rig2.ctl";
-  rig2.extra_args = {"--control", ctl2};
-  ASSERT_TRUE(rig2.start("one-host-api")) << ts::slurp(rig2.err);
-  allow_down_time(rig2.config_path);
-  {
-    std::ofstream(rig2.config_path, std::ios::app)
-        << "\n[http]\nprotocol_dir = \"" << dir_ << "\"\n";
-  }
-  const std::string api_db = dir_ + "/api.db";
-  auto serve = [&, n = 0]() mutable {
-    ++n;
-    return ts::spawn_process({ts::kStationBin, "serve", "--config", rig2.config_path, "--db",
-                              api_db, "--http", "127.0.0.1:0"},
-                             fmt::format("{}.{}.out", api_db, n),
-                             fmt::format("{}.{}.err", api_db, n));
-  };
-  pid_t service = serve();
-  std::string port;
-  ASSERT_TRUE(ts::wait_until(
-      [&] {
-        const std::string out = ts::slurp(api_db + ".1.out");
-        const auto at = out.find("127.0.0.1:");
-        if (at == std::string::npos) return false;
-        port = out.substr(at + 10, out.find_first_not_of("0123456789", at + 10) - at - 10);
-        return !port.empty();
-      },
-      20s))
-      << ts::slurp(api_db + ".1.err");
-  const std::string token = ts::slurp(api_db + ".token");
-  const pid_t curl = ts::spawn_process(
-      {"/usr/bin/curl", "-s", "-o", api_db + ".post", "-w", "%{http_code}", "-X", "POST", "-H",
-       "Authorization: Bearer " + token.substr(0, token.find_first_of("\r\n")), "-H",
-       "Content-Type: application/json", "-d", R"({"protocol":"one_host","operator":"t"})",
-       "http://127.0.0.1:" + port + "/api/runs"},
-      api_db + ".curl.out", api_db + ".curl.err");
-  ts::wait_bounded(curl, 20s);
-  ASSERT_EQ(ts::slurp(api_db + ".curl.out"), "202") << ts::slurp(api_db + ".post");
-  service = play_script(rig2, ctl2, api_db, service, serve);
-  ASSERT_TRUE(ts::wait_until(
-      [&] {
-        const auto s = query(api_db, "SELECT state FROM runs");
-        return !s.empty() && s[0] != "running";
-      },
-      120s));
-  kill(service, SIGTERM);
-  ts::wait_bounded(service, 20s);
-  const Outcome api_run = outcome_of(api_db);
+  // 2. and 3., side by side: each its own simrig on the wall clock.
+  Outcome rig_run, api_run;
+  std::thread rig_leg([&] { run_on_simrig(rig_run); });
+  serve_through_api(api_run);
+  rig_leg.join();
 
   // The same run, four ways.
   EXPECT_EQ(want.states, (std::vector<std::string>{"completed"}));
@@ -298,7 +278,7 @@ TEST_F(OneHost, OneFaultScriptGivesTheSameRunUnderSimRigApiAndReplay) {
     }
   }
   EXPECT_NE(replay(sim_session, sim_db).find(": same"), std::string::npos);
-  EXPECT_NE(replay(rig_session, rig_db).find(": same"), std::string::npos);
+  EXPECT_NE(replay(dir_ + "/rig.session", dir_ + "/rig.db").find(": same"), std::string::npos);
 }
 
 }  // namespace
@@ -320,7 +300,7 @@ TEST_F(OneHost, ASimulationKilledBeforeItsFirstCommitResumesAndReplays) {
     killed.insert(killed.end(), {"--fault", fmt::format("{}:kill", kill_at)});
     int st = ts::wait_bounded(ts::spawn_process(killed, db + ".a.out", db + ".a.err"), 60s);
     ASSERT_TRUE(WIFSIGNALED(st) && WTERMSIG(st) == SIGKILL) << ts::slurp(db + ".a.err");
-    EXPECT_EQ(query(db, "SELECT count(*) FROM samples"), (std::vector<std::string>{"0"}));
+    EXPECT_EQ(open_store(db)->sample_count(1), 0);
     st = ts::wait_bounded(ts::spawn_process(run, db + ".b.out", db + ".b.err"), 60s);
     ASSERT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0) << ts::slurp(db + ".b.err");
     EXPECT_EQ(outcome_of(db).states, (std::vector<std::string>{"completed"}));
