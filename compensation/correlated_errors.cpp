@@ -4,152 +4,20 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
-#include <map>
 #include <utility>
 #include <vector>
 
-#include "compensation/reml_filter.hpp"
+#include "compensation/error_model_search.hpp"
 
 namespace station::compensation {
 namespace {
 
-constexpr double kMaxShare = 0.99;  // q = 1 with tau -> infinity makes the filter degenerate
-constexpr int kCoarseSteps = 6;     // 6 x 6 x 6 grid over log tau, q and the walk's size, then
-constexpr int kRefinements = 3;     // 3 rounds of 3 x 3 x 3 around the best point
+using namespace model_search;
+
 // The error models averaged: the most likely grid points, at most this many, each at least
 // kMinWeight of the best's likelihood.
 constexpr std::size_t kMaxComponents = 32;
 constexpr double kMinWeight = 1e-3;
-bool same_run(std::span<const int> segment, Eigen::Index i, Eigen::Index j) {
-  return segment.empty() ||
-         segment[static_cast<std::size_t>(i)] == segment[static_cast<std::size_t>(j)];
-}
-
-double time_of(std::span<const double> t_s, Eigen::Index i) {
-  return t_s.empty() ? static_cast<double>(i) : t_s[static_cast<std::size_t>(i)];
-}
-
-/// Correlation of the Gauss-Markov part from bin i-1 to bin i, for each bin (0 across runs).
-void step_corrs(std::vector<double>& phi, std::span<const double> t_s, std::span<const int> segment,
-                Eigen::Index n, double tau_s) {
-  phi.assign(static_cast<std::size_t>(n), 0.0);
-  for (Eigen::Index i = 1; i < n; ++i) {
-    if (!same_run(segment, i, i - 1)) continue;
-    phi[static_cast<std::size_t>(i)] =
-        std::exp(-std::abs(time_of(t_s, i) - time_of(t_s, i - 1)) / tau_s);
-  }
-}
-
-/// Hours from bin i-1 to bin i within a run; -1 where bin i starts a run.
-void step_hours(std::vector<double>& dt_h, std::span<const double> t_s,
-                std::span<const int> segment, Eigen::Index n) {
-  dt_h.assign(static_cast<std::size_t>(n), -1.0);
-  for (Eigen::Index i = 1; i < n; ++i) {
-    if (same_run(segment, i, i - 1))
-      dt_h[static_cast<std::size_t>(i)] = (time_of(t_s, i) - time_of(t_s, i - 1)) / 3600.0;
-  }
-}
-
-/// Median spacing of neighbouring bins of one run, s (1 when times are not given).
-double bin_spacing_s(std::span<const double> t_s, std::span<const int> segment) {
-  std::vector<double> gaps;
-  for (std::size_t i = 1; i < t_s.size(); ++i) {
-    if (segment.empty() || segment[i] == segment[i - 1]) gaps.push_back(t_s[i] - t_s[i - 1]);
-  }
-  if (gaps.empty()) return 1.0;
-  std::nth_element(gaps.begin(), gaps.begin() + static_cast<long>(gaps.size() / 2), gaps.end());
-  return std::max(gaps[gaps.size() / 2], 1e-9);
-}
-
-using reml::Profile;
-
-struct Point {
-  double log_tau = 0, q = 0, u = 0;  // u: log10 of the walk's variance over a run, in s^2
-  Profile profile;
-  /// Two grid points are one error model when q, the walk and (where q > 0) tau agree.
-  bool same_model(const Point& o) const {
-    return q == o.q && u == o.u && (q == 0 || log_tau == o.log_tau);
-  }
-};
-
-/// What the search needs: the rows [y X], the bin times and runs.
-struct Problem {
-  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> z;
-  std::span<const double> t_s;
-  std::span<const int> segment;
-  double span_h = 1;
-  std::vector<double> dt_h;
-  std::map<double, std::vector<double>> phi;  // step correlations by log tau, made once each
-  std::vector<Point>* record = nullptr;
-
-  const std::vector<double>& phi_at(double log_tau) {
-    auto [it, added] = phi.try_emplace(log_tau);
-    if (added) step_corrs(it->second, t_s, segment, z.rows(), std::exp(log_tau));
-    return it->second;
-  }
-};
-
-// The walk's size: log10 of its variance over the longest run in units of s^2, from 1e-3 (read
-// as no walk at all) to 100.
-constexpr double kWalkLo = -3, kWalkHi = 2;
-double walk_per_h(const Problem& pb, double u) {
-  return u <= kWalkLo ? 0.0 : std::pow(10.0, u) / pb.span_h;
-}
-
-struct Box {
-  double tau_lo, tau_hi, q_lo, q_hi, u_lo, u_hi;
-};
-
-double at(double lo, double hi, int i, int steps) {
-  return lo + (hi - lo) * i / (steps - 1);
-}
-
-/// Grid search over the box, `steps` points each way, in grid order (the first of equally likely
-/// points wins). A model the grid repeats (q = 0 at every tau, a clamped edge, the best point so
-/// far) is evaluated once; the others go reml::kLanes to a pass.
-void search(Point& best, Problem& pb, const Box& b, int steps) {
-  std::vector<Point> pts;
-  for (int a = 0; a < steps; ++a)
-    for (int c = 0; c < steps; ++c)
-      for (int d = 0; d < steps; ++d)
-        pts.push_back({at(b.tau_lo, b.tau_hi, a, steps),
-                       std::clamp(at(b.q_lo, b.q_hi, c, steps), 0.0, kMaxShare),
-                       std::clamp(at(b.u_lo, b.u_hi, d, steps), kWalkLo, kWalkHi),
-                       {}});
-  std::vector<Point> unique{best};
-  std::vector<std::size_t> which(pts.size());
-  std::vector<reml::Model> models;
-  for (std::size_t i = 0; i < pts.size(); ++i) {
-    const auto it = std::find_if(unique.begin(), unique.end(),
-                                 [&](const Point& e) { return e.same_model(pts[i]); });
-    which[i] = static_cast<std::size_t>(it - unique.begin());
-    if (it != unique.end()) continue;
-    unique.push_back(pts[i]);
-    models.push_back({&pb.phi_at(pts[i].log_tau), pts[i].q, walk_per_h(pb, pts[i].u)});
-  }
-  std::vector<Profile> found(models.size());
-  reml::profiles(pb.z, pb.dt_h, models, found);
-  for (std::size_t j = 0; j < found.size(); ++j) unique[j + 1].profile = found[j];
-  for (std::size_t i = 0; i < pts.size(); ++i) {
-    pts[i].profile = unique[which[i]].profile;
-    if (pb.record) pb.record->push_back(pts[i]);
-    if (pts[i].profile.minus2_loglik < best.profile.minus2_loglik) best = pts[i];
-  }
-}
-
-/// The longest time one run spans, s (the whole series when no runs are given).
-double longest_run_s(std::span<const double> t_s, std::span<const int> segment, Eigen::Index n) {
-  double longest = 0;
-  Eigen::Index first = 0;
-  for (Eigen::Index i = 1; i <= n; ++i) {
-    if (i < n && same_run(segment, i, i - 1)) continue;
-    longest = std::max(longest, time_of(t_s, i - 1) - time_of(t_s, first));
-    first = i;
-  }
-  return longest;
-}
-
 /// The coarse grid's most likely points as the model's mixture: weights relative to the best
 /// point found, finite ones only, ties kept in grid order. The q = 0 points of every tau are all
 /// kept although tau does not matter there: each stands for the slab of small q at its tau, the
@@ -173,33 +41,12 @@ void add_mixture(ErrorModel& model, std::vector<Point>& grid, const Point& best,
   }
 }
 
-}  // namespace
-
-namespace {
-
 /// Independent bins: sigma from the OLS residuals (RSS / (n - p)).
 ErrorModel ols_only(const Eigen::MatrixXd& x, const Eigen::VectorXd& y) {
   ErrorModel model;
   const Eigen::VectorXd b = x.colPivHouseholderQr().solve(y);
   model.sigma_dph = std::sqrt((y - x * b).squaredNorm() / static_cast<double>(x.rows() - x.cols()));
   return model;
-}
-
-/// Finer searches around the best point so far, each on a grid half as wide.
-void refine(Point& best, Problem& pb, double lo, double hi) {
-  double half_tau = (hi - lo) / (kCoarseSteps - 1), half_q = kMaxShare / (kCoarseSteps - 1);
-  double half_u = (kWalkHi - kWalkLo) / (kCoarseSteps - 1);
-  for (int round = 0; round < kRefinements; ++round) {
-    const Point c = best;
-    search(best, pb,
-           {std::max(c.log_tau - half_tau, lo), std::min(c.log_tau + half_tau, hi),
-            std::max(c.q - half_q, 0.0), std::min(c.q + half_q, kMaxShare),
-            std::max(c.u - half_u, kWalkLo), std::min(c.u + half_u, kWalkHi)},
-           3);
-    half_tau /= 2;
-    half_q /= 2;
-    half_u /= 2;
-  }
 }
 
 }  // namespace
@@ -212,26 +59,14 @@ ErrorModel estimate_error_model(const Eigen::MatrixXd& x, const Eigen::VectorXd&
       p + 1 > reml::kMaxColumns) {  // too few bins to estimate three more parameters
     return ols_only(x, y);
   }
-  const double spacing_s = bin_spacing_s(t_s, segment);
-  const double span_s = std::max(longest_run_s(t_s, segment, n), spacing_s);
-  // tau from a third of a bin (the Gauss-Markov part is then white) to ten record lengths
-  // (then it is a drift the constant and the regressors mostly absorb).
-  const double lo = std::log(spacing_s / 3.0), hi = std::log(10.0 * span_s);
-  Problem pb{{}, t_s, segment, span_s / 3600.0, {}, {}};
-  pb.z.resize(n, p + 1);
-  pb.z.col(0) = y;
-  pb.z.rightCols(p) = x;
-  step_hours(pb.dt_h, t_s, segment, n);
-  Point best;
-  best.log_tau = lo;
-  best.u = kWalkLo;  // q = 0 and no walk: independent bins
-  const reml::Model iid{&pb.phi_at(lo), 0, 0};
-  reml::profiles(pb.z, pb.dt_h, {&iid, 1}, {&best.profile, 1});
+  Problem pb = make_problem(x, y, t_s, segment);
+  const double hi = pb.tau_hi, spacing_s = pb.spacing_s;
+  Point best = iid_point(pb);
   std::vector<Point> grid;
   pb.record = &grid;
-  search(best, pb, {lo, hi, 0.0, kMaxShare, kWalkLo, kWalkHi}, kCoarseSteps);
+  search(best, pb, whole_box(pb), kCoarseSteps);
   pb.record = nullptr;
-  refine(best, pb, lo, hi);
+  refine(best, pb);
   if (!std::isfinite(best.profile.minus2_loglik) || !(best.profile.sigma2 > 0)) {
     // No error model fits (a noise-free or constant bias): the OLS errors, as with too few bins.
     return ols_only(x, y);

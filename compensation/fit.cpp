@@ -155,6 +155,8 @@ void check_result(const FitResult& r) {
     throw DataError("fit: R^2 or the residual RMS is not finite");
 }
 
+}  // namespace
+
 Eigen::MatrixXd design_matrix(const ModelInput& in, const ModelSpec& spec) {
   const auto n = static_cast<Eigen::Index>(in.bias_dph.size());
   Eigen::MatrixXd x(n, static_cast<Eigen::Index>(spec.terms.size() + 1));
@@ -173,6 +175,8 @@ Eigen::MatrixXd design_matrix(const ModelInput& in, const ModelSpec& spec) {
   }
   return x;
 }
+
+namespace {
 
 /// Newey & West (1987) heteroskedasticity- and autocorrelation-consistent covariance of the
 /// scaled coefficients: n/(n-p) A S A, A = (X'X)^-1 = R^-1 R^-T, S = sum_l w_l (G_l + G_l'),

@@ -2,6 +2,7 @@
 //   B = B0 + sum_i k_i dT^i (i = 1..4) + k0 gradT [+ kr dT/dt] [+ kc channel],  dT = T - T_ref.
 #pragma once
 
+#include <Eigen/Dense>
 #include <cstddef>
 #include <optional>
 #include <span>
@@ -90,11 +91,14 @@ struct FitResult {
   std::vector<double> vif;
   /// The lack-of-fit check (fit_diagnostics.hpp): each candidate term not in the model, tried.
   struct Candidate {
-    std::string option;                ///< "dT2", "dT3", "dTdt", "gradTdT"
-    double value = 0;                  ///< its coefficient in the extended model
-    double std_error = 0;              ///< its standard error under this fit's error model
-    double z = 0;                      ///< value / std_error
-    bool significant = false;          ///< |z| above the Bonferroni bound
+    std::string option;        ///< "dT2", "dT3", "dTdt", "gradTdT"
+    double value = 0;          ///< its coefficient in the extended model
+    double std_error = 0;      ///< its standard error under this fit's error model (Wald)
+    /// The likelihood ratio of the extended model against this one, each with its own error
+    /// model (model_choice.hpp): chi^2 with 1 degree of freedom when the term is absent.
+    double likelihood_ratio = 0;
+    double z = 0;              ///< its signed root: sign(value) sqrt(likelihood_ratio)
+    bool significant = false;  ///< |z| above the Bonferroni bound
     std::vector<double> coefficients;  ///< the extended model's, names then the candidate's
   };
   std::vector<Candidate> candidates;
@@ -111,6 +115,10 @@ FitResult fit_model(const ModelInput& in, const ModelSpec& spec);
 /// The same fit under a given error model (no REML search) and without diagnostics: how the
 /// lack-of-fit check fits a model's extensions under that model's own error model.
 FitResult fit_model_under(const ModelInput& in, const ModelSpec& spec, const ErrorModel& model);
+
+/// The design matrix of `spec` on `in`: a column of ones (B0), then one column per term in the
+/// spec's order. Throws DataError when a term has no data for every bin.
+Eigen::MatrixXd design_matrix(const ModelInput& in, const ModelSpec& spec);
 
 /// Model value B(x) at each point.
 std::vector<double> predict(const FitResult& fit, const ModelInput& in);

@@ -7,6 +7,8 @@
 #include <optional>
 #include <string>
 
+#include "compensation/model_choice.hpp"
+
 namespace station::compensation {
 namespace {
 
@@ -45,9 +47,11 @@ void warn_missing(FitResult& fit, const FitResult::Candidate& c, const FitResult
   }
   fit.warnings.push_back("the model may be missing term " + c.option +
                          ": adding it explains "
-                         "significantly more (z = " +
-                         num(c.z, "%.1f") + ", beyond " + num(fit.candidate_z_critical, "%.2f") +
-                         " under the error model, 1 % over the candidates); with it " + with +
+                         "significantly more (likelihood ratio " +
+                         num(c.likelihood_ratio, "%.1f") + ", z = " + num(c.z, "%.1f") +
+                         ", beyond " + num(fit.candidate_z_critical, "%.2f") +
+                         ", each model with its own error model, 1 % over the candidates); with "
+                         "it " + with +
                          " (fit --terms " + c.option + " ... to include it)");
 }
 
@@ -94,6 +98,29 @@ void warn_collinear(const ModelInput& in, FitResult& fit) {
         "--serial SN --runs A,B), where the gradient differs at the same temperature");
 }
 
+/// The likelihood ratio of spec + each candidate against spec, every model with its own error
+/// model (model_choice.hpp); 0 where a candidate cannot be fitted.
+std::vector<double> likelihood_ratios(const ModelInput& in, const ModelSpec& spec,
+                                      const std::vector<Term>& tried, double bound_lr) {
+  ModelSpec all = spec;
+  all.terms.insert(all.terms.end(), tried.begin(), tried.end());
+  const auto p = static_cast<Eigen::Index>(spec.terms.size() + 1);
+  const Eigen::MatrixXd x = base_and_candidates(design_matrix(in, all), p);
+  const Eigen::Map<const Eigen::VectorXd> y(in.bias_dph.data(),
+                                            static_cast<Eigen::Index>(in.bias_dph.size()));
+  std::vector<std::vector<int>> subsets(tried.size() + 1);
+  for (int j = 0; j < p; ++j) subsets[0].push_back(j);
+  for (std::size_t k = 0; k < tried.size(); ++k) {
+    subsets[k + 1] = subsets[0];
+    subsets[k + 1].push_back(static_cast<int>(p + static_cast<Eigen::Index>(k)));
+  }
+  const std::vector<double> dev = max_ml_deviances(x, y, subsets, in.t_s, in.segment, bound_lr);
+  std::vector<double> lr(tried.size());
+  for (std::size_t k = 0; k < tried.size(); ++k)
+    lr[k] = std::isfinite(dev[k + 1]) && std::isfinite(dev[0]) ? dev[0] - dev[k + 1] : 0.0;
+  return lr;
+}
+
 }  // namespace
 
 void diagnose_fit(const ModelInput& in, FitResult& fit) {
@@ -105,33 +132,34 @@ void diagnose_fit(const ModelInput& in, FitResult& fit) {
       tried.push_back(t);
   if (tried.empty()) return;
   fit.candidate_z_critical = kZCritical[std::min<std::size_t>(tried.size(), 4) - 1];
-  std::optional<std::size_t> best;  // index into fit.candidates (it grows: no pointers)
-  const FitResult* best_fit = nullptr;
-  std::vector<FitResult> extended;
-  extended.reserve(tried.size());
-  for (const Term t : tried) {
+  const std::vector<double> lr = likelihood_ratios(
+      in, fit.spec, tried, fit.candidate_z_critical * fit.candidate_z_critical);
+  std::optional<std::size_t> best;  // index into fit.candidates
+  FitResult best_fit;
+  for (std::size_t k = 0; k < tried.size(); ++k) {
     ModelSpec spec = fit.spec;
-    spec.terms.push_back(t);
+    spec.terms.push_back(tried[k]);
+    FitResult e;
     try {
-      extended.push_back(fit_model_under(in, spec, fit.error_model));
+      e = fit_model_under(in, spec, fit.error_model);
     } catch (const std::exception&) {
       continue;  // too few bins, or the candidate is collinear with the model: nothing to say
     }
-    const FitResult& e = extended.back();
     FitResult::Candidate c;
-    c.option = std::string(term_option_name(t));
+    c.option = std::string(term_option_name(tried[k]));
     c.value = e.coefficients.back();
     c.std_error = e.std_errors.back();
-    c.z = c.std_error > 0 ? c.value / c.std_error : 0.0;
+    c.likelihood_ratio = std::max(lr[k], 0.0);
+    c.z = std::copysign(std::sqrt(c.likelihood_ratio), c.value);
     c.significant = std::abs(c.z) > fit.candidate_z_critical;
     c.coefficients = e.coefficients;
     fit.candidates.push_back(c);
     if (c.significant && (!best || std::abs(c.z) > std::abs(fit.candidates[*best].z))) {
       best = fit.candidates.size() - 1;
-      best_fit = &e;  // `extended` was reserved: no reallocation moves it
+      best_fit = std::move(e);
     }
   }
-  if (best) warn_missing(fit, fit.candidates[*best], *best_fit);
+  if (best) warn_missing(fit, fit.candidates[*best], best_fit);
 }
 
 }  // namespace station::compensation

@@ -1,13 +1,15 @@
 // Diagnostics every fit carries (issue 22): is a term missing, and can the protocol tell the
 // terms apart?
 //
-// Lack of fit: each candidate extension of the model (dT^2, dT^3, dT/dt, gradT x dT) not already
-// in it is fitted in turn under the model's own error model (fit_model_under: the same honest
-// covariance, no new REML search), and its coefficient is tested against zero with a Wald z test,
-// z = value / standard error, a 1-degree-of-freedom F test under the error model (Greene,
-// Econometric Analysis, 7th ed., §5.4). The m candidates are tested together at a family-wise
-// level of 1 % by Bonferroni: |z| > Phi^-1(1 - 0.005 / m). A significant candidate is named in a
-// warning with what k1 and k0 become with it.
+// Lack of fit (issue 32): each candidate extension of the model (dT^2, dT^3, dT/dt, gradT x dT)
+// not already in it is compared with the model by the likelihood ratio of model_choice.hpp,
+// both models with their own error model searched afresh: a missing term the base fit's error
+// model took for a "drift" (a rate random walk at the edge of its search) must now beat that
+// drift on likelihood (under one shared error model, the old Wald test, it never showed). The m
+// candidates are tested together at a family-wise level of 1 % by Bonferroni: the ratio's signed
+// root z must pass Phi^-1(1 - 0.005 / m). A significant candidate is named in a warning with
+// what k1 and k0 become with it. Each candidate's coefficient and Wald standard error under the
+// fit's own error model are kept beside the ratio for reference.
 //
 // Collinearity: the variance inflation factor of each term (fit.cpp, FitResult::vif); above 10 a
 // term is poorly determined (Kutner et al., Applied Linear Statistical Models, 5th ed., §10.5).

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 namespace station::compensation::reml {
@@ -135,7 +136,43 @@ Profile finish(const SmallMatrix& m, double sum_log_f, Eigen::Index n) {
   return out;
 }
 
+/// -2 l of y on the columns `cols` from what one lane gathered (see ml_deviances).
+double ml_deviance(const SmallMatrix& m, double sum_log_f, Eigen::Index n, const Columns& cols) {
+  const auto p = static_cast<Eigen::Index>(cols.size());
+  SmallMatrix mxx(p, p);
+  SmallVector mxy(p);
+  for (Eigen::Index a = 0; a < p; ++a) {
+    const int ca = cols[static_cast<std::size_t>(a)];
+    mxy(a) = m(0, ca);
+    for (Eigen::Index b = 0; b < p; ++b) {
+      const int cb = cols[static_cast<std::size_t>(b)];
+      mxx(a, b) = m(std::min(ca, cb), std::max(ca, cb));  // the upper triangle holds it
+    }
+  }
+  const Eigen::LDLT<SmallMatrix> ldlt(mxx);
+  const double rss = m(0, 0) - mxy.dot(ldlt.solve(mxy));
+  if (!(rss > 0) || ldlt.info() != Eigen::Success) return std::numeric_limits<double>::infinity();
+  const auto nd = static_cast<double>(n);
+  return sum_log_f + nd * std::log(rss / nd);
+}
+
 }  // namespace
+
+void ml_deviances(const RowMajor& z, const std::vector<double>& dt_h,
+                  std::span<const Model> models, std::span<const Columns> subsets,
+                  std::span<double> out) {
+  const std::size_t s = subsets.size();
+  for (std::size_t first = 0; first < models.size(); first += L) {
+    const std::size_t lanes = std::min<std::size_t>(L, models.size() - first);
+    std::array<Model, L> md;
+    for (std::size_t l = 0; l < L; ++l) md[l] = models[first + std::min(l, lanes - 1)];
+    const Gathered g = pass_for(static_cast<int>(z.cols()), z.data(), z.rows(), dt_h, md,
+                                std::make_integer_sequence<int, kMaxColumns - 1>{});
+    for (std::size_t l = 0; l < lanes; ++l)
+      for (std::size_t j = 0; j < s; ++j)
+        out[(first + l) * s + j] = ml_deviance(g.m[l], g.sum_log_f[l], z.rows(), subsets[j]);
+  }
+}
 
 void profiles(const RowMajor& z, const std::vector<double>& dt_h, std::span<const Model> models,
               std::span<Profile> out) {

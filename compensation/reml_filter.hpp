@@ -38,4 +38,17 @@ struct Profile {
 void profiles(const RowMajor& z, const std::vector<double>& dt_h, std::span<const Model> models,
               std::span<Profile> out);
 
+/// Columns of z (1..p; y is column 0) a regression uses.
+using Columns = std::vector<int>;
+
+/// -2 x the maximum log-likelihood (not the restricted one), the regression coefficients and s^2
+/// concentrated out at their maximum-likelihood values (s^2 = RSS_GLS / n), constants dropped:
+///   -2 l = sum log f + n log(RSS_GLS / n)        (Harvey 1989, sec. 3.4, eq. 3.4.10),
+/// of y on each column subset under each model, out[model * subsets.size() + subset]. Unlike
+/// the restricted likelihood, whose term log |X' F^-1 X| changes with the columns, these compare
+/// across subsets: the same y, the same n, nested column sets give likelihood ratios.
+void ml_deviances(const RowMajor& z, const std::vector<double>& dt_h,
+                  std::span<const Model> models, std::span<const Columns> subsets,
+                  std::span<double> out);
+
 }  // namespace station::compensation::reml

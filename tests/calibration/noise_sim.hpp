@@ -26,11 +26,14 @@ struct Protocol {
   double low_c = -40, high_c = 70, heat_c_per_h = 10, soak_s = 0;
 };
 
-/// Bins of one recording (bias 0): mean housing temperature, mean gradient, mid times.
+/// Bins of one recording (bias 0): mean housing temperature, mean gradient, the housing
+/// temperature's least-squares slope over the bin (deg C/h, as compensation/binning.cpp takes it),
+/// mid times.
 inline compensation::ModelData protocol_bins(const Protocol& p, int segment) {
   const double a_air = 1 - std::exp(-1.0 / 120), a_h = 1 - std::exp(-1.0 / 1200),
                a_c = 1 - std::exp(-1.0 / 3600);
   double sp = 25, air = 25, housing = 25, core = 25, t = 0, soaked = 0, sum_t = 0, sum_g = 0;
+  double sum_kt = 0;  // sum of (k - (kBinS - 1) / 2) T_k over the bin: the slope's numerator
   bool heating = false;
   int n = 0;
   compensation::ModelData d;
@@ -48,15 +51,17 @@ inline compensation::ModelData protocol_bins(const Protocol& p, int segment) {
     if (std::abs(air - p.high_c) <= 0.5) break;
     sum_t += housing;
     sum_g += core - housing;
+    sum_kt += (n - (kBinS - 1) / 2) * housing;
     if (++n < static_cast<int>(kBinS)) continue;
     d.bias_dph.push_back(0);
     d.temp_c.push_back(sum_t / n);
     d.grad_c.push_back(sum_g / n);
-    d.dtdt_c_per_h.push_back(0);
+    // S_kk = sum (k - mean)^2 = n (n^2 - 1) / 12 over k = 0..n-1, 1 s apart.
+    d.dtdt_c_per_h.push_back(3600.0 * sum_kt / (kBinS * (kBinS * kBinS - 1) / 12));
     d.channel.push_back(0);
     d.t_mid_s.push_back(t - kBinS / 2);
     d.segment.push_back(segment);
-    sum_t = sum_g = 0;
+    sum_t = sum_g = sum_kt = 0;
     n = 0;
   }
   return d;

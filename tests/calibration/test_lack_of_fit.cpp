@@ -1,0 +1,180 @@
+// Monte-Carlo power and size of the lack-of-fit check (issue 32, compensation/model_choice.hpp):
+// a term the fitted paper model (B0 + k1 dT + k0 gradT) lacks must be named, under every noise
+// row of NoiseCoverage, in at least 80 % of the realizations, and a correctly specified model
+// warned about in at most 10 %. The simulator is the test's own (noise_sim.hpp): the paper
+// cycle's bins, the noise added by methods unlike the station's error model.
+//
+// The missing terms, each the size the issue measured (k2 = 1e-5 deg/h/C^2; dT/dt 0.004
+// deg/h per C/h) or, for the two it gives no size for (k3 dT^3 and kg gradT dT), the size at which
+// the term shows in the bins as much as that k2 term does: the part of it the fitted model cannot
+// absorb (its residual after least squares on B0, dT and gradT) has the same norm.
+//
+// Where no test can reach 80 % the bound is what one could: the power of the oracle test that
+// knows the noise's true covariance (generalized least squares of the extended model, the
+// candidate's z against the same Bonferroni bound: with a known covariance the most powerful
+// unbiased test of one coefficient), computed here from the sample covariance of many
+// realizations of the noise alone. Strong flicker hides a k2 = 1e-5 term from any test: the
+// oracle names it in 38 % of flicker B 0.006 realizations.
+// GYRO_LACK_OF_FIT_REALIZATIONS overrides the count per cell (docs/UNCERTAINTY.md's table: 200).
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <functional>
+#include <string>
+
+#include "noise_sim.hpp"
+
+namespace station::test::noise {
+namespace {
+
+constexpr double kB0 = 0.02, kK1 = 1.5e-4, kK0 = 5.5e-3, kK2 = 1e-5, kKr = 0.004;
+
+struct Row {
+  const char* name;
+  Levels levels;
+};
+
+// NoiseCoverage's rows (test_noise_coverage.cpp).
+const Row kRows[] = {
+    {"white only", {}},
+    {"Gauss-Markov 0.004 deg/h, tau 1.5 h", {.gm_dph = 0.004, .gm_tau_s = 5400}},
+    {"simulator's levels (GM 0.003/1 h, RRW 1e-4)",
+     {.gm_dph = 0.003, .gm_tau_s = 3600, .rrw_dphpsh = 1e-4}},
+    {"flicker B 0.006 deg/h", {.flicker_b_dph = 0.006}},
+    {"rate random walk K 0.003", {.rrw_dphpsh = 0.003}},
+    {"rate random walk K 0.001", {.rrw_dphpsh = 0.001}},
+    {"mixture: GM 0.003/1.5 h + flicker 0.004 + RRW 0.001",
+     {.gm_dph = 0.003, .gm_tau_s = 5400, .flicker_b_dph = 0.004, .rrw_dphpsh = 0.001}},
+};
+
+using Extra = std::function<double(const compensation::ModelData&, std::size_t)>;
+
+struct Case {
+  const char* missing;  ///< the option the warning must name; "" for none
+  Extra extra;          ///< the missing term's contribution at bin i
+  compensation::Term term = compensation::Term::dT2;
+  double size = 0;  ///< its coefficient
+};
+
+/// The norm of what the paper model leaves of a term: its residual after least squares on the
+/// model's columns.
+double unexplained(const compensation::ModelData& d, const Extra& f) {
+  const Eigen::MatrixXd x = compensation::design_matrix(d.view(), {});
+  Eigen::VectorXd v(x.rows());
+  for (Eigen::Index i = 0; i < x.rows(); ++i) v(i) = f(d, static_cast<std::size_t>(i));
+  return (v - x * x.colPivHouseholderQr().solve(v)).norm();
+}
+
+std::vector<Case> cases(const compensation::ModelData& d) {
+  const auto dt = [](const compensation::ModelData& m, std::size_t i) { return m.temp_c[i] - 25; };
+  const Extra k2 = [dt](const auto& m, std::size_t i) { return kK2 * std::pow(dt(m, i), 2); };
+  const Extra cube = [dt](const auto& m, std::size_t i) { return std::pow(dt(m, i), 3); };
+  const Extra cross = [dt](const auto& m, std::size_t i) { return m.grad_c[i] * dt(m, i); };
+  const double k3 = unexplained(d, k2) / unexplained(d, cube);
+  const double kg = unexplained(d, k2) / unexplained(d, cross);
+  using compensation::Term;
+  return {{"", [](const auto&, std::size_t) { return 0.0; }},
+          {"dT2", k2, Term::dT2, kK2},
+          {"dT3", [=](const auto& m, std::size_t i) { return k3 * cube(m, i); }, Term::dT3, k3},
+          {"dTdt", [](const auto& m, std::size_t i) { return kKr * m.dtdt_c_per_h[i]; },
+           Term::dTdt, kKr},
+          {"gradTdT", [=](const auto& m, std::size_t i) { return kg * cross(m, i); },
+           Term::gradTdT, kg}};
+}
+
+int realizations(bool null_case) {
+  const char* env = std::getenv("GYRO_LACK_OF_FIT_REALIZATIONS");
+  return env != nullptr ? std::max(20, std::atoi(env)) : null_case ? 100 : 60;
+}
+
+/// The inverse covariance of the bins' noise, from `draws` realizations of the noise alone:
+/// (draws - p - 2) / (draws - 1) S^-1 is unbiased for Sigma^-1 (S the sample covariance of p
+/// bins, mean known to be 0: Anderson, An Introduction to Multivariate Statistical Analysis,
+/// 3rd ed., 2003, sec. 7.2, with draws degrees of freedom).
+Eigen::MatrixXd noise_precision(const compensation::ModelData& design, const Levels& lv) {
+  constexpr int kDraws = 1000;
+  const auto n = static_cast<Eigen::Index>(design.bias_dph.size());
+  std::mt19937_64 rng(77);
+  Eigen::MatrixXd s = Eigen::MatrixXd::Zero(n, n);
+  for (int r = 0; r < kDraws; ++r) {
+    compensation::ModelData d = design;
+    std::fill(d.bias_dph.begin(), d.bias_dph.end(), 0.0);
+    add_noise(d, lv, rng);
+    const Eigen::Map<const Eigen::VectorXd> e(d.bias_dph.data(), n);
+    s.selfadjointView<Eigen::Lower>().rankUpdate(e, 1.0 / kDraws);
+  }
+  s = s.selfadjointView<Eigen::Lower>();
+  return (kDraws - static_cast<double>(n) - 2) / kDraws * s.inverse();
+}
+
+/// Power of the oracle test: the candidate's GLS z, N(delta, 1), beyond +-z_crit.
+double oracle_power(const compensation::ModelData& design, const Eigen::MatrixXd& precision,
+                    const Case& c, double z_crit) {
+  compensation::ModelSpec spec;
+  spec.terms.push_back(c.term);
+  const Eigen::MatrixXd x = compensation::design_matrix(design.view(), spec);
+  const Eigen::MatrixXd cov = (x.transpose() * precision * x).inverse();
+  const double delta = c.size / std::sqrt(cov(x.cols() - 1, x.cols() - 1));
+  return 0.5 * (std::erfc((z_crit - delta) / std::sqrt(2.0)) +
+                std::erfc((z_crit + delta) / std::sqrt(2.0)));
+}
+
+/// The option a fit's lack-of-fit warning names ("" when it warns of none).
+std::string named(const compensation::FitResult& fit) {
+  for (const auto& w : fit.warnings) {
+    const std::string key = "missing term ";
+    if (const auto at = w.find(key); at != std::string::npos)
+      return w.substr(at + key.size(), w.find(':', at) - at - key.size());
+  }
+  return "";
+}
+
+/// Share of realizations whose fit names `c.missing` (or, for the null case, names anything).
+double share_named(const compensation::ModelData& design, const Case& c, const Levels& lv,
+                   std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  int hits = 0;
+  const int n = realizations(*c.missing == 0);
+  for (int r = 0; r < n; ++r) {
+    compensation::ModelData d = design;
+    for (std::size_t i = 0; i < d.bias_dph.size(); ++i)
+      d.bias_dph[i] = kB0 + kK1 * (d.temp_c[i] - 25) + kK0 * d.grad_c[i] + c.extra(design, i);
+    add_noise(d, lv, rng);
+    const std::string said = named(compensation::fit_model(d.view(), {}));
+    hits += std::string(c.missing).empty() ? !said.empty() : said == c.missing;
+  }
+  return static_cast<double>(hits) / n;
+}
+
+TEST(LackOfFit, NamesAMissingTermUnderEveryNoiseAndRarelyWarnsWithoutOne) {
+  const compensation::ModelData design = protocols_bins({Protocol{}});
+  constexpr double kZCrit = 3.0233;  // 1 % family-wise over the 4 candidates (fit_diagnostics)
+  std::uint64_t seed = 3200;
+  for (const Row& row : kRows) {
+    const Eigen::MatrixXd precision = noise_precision(design, row.levels);
+    std::string line = std::string("| ") + row.name;
+    for (const Case& c : cases(design)) {
+      const double s = share_named(design, c, row.levels, seed++);
+      const int n = realizations(*c.missing == 0);
+      SCOPED_TRACE(std::string(row.name) + ", missing " + (*c.missing ? c.missing : "nothing"));
+      // One-sided binomial slack at 1 %: 2.33 sd of a share of n at the bound.
+      const auto slack = [n](double p) { return 2.33 * std::sqrt(p * (1 - p) / n); };
+      char cell[48];
+      if (*c.missing == 0) {
+        std::snprintf(cell, sizeof cell, " | %.2f", s);
+        EXPECT_LE(s, 0.10 + slack(0.10)) << "false alarms";
+      } else {
+        const double oracle = oracle_power(design, precision, c, kZCrit);
+        const double goal = std::min(0.80, oracle);
+        std::snprintf(cell, sizeof cell, " | %.2f (%.2f)", s, oracle);
+        EXPECT_GE(s, goal - slack(goal)) << "named too rarely; the oracle: " << oracle;
+      }
+      line += cell;
+    }
+    std::printf("%s |\n", line.c_str());
+  }
+}
+
+}  // namespace
+}  // namespace station::test::noise
