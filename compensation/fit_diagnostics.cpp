@@ -12,8 +12,6 @@
 namespace station::compensation {
 namespace {
 
-constexpr std::array<Term, 4> kCandidates{Term::dT2, Term::dT3, Term::dTdt, Term::gradTdT};
-
 /// Phi^-1(1 - 0.005 / m), m = 1..4: the two-sided 1 % Bonferroni bound for m tests (standard
 /// normal quantiles 0.995, 0.9975, 0.99833, 0.99875; Abramowitz & Stegun, Table 26.5).
 constexpr std::array<double, 4> kZCritical{2.5758, 2.8070, 2.9352, 3.0233};
@@ -98,41 +96,26 @@ void warn_collinear(const ModelInput& in, FitResult& fit) {
         "--serial SN --runs A,B), where the gradient differs at the same temperature");
 }
 
-/// The likelihood ratio of spec + each candidate against spec, every model with its own error
-/// model (model_choice.hpp); 0 where a candidate cannot be fitted.
-std::vector<double> likelihood_ratios(const ModelInput& in, const ModelSpec& spec,
-                                      const std::vector<Term>& tried, double bound_lr) {
-  ModelSpec all = spec;
-  all.terms.insert(all.terms.end(), tried.begin(), tried.end());
-  const auto p = static_cast<Eigen::Index>(spec.terms.size() + 1);
-  const Eigen::MatrixXd x = base_and_candidates(design_matrix(in, all), p);
-  const Eigen::Map<const Eigen::VectorXd> y(in.bias_dph.data(),
-                                            static_cast<Eigen::Index>(in.bias_dph.size()));
-  std::vector<std::vector<int>> subsets(tried.size() + 1);
-  for (int j = 0; j < p; ++j) subsets[0].push_back(j);
-  for (std::size_t k = 0; k < tried.size(); ++k) {
-    subsets[k + 1] = subsets[0];
-    subsets[k + 1].push_back(static_cast<int>(p + static_cast<Eigen::Index>(k)));
-  }
-  const std::vector<double> dev = max_ml_deviances(x, y, subsets, in.t_s, in.segment, bound_lr);
-  std::vector<double> lr(tried.size());
-  for (std::size_t k = 0; k < tried.size(); ++k)
-    lr[k] = std::isfinite(dev[k + 1]) && std::isfinite(dev[0]) ? dev[0] - dev[k + 1] : 0.0;
-  return lr;
+}  // namespace
+
+std::vector<Term> candidates_for(const ModelInput& in, const ModelSpec& spec) {
+  std::vector<Term> tried;
+  for (const Term t : {Term::dT2, Term::dT3, Term::dTdt, Term::gradTdT})
+    if (std::find(spec.terms.begin(), spec.terms.end(), t) == spec.terms.end() && has_data(t, in))
+      tried.push_back(t);
+  return tried;
 }
 
-}  // namespace
+double candidate_z_critical(std::size_t candidates) {
+  return candidates == 0 ? 0.0 : kZCritical[std::min<std::size_t>(candidates, 4) - 1];
+}
 
 void diagnose_fit(const ModelInput& in, FitResult& fit) {
   warn_collinear(in, fit);
-  std::vector<Term> tried;
-  for (const Term t : kCandidates)
-    if (std::find(fit.spec.terms.begin(), fit.spec.terms.end(), t) == fit.spec.terms.end() &&
-        has_data(t, in))
-      tried.push_back(t);
+  const std::vector<Term> tried = candidates_for(in, fit.spec);
   if (tried.empty()) return;
-  fit.candidate_z_critical = kZCritical[std::min<std::size_t>(tried.size(), 4) - 1];
-  const std::vector<double> lr = likelihood_ratios(
+  fit.candidate_z_critical = candidate_z_critical(tried.size());
+  const std::vector<double> lr = extension_likelihood_ratios(
       in, fit.spec, tried, fit.candidate_z_critical * fit.candidate_z_critical);
   std::optional<std::size_t> best;  // index into fit.candidates
   FitResult best_fit;

@@ -24,6 +24,13 @@ namespace station::compensation {
 /// The VIF above which a term is reported as poorly determined.
 inline constexpr double kVifLimit = 10.0;
 
+/// The candidate terms of the lack-of-fit check not in `spec` whose data `in` has: dT2, dT3,
+/// dTdt, gradTdT (dTdt needs bin slopes, gradTdT gradients). The one list `fit --select` tries.
+std::vector<Term> candidates_for(const ModelInput& in, const ModelSpec& spec);
+
+/// The bound |z| must pass when `candidates` terms are tested together (family-wise 1 %).
+double candidate_z_critical(std::size_t candidates);
+
 /// Fills fit.candidates, fit.candidate_z_critical and adds the warnings. Candidates whose data
 /// are missing (dT/dt of a 1 Hz record) or whose extended fit is impossible are skipped.
 void diagnose_fit(const ModelInput& in, FitResult& fit);

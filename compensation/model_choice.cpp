@@ -81,4 +81,25 @@ Eigen::MatrixXd base_and_candidates(const Eigen::MatrixXd& x, Eigen::Index p) {
   return out;
 }
 
+std::vector<double> extension_likelihood_ratios(const ModelInput& in, const ModelSpec& spec,
+                                                const std::vector<Term>& tried, double bound_lr) {
+  ModelSpec all = spec;
+  all.terms.insert(all.terms.end(), tried.begin(), tried.end());
+  const auto p = static_cast<Eigen::Index>(spec.terms.size() + 1);
+  const Eigen::MatrixXd x = base_and_candidates(design_matrix(in, all), p);
+  const Eigen::Map<const Eigen::VectorXd> y(in.bias_dph.data(),
+                                            static_cast<Eigen::Index>(in.bias_dph.size()));
+  std::vector<std::vector<int>> subsets(tried.size() + 1);
+  for (int j = 0; j < p; ++j) subsets[0].push_back(j);
+  for (std::size_t k = 0; k < tried.size(); ++k) {
+    subsets[k + 1] = subsets[0];
+    subsets[k + 1].push_back(static_cast<int>(p + static_cast<Eigen::Index>(k)));
+  }
+  const std::vector<double> dev = max_ml_deviances(x, y, subsets, in.t_s, in.segment, bound_lr);
+  std::vector<double> lr(tried.size());
+  for (std::size_t k = 0; k < tried.size(); ++k)
+    lr[k] = std::isfinite(dev[k + 1]) && std::isfinite(dev[0]) ? dev[0] - dev[k + 1] : 0.0;
+  return lr;
+}
+
 }  // namespace station::compensation

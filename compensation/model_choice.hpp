@@ -20,6 +20,8 @@
 #include <span>
 #include <vector>
 
+#include "compensation/fit.hpp"
+
 namespace station::compensation {
 
 /// -2 x the maximum log-likelihood (constants dropped) of y = X_s b + e for each column subset s
@@ -41,5 +43,11 @@ std::vector<double> max_ml_deviances(const Eigen::MatrixXd& x, const Eigen::Vect
 /// column well conditioned for max_ml_deviances. A candidate that the base columns already span
 /// is left as zeros (its subset's fit then fails and reads as no improvement).
 Eigen::MatrixXd base_and_candidates(const Eigen::MatrixXd& x, Eigen::Index p);
+
+/// The likelihood ratio of spec + t against spec for each t of `tried`, every model with its own
+/// error model; 0 where one cannot be fitted. `bound_lr`: the bound a test will hold them to
+/// (max_ml_deviances refines the ones within reach of it).
+std::vector<double> extension_likelihood_ratios(const ModelInput& in, const ModelSpec& spec,
+                                                const std::vector<Term>& tried, double bound_lr);
 
 }  // namespace station::compensation

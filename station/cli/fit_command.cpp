@@ -7,11 +7,13 @@
 #include <set>
 
 #include "compensation/cross_validation.hpp"
+#include "compensation/model_selection.hpp"
 #include "station/cli/commands.hpp"
 #include "station/cli/exit_status.hpp"
 #include "station/common/input_error.hpp"
 #include "station/parts/judged_fit.hpp"
 #include "station/store/calibration.hpp"
+#include "station/store/fit_model_choice.hpp"
 #include "station/store/fit_json.hpp"
 
 namespace station {
@@ -24,7 +26,7 @@ struct FitOptions {
   std::vector<std::int64_t> runs;
   std::optional<std::int64_t> run;
   double ref_temp_c = 25.0;
-  bool all = false, json = false, cv = false;
+  bool all = false, json = false, cv = false, select = false;
 };
 
 /// Leave-one-run-out cross-validation of one fit's model over its runs, or why there is none
@@ -115,6 +117,18 @@ void print_fit(const JudgedFit& jf) {
   fmt::print("  verdict: {}\n", verdict_text(jf.verdict));
 }
 
+/// `--select`: the model chosen from `base` over the serial's runs (model_selection.hpp).
+sc::ModelSelection select_for(Store& store, const std::string& serial,
+                              const std::vector<std::int64_t>& runs, const sc::ModelSpec& base) {
+  const sc::ModelData data = store.model_data(serial, runs);
+  try {
+    return sc::select_model(data.view(), base);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(fmt::format("{}: serial '{}', runs {}: --select: {}", store.db().path(),
+                                 serial, fmt::join(runs, ","), e.what()));
+  }
+}
+
 int run_fit(const FitOptions& o) {
   // A bad part file stops before the database is opened.
   std::optional<PartFile> parts;
@@ -134,7 +148,14 @@ int run_fit(const FitOptions& o) {
   } else {
     const auto runs = o.runs.empty() ? store.runs_of_serial(o.serial) : o.runs;
     const auto limits = runs.empty() ? std::nullopt : limits_for(store, o.serial, runs, choice);
-    result.fits.push_back(judge_and_store(store, fit_serial(store, o.serial, runs, spec), limits));
+    std::optional<sc::ModelSelection> sel;
+    if (o.select && !runs.empty()) sel = select_for(store, o.serial, runs, spec);
+    result.fits.push_back(
+        judge_and_store(store, fit_serial(store, o.serial, runs, sel ? sel->chosen : spec), limits));
+    if (sel) {
+      save_fit_model_choice(store, result.fits.back().fit.fit_id, model_selection_json(*sel));
+      if (!o.json) fmt::print("{}", model_selection_text(*sel));
+    }
   }
   // Serials with nothing to fit: one line each on stderr, and exit status 1 (the others stored).
   for (const auto& s : result.skipped) fmt::print(stderr, "station: fit skipped: {}\n", s);
@@ -144,6 +165,8 @@ int run_fit(const FitOptions& o) {
     nlohmann::json arr = nlohmann::json::array();
     for (const auto& f : fits) {
       arr.push_back(fit_json(f));
+      const auto choice = load_fit_model_choice(store, f.fit.fit_id);
+      arr.back()["model_choice"] = choice ? *choice : nlohmann::json();
       if (o.cv) arr.back()["cross_validation"] = cv_json(cross_validate(store, f.fit), f.fit.runs);
     }
     std::cout << (o.all ? arr : arr[0]).dump(2) << '\n';
@@ -179,6 +202,12 @@ void add_fit_commands(CLI::App& app, CommandStatus& status) {
       ->capture_default_str();
   fit->add_option("--ref-temp-c", o->ref_temp_c, "T_ref, C")->capture_default_str();
   fit->add_flag("--json", o->json, "print JSON");
+  fit->add_flag("--select", o->select,
+                "choose the model: from --terms, add the candidate terms (dT2, dT3, dTdt, "
+                "gradTdT) one at a time while they help, by leave-one-run-out prediction error "
+                "with two or more runs, by likelihood ratio with one; prints the models tried and "
+                "stores the choice with the fit")
+      ->excludes(all);
   fit->add_flag("--cv", o->cv,
                 "leave-one-run-out cross-validation: prediction error on each held-out run "
                 "beside the in-sample residual (two or more runs)");

@@ -67,7 +67,8 @@ const std::vector<FleetTable> kTables = {
      "rev,uuid,station,local_id,serial,created_utc,runs_json,run_uuids_json,terms,ref_temp_c,"
      "coefficients_json,std_errors_json,n_bins,r2,residual_rms_dph,condition_number,"
      "std_before_dph,std_after_dph,std_ratio,warnings_json,std_errors_ols_json,error_model_json,"
-     "part_number,verdict_json,adev_floor_dph,temp_min_c,temp_max_c,grad_min_c,grad_max_c",
+     "part_number,verdict_json,adev_floor_dph,temp_min_c,temp_max_c,grad_min_c,grad_max_c,"
+     "model_choice_json",
      "uuid",
      "SELECT " STATION_REV("fit", "f.id") ", f.uuid, " STATION_FIT_STATION(
          "f") ", f.id, f.serial, f.created_utc, f.runs_json, "
@@ -79,8 +80,8 @@ const std::vector<FleetTable> kTables = {
               "f.std_ratio, "
               "f.warnings_json, f.std_errors_ols_json, f.error_model_json, f.part_number, "
               "f.verdict_json, "
-              "f.adev_floor_dph, f.temp_min_c, f.temp_max_c, f.grad_min_c, f.grad_max_c "
-              "FROM fits AS f WHERE f.id = :id",
+              "f.adev_floor_dph, f.temp_min_c, f.temp_max_c, f.grad_min_c, f.grad_max_c, "
+              "f.model_choice_json FROM fits AS f WHERE f.id = :id",
      Merge::upsert},
     {"releases", Item::release,
      "rev,uuid,station,local_id,fit_uuid,serial,released_utc,released_by,note,override_reason,"

@@ -122,6 +122,7 @@ nlohmann::json diagnostics_json(const compensation::FitResult& fit) {
     cands.push_back({{"term", c.option},
                      {"value", c.value},
                      {"std_error", c.std_error},
+                     {"likelihood_ratio", c.likelihood_ratio},
                      {"z", c.z},
                      {"significant", c.significant},
                      {"coefficients_with_it", coef}});

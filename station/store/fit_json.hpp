@@ -40,7 +40,9 @@ nlohmann::json fit_summary_json(const compensation::FitResult& fit,
 nlohmann::json fit_summary_json_with_diagnostics(const compensation::FitResult& fit,
                                                  const compensation::Evaluation& eval);
 /// {"vif": {name: VIF}, "vif_limit", "missing_term_candidates": [{"term", "value", "std_error",
-/// "z", "significant", "coefficients_with_it"}], "z_critical"} (compensation/fit_diagnostics.hpp).
+/// "likelihood_ratio", "z", "significant", "coefficients_with_it"}], "z_critical"}
+/// (compensation/fit_diagnostics.hpp: z is the likelihood ratio's signed root, std_error the
+/// Wald error under the fit's own error model).
 nlohmann::json diagnostics_json(const compensation::FitResult& fit);
 /// The std ratio as JSON: a number, or null when undefined.
 nlohmann::json std_ratio_json(const compensation::Evaluation& eval);

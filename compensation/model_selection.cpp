@@ -1,0 +1,133 @@
+// Forward selection of the model's terms (see the header).
+#include "compensation/model_selection.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <set>
+
+#include "compensation/cross_validation.hpp"
+#include "compensation/fit_diagnostics.hpp"
+#include "compensation/model_choice.hpp"
+
+namespace station::compensation {
+namespace {
+
+std::string spec_text(const ModelSpec& s) {
+  std::string out = "B0";
+  for (const Term t : s.terms) out += "+" + std::string(term_option_name(t));
+  return out;
+}
+
+std::string num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4g", v);
+  return buf;
+}
+
+ModelSpec with(const ModelSpec& s, Term t) {
+  ModelSpec out = s;
+  out.terms.push_back(t);
+  return out;
+}
+
+/// The one-standard-error rule on paired folds (Hastie, Tibshirani & Friedman §7.10.1, here for
+/// one more term): the held-out mean squared error of each run without the term minus with it,
+/// d_r; the term helps when mean(d) exceeds its standard error sd(d) / sqrt(R). With two runs
+/// that is: it lowers the prediction error on both.
+double help_beyond_one_se(const CrossValidation& without, const CrossValidation& with_term) {
+  std::vector<double> d;
+  for (std::size_t r = 0; r < without.runs.size() && r < with_term.runs.size(); ++r)
+    d.push_back(std::pow(without.runs[r].rms_dph, 2) - std::pow(with_term.runs[r].rms_dph, 2));
+  if (d.size() < 2) return 0;
+  double mean = 0;
+  for (const double v : d) mean += v / static_cast<double>(d.size());
+  return mean - sample_std(d) / std::sqrt(static_cast<double>(d.size()));
+}
+
+/// One step by held-out error: of the candidates that help beyond one standard error and whose
+/// likelihood ratio over all the runs passes the bound, the one with the lowest pooled RMS.
+std::optional<Term> step_by_cv(const ModelInput& in, ModelSelection& sel, int step,
+                               CrossValidation& current) {
+  std::optional<Term> best;
+  std::optional<CrossValidation> best_cv;
+  const std::vector<Term> cands = candidates_for(in, sel.chosen);
+  if (cands.empty()) return best;
+  const double bound = std::pow(candidate_z_critical(cands.size()), 2);
+  const std::vector<double> lr = extension_likelihood_ratios(in, sel.chosen, cands, bound);
+  for (std::size_t k = 0; k < cands.size(); ++k) {
+    const Term t = cands[k];
+    TriedModel m;
+    m.spec = with(sel.chosen, t);
+    m.step = step;
+    m.added = term_option_name(t);
+    m.likelihood_ratio = lr[k];
+    try {
+      CrossValidation cv = leave_one_run_out(in, m.spec);
+      m.held_out_rms_dph = cv.pooled_rms_dph;
+      if (lr[k] > bound && help_beyond_one_se(current, cv) > 0 &&
+          (!best_cv || cv.pooled_rms_dph < best_cv->pooled_rms_dph))
+        best = t, best_cv = std::move(cv);
+    } catch (const std::exception& e) {
+      m.not_fitted = e.what();
+    }
+    sel.tried.push_back(std::move(m));
+  }
+  if (best_cv) current = std::move(*best_cv);
+  return best;
+}
+
+/// One step by likelihood ratio: the candidate with the largest ratio, if beyond the bound.
+std::optional<Term> step_by_lr(const ModelInput& in, ModelSelection& sel, int step) {
+  const std::vector<Term> cands = candidates_for(in, sel.chosen);
+  if (cands.empty()) return std::nullopt;
+  const double bound = std::pow(candidate_z_critical(cands.size()), 2);
+  const std::vector<double> lr = extension_likelihood_ratios(in, sel.chosen, cands, bound);
+  std::optional<Term> best;
+  double best_lr = bound;
+  for (std::size_t k = 0; k < cands.size(); ++k) {
+    TriedModel m;
+    m.spec = with(sel.chosen, cands[k]);
+    m.step = step;
+    m.added = term_option_name(cands[k]);
+    m.likelihood_ratio = lr[k];
+    sel.tried.push_back(std::move(m));
+    if (lr[k] > best_lr) best_lr = lr[k], best = cands[k];
+  }
+  return best;
+}
+
+}  // namespace
+
+ModelSelection select_model(const ModelInput& in, const ModelSpec& base) {
+  ModelSelection sel;
+  sel.chosen = base;
+  const std::set<int> runs(in.segment.begin(), in.segment.end());
+  const bool cv = runs.size() >= 2;
+  sel.method = cv ? "leave-one-run-out" : "likelihood ratio";
+  CrossValidation current;
+  sel.tried.emplace_back().spec = base;
+  if (cv) {
+    current = leave_one_run_out(in, base);
+    sel.tried.back().held_out_rms_dph = current.pooled_rms_dph;
+  } else {
+    (void)fit_model(in, base);  // the base must fit: its errors are what the caller reads
+  }
+  for (int step = 1;; ++step) {
+    const auto t = cv ? step_by_cv(in, sel, step, current) : step_by_lr(in, sel, step);
+    if (!t) break;
+    sel.chosen = with(sel.chosen, *t);
+  }
+  for (auto& m : sel.tried)
+    m.chosen = spec_text(m.spec) == spec_text(sel.chosen) && !m.not_fitted;
+  sel.reason =
+      cv ? "held-out RMS " + num(current.pooled_rms_dph * 1e3) + " mdeg/h over " +
+               std::to_string(runs.size()) + " runs, each left out in turn; a term added only "
+               "where it lowered the held-out error by more than its standard error across the "
+               "runs"
+         : "one run: each term added only while its likelihood ratio (each model with its own "
+           "error model) passed the 1 % family-wise bound over the candidates left";
+  sel.reason = spec_text(sel.chosen) + ": " + sel.reason;
+  return sel;
+}
+
+}  // namespace station::compensation
