@@ -86,10 +86,18 @@ struct NoiseTerms {
 /// + K'^2 tau/3), each point weighted by the inverse variance of its AVAR estimate,
 /// 2 sigma^4 / edf (chi-squared with the point's Greenhall edf), the model's sigma iterated in
 /// place of the noisy estimate; the squared coefficients kept non-negative (the best of the
-/// term subsets whose fit is feasible: the NNLS solution). The terms no longer depend on which
-/// taus the curve has. Standard errors from the fit's covariance, scaled up by chi^2/dof when the
-/// model does not explain the points, and carried to each coefficient by the delta method
-/// (se(c) = se(c^2) / 2c). Rate in deg/h, tau in s. Pure.
+/// term subsets whose fit is feasible: the NNLS solution). At most 4 points per octave enter
+/// (denser curves are thinned by tau). The terms do not depend on which taus the curve has.
+/// Standard errors: the sandwich covariance of that fit under the model covariance of the
+/// correlated overlapping AVAR estimates at the fitted terms (noise_fit_cov.hpp; points without
+/// m and n, e.g. an analytic curve, are taken as independent with variance 2 sigma^4 / edf),
+/// scaled up by fit_chi2_per_dof when that is above 1, and carried to each coefficient by the
+/// delta method (se(c) = se(c^2) / 2c). fit_chi2_per_dof is the generalized chi^2 of the
+/// residuals under that covariance over its expectation (about 1 when the terms explain the
+/// curve; chi^2 / dof for independent points). Q is reported only when Q^2 is above 0 at the
+/// one-sided 1 % level under that covariance, else the other terms are refit without it (about
+/// 1 % of Q-free records report one); N, B and K whenever the fit keeps them. Rate in deg/h, tau
+/// in s. A few ms for an octave curve of 2e6 samples. Pure.
 NoiseTerms fit_noise_terms(std::span<const AdevPoint> curve);
 
 /// The Allan deviation the terms predict at tau (deg/h): the fitted model drawn on a figure.

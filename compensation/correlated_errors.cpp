@@ -4,6 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <map>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -27,18 +30,52 @@ void add_mixture(ErrorModel& model, std::vector<Point>& grid, const Point& best,
                  const Problem& pb) {
   std::vector<Point> kept;
   for (const Point& e : grid) {
-    if (!std::isfinite(e.profile.minus2_loglik) || !(e.profile.sigma2 > 0)) continue;
+    if (!std::isfinite(objective(e, pb)) || !(e.profile.sigma2 > 0)) continue;
     kept.push_back(e);
   }
-  std::stable_sort(kept.begin(), kept.end(), [](const Point& a, const Point& b) {
-    return a.profile.minus2_loglik < b.profile.minus2_loglik;
+  std::stable_sort(kept.begin(), kept.end(), [&pb](const Point& a, const Point& b) {
+    return objective(a, pb) < objective(b, pb);
   });
   for (const Point& e : kept) {
-    const double w = std::exp(-0.5 * (e.profile.minus2_loglik - best.profile.minus2_loglik));
+    const double w = std::exp(-0.5 * (objective(e, pb) - objective(best, pb)));
     if (w < kMinWeight || model.mixture.size() == kMaxComponents) break;
     model.mixture.push_back({e.q > 0 ? std::exp(e.log_tau) : 0, e.q, std::sqrt(e.profile.sigma2),
                              std::sqrt(e.profile.sigma2) * std::sqrt(walk_per_h(pb, e.u)), w});
   }
+}
+
+// chi^2(1) at 95 %: a walk whose profile restricted likelihood is within this of the best is not
+// excluded by the bins (the profile-likelihood interval; Pawitan, In All Likelihood, 2001, 2.6).
+constexpr double kChi2One95 = 3.8415;
+
+/// The largest walk the bins do not exclude at 95 %: the profile of -2 l_R over the walk's size
+/// (the coarse grid's best over tau and q at each size), where it crosses best + kChi2One95,
+/// linear in the size between grid values; the Gauss-Markov part and s of the point below it.
+std::optional<ErrorModel::Component> largest_walk_not_excluded(const std::vector<Point>& grid,
+                                                               const Problem& pb) {
+  std::map<double, const Point*> profile;  // by walk size u, increasing
+  double best = std::numeric_limits<double>::infinity();
+  for (const Point& e : grid) {
+    if (!std::isfinite(e.profile.minus2_loglik) || !(e.profile.sigma2 > 0)) continue;
+    auto [it, added] = profile.try_emplace(e.u, &e);
+    if (!added && e.profile.minus2_loglik < it->second->profile.minus2_loglik) it->second = &e;
+    best = std::min(best, e.profile.minus2_loglik);
+  }
+  const double bound = best + kChi2One95;
+  auto last = profile.end();  // the largest size inside the bound
+  for (auto it = profile.begin(); it != profile.end(); ++it)
+    if (it->second->profile.minus2_loglik <= bound) last = it;
+  if (last == profile.end()) return std::nullopt;
+  const Point* inside = last->second;
+  double u = last->first;
+  if (const auto next = std::next(last); next != profile.end()) {  // crosses between the two
+    const double d0 = inside->profile.minus2_loglik, d1 = next->second->profile.minus2_loglik;
+    u += (next->first - u) * std::clamp((bound - d0) / (d1 - d0), 0.0, 1.0);
+  }
+  if (u <= kWalkLo) return std::nullopt;
+  const double s2 = inside->profile.sigma2;
+  return ErrorModel::Component{inside->q > 0 ? std::exp(inside->log_tau) : 0, inside->q,
+                               std::sqrt(s2), std::sqrt(s2 * walk_per_h(pb, u)), 1.0};
 }
 
 /// Independent bins: sigma from the OLS residuals (RSS / (n - p)).
@@ -52,7 +89,8 @@ ErrorModel ols_only(const Eigen::MatrixXd& x, const Eigen::VectorXd& y) {
 }  // namespace
 
 ErrorModel estimate_error_model(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
-                                std::span<const double> t_s, std::span<const int> segment) {
+                                std::span<const double> t_s, std::span<const int> segment,
+                                const NoisePrior* prior) {
   const Eigen::Index n = x.rows(), p = x.cols();
   ErrorModel model;
   if (n < p + kMinBinsForErrorModelExtra || p < 1 ||
@@ -60,6 +98,8 @@ ErrorModel estimate_error_model(const Eigen::MatrixXd& x, const Eigen::VectorXd&
     return ols_only(x, y);
   }
   Problem pb = make_problem(x, y, t_s, segment);
+  pb.prior = prior != nullptr && !prior->empty() ? prior : nullptr;
+  if (pb.prior != nullptr) model.prior = *pb.prior;
   const double hi = pb.tau_hi, spacing_s = pb.spacing_s;
   Point best = iid_point(pb);
   std::vector<Point> grid;
@@ -73,6 +113,7 @@ ErrorModel estimate_error_model(const Eigen::MatrixXd& x, const Eigen::VectorXd&
   }
   model.sigma_dph = std::sqrt(best.profile.sigma2);
   add_mixture(model, grid, best, pb);
+  model.walk_not_excluded = largest_walk_not_excluded(grid, pb);
   if (best.q <= 0 && best.u <= kWalkLo && model.mixture.empty())
     return model;  // no correlated part: independent bins
   model.method = "white+gm+rrw (REML)";

@@ -29,9 +29,12 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
+
+#include "compensation/noise_prior.hpp"
 
 namespace station::compensation {
 
@@ -56,6 +59,12 @@ struct ErrorModel {
     double corr_time_s = 0, correlated_share = 0, sigma_dph = 0, rrw_dph_per_sqrt_h = 0, weight = 0;
   };
   std::vector<Component> mixture;
+  /// The largest rate random walk the bins do not exclude at 95 % (profile restricted
+  /// likelihood), with the rest of its error model; empty when the bins exclude every walk.
+  /// What a fit without a prior assumed about a walk it cannot see (issue 32).
+  std::optional<Component> walk_not_excluded;
+  /// The part's noise the model was estimated under (noise_prior.hpp); empty: none given.
+  std::optional<NoisePrior> prior;
 };
 
 /// Bins beyond the p coefficients the error model needs to estimate anything: with fewer it is
@@ -68,8 +77,10 @@ inline constexpr long kMinBinsForErrorModelExtra = 5;
 /// bin times (increasing within a segment), `segment` the run each bin came from (bins of different
 /// runs are independent; empty: one run). Needs at least p + kMinBinsForErrorModelExtra bins; with
 /// fewer the model is "iid" with s^2 = RSS/(n-p).
+/// `prior`: the part's noise (noise_prior.hpp), weighing the models with the likelihood.
 ErrorModel estimate_error_model(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
-                                std::span<const double> t_s, std::span<const int> segment);
+                                std::span<const double> t_s, std::span<const int> segment,
+                                const NoisePrior* prior = nullptr);
 
 /// Variances of the OLS coefficients of y = X b + e under `model` (its mixture when it has one),
 /// with X = Q R (thin QR, Q `q_basis` n x p, `r_inv` = R^-1): the diagonal of s^2 R^-1 Q' C Q R^-T,

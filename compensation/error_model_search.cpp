@@ -129,7 +129,7 @@ void search(Point& best, Problem& pb, const Box& b, int steps) {
   evaluate(pts, pb, best);
   for (const Point& e : pts) {
     if (pb.record) pb.record->push_back(e);
-    if (e.profile.minus2_loglik < best.profile.minus2_loglik) best = e;
+    if (objective(e, pb) < objective(best, pb)) best = e;
   }
 }
 
@@ -179,6 +179,18 @@ Point iid_point(Problem& pb) {
   std::vector<Point> one{iid};
   evaluate(one, pb, Point{0, -1, 0, {}, {}});  // q = -1: no model repeats it
   return one[0];
+}
+
+double walk_dph_rt_h(const Point& e, const Problem& pb) {
+  return std::sqrt(e.profile.sigma2 * walk_per_h(pb, e.u));
+}
+
+double objective(const Point& e, const Problem& pb) {
+  if (pb.prior == nullptr) return e.profile.minus2_loglik;
+  const double white_sd = std::sqrt((1 - e.q) * e.profile.sigma2);
+  return e.profile.minus2_loglik +
+         noise_prior_penalty(*pb.prior, white_sd, walk_dph_rt_h(e, pb), pb.spacing_s,
+                             pb.span_h);
 }
 
 Box whole_box(const Problem& pb) {

@@ -10,6 +10,7 @@
 #include <span>
 #include <vector>
 
+#include "compensation/noise_prior.hpp"
 #include "compensation/reml_filter.hpp"
 
 namespace station::compensation::model_search {
@@ -47,6 +48,7 @@ struct Problem {
   std::map<double, std::vector<double>> phi;  // step correlations by log tau, made once each
   std::vector<Point>* record = nullptr;
   std::span<const reml::Columns> subsets;  // non-empty: the maximum likelihood search
+  const NoisePrior* prior = nullptr;       // the part's noise (noise_prior.hpp), if given
 
   const std::vector<double>& phi_at(double log_tau) {
     auto [it, added] = phi.try_emplace(log_tau);
@@ -65,6 +67,10 @@ inline constexpr double kWalkLo = -3, kWalkHi = 2;
 
 /// The walk's variance per hour (units of s^2) at size u.
 double walk_per_h(const Problem& pb, double u);
+/// A point's walk, deg/h/sqrt(h), at its restricted-likelihood s^2.
+double walk_dph_rt_h(const Point& e, const Problem& pb);
+/// What the restricted-likelihood search minimizes: -2 l_R, plus -2 log prior with pb.prior.
+double objective(const Point& e, const Problem& pb);
 /// The search's problem for y on the columns of x, bins at t_s in runs `segment`.
 Problem make_problem(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
                      std::span<const double> t_s, std::span<const int> segment);
@@ -76,7 +82,7 @@ Box refined_box(const Point& c, int round, const Problem& pb);
 std::vector<Point> grid_points(const Box& b, int steps);
 /// Evaluates each point: its restricted likelihood, or with pb.subsets its maximum likelihoods.
 void evaluate(std::vector<Point>& pts, Problem& pb, const Point& known);
-/// Grid search over the box for the most likely point by restricted likelihood.
+/// Grid search over the box for the point of least objective().
 void search(Point& best, Problem& pb, const Box& b, int steps);
 /// Finer searches around the best point so far, each on a grid half as wide.
 void refine(Point& best, Problem& pb);

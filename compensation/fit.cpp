@@ -349,6 +349,19 @@ void set_goodness(FitResult& res, const Eigen::Ref<const Eigen::VectorXd>& y, do
   res.residual_rms_dph = std::sqrt(rss / static_cast<double>(y.size()));
 }
 
+/// Without a prior: the standard errors under the largest walk the bins do not exclude.
+void set_walk_errors(FitResult& res, const Eigen::MatrixXd& q_basis, const Eigen::MatrixXd& r_inv,
+                     const ModelInput& in, const Eigen::VectorXd& scale) {
+  if (res.error_model.prior || !res.error_model.walk_not_excluded) return;
+  ErrorModel walk;
+  const auto& c = *res.error_model.walk_not_excluded;
+  walk.corr_time_s = c.corr_time_s, walk.correlated_share = c.correlated_share;
+  walk.sigma_dph = c.sigma_dph, walk.rrw_dph_per_sqrt_h = c.rrw_dph_per_sqrt_h;
+  const Eigen::VectorXd v = ols_variances_under(walk, q_basis, r_inv, in.t_s, in.segment);
+  for (Eigen::Index j = 0; j < v.size(); ++j)
+    res.std_errors_walk_not_excluded.push_back(std::sqrt(v(j)) / scale(j));
+}
+
 FitResult fit_impl(const ModelInput& in, const ModelSpec& spec, const ErrorModel* fixed) {
   const std::size_t p = spec.terms.size() + 1;
   const std::size_t n = in.bias_dph.size();
@@ -385,8 +398,10 @@ FitResult fit_impl(const ModelInput& in, const ModelSpec& spec, const ErrorModel
   // The error model sees the orthonormal basis Q of the design (same column space, so the same
   // likelihood) and the sandwich is formed from Q and R^-1: neither squares X's condition.
   const Eigen::MatrixXd q_basis = qr.householderQ() * Eigen::MatrixXd::Identity(x.rows(), pi);
-  res.error_model =
-      fixed != nullptr ? *fixed : estimate_error_model(q_basis, y, in.t_s, in.segment);
+  res.error_model = fixed != nullptr ? *fixed
+                                      : estimate_error_model(q_basis, y, in.t_s, in.segment,
+                                                             spec.noise_prior ? &*spec.noise_prior
+                                                                              : nullptr);
   // No correlated part: the model's covariance is s^2 I and the errors are the OLS ones exactly.
   const Eigen::VectorXd var_model =
       res.error_model.correlated_share > 0 || res.error_model.rrw_dph_per_sqrt_h > 0 ||
@@ -401,6 +416,7 @@ FitResult fit_impl(const ModelInput& in, const ModelSpec& spec, const ErrorModel
   const Eigen::VectorXd var_hac =
       fixed != nullptr ? Eigen::VectorXd::Zero(pi) : hac_variances(x, resid, r_inv, res.hac_lag);
   set_coefficients(res, spec, beta_scaled, scale, var_model, var_scaled, var_hac);
+  if (fixed == nullptr) set_walk_errors(res, q_basis, r_inv, in, scale);
   set_goodness(res, y, rss);
   add_fit_warnings(res, n, p, fixed != nullptr);
   check_result(res);

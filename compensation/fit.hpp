@@ -8,6 +8,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "compensation/binning.hpp"
@@ -34,8 +35,14 @@ std::vector<Term> parse_terms(std::string_view list);
 
 /// Which terms, and the reference temperature for dT.
 struct ModelSpec {
+  ModelSpec() = default;
+  ModelSpec(std::vector<Term> t, double ref_c, std::optional<NoisePrior> prior = std::nullopt)
+      : terms(std::move(t)), ref_temp_c(ref_c), noise_prior(std::move(prior)) {}
+
   std::vector<Term> terms{Term::dT, Term::gradT};  ///< the paper's k1 and k0
   double ref_temp_c = 25.0;                        ///< T_ref, deg C
+  /// The part's noise, a prior on the error model (noise_prior.hpp); empty: none known.
+  std::optional<NoisePrior> noise_prior;
 };
 
 /// Per-bin model inputs (all spans the same length; grad/dtdt/channel may be empty if unused).
@@ -77,6 +84,9 @@ struct FitResult {
   /// comparison (they are optimistic when the bins share bias-instability noise).
   std::vector<double> std_errors_ols;
   ErrorModel error_model;  ///< the error model behind std_errors
+  /// Without a prior: each coefficient's standard error under the largest walk the bins do not
+  /// exclude (error_model.walk_not_excluded); empty when there is none or a prior was given.
+  std::vector<double> std_errors_walk_not_excluded;
   /// Newey-West (HAC) standard errors: honest when the residuals of neighbouring bins are
   /// correlated (bias instability over hours). Bartlett weights up to hac_lag bins.
   std::vector<double> std_errors_hac;

@@ -34,7 +34,18 @@ struct AnalyzeOptions {
   std::optional<double> earth_rate_dph, latitude_deg;
   std::string axis = "up";
   bool json = false;
+  /// The part's noise (--arw, --bias-instability, --rrw, --noise-trust): a prior on the error
+  /// model, in the part file's units (compensation/noise_prior.hpp).
+  std::optional<double> arw_deg_rt_h, bias_instability_dph, rrw_dph_rt_h;
+  double noise_trust = sc::NoisePrior{}.trust_factor;
 };
+
+/// The prior the options give; empty when they give no term.
+std::optional<sc::NoisePrior> noise_prior_of(const AnalyzeOptions& o) {
+  sc::NoisePrior p{o.arw_deg_rt_h, o.bias_instability_dph, o.rrw_dph_rt_h, o.noise_trust};
+  if (p.empty()) return std::nullopt;
+  return p;
+}
 
 /// Earth rate from the options: explicit value, or latitude + axis ("up", ..., "heading:DEG").
 double earth_rate_from(const AnalyzeOptions& o) {
@@ -122,7 +133,7 @@ Analysis analyze(const AnalyzeOptions& o) {
     const sc::ModelData data = sc::model_data_from_bins(bins, a.earth_rate_dph);
     a.bins_used = data.bias_dph.size();
     a.bins_flagged = bins.size() - a.bins_used;
-    a.fit = sc::fit_model(data.view(), sc::ModelSpec{terms, o.ref_temp_c});
+    a.fit = sc::fit_model(data.view(), sc::ModelSpec{terms, o.ref_temp_c, noise_prior_of(o)});
     a.eval = sc::evaluate(data.bias_dph, sc::compensate(a.fit, data.view()), a.earth_rate_dph);
   } catch (const sc::DataError& e) {
     throw InputError(fmt::format("{}: {}", o.file, e.what()));
@@ -167,6 +178,7 @@ void print_table(const AnalyzeOptions& o, const Analysis& a) {
   fmt::print("\n{}\n", evaluation_text(a.eval));
   fmt::print("R^2 {:.4f}, residual RMS {:.5f} deg/h, condition number {:.1f}\n", a.fit.r2,
              a.fit.residual_rms_dph, a.fit.condition_number);
+  fmt::print("{}\n", walk_text(a.fit));
   for (const auto& w : a.warnings) fmt::print("warning: {}\n", w);
 }
 
@@ -207,6 +219,20 @@ void add_analyze_command(CLI::App& app, CommandStatus& status) {
       ->check(finite_within(-90.0, 90.0, "deg"));
   cmd->add_option("--axis", o->axis, "up|down|north|south|east|west|heading:DEG")
       ->capture_default_str();
+  cmd->add_option("--arw", o->arw_deg_rt_h,
+                  "the part's angle random walk N, deg/sqrt(h): a prior on the error model")
+      ->check(finite_positive(1e6, "deg/sqrt(h)"));
+  cmd->add_option("--bias-instability", o->bias_instability_dph,
+                  "the part's bias instability B, deg/h: a prior on the error model")
+      ->check(finite_positive(1e6, "deg/h"));
+  cmd->add_option("--rrw", o->rrw_dph_rt_h,
+                  "the part's rate random walk K, deg/h/sqrt(h) (0: none): a prior on the error "
+                  "model")
+      ->check(finite_within(0.0, 1e6, "deg/h/sqrt(h)"));
+  cmd->add_option("--noise-trust", o->noise_trust,
+                  "how far to trust the part's noise: the true value within x/ this factor")
+      ->capture_default_str()
+      ->check(finite_within(1.0001, 1e3, ""));
   cmd->add_flag("--json", o->json, "print one JSON object");
   cmd->callback([o, &status] {
     const Analysis a = analyze(*o);

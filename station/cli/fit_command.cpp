@@ -27,6 +27,7 @@ struct FitOptions {
   std::optional<std::int64_t> run;
   double ref_temp_c = 25.0;
   bool all = false, json = false, cv = false, select = false;
+  bool terms_given = false;  ///< --terms was on the command line (a part's model gives way)
 };
 
 /// Leave-one-run-out cross-validation of one fit's model over its runs, or why there is none
@@ -111,6 +112,7 @@ void print_fit(const JudgedFit& jf) {
                f.fit.std_errors_ols[i], vif);
   }
   fmt::print("  {}\n", error_model_text(f.fit.error_model));
+  fmt::print("  {}\n", walk_text(f.fit));
   fmt::print("  {}\n", evaluation_text(f.eval));
   for (const auto& w : f.fit.warnings) fmt::print("  warning: {}\n", w);
   if (jf.adev_floor_dph) fmt::print("  ADEV floor {:.5f} deg/h\n", *jf.adev_floor_dph);
@@ -144,17 +146,21 @@ int run_fit(const FitOptions& o) {
   if (o.all) {
     if (o.run && !store.find_run(*o.run))
       throw InputError(fmt::format("{}: no run {}", o.db, *o.run));
-    result = fit_all(store, o.run, spec, choice);
+    result = fit_all(store, o.run, spec, choice, o.terms_given);
   } else {
     const auto runs = o.runs.empty() ? store.runs_of_serial(o.serial) : o.runs;
     const auto limits = runs.empty() ? std::nullopt : limits_for(store, o.serial, runs, choice);
+    const sc::ModelSpec part_spec = part_model_spec(spec, limits, o.terms_given);
     std::optional<sc::ModelSelection> sel;
-    if (o.select && !runs.empty()) sel = select_for(store, o.serial, runs, spec);
-    result.fits.push_back(
-        judge_and_store(store, fit_serial(store, o.serial, runs, sel ? sel->chosen : spec), limits));
+    if (o.select && !runs.empty()) sel = select_for(store, o.serial, runs, part_spec);
+    result.fits.push_back(judge_and_store(
+        store, fit_serial(store, o.serial, runs, sel ? sel->chosen : part_spec), limits));
+    const auto fit_id = result.fits.back().fit.fit_id;
     if (sel) {
-      save_fit_model_choice(store, result.fits.back().fit.fit_id, model_selection_json(*sel));
+      save_fit_model_choice(store, fit_id, model_selection_json(*sel));
       if (!o.json) fmt::print("{}", model_selection_text(*sel));
+    } else {
+      note_part_model(store, fit_id, limits, o.terms_given);
     }
   }
   // Serials with nothing to fit: one line each on stderr, and exit status 1 (the others stored).
@@ -211,7 +217,10 @@ void add_fit_commands(CLI::App& app, CommandStatus& status) {
   fit->add_flag("--cv", o->cv,
                 "leave-one-run-out cross-validation: prediction error on each held-out run "
                 "beside the in-sample residual (two or more runs)");
-  fit->callback([o, &status] { status.exit_code = run_fit(*o); });
+  fit->callback([o, fit, &status] {
+    o->terms_given = fit->count("--terms") > 0;
+    status.exit_code = run_fit(*o);
+  });
 }
 
 }  // namespace station

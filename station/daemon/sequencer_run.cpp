@@ -32,11 +32,15 @@ RunState Sequencer::finish(RunState end_state, double t_s) {
   for (const auto& slot : config_.slots) {
     try {
       const auto it = lossy.find(slot.serial);
+      const auto part = options_.part_limits.find(slot.serial);
+      const auto limits = part == options_.part_limits.end() ? std::nullopt
+                                                             : std::optional{part->second};
+      compensation::ModelSpec paper;  // B0 + k1 dT + k0 gradT
+      paper.ref_temp_c = config_.ref_temp_c;
       const auto f =
-          fit_serial(store_, slot.serial, {run_id_},
-                     compensation::ModelSpec{{compensation::Term::dT, compensation::Term::gradT},
-                                             config_.ref_temp_c},
+          fit_serial(store_, slot.serial, {run_id_}, part_model_spec(paper, limits, false),
                      it == lossy.end() ? std::vector<std::string>{} : std::vector{it->second});
+      note_part_model(store_, f.fit_id, limits, false);
       emit(t_s, Severity::info, "seq", EventKind::fit,
            fmt::format("{}: k1 {:.4e} deg/h/C, k0 {:.4e} deg/h/C, std ratio {} over {} bins",
                        slot.serial, f.fit.coefficients[1], f.fit.coefficients[2],

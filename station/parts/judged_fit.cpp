@@ -7,6 +7,7 @@
 #include <algorithm>
 
 #include "compensation/adev_floor.hpp"
+#include "station/store/fit_model_choice.hpp"
 #include "station/store/fit_verdicts.hpp"
 #include "station/store/serial_history.hpp"
 
@@ -79,8 +80,22 @@ std::optional<Verdict> stored_verdict(Store& store, std::int64_t fit_id) {
   }
 }
 
+sc::ModelSpec part_model_spec(sc::ModelSpec given, const std::optional<PartLimits>& limits,
+                              bool terms_given) {
+  if (!limits) return given;
+  if (limits->model && !terms_given) given.terms = sc::parse_terms(*limits->model);
+  if (limits->noise) given.noise_prior = limits->noise;
+  return given;
+}
+
+void note_part_model(Store& store, std::int64_t fit_id, const std::optional<PartLimits>& limits,
+                     bool terms_given) {
+  if (limits && limits->model && !terms_given)
+    save_fit_model_choice(store, fit_id, part_model_choice_json(limits->number, *limits->model));
+}
+
 FitAllResult fit_all(Store& store, std::optional<std::int64_t> run_id, const sc::ModelSpec& spec,
-                     const PartChoice& choice) {
+                     const PartChoice& choice, bool terms_given) {
   std::vector<std::string> serials;
   if (run_id) {
     for (const auto& s : store.run_slots(*run_id)) serials.push_back(s.serial);
@@ -96,7 +111,10 @@ FitAllResult fit_all(Store& store, std::optional<std::int64_t> run_id, const sc:
         run_id ? std::vector{*run_id} : store.runs_of_serial(serial);
     const auto limits = limits_for(store, serial, runs, choice);
     try {
-      out.fits.push_back(judge_and_store(store, fit_serial(store, serial, runs, spec), limits));
+      out.fits.push_back(judge_and_store(
+          store, fit_serial(store, serial, runs, part_model_spec(spec, limits, terms_given)),
+          limits));
+      note_part_model(store, out.fits.back().fit.fit_id, limits, terms_given);
     } catch (const InputError& e) {
       out.skipped.emplace_back(e.what());
     }

@@ -34,6 +34,18 @@ std::optional<PartLimits> limits_for(Store& store, const std::string& serial,
                                      const std::vector<std::int64_t>& runs,
                                      const PartChoice& choice);
 
+/// The model a fit judged against `limits` uses (one rule for fit, fit --all and run): `given`,
+/// whose terms give way to the part's model when the part file fixes one and the terms were
+/// not given explicitly (`terms_given`), with the part's noise as the prior on the error model.
+compensation::ModelSpec part_model_spec(compensation::ModelSpec given,
+                                        const std::optional<PartLimits>& limits,
+                                        bool terms_given);
+
+/// Stores with fit `fit_id` that its part fixed its model (migration 9), when part_model_spec
+/// took the part's model.
+void note_part_model(Store& store, std::int64_t fit_id, const std::optional<PartLimits>& limits,
+                     bool terms_given);
+
 /// The compensated 1 Hz record of `serial` in `run_id`: rate - Earth rate - model, over the
 /// samples that went into bins (gaps closed up). Empty when the model has a term the 1 Hz record
 /// does not carry (dTdt, channel).
@@ -61,7 +73,9 @@ struct FitAllResult {
 /// Fits and judges every serial of run `run_id` over that run (no run: every serial of the
 /// database over all its runs) in one transaction. A serial with nothing to fit is skipped and
 /// listed; a part-file error throws and rolls everything back.
+/// `spec` goes through part_model_spec per serial (`terms_given`: the terms were explicit).
 FitAllResult fit_all(Store& store, std::optional<std::int64_t> run_id,
-                     const compensation::ModelSpec& spec, const PartChoice& choice);
+                     const compensation::ModelSpec& spec, const PartChoice& choice,
+                     bool terms_given = false);
 
 }  // namespace station

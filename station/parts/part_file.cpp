@@ -7,7 +7,9 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "compensation/fit.hpp"
 #include "station/config/toml_reader.hpp"
+#include "station/store/fit_json.hpp"
 
 namespace station {
 namespace {
@@ -33,10 +35,42 @@ LimitRange read_range(const TomlView& part, std::string_view key) {
   return r;
 }
 
+/// [part."PN".noise]: the IEEE 952 terms the part's data sheet gives, and how far to trust them.
+std::optional<compensation::NoisePrior> read_noise(const TomlView& part) {
+  const auto t = part.opt_table("noise");
+  if (!t) return std::nullopt;
+  t->allow_only({"arw_deg_rt_h", "bias_instability_dph", "rrw_dph_rt_h", "trust_factor"});
+  compensation::NoisePrior n;
+  n.arw_deg_rt_h = positive(*t, "arw_deg_rt_h");
+  n.bias_instability_dph = positive(*t, "bias_instability_dph");
+  n.rrw_dph_rt_h = t->opt_number("rrw_dph_rt_h");
+  if (n.rrw_dph_rt_h && !(*n.rrw_dph_rt_h >= 0))
+    throw t->error("rrw_dph_rt_h", fmt::format("{:g} must be 0 (no walk) or above", *n.rrw_dph_rt_h));
+  if (const auto f = t->opt_number("trust_factor")) {
+    if (!(*f > 1)) throw t->error("trust_factor", fmt::format("{:g} must be above 1", *f));
+    n.trust_factor = *f;
+  }
+  if (n.empty()) throw part.error("noise", "give arw_deg_rt_h, bias_instability_dph or rrw_dph_rt_h");
+  return n;
+}
+
+/// model = "dT,gradT": checked as `fit --terms` checks it.
+std::optional<std::string> read_model(const TomlView& part) {
+  const auto m = part.opt_string("model");
+  if (!m) return std::nullopt;
+  try {
+    (void)compensation::parse_terms(*m);
+  } catch (const std::invalid_argument& e) {
+    throw part.error("model", e.what());
+  }
+  return m;
+}
+
 PartLimits read_part(const TomlView& v, const std::string& number) {
   v.allow_only({"description", "B0_dph", "k1_dph_per_c", "k0_dph_per_c", "max_std_after_dph",
                 "max_std_ratio", "max_adev_floor_dph", "min_complete_bins", "max_k1_se_dph_per_c",
-                "max_k0_se_dph_per_c", "max_verify_std_dph", "max_verify_ratio"});
+                "max_k0_se_dph_per_c", "max_verify_std_dph", "max_verify_ratio", "model",
+                "noise"});
   PartLimits p;
   p.number = number;
   p.description = v.opt_string("description").value_or("");
@@ -52,8 +86,11 @@ PartLimits read_part(const TomlView& v, const std::string& number) {
   p.max_k0_se_dph_per_c = positive(v, "max_k0_se_dph_per_c");
   p.max_verify_std_dph = positive(v, "max_verify_std_dph");
   p.max_verify_ratio = positive(v, "max_verify_ratio");
+  p.model = read_model(v);
+  p.noise = read_noise(v);
   return p;
 }
+
 
 json range_json(const LimitRange& r) {
   json j = json::object();
@@ -148,6 +185,8 @@ json part_limits_json(const PartLimits& p) {
   put("max_k0_se_dph_per_c", p.max_k0_se_dph_per_c);
   put("max_verify_std_dph", p.max_verify_std_dph);
   put("max_verify_ratio", p.max_verify_ratio);
+  put("model", p.model);
+  if (p.noise) j["noise"] = noise_json(*p.noise);
   return j;
 }
 
@@ -167,6 +206,8 @@ PartLimits part_limits_from_json(const json& j) {
     p.max_k0_se_dph_per_c = opt_from_json<double>(j, "max_k0_se_dph_per_c");
     p.max_verify_std_dph = opt_from_json<double>(j, "max_verify_std_dph");
     p.max_verify_ratio = opt_from_json<double>(j, "max_verify_ratio");
+    p.model = opt_from_json<std::string>(j, "model");
+    if (j.contains("noise")) p.noise = noise_prior_from_json(j.at("noise"));
     return p;
   } catch (const json::exception& e) {
     throw std::invalid_argument(fmt::format("stored part limits: {}", e.what()));

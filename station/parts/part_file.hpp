@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 
+#include "compensation/noise_prior.hpp"
 #include "station/config/config.hpp"
 
 namespace station {
@@ -34,6 +35,11 @@ struct PartLimits {
   /// Verification on an independent run (`station verify`), not part of a fit's verdict:
   std::optional<double> max_verify_std_dph;  ///< std of the compensated bins, deg/h
   std::optional<double> max_verify_ratio;    ///< std after / std before on that run
+  /// The model production fits ("dT,gradT", compensation::parse_terms): a part file may fix it.
+  std::optional<std::string> model;
+  /// The part's noise ([part."PN".noise]): a prior on the fit's error model
+  /// (compensation/noise_prior.hpp), from the data sheet or `station adev`'s term fit.
+  std::optional<compensation::NoisePrior> noise;
 };
 
 /// A whole part file.

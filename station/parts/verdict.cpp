@@ -1,6 +1,8 @@
 // Verdict: every limit of the part, checked against the fit.
 #include "station/parts/verdict.hpp"
 
+#include "station/store/fit_json.hpp"
+
 #include <fmt/format.h>
 
 #include <cmath>
@@ -60,6 +62,7 @@ class Checker {
 Verdict judge_fit(const PartLimits& p, const VerdictInputs& in) {
   Verdict v;
   v.part_number = p.number;
+  v.context = walk_text(in.fit);
   Checker c(v);
   const auto b0 = coefficient(in.fit, "B0"), k1 = coefficient(in.fit, "k1"),
              k0 = coefficient(in.fit, "k0");
@@ -95,7 +98,9 @@ json verdict_json(const Verdict& v) {
                       {"value", f.value ? json(*f.value) : json(nullptr)},
                       {"bound", f.bound}});
   }
-  return {{"pass", v.pass}, {"failed", failed}, {"part", v.part_number}, {"checked", v.checked}};
+  json j{{"pass", v.pass}, {"failed", failed}, {"part", v.part_number}, {"checked", v.checked}};
+  if (!v.context.empty()) j["context"] = v.context;
+  return j;
 }
 
 Verdict verdict_from_json(const json& j) {
@@ -104,6 +109,7 @@ Verdict verdict_from_json(const json& j) {
     v.pass = j.at("pass").get<bool>();
     v.part_number = j.at("part").get<std::string>();
     v.checked = j.at("checked").get<int>();
+    v.context = j.value("context", "");
     for (const auto& f : j.at("failed")) {
       const json& value = f.at("value");
       v.failed.push_back({f.at("limit").get<std::string>(),

@@ -27,6 +27,9 @@ struct Verdict {
   bool pass = true;
   std::vector<LimitFailure> failed;
   int checked = 0;  ///< limits the part sets (each end of a range counts once)
+  /// What the fit's errors assumed about a rate random walk (walk_text of fit_json.hpp): the
+  /// part's noise, or the largest walk the bins could not exclude. Empty in older verdicts.
+  std::string context;
 };
 
 /// What a verdict looks at besides the coefficients.

@@ -102,6 +102,7 @@ std::string evaluation_table(const FitRecord& rec) {
   t += kv("bins (count)", {std::to_string(rec.fit.n_points)});
   t += kv("R\u00b2 (fraction)", {num(rec.fit.r2)});
   t += kv("uncertainty model", {html_escape(error_model_text(rec.fit.error_model))});
+  t += kv("rate random walk", {html_escape(walk_text(rec.fit))});
   t += kv("fit", {fmt::format("{} ({}, runs {})", rec.id, html_escape(rec.created_utc),
                               fmt::join(rec.runs, ","))});
   for (const auto& w : rec.fit.warnings) t += kv("warning", {html_escape(w)});

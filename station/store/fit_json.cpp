@@ -37,8 +37,29 @@ nlohmann::json std_errors_ols_json(const compensation::FitResult& fit) {
   return keyed(fit, fit.std_errors_ols);
 }
 
+nlohmann::json noise_json(const compensation::NoisePrior& n) {
+  nlohmann::json j{{"trust_factor", n.trust_factor}};
+  if (n.arw_deg_rt_h) j["arw_deg_rt_h"] = *n.arw_deg_rt_h;
+  if (n.bias_instability_dph) j["bias_instability_dph"] = *n.bias_instability_dph;
+  if (n.rrw_dph_rt_h) j["rrw_dph_rt_h"] = *n.rrw_dph_rt_h;
+  return j;
+}
+
+compensation::NoisePrior noise_prior_from_json(const nlohmann::json& j) {
+  compensation::NoisePrior n;
+  const auto opt = [&j](const char* key) {
+    return j.contains(key) ? std::optional(j.at(key).get<double>()) : std::nullopt;
+  };
+  n.arw_deg_rt_h = opt("arw_deg_rt_h");
+  n.bias_instability_dph = opt("bias_instability_dph");
+  n.rrw_dph_rt_h = opt("rrw_dph_rt_h");
+  n.trust_factor = j.value("trust_factor", n.trust_factor);
+  return n;
+}
+
+
 nlohmann::json error_model_json(const compensation::ErrorModel& m) {
-  return {{"method", m.method},
+  nlohmann::json j{{"method", m.method},
           {"corr_time_s", m.corr_time_s},
           {"correlated_share", m.correlated_share},
           {"sigma_dph", m.sigma_dph},
@@ -46,6 +67,52 @@ nlohmann::json error_model_json(const compensation::ErrorModel& m) {
           {"rrw_dph_per_sqrt_h", m.rrw_dph_per_sqrt_h},
           {"models_averaged", m.mixture.size()},
           {"on_search_boundary", m.on_search_boundary}};
+  j["prior"] = m.prior ? noise_json(*m.prior) : nlohmann::json();
+  return j;
+}
+
+nlohmann::json fit_error_model_json(const compensation::FitResult& fit) {
+  nlohmann::json j = error_model_json(fit.error_model);
+  const auto& w = fit.error_model.walk_not_excluded;
+  j["walk_not_excluded"] =
+      w ? nlohmann::json{{"rrw_dph_per_sqrt_h", w->rrw_dph_per_sqrt_h},
+                         {"std_errors", keyed(fit, fit.std_errors_walk_not_excluded)}}
+        : nlohmann::json();
+  return j;
+}
+
+void read_walk_not_excluded(const nlohmann::json& j, compensation::FitResult& fit) {
+  if (!j.contains("walk_not_excluded") || j.at("walk_not_excluded").is_null()) return;
+  const auto& w = j.at("walk_not_excluded");
+  compensation::ErrorModel::Component c;
+  c.rrw_dph_per_sqrt_h = w.at("rrw_dph_per_sqrt_h").get<double>();
+  fit.error_model.walk_not_excluded = c;
+  if (!w.at("std_errors").is_object()) return;
+  for (const auto& n : fit.names) fit.std_errors_walk_not_excluded.push_back(w.at("std_errors").at(n));
+}
+
+std::string walk_text(const compensation::FitResult& fit) {
+  const auto& m = fit.error_model;
+  if (m.prior) {
+    const auto& p = *m.prior;
+    const auto term = [](const char* name, const std::optional<double>& v, const char* unit) {
+      return v ? fmt::format(" {} {:.3g} {}", name, *v, unit) : std::string();
+    };
+    return fmt::format("noise: the part's{}{}{} (trust x{:g}) weighs the error model",
+                       term("N", p.arw_deg_rt_h, "deg/sqrt(h)"),
+                       term("B", p.bias_instability_dph, "deg/h"),
+                       term("K", p.rrw_dph_rt_h, "deg/h/sqrt(h)"), p.trust_factor);
+  }
+  if (!m.walk_not_excluded) return "walk: the bins exclude a rate random walk (95 %)";
+  std::string k1;
+  for (std::size_t i = 0; i < fit.names.size() && i < fit.std_errors_walk_not_excluded.size(); ++i)
+    if (fit.names[i] == "k1")
+      k1 = fmt::format("; under it k1 +- {:.2e} deg/h/C (reported +- {:.2e})",
+                       fit.std_errors_walk_not_excluded[i], fit.std_errors[i]);
+  return fmt::format(
+      "walk: the bins cannot exclude a rate random walk up to K = {:.2e} deg/h/sqrt(h) (95 %){}; "
+      "no part noise given (a part file's [part.\"PN\".noise] decides it)",
+      m.walk_not_excluded->rrw_dph_per_sqrt_h, k1);
 }
 
 std::string error_model_text(const compensation::ErrorModel& m) {
@@ -76,6 +143,7 @@ compensation::ErrorModel error_model_from_json(const nlohmann::json& j) {
   m.rho_per_bin = j.value("rho_per_bin", 0.0);
   m.rrw_dph_per_sqrt_h = j.value("rrw_dph_per_sqrt_h", 0.0);
   m.on_search_boundary = j.value("on_search_boundary", false);
+  if (j.contains("prior") && j.at("prior").is_object()) m.prior = noise_prior_from_json(j.at("prior"));
   return m;
 }
 
@@ -89,7 +157,8 @@ nlohmann::json fit_summary_json(const compensation::FitResult& fit,
           {"units", units_json(fit)},
           {"std_errors", std_errors_json(fit)},
           {"std_errors_ols", std_errors_ols_json(fit)},
-          {"error_model", error_model_json(fit.error_model)},
+          {"error_model", fit_error_model_json(fit)},
+          {"walk", walk_text(fit)},
           {"std_errors_hac", std_errors_hac_json(fit)},
           {"hac_lag", fit.hac_lag},
           {"bins", fit.n_points},

@@ -28,6 +28,19 @@ nlohmann::json error_model_json(const compensation::ErrorModel& model);
 std::string error_model_text(const compensation::ErrorModel& model);
 /// Reads error_model_json back; missing keys stay at their defaults.
 compensation::ErrorModel error_model_from_json(const nlohmann::json& j);
+/// {"arw_deg_rt_h", "bias_instability_dph", "rrw_dph_rt_h", "trust_factor"} (absent: not given).
+nlohmann::json noise_json(const compensation::NoisePrior& noise);
+/// The inverse of noise_json; throws nlohmann::json::exception on a malformed object.
+compensation::NoisePrior noise_prior_from_json(const nlohmann::json& j);
+/// error_model_json and the largest walk the bins do not exclude, with each coefficient's
+/// standard error under it: {..., "walk_not_excluded": {"rrw_dph_per_sqrt_h", "std_errors"}}
+/// (null with a prior, or when the bins exclude every walk). What the store keeps.
+nlohmann::json fit_error_model_json(const compensation::FitResult& fit);
+/// Reads fit_error_model_json's walk back into `fit` (its names set).
+void read_walk_not_excluded(const nlohmann::json& j, compensation::FitResult& fit);
+/// One line on the walk: with the part's noise given, what was given; without, the largest walk
+/// the bins cannot exclude and k1's error under it (issue 32).
+std::string walk_text(const compensation::FitResult& fit);
 nlohmann::json std_errors_hac_json(const compensation::FitResult& fit);
 /// The fit and its evaluation as every command reports them: coefficients, std_errors,
 /// std_errors_hac, hac_lag, bins, r2, residual_rms_dph, condition_number, std_before_dph,

@@ -34,6 +34,15 @@ nlohmann::json model_selection_json(const compensation::ModelSelection& sel) {
           {"tried", tried}};
 }
 
+nlohmann::json part_model_choice_json(const std::string& part_number, const std::string& model) {
+  compensation::ModelSpec spec;
+  spec.terms = compensation::parse_terms(model);
+  return {{"method", "part file"},
+          {"part_number", part_number},
+          {"chosen", model_text(spec)},
+          {"reason", fmt::format("part {} fixes the model for production", part_number)}};
+}
+
 std::string model_selection_text(const compensation::ModelSelection& sel) {
   std::string out = fmt::format("  model selection ({}):\n", sel.method);
   for (const auto& m : sel.tried) {

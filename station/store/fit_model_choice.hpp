@@ -17,6 +17,9 @@ namespace station {
 /// "likelihood_ratio", "not_fitted", "chosen"}]} (absent numbers are null).
 nlohmann::json model_selection_json(const compensation::ModelSelection& sel);
 
+/// {"method": "part file", "part_number", "chosen", "reason"}: the part fixes the model.
+nlohmann::json part_model_choice_json(const std::string& part_number, const std::string& model);
+
 /// The table people read: one line per model tried, the chosen one marked, then the reason.
 std::string model_selection_text(const compensation::ModelSelection& sel);
 

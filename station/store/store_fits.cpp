@@ -114,7 +114,7 @@ std::int64_t Store::save_fit(const std::string& serial, const std::vector<std::i
       .bind(10, fit.residual_rms_dph);
   st.bind(11, fit.condition_number).bind(12, eval.std_before_dph).bind(13, eval.std_after_dph);
   st.bind(14, eval.std_ratio).bind(15, json(fit.warnings).dump());
-  st.bind(16, std_errors_ols_json(fit).dump()).bind(17, error_model_json(fit.error_model).dump());
+  st.bind(16, std_errors_ols_json(fit).dump()).bind(17, fit_error_model_json(fit).dump());
   for (int c = 18; c <= 21; ++c) st.bind_null(c);
   if (span) st.bind(18, span->temp_min_c).bind(19, span->temp_max_c);
   if (span) st.bind(20, span->grad_min_c).bind(21, span->grad_max_c);
@@ -159,7 +159,10 @@ FitRecord read_fit(const Statement& st) {
   for (const auto& n : r.fit.names) {
     if (se_ols.is_object()) r.fit.std_errors_ols.push_back(se_ols.at(n).get<double>());
   }
-  r.fit.error_model = error_model_from_json(json::parse(st.column_text(16)));
+  const json em = json::parse(st.column_text(16));
+  r.fit.error_model = error_model_from_json(em);
+  r.fit.spec.noise_prior = r.fit.error_model.prior;
+  read_walk_not_excluded(em, r.fit);
   if (!st.column_is_null(18) && !st.column_is_null(19) && !st.column_is_null(20) &&
       !st.column_is_null(21))
     r.span = FitSpan{st.column_double(18), st.column_double(19), st.column_double(20),

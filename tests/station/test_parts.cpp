@@ -96,6 +96,22 @@ TEST(Parts, LimitsSurviveTheJsonSnapshotStoredWithARun) {
   EXPECT_EQ(*back.min_complete_bins, 40);
 }
 
+// Issue 32: the part's model and noise survive the run's snapshot, and are what a fit uses.
+TEST(Parts, TheModelAndNoiseSurviveTheSnapshot) {
+  const auto p = station::parse_part_file(kGood + "model = \"dT,dT2,gradT\"\n[part.\"GX-1\".noise]\n"
+                                          "arw_deg_rt_h = 0.003\nrrw_dph_rt_h = 0\ntrust_factor = 1.5\n",
+                                          "parts.toml")
+                     .parts.at("GX-1");
+  ASSERT_TRUE(p.model && p.noise);
+  EXPECT_EQ(*p.model, "dT,dT2,gradT");
+  EXPECT_EQ(*p.noise->arw_deg_rt_h, 0.003);
+  EXPECT_EQ(*p.noise->rrw_dph_rt_h, 0.0);
+  EXPECT_FALSE(p.noise->bias_instability_dph);
+  EXPECT_EQ(p.noise->trust_factor, 1.5);
+  const auto back = station::part_limits_from_json(station::part_limits_json(p));
+  EXPECT_EQ(station::part_limits_json(back), station::part_limits_json(p));
+}
+
 TEST(Parts, EachBadFileIsOneLineNamingFileLineAndKey) {
   struct Case {
     std::string text, expected;
@@ -121,6 +137,17 @@ TEST(Parts, EachBadFileIsOneLineNamingFileLineAndKey) {
       {"[parts.A]\n", "parts.toml:1: key 'parts': unknown key (allowed here: part)"},
       {"", "parts.toml:1: key 'part': no [part.\"NUMBER\"] tables: the file names no part"},
       {"[part.A]\nmax_std_ratio = 0.5\nmax_std_ratio = 0.4\n", "parts.toml:3:"},
+      // Issue 32: the part's model and noise.
+      {"[part.A]\nmodel = \"dT,dT9\"\n", "parts.toml:2: key 'part.A.model': unknown term 'dT9'"},
+      {"[part.A.noise]\narw_deg_rt_h = 0\n",
+       "parts.toml:2: key 'part.A.noise.arw_deg_rt_h': 0 must be above 0"},
+      {"[part.A.noise]\nrrw_dph_rt_h = -1e-4\n",
+       "parts.toml:2: key 'part.A.noise.rrw_dph_rt_h': -0.0001 must be 0 (no walk) or above"},
+      {"[part.A.noise]\narw_deg_rt_h = 0.003\ntrust_factor = 1\n",
+       "parts.toml:3: key 'part.A.noise.trust_factor': 1 must be above 1"},
+      {"[part.A.noise]\nK = 1e-4\n", "parts.toml:2: key 'part.A.noise.K': unknown key"},
+      {"[part.A.noise]\ntrust_factor = 3\n",
+       "parts.toml:1: key 'part.A.noise': give arw_deg_rt_h, bias_instability_dph or rrw_dph_rt_h"},
   };
   for (const auto& c : cases) {
     const auto e = error_of(c.text);

@@ -173,3 +173,54 @@ TEST(PartsCli, AFitWithoutAPartSaysSo) {
   ASSERT_EQ(all.status, 0) << all.out;
   EXPECT_TRUE(nlohmann::json::parse(all.out)[0]["verdict"].is_null());
 }
+
+// Issue 32: a part that fixes the model and gives its noise. The run's fit and a refit use the
+// part's model and weigh the part's noise; the fit records that the part chose the model; an
+// explicit --terms overrides the model (exploratory) and records no choice; --select records
+// the models it tried; without a part the fit says what it assumed about a walk.
+TEST(PartsCli, ThePartsModelAndNoiseAreWhatTheFitUses) {
+  const auto parts = write_temp("noise_parts.toml", R"([part."NOISY"]
+max_std_ratio = 10.0
+model = "dT,dT2,gradT"
+[part."NOISY".noise]
+arw_deg_rt_h = 0.003
+rrw_dph_rt_h = 1e-4
+trust_factor = 2
+)");
+  const auto db = ts::fresh_db("cli-part-noise");
+  const auto run = station_cmd("run --sim --gyros 1 --seed 4 --new --json --db " + db +
+                                   " --protocol " + kShortCycle + " --parts " + parts,
+                               false);
+  ASSERT_EQ(run.status, 0) << run.out;
+  const auto fit = nlohmann::json::parse(
+      station_cmd("fit --db " + db + " --serial SIM-0001 --json", false).out);
+  EXPECT_TRUE(fit["coefficients"].contains("k2")) << fit.dump();
+  EXPECT_EQ(fit["error_model"]["prior"]["rrw_dph_rt_h"], 1e-4) << fit["error_model"].dump();
+  EXPECT_EQ(fit["model_choice"]["method"], "part file");
+  EXPECT_EQ(fit["model_choice"]["chosen"], "B0+dT+dT2+gradT");
+  EXPECT_NE(fit["walk"].get<std::string>().find("K 0.0001"), std::string::npos) << fit["walk"];
+  EXPECT_EQ(fit["verdict"]["context"], fit["walk"]);
+
+  const auto given = nlohmann::json::parse(
+      station_cmd("fit --db " + db + " --serial SIM-0001 --terms dT --json", false).out);
+  EXPECT_FALSE(given["coefficients"].contains("k0")) << given.dump();
+  EXPECT_TRUE(given["model_choice"].is_null());
+
+  const auto sel = station_cmd("fit --db " + db + " --serial SIM-0001 --select --terms dT,gradT",
+                               false);
+  ASSERT_EQ(sel.status, 0) << sel.out;
+  EXPECT_NE(sel.out.find("model selection (likelihood ratio):"), std::string::npos) << sel.out;
+  EXPECT_NE(sel.out.find("B0+dT+gradT+dT3"), std::string::npos) << sel.out;
+  const auto sj = nlohmann::json::parse(
+      station_cmd("fit --db " + db + " --serial SIM-0001 --select --json", false).out);
+  EXPECT_EQ(sj["model_choice"]["method"], "likelihood ratio") << sj["model_choice"].dump();
+  EXPECT_GE(sj["model_choice"]["tried"].size(), 2u);
+
+  const auto bare_db = ts::fresh_db("cli-no-part-walk");
+  ASSERT_EQ(station_cmd("run --sim --gyros 1 --new --db " + bare_db + " --protocol " + kShortCycle,
+                        false)
+                .status,
+            0);
+  const auto bare = station_cmd("fit --db " + bare_db + " --serial SIM-0001", false);
+  EXPECT_NE(bare.out.find("walk: the bins"), std::string::npos) << bare.out;
+}
