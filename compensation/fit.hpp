@@ -126,6 +126,11 @@ FitResult fit_model(const ModelInput& in, const ModelSpec& spec);
 /// lack-of-fit check fits a model's extensions under that model's own error model.
 FitResult fit_model_under(const ModelInput& in, const ModelSpec& spec, const ErrorModel& model);
 
+/// Refuses data the model cannot use: every value finite and within its physical bound, so no
+/// entry of the design matrix, and no sum of their squares, can overflow. Throws DataError
+/// naming the bin and the term.
+void check_model_input(const ModelInput& in, const ModelSpec& spec);
+
 /// The design matrix of `spec` on `in`: a column of ones (B0), then one column per term in the
 /// spec's order. Throws DataError when a term has no data for every bin.
 Eigen::MatrixXd design_matrix(const ModelInput& in, const ModelSpec& spec);

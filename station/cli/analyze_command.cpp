@@ -182,6 +182,24 @@ void print_table(const AnalyzeOptions& o, const Analysis& a) {
   for (const auto& w : a.warnings) fmt::print("warning: {}\n", w);
 }
 
+/// The part's noise (a prior on the error model, compensation/noise_prior.hpp).
+void add_noise_options(CLI::App* cmd, AnalyzeOptions& o) {
+  cmd->add_option("--arw", o.arw_deg_rt_h,
+                  "the part's angle random walk N, deg/sqrt(h): a prior on the error model")
+      ->check(finite_positive(1e6, "deg/sqrt(h)"));
+  cmd->add_option("--bias-instability", o.bias_instability_dph,
+                  "the part's bias instability B, deg/h: a prior on the error model")
+      ->check(finite_positive(1e6, "deg/h"));
+  cmd->add_option("--rrw", o.rrw_dph_rt_h,
+                  "the part's rate random walk K, deg/h/sqrt(h) (0: none): a prior on the error "
+                  "model")
+      ->check(finite_within(0.0, 1e6, "deg/h/sqrt(h)"));
+  cmd->add_option("--noise-trust", o.noise_trust,
+                  "how far to trust the part's noise: the true value within x/ this factor")
+      ->capture_default_str()
+      ->check(finite_within(1.0001, 1e3, ""));
+}
+
 }  // namespace
 
 void add_analyze_command(CLI::App& app, CommandStatus& status) {
@@ -219,20 +237,7 @@ void add_analyze_command(CLI::App& app, CommandStatus& status) {
       ->check(finite_within(-90.0, 90.0, "deg"));
   cmd->add_option("--axis", o->axis, "up|down|north|south|east|west|heading:DEG")
       ->capture_default_str();
-  cmd->add_option("--arw", o->arw_deg_rt_h,
-                  "the part's angle random walk N, deg/sqrt(h): a prior on the error model")
-      ->check(finite_positive(1e6, "deg/sqrt(h)"));
-  cmd->add_option("--bias-instability", o->bias_instability_dph,
-                  "the part's bias instability B, deg/h: a prior on the error model")
-      ->check(finite_positive(1e6, "deg/h"));
-  cmd->add_option("--rrw", o->rrw_dph_rt_h,
-                  "the part's rate random walk K, deg/h/sqrt(h) (0: none): a prior on the error "
-                  "model")
-      ->check(finite_within(0.0, 1e6, "deg/h/sqrt(h)"));
-  cmd->add_option("--noise-trust", o->noise_trust,
-                  "how far to trust the part's noise: the true value within x/ this factor")
-      ->capture_default_str()
-      ->check(finite_within(1.0001, 1e3, ""));
+  add_noise_options(cmd, *o);
   cmd->add_flag("--json", o->json, "print one JSON object");
   cmd->callback([o, &status] {
     const Analysis a = analyze(*o);

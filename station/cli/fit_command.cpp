@@ -131,6 +131,25 @@ sc::ModelSelection select_for(Store& store, const std::string& serial,
   }
 }
 
+/// `--serial SN`: the part's model and noise, --select's choice, the fit judged and stored.
+JudgedFit fit_one(Store& store, const FitOptions& o, const sc::ModelSpec& spec,
+                  const PartChoice& choice) {
+  const auto runs = o.runs.empty() ? store.runs_of_serial(o.serial) : o.runs;
+  const auto limits = runs.empty() ? std::nullopt : limits_for(store, o.serial, runs, choice);
+  const sc::ModelSpec part_spec = part_model_spec(spec, limits, o.terms_given);
+  std::optional<sc::ModelSelection> sel;
+  if (o.select && !runs.empty()) sel = select_for(store, o.serial, runs, part_spec);
+  JudgedFit out = judge_and_store(
+      store, fit_serial(store, o.serial, runs, sel ? sel->chosen : part_spec), limits);
+  if (sel) {
+    save_fit_model_choice(store, out.fit.fit_id, model_selection_json(*sel));
+    if (!o.json) fmt::print("{}", model_selection_text(*sel));
+  } else {
+    note_part_model(store, out.fit.fit_id, limits, o.terms_given);
+  }
+  return out;
+}
+
 int run_fit(const FitOptions& o) {
   // A bad part file stops before the database is opened.
   std::optional<PartFile> parts;
@@ -148,20 +167,7 @@ int run_fit(const FitOptions& o) {
       throw InputError(fmt::format("{}: no run {}", o.db, *o.run));
     result = fit_all(store, o.run, spec, choice, o.terms_given);
   } else {
-    const auto runs = o.runs.empty() ? store.runs_of_serial(o.serial) : o.runs;
-    const auto limits = runs.empty() ? std::nullopt : limits_for(store, o.serial, runs, choice);
-    const sc::ModelSpec part_spec = part_model_spec(spec, limits, o.terms_given);
-    std::optional<sc::ModelSelection> sel;
-    if (o.select && !runs.empty()) sel = select_for(store, o.serial, runs, part_spec);
-    result.fits.push_back(judge_and_store(
-        store, fit_serial(store, o.serial, runs, sel ? sel->chosen : part_spec), limits));
-    const auto fit_id = result.fits.back().fit.fit_id;
-    if (sel) {
-      save_fit_model_choice(store, fit_id, model_selection_json(*sel));
-      if (!o.json) fmt::print("{}", model_selection_text(*sel));
-    } else {
-      note_part_model(store, fit_id, limits, o.terms_given);
-    }
+    result.fits.push_back(fit_one(store, o, spec, choice));
   }
   // Serials with nothing to fit: one line each on stderr, and exit status 1 (the others stored).
   for (const auto& s : result.skipped) fmt::print(stderr, "station: fit skipped: {}\n", s);

@@ -32,13 +32,14 @@ void check_run(Store& store, const FitRecord& fit, std::int64_t run_id) {
                                  fit.serial));
 }
 
-/// Slope of `after` against T and its honest SE (the station's own fit, terms dT).
+/// Slope of `after` against T and its honest SE (the station's own fit, terms dT), under the
+/// part's noise when the fit had it (a prior on the error model: noise_prior.hpp).
 void fit_drift(const sc::ModelData& bins, const std::vector<double>& after, double t_ref_c,
-               VerificationResult& v) {
+               const std::optional<sc::NoisePrior>& prior, VerificationResult& v) {
   sc::ModelData d = bins;
   d.bias_dph = after;
   try {
-    const sc::FitResult line = sc::fit_model(d.view(), {{sc::Term::dT}, t_ref_c});
+    const sc::FitResult line = sc::fit_model(d.view(), {{sc::Term::dT}, t_ref_c, prior});
     v.drift_dph_per_c = line.coefficients[1];
     v.drift_se_dph_per_c = line.std_errors[1];
   } catch (const std::exception&) {
@@ -73,7 +74,8 @@ VerificationResult verify_fit(Store& store, const FitRecord& fit, std::int64_t r
   v.eval = sc::evaluate(v.before_dph, v.after_dph);
   v.mean_residual_dph =
       std::accumulate(v.after_dph.begin(), v.after_dph.end(), 0.0) / static_cast<double>(v.bins);
-  fit_drift(bins, v.after_dph, block.t_ref_c, v);
+  fit_drift(bins, v.after_dph, block.t_ref_c,
+            fit.fit.spec.noise_prior ? fit.fit.spec.noise_prior : (limits ? limits->noise : std::nullopt), v);
   const sc::ModelData rec = record_model_data(store, run_id, fit.serial);
   std::vector<double> record(rec.bias_dph.size());
   for (std::size_t i = 0; i < record.size(); ++i)
