@@ -95,9 +95,9 @@ struct NoiseTerms {
 /// delta method (se(c) = se(c^2) / 2c). fit_chi2_per_dof is the generalized chi^2 of the
 /// residuals under that covariance over its expectation (about 1 when the terms explain the
 /// curve; chi^2 / dof for independent points). Q is reported only when Q^2 is above 0 at the
-/// one-sided 1 % level under that covariance, else the other terms are refit without it (about
-/// 1 % of Q-free records report one); N, B and K whenever the fit keeps them. Rate in deg/h, tau
-/// in s. A few ms for an octave curve of 2e6 samples. Pure.
+/// one-sided 1 % level under that covariance, else the other terms are refit without it (1 to
+/// 3 % of Q-free records report one in test NoiseFitCoverage); N, B and K whenever the fit keeps
+/// them. Rate in deg/h, tau in s. A few ms for an octave curve of 2e6 samples. Pure.
 NoiseTerms fit_noise_terms(std::span<const AdevPoint> curve);
 
 /// The Allan deviation the terms predict at tau (deg/h): the fitted model drawn on a figure.
