@@ -66,15 +66,9 @@ void step_hours(std::vector<double>& dt_h, std::span<const double> t_s,
   }
 }
 
-
-
-
-
 double walk_per_h(const Problem& pb, double u) {
   return u <= kWalkLo ? 0.0 : std::pow(10.0, u) / pb.span_h;
 }
-
-
 
 /// The box's grid, `steps` points each way, clamped to the search's range, in grid order.
 std::vector<Point> grid_points(const Box& b, int steps) {
@@ -133,21 +127,23 @@ void search(Point& best, Problem& pb, const Box& b, int steps) {
   }
 }
 
-
-
 /// The box of refinement round `round` around c: the coarse grid's spacing halved each round.
 Box refined_box(const Point& c, int round, const Problem& pb) {
   const double shrink = std::ldexp(1.0, -round) / (kCoarseSteps - 1);
   const double half_tau = (pb.tau_hi - pb.tau_lo) * shrink, half_q = kMaxShare * shrink,
                half_u = (kWalkHi - kWalkLo) * shrink;
-  return {std::max(c.log_tau - half_tau, pb.tau_lo), std::min(c.log_tau + half_tau, pb.tau_hi),
-          std::max(c.q - half_q, 0.0),               std::min(c.q + half_q, kMaxShare),
-          std::max(c.u - half_u, kWalkLo),           std::min(c.u + half_u, kWalkHi)};
+  return {std::max(c.log_tau - half_tau, pb.tau_lo),
+          std::min(c.log_tau + half_tau, pb.tau_hi),
+          std::max(c.q - half_q, 0.0),
+          std::min(c.q + half_q, kMaxShare),
+          std::max(c.u - half_u, kWalkLo),
+          std::min(c.u + half_u, kWalkHi)};
 }
 
 /// Finer searches around the best point so far, each on a grid half as wide.
 void refine(Point& best, Problem& pb) {
-  for (int round = 0; round < kRefinements; ++round) search(best, pb, refined_box(best, round, pb), 3);
+  for (int round = 0; round < kRefinements; ++round)
+    search(best, pb, refined_box(best, round, pb), 3);
 }
 
 /// The search's problem: rows [y X], run starts, tau's range from a third of a bin (the
@@ -189,8 +185,7 @@ double objective(const Point& e, const Problem& pb) {
   if (pb.prior == nullptr) return e.profile.minus2_loglik;
   const double white_sd = std::sqrt((1 - e.q) * e.profile.sigma2);
   return e.profile.minus2_loglik +
-         noise_prior_penalty(*pb.prior, white_sd, walk_dph_rt_h(e, pb), pb.spacing_s,
-                             pb.span_h);
+         noise_prior_penalty(*pb.prior, white_sd, walk_dph_rt_h(e, pb), pb.spacing_s, pb.span_h);
 }
 
 Box whole_box(const Problem& pb) {

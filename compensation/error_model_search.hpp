@@ -18,8 +18,8 @@ namespace station::compensation::model_search {
 using reml::Profile;
 
 inline constexpr double kMaxShare = 0.99;  // q = 1 with tau -> infinity: a degenerate filter
-inline constexpr int kCoarseSteps = 6;  // 6 x 6 x 6 grid over log tau, q and the walk's size,
-inline constexpr int kRefinements = 3;  // then 3 rounds of 3 x 3 x 3 around the best point
+inline constexpr int kCoarseSteps = 6;     // 6 x 6 x 6 grid over log tau, q and the walk's size,
+inline constexpr int kRefinements = 3;     // then 3 rounds of 3 x 3 x 3 around the best point
 
 /// Correlation of the Gauss-Markov part from bin i-1 to bin i, for each bin (0 across runs).
 void step_corrs(std::vector<double>& phi, std::span<const double> t_s, std::span<const int> segment,

@@ -208,11 +208,12 @@ FitResult fit_impl(const ModelInput& in, const ModelSpec& spec, const ErrorModel
   // The error model sees the orthonormal basis Q of the design (same column space, so the same
   // likelihood) and the sandwich is formed from Q and R^-1: neither squares X's condition.
   const Eigen::MatrixXd q_basis = qr.householderQ() * Eigen::MatrixXd::Identity(x.rows(), pi);
-  res.error_model = fixed != nullptr ? *fixed
-                                      : estimate_error_model(q_basis, y, in.t_s, in.segment,
-                                                             spec.noise_prior ? &*spec.noise_prior
-                                                                              : nullptr);
-  const Eigen::VectorXd var_model = model_variances(res.error_model, q_basis, r_inv, in, var_scaled);
+  res.error_model = fixed != nullptr
+                        ? *fixed
+                        : estimate_error_model(q_basis, y, in.t_s, in.segment,
+                                               spec.noise_prior ? &*spec.noise_prior : nullptr);
+  const Eigen::VectorXd var_model =
+      model_variances(res.error_model, q_basis, r_inv, in, var_scaled);
   // Lag rule of Newey & West (1994): L = floor(4 (n/100)^(2/9)).
   res.hac_lag = static_cast<std::size_t>(
       std::floor(4.0 * std::pow(static_cast<double>(n) / 100.0, 2.0 / 9.0)));

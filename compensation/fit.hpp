@@ -101,14 +101,14 @@ struct FitResult {
   std::vector<double> vif;
   /// The lack-of-fit check (fit_diagnostics.hpp): each candidate term not in the model, tried.
   struct Candidate {
-    std::string option;        ///< "dT2", "dT3", "dTdt", "gradTdT"
-    double value = 0;          ///< its coefficient in the extended model
-    double std_error = 0;      ///< its standard error under this fit's error model (Wald)
+    std::string option;    ///< "dT2", "dT3", "dTdt", "gradTdT"
+    double value = 0;      ///< its coefficient in the extended model
+    double std_error = 0;  ///< its standard error under this fit's error model (Wald)
     /// The likelihood ratio of the extended model against this one, each with its own error
     /// model (model_choice.hpp): chi^2 with 1 degree of freedom when the term is absent.
     double likelihood_ratio = 0;
-    double z = 0;              ///< its signed root: sign(value) sqrt(likelihood_ratio)
-    bool significant = false;  ///< |z| above the Bonferroni bound
+    double z = 0;                      ///< its signed root: sign(value) sqrt(likelihood_ratio)
+    bool significant = false;          ///< |z| above the Bonferroni bound
     std::vector<double> coefficients;  ///< the extended model's, names then the candidate's
   };
   std::vector<Candidate> candidates;

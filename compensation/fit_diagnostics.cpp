@@ -49,8 +49,8 @@ void warn_missing(FitResult& fit, const FitResult::Candidate& c, const FitResult
                          num(c.likelihood_ratio, "%.1f") + ", z = " + num(c.z, "%.1f") +
                          ", beyond " + num(fit.candidate_z_critical, "%.2f") +
                          ", each model with its own error model, 1 % over the candidates); with "
-                         "it " + with +
-                         " (fit --terms " + c.option + " ... to include it)");
+                         "it " +
+                         with + " (fit --terms " + c.option + " ... to include it)");
 }
 
 /// 1 / (1 - r^2) of dT against gradT: the VIF k1 and k0 would have alone together.

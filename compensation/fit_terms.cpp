@@ -135,7 +135,6 @@ void check_model_input(const ModelInput& in, const ModelSpec& spec) {
   }
 }
 
-
 Eigen::MatrixXd design_matrix(const ModelInput& in, const ModelSpec& spec) {
   const auto n = static_cast<Eigen::Index>(in.bias_dph.size());
   Eigen::MatrixXd x(n, static_cast<Eigen::Index>(spec.terms.size() + 1));

@@ -51,15 +51,15 @@ std::vector<double> max_ml_deviances(const Eigen::MatrixXd& x, const Eigen::Vect
   Problem pb = make_problem(x, y, t_s, segment);
   pb.subsets = cols;
   std::vector<Point> best(subsets.size(), iid_point(pb));
-  const bool enough =
-      x.rows() >= static_cast<Eigen::Index>(widest) + kMinBinsForErrorModelExtra;
+  const bool enough = x.rows() >= static_cast<Eigen::Index>(widest) + kMinBinsForErrorModelExtra;
   if (enough) {
     std::vector<Point> pts = grid_points(whole_box(pb), kCoarseSteps);
     evaluate(pts, pb, best[0]);
     keep_best(best, pts);
     refine_subset(best, 0, pb);
     for (std::size_t s = 1; s < best.size(); ++s)
-      if (best[0].ml[0] - best[s].ml[s] >= refine_from_lr - kRefinementGain) refine_subset(best, s, pb);
+      if (best[0].ml[0] - best[s].ml[s] >= refine_from_lr - kRefinementGain)
+        refine_subset(best, s, pb);
   }
   std::vector<double> out(subsets.size());
   for (std::size_t s = 0; s < best.size(); ++s) out[s] = best[s].ml[s];

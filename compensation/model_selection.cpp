@@ -117,11 +117,11 @@ ModelSelection select_model(const ModelInput& in, const ModelSpec& base) {
     if (!t) break;
     sel.chosen = with(sel.chosen, *t);
   }
-  for (auto& m : sel.tried)
-    m.chosen = spec_text(m.spec) == spec_text(sel.chosen) && !m.not_fitted;
+  for (auto& m : sel.tried) m.chosen = spec_text(m.spec) == spec_text(sel.chosen) && !m.not_fitted;
   sel.reason =
       cv ? "held-out RMS " + num(current.pooled_rms_dph * 1e3) + " mdeg/h over " +
-               std::to_string(runs.size()) + " runs, each left out in turn; a term added only "
+               std::to_string(runs.size()) +
+               " runs, each left out in turn; a term added only "
                "where it lowered the held-out error by more than its standard error across the "
                "runs"
          : "one run: each term added only while its likelihood ratio (each model with its own "

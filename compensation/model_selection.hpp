@@ -25,12 +25,12 @@ namespace station::compensation {
 /// One model the selection tried.
 struct TriedModel {
   ModelSpec spec;
-  int step = 0;                             ///< 0: the base; k: the k-th term added
-  std::string added;                        ///< the term this model adds to its step's start
-  std::optional<double> held_out_rms_dph;   ///< pooled leave-one-run-out RMS (two or more runs)
-  std::optional<double> likelihood_ratio;   ///< against its step's start (one run)
-  std::optional<std::string> not_fitted;    ///< why it could not be tried
-  bool chosen = false;                      ///< the model selected
+  int step = 0;                            ///< 0: the base; k: the k-th term added
+  std::string added;                       ///< the term this model adds to its step's start
+  std::optional<double> held_out_rms_dph;  ///< pooled leave-one-run-out RMS (two or more runs)
+  std::optional<double> likelihood_ratio;  ///< against its step's start (one run)
+  std::optional<std::string> not_fitted;   ///< why it could not be tried
+  bool chosen = false;                     ///< the model selected
 };
 
 struct ModelSelection {

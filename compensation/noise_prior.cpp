@@ -36,8 +36,8 @@ double noise_prior_penalty(const NoisePrior& prior, double white_sd_dph, double 
                            double bin_s, double span_h) {
   double penalty = 0;
   if (prior.arw_deg_rt_h && white_sd_dph > 0)
-    penalty += log_normal(white_sd_dph, 60.0 * *prior.arw_deg_rt_h / std::sqrt(bin_s),
-                          prior.trust_factor);
+    penalty +=
+        log_normal(white_sd_dph, 60.0 * *prior.arw_deg_rt_h / std::sqrt(bin_s), prior.trust_factor);
   if (const auto walk = prior_walk_dph_rt_h(prior, span_h)) {
     const double k0 = *walk;
     if (k0 == 0) {

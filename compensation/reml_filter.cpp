@@ -158,9 +158,8 @@ double ml_deviance(const SmallMatrix& m, double sum_log_f, Eigen::Index n, const
 
 }  // namespace
 
-void ml_deviances(const RowMajor& z, const std::vector<double>& dt_h,
-                  std::span<const Model> models, std::span<const Columns> subsets,
-                  std::span<double> out) {
+void ml_deviances(const RowMajor& z, const std::vector<double>& dt_h, std::span<const Model> models,
+                  std::span<const Columns> subsets, std::span<double> out) {
   const std::size_t s = subsets.size();
   for (std::size_t first = 0; first < models.size(); first += L) {
     const std::size_t lanes = std::min<std::size_t>(L, models.size() - first);

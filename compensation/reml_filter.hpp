@@ -47,8 +47,7 @@ using Columns = std::vector<int>;
 /// of y on each column subset under each model, out[model * subsets.size() + subset]. Unlike
 /// the restricted likelihood, whose term log |X' F^-1 X| changes with the columns, these compare
 /// across subsets: the same y, the same n, nested column sets give likelihood ratios.
-void ml_deviances(const RowMajor& z, const std::vector<double>& dt_h,
-                  std::span<const Model> models, std::span<const Columns> subsets,
-                  std::span<double> out);
+void ml_deviances(const RowMajor& z, const std::vector<double>& dt_h, std::span<const Model> models,
+                  std::span<const Columns> subsets, std::span<double> out);
 
 }  // namespace station::compensation::reml

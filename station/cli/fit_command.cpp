@@ -13,8 +13,8 @@
 #include "station/common/input_error.hpp"
 #include "station/parts/judged_fit.hpp"
 #include "station/store/calibration.hpp"
-#include "station/store/fit_model_choice.hpp"
 #include "station/store/fit_json.hpp"
+#include "station/store/fit_model_choice.hpp"
 
 namespace station {
 namespace {

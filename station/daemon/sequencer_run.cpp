@@ -33,8 +33,8 @@ RunState Sequencer::finish(RunState end_state, double t_s) {
     try {
       const auto it = lossy.find(slot.serial);
       const auto part = options_.part_limits.find(slot.serial);
-      const auto limits = part == options_.part_limits.end() ? std::nullopt
-                                                             : std::optional{part->second};
+      const auto limits =
+          part == options_.part_limits.end() ? std::nullopt : std::optional{part->second};
       compensation::ModelSpec paper;  // B0 + k1 dT + k0 gradT
       paper.ref_temp_c = config_.ref_temp_c;
       const auto f =

@@ -38,8 +38,7 @@ std::optional<PartLimits> limits_for(Store& store, const std::string& serial,
 /// whose terms give way to the part's model when the part file fixes one and the terms were
 /// not given explicitly (`terms_given`), with the part's noise as the prior on the error model.
 compensation::ModelSpec part_model_spec(compensation::ModelSpec given,
-                                        const std::optional<PartLimits>& limits,
-                                        bool terms_given);
+                                        const std::optional<PartLimits>& limits, bool terms_given);
 
 /// Stores with fit `fit_id` that its part fixed its model (migration 9), when part_model_spec
 /// took the part's model.

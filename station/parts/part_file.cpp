@@ -45,12 +45,14 @@ std::optional<compensation::NoisePrior> read_noise(const TomlView& part) {
   n.bias_instability_dph = positive(*t, "bias_instability_dph");
   n.rrw_dph_rt_h = t->opt_number("rrw_dph_rt_h");
   if (n.rrw_dph_rt_h && !(*n.rrw_dph_rt_h >= 0))
-    throw t->error("rrw_dph_rt_h", fmt::format("{:g} must be 0 (no walk) or above", *n.rrw_dph_rt_h));
+    throw t->error("rrw_dph_rt_h",
+                   fmt::format("{:g} must be 0 (no walk) or above", *n.rrw_dph_rt_h));
   if (const auto f = t->opt_number("trust_factor")) {
     if (!(*f > 1)) throw t->error("trust_factor", fmt::format("{:g} must be above 1", *f));
     n.trust_factor = *f;
   }
-  if (n.empty()) throw part.error("noise", "give arw_deg_rt_h, bias_instability_dph or rrw_dph_rt_h");
+  if (n.empty())
+    throw part.error("noise", "give arw_deg_rt_h, bias_instability_dph or rrw_dph_rt_h");
   return n;
 }
 
@@ -69,8 +71,7 @@ std::optional<std::string> read_model(const TomlView& part) {
 PartLimits read_part(const TomlView& v, const std::string& number) {
   v.allow_only({"description", "B0_dph", "k1_dph_per_c", "k0_dph_per_c", "max_std_after_dph",
                 "max_std_ratio", "max_adev_floor_dph", "min_complete_bins", "max_k1_se_dph_per_c",
-                "max_k0_se_dph_per_c", "max_verify_std_dph", "max_verify_ratio", "model",
-                "noise"});
+                "max_k0_se_dph_per_c", "max_verify_std_dph", "max_verify_ratio", "model", "noise"});
   PartLimits p;
   p.number = number;
   p.description = v.opt_string("description").value_or("");
@@ -90,7 +91,6 @@ PartLimits read_part(const TomlView& v, const std::string& number) {
   p.noise = read_noise(v);
   return p;
 }
-
 
 json range_json(const LimitRange& r) {
   json j = json::object();

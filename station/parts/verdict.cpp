@@ -1,12 +1,12 @@
 // Verdict: every limit of the part, checked against the fit.
 #include "station/parts/verdict.hpp"
 
-#include "station/store/fit_json.hpp"
-
 #include <fmt/format.h>
 
 #include <cmath>
 #include <stdexcept>
+
+#include "station/store/fit_json.hpp"
 
 namespace station {
 namespace {

@@ -74,8 +74,10 @@ VerificationResult verify_fit(Store& store, const FitRecord& fit, std::int64_t r
   v.eval = sc::evaluate(v.before_dph, v.after_dph);
   v.mean_residual_dph =
       std::accumulate(v.after_dph.begin(), v.after_dph.end(), 0.0) / static_cast<double>(v.bins);
-  fit_drift(bins, v.after_dph, block.t_ref_c,
-            fit.fit.spec.noise_prior ? fit.fit.spec.noise_prior : (limits ? limits->noise : std::nullopt), v);
+  fit_drift(
+      bins, v.after_dph, block.t_ref_c,
+      fit.fit.spec.noise_prior ? fit.fit.spec.noise_prior : (limits ? limits->noise : std::nullopt),
+      v);
   const sc::ModelData rec = record_model_data(store, run_id, fit.serial);
   std::vector<double> record(rec.bias_dph.size());
   for (std::size_t i = 0; i < record.size(); ++i)

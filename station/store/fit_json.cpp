@@ -57,16 +57,15 @@ compensation::NoisePrior noise_prior_from_json(const nlohmann::json& j) {
   return n;
 }
 
-
 nlohmann::json error_model_json(const compensation::ErrorModel& m) {
   nlohmann::json j{{"method", m.method},
-          {"corr_time_s", m.corr_time_s},
-          {"correlated_share", m.correlated_share},
-          {"sigma_dph", m.sigma_dph},
-          {"rho_per_bin", m.rho_per_bin},
-          {"rrw_dph_per_sqrt_h", m.rrw_dph_per_sqrt_h},
-          {"models_averaged", m.mixture.size()},
-          {"on_search_boundary", m.on_search_boundary}};
+                   {"corr_time_s", m.corr_time_s},
+                   {"correlated_share", m.correlated_share},
+                   {"sigma_dph", m.sigma_dph},
+                   {"rho_per_bin", m.rho_per_bin},
+                   {"rrw_dph_per_sqrt_h", m.rrw_dph_per_sqrt_h},
+                   {"models_averaged", m.mixture.size()},
+                   {"on_search_boundary", m.on_search_boundary}};
   j["prior"] = m.prior ? noise_json(*m.prior) : nlohmann::json();
   return j;
 }
@@ -88,7 +87,8 @@ void read_walk_not_excluded(const nlohmann::json& j, compensation::FitResult& fi
   c.rrw_dph_per_sqrt_h = w.at("rrw_dph_per_sqrt_h").get<double>();
   fit.error_model.walk_not_excluded = c;
   if (!w.at("std_errors").is_object()) return;
-  for (const auto& n : fit.names) fit.std_errors_walk_not_excluded.push_back(w.at("std_errors").at(n));
+  for (const auto& n : fit.names)
+    fit.std_errors_walk_not_excluded.push_back(w.at("std_errors").at(n));
 }
 
 std::string walk_text(const compensation::FitResult& fit) {
@@ -143,7 +143,8 @@ compensation::ErrorModel error_model_from_json(const nlohmann::json& j) {
   m.rho_per_bin = j.value("rho_per_bin", 0.0);
   m.rrw_dph_per_sqrt_h = j.value("rrw_dph_per_sqrt_h", 0.0);
   m.on_search_boundary = j.value("on_search_boundary", false);
-  if (j.contains("prior") && j.at("prior").is_object()) m.prior = noise_prior_from_json(j.at("prior"));
+  if (j.contains("prior") && j.at("prior").is_object())
+    m.prior = noise_prior_from_json(j.at("prior"));
   return m;
 }
 

@@ -46,14 +46,13 @@ nlohmann::json part_model_choice_json(const std::string& part_number, const std:
 std::string model_selection_text(const compensation::ModelSelection& sel) {
   std::string out = fmt::format("  model selection ({}):\n", sel.method);
   for (const auto& m : sel.tried) {
-    std::string figure = m.not_fitted ? "not fitted: " + *m.not_fitted
-                         : m.held_out_rms_dph
-                             ? fmt::format("held-out RMS {:.5f} deg/h", *m.held_out_rms_dph)
-                         : m.likelihood_ratio
-                             ? fmt::format("likelihood ratio {:.1f}", *m.likelihood_ratio)
+    std::string figure =
+        m.not_fitted         ? "not fitted: " + *m.not_fitted
+        : m.held_out_rms_dph ? fmt::format("held-out RMS {:.5f} deg/h", *m.held_out_rms_dph)
+        : m.likelihood_ratio ? fmt::format("likelihood ratio {:.1f}", *m.likelihood_ratio)
                              : std::string("the base");
-    out += fmt::format("  {} step {} {:<24} {}\n", m.chosen ? "*" : " ", m.step,
-                       model_text(m.spec), figure);
+    out += fmt::format("  {} step {} {:<24} {}\n", m.chosen ? "*" : " ", m.step, model_text(m.spec),
+                       figure);
   }
   return out + fmt::format("  chosen {}\n", sel.reason);
 }

@@ -77,10 +77,10 @@ std::vector<Case> cases(const compensation::ModelData& d) {
   return {{"", [](const auto&, std::size_t) { return 0.0; }},
           {"dT2", k2, Term::dT2, kK2},
           {"dT3", [=](const auto& m, std::size_t i) { return k3 * cube(m, i); }, Term::dT3, k3},
-          {"dTdt", [](const auto& m, std::size_t i) { return kKr * m.dtdt_c_per_h[i]; },
-           Term::dTdt, kKr},
-          {"gradTdT", [=](const auto& m, std::size_t i) { return kg * cross(m, i); },
-           Term::gradTdT, kg}};
+          {"dTdt", [](const auto& m, std::size_t i) { return kKr * m.dtdt_c_per_h[i]; }, Term::dTdt,
+           kKr},
+          {"gradTdT", [=](const auto& m, std::size_t i) { return kg * cross(m, i); }, Term::gradTdT,
+           kg}};
 }
 
 int realizations(bool null_case) {

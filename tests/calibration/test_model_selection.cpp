@@ -35,7 +35,9 @@ Shares choose(const std::vector<Protocol>& ps, double k2, std::uint64_t seed, in
     s.base += t.size() == 2 ? 1.0 / n : 0.0;
     s.with_dt2 += t.size() == 3 && t[2] == compensation::Term::dT2 ? 1.0 / n : 0.0;
     EXPECT_EQ(sel.method, ps.size() > 1 ? "leave-one-run-out" : "likelihood ratio");
-    EXPECT_EQ(std::count_if(sel.tried.begin(), sel.tried.end(), [](const auto& m) { return m.chosen; }), 1);
+    EXPECT_EQ(
+        std::count_if(sel.tried.begin(), sel.tried.end(), [](const auto& m) { return m.chosen; }),
+        1);
   }
   return s;
 }

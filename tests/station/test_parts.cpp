@@ -98,10 +98,12 @@ TEST(Parts, LimitsSurviveTheJsonSnapshotStoredWithARun) {
 
 // Issue 32: the part's model and noise survive the run's snapshot, and are what a fit uses.
 TEST(Parts, TheModelAndNoiseSurviveTheSnapshot) {
-  const auto p = station::parse_part_file(kGood + "model = \"dT,dT2,gradT\"\n[part.\"GX-1\".noise]\n"
-                                          "arw_deg_rt_h = 0.003\nrrw_dph_rt_h = 0\ntrust_factor = 1.5\n",
-                                          "parts.toml")
-                     .parts.at("GX-1");
+  const auto p =
+      station::parse_part_file(kGood +
+                                   "model = \"dT,dT2,gradT\"\n[part.\"GX-1\".noise]\n"
+                                   "arw_deg_rt_h = 0.003\nrrw_dph_rt_h = 0\ntrust_factor = 1.5\n",
+                               "parts.toml")
+          .parts.at("GX-1");
   ASSERT_TRUE(p.model && p.noise);
   EXPECT_EQ(*p.model, "dT,dT2,gradT");
   EXPECT_EQ(*p.noise->arw_deg_rt_h, 0.003);

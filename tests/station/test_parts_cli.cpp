@@ -192,8 +192,8 @@ trust_factor = 2
                                    " --protocol " + kShortCycle + " --parts " + parts,
                                false);
   ASSERT_EQ(run.status, 0) << run.out;
-  const auto fit = nlohmann::json::parse(
-      station_cmd("fit --db " + db + " --serial SIM-0001 --json", false).out);
+  const auto fit =
+      nlohmann::json::parse(station_cmd("fit --db " + db + " --serial SIM-0001 --json", false).out);
   EXPECT_TRUE(fit["coefficients"].contains("k2")) << fit.dump();
   EXPECT_EQ(fit["error_model"]["prior"]["rrw_dph_rt_h"], 1e-4) << fit["error_model"].dump();
   EXPECT_EQ(fit["model_choice"]["method"], "part file");
@@ -206,8 +206,8 @@ trust_factor = 2
   EXPECT_FALSE(given["coefficients"].contains("k0")) << given.dump();
   EXPECT_TRUE(given["model_choice"].is_null());
 
-  const auto sel = station_cmd("fit --db " + db + " --serial SIM-0001 --select --terms dT,gradT",
-                               false);
+  const auto sel =
+      station_cmd("fit --db " + db + " --serial SIM-0001 --select --terms dT,gradT", false);
   ASSERT_EQ(sel.status, 0) << sel.out;
   EXPECT_NE(sel.out.find("model selection (likelihood ratio):"), std::string::npos) << sel.out;
   EXPECT_NE(sel.out.find("B0+dT+gradT+dT3"), std::string::npos) << sel.out;
@@ -217,10 +217,10 @@ trust_factor = 2
   EXPECT_GE(sj["model_choice"]["tried"].size(), 2u);
 
   const auto bare_db = ts::fresh_db("cli-no-part-walk");
-  ASSERT_EQ(station_cmd("run --sim --gyros 1 --new --db " + bare_db + " --protocol " + kShortCycle,
-                        false)
-                .status,
-            0);
+  ASSERT_EQ(
+      station_cmd("run --sim --gyros 1 --new --db " + bare_db + " --protocol " + kShortCycle, false)
+          .status,
+      0);
   const auto bare = station_cmd("fit --db " + bare_db + " --serial SIM-0001", false);
   EXPECT_NE(bare.out.find("walk: the bins"), std::string::npos) << bare.out;
 }
