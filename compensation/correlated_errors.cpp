@@ -52,7 +52,8 @@ constexpr double kChi2One95 = 3.8415;
 /// (the coarse grid's best over tau and q at each size), where it crosses best + kChi2One95,
 /// linear in the size between grid values; the Gauss-Markov part and s of the point below it.
 std::optional<ErrorModel::Component> largest_walk_not_excluded(const std::vector<Point>& grid,
-                                                               const Problem& pb) {
+                                                               const Problem& pb, bool& at_edge) {
+  at_edge = false;
   std::map<double, const Point*> profile;  // by walk size u, increasing
   double best = std::numeric_limits<double>::infinity();
   for (const Point& e : grid) {
@@ -71,6 +72,8 @@ std::optional<ErrorModel::Component> largest_walk_not_excluded(const std::vector
   if (const auto next = std::next(last); next != profile.end()) {  // crosses between the two
     const double d0 = inside->profile.minus2_loglik, d1 = next->second->profile.minus2_loglik;
     u += (next->first - u) * std::clamp((bound - d0) / (d1 - d0), 0.0, 1.0);
+  } else {
+    at_edge = u >= kWalkHi;  // even the search's largest walk is inside
   }
   if (u <= kWalkLo) return std::nullopt;
   const double s2 = inside->profile.sigma2;
@@ -78,9 +81,11 @@ std::optional<ErrorModel::Component> largest_walk_not_excluded(const std::vector
                                std::sqrt(s2), std::sqrt(s2 * walk_per_h(pb, u)), 1.0};
 }
 
-/// Independent bins: sigma from the OLS residuals (RSS / (n - p)).
-ErrorModel ols_only(const Eigen::MatrixXd& x, const Eigen::VectorXd& y) {
+/// Independent bins: sigma from the OLS residuals (RSS / (n - p)); the prior kept as given
+/// (walk_assessed false: it weighed nothing).
+ErrorModel ols_only(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const NoisePrior* prior) {
   ErrorModel model;
+  if (prior != nullptr && !prior->empty()) model.prior = *prior;
   const Eigen::VectorXd b = x.colPivHouseholderQr().solve(y);
   model.sigma_dph = std::sqrt((y - x * b).squaredNorm() / static_cast<double>(x.rows() - x.cols()));
   return model;
@@ -95,7 +100,7 @@ ErrorModel estimate_error_model(const Eigen::MatrixXd& x, const Eigen::VectorXd&
   ErrorModel model;
   if (n < p + kMinBinsForErrorModelExtra || p < 1 ||
       p + 1 > reml::kMaxColumns) {  // too few bins to estimate three more parameters
-    return ols_only(x, y);
+    return ols_only(x, y, prior);
   }
   Problem pb = make_problem(x, y, t_s, segment);
   pb.prior = prior != nullptr && !prior->empty() ? prior : nullptr;
@@ -109,11 +114,17 @@ ErrorModel estimate_error_model(const Eigen::MatrixXd& x, const Eigen::VectorXd&
   refine(best, pb);
   if (!std::isfinite(best.profile.minus2_loglik) || !(best.profile.sigma2 > 0)) {
     // No error model fits (a noise-free or constant bias): the OLS errors, as with too few bins.
-    return ols_only(x, y);
+    return ols_only(x, y, pb.prior);
   }
   model.sigma_dph = std::sqrt(best.profile.sigma2);
   add_mixture(model, grid, best, pb);
-  model.walk_not_excluded = largest_walk_not_excluded(grid, pb);
+  model.walk_assessed = true;
+  model.walk_search_max_dph_rt_h = std::sqrt(best.profile.sigma2 * walk_per_h(pb, kWalkHi));
+  if (pb.prior == nullptr)
+    model.walk_not_excluded =
+        largest_walk_not_excluded(grid, pb, model.walk_bound_at_search_edge);
+  else if (const auto k = prior_walk_dph_rt_h(*pb.prior, pb.span_h))
+    model.prior_walk_beyond_search = *k > pb.prior->trust_factor * model.walk_search_max_dph_rt_h;
   if (best.q <= 0 && best.u <= kWalkLo && model.mixture.empty())
     return model;  // no correlated part: independent bins
   model.method = "white+gm+rrw (REML)";

@@ -63,6 +63,16 @@ struct ErrorModel {
   /// likelihood), with the rest of its error model; empty when the bins exclude every walk.
   /// What a fit without a prior assumed about a walk it cannot see (issue 32).
   std::optional<Component> walk_not_excluded;
+  /// The bins do not exclude even the largest walk the search spans: walk_not_excluded is that
+  /// edge, a lower bound of what they cannot exclude.
+  bool walk_bound_at_search_edge = false;
+  /// The search ran (false: too few bins, or no error model fits; nothing was assessed).
+  bool walk_assessed = false;
+  /// The largest walk the search spans at the fitted s, deg/h/sqrt(h) (0: no search).
+  double walk_search_max_dph_rt_h = 0;
+  /// The prior's walk lies beyond trust_factor x that largest walk: the prior could not pull the
+  /// errors up to it (the fit warns).
+  bool prior_walk_beyond_search = false;
   /// The part's noise the model was estimated under (noise_prior.hpp); empty: none given.
   std::optional<NoisePrior> prior;
 };

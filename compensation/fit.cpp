@@ -116,6 +116,14 @@ void add_fit_warnings(FitResult& res, std::size_t n, std::size_t p, bool fixed_e
         number_text(res.error_model.rrw_dph_per_sqrt_h) +
         " deg/h/sqrt(h)); the uncertainties are less certain");
   }
+  if (res.error_model.prior_walk_beyond_search) {
+    res.warnings.push_back(
+        "the part's noise implies a rate random walk beyond the largest the error model searches "
+        "(" +
+        number_text(res.error_model.walk_search_max_dph_rt_h) +
+        " deg/h/sqrt(h) for these bins): the errors do not reach it; check the part file's "
+        "[noise]");
+  }
 }
 
 /// The coefficients and their three kinds of standard error, back in the columns' own units.

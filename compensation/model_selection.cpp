@@ -1,6 +1,7 @@
 // Forward selection of the model's terms (see the header).
 #include "compensation/model_selection.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <set>
@@ -22,6 +23,16 @@ std::string num(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.4g", v);
   return buf;
+}
+
+/// The candidates not in the model whose data the bins have, among `allowed` (empty: all).
+std::vector<Term> allowed_candidates(const ModelInput& in, const ModelSpec& s,
+                                     std::span<const Term> allowed) {
+  std::vector<Term> out;
+  for (const Term t : candidates_for(in, s))
+    if (allowed.empty() || std::find(allowed.begin(), allowed.end(), t) != allowed.end())
+      out.push_back(t);
+  return out;
 }
 
 ModelSpec with(const ModelSpec& s, Term t) {
@@ -47,10 +58,10 @@ double help_beyond_one_se(const CrossValidation& without, const CrossValidation&
 /// One step by held-out error: of the candidates that help beyond one standard error and whose
 /// likelihood ratio over all the runs passes the bound, the one with the lowest pooled RMS.
 std::optional<Term> step_by_cv(const ModelInput& in, ModelSelection& sel, int step,
-                               CrossValidation& current) {
+                               CrossValidation& current, std::span<const Term> allowed) {
   std::optional<Term> best;
   std::optional<CrossValidation> best_cv;
-  const std::vector<Term> cands = candidates_for(in, sel.chosen);
+  const std::vector<Term> cands = allowed_candidates(in, sel.chosen, allowed);
   if (cands.empty()) return best;
   const double bound = std::pow(candidate_z_critical(cands.size()), 2);
   const std::vector<double> lr = extension_likelihood_ratios(in, sel.chosen, cands, bound);
@@ -77,8 +88,9 @@ std::optional<Term> step_by_cv(const ModelInput& in, ModelSelection& sel, int st
 }
 
 /// One step by likelihood ratio: the candidate with the largest ratio, if beyond the bound.
-std::optional<Term> step_by_lr(const ModelInput& in, ModelSelection& sel, int step) {
-  const std::vector<Term> cands = candidates_for(in, sel.chosen);
+std::optional<Term> step_by_lr(const ModelInput& in, ModelSelection& sel, int step,
+                               std::span<const Term> allowed) {
+  const std::vector<Term> cands = allowed_candidates(in, sel.chosen, allowed);
   if (cands.empty()) return std::nullopt;
   const double bound = std::pow(candidate_z_critical(cands.size()), 2);
   const std::vector<double> lr = extension_likelihood_ratios(in, sel.chosen, cands, bound);
@@ -98,22 +110,28 @@ std::optional<Term> step_by_lr(const ModelInput& in, ModelSelection& sel, int st
 
 }  // namespace
 
-ModelSelection select_model(const ModelInput& in, const ModelSpec& base) {
+ModelSelection select_model(const ModelInput& in, const ModelSpec& base,
+                            std::span<const Term> allowed) {
   ModelSelection sel;
   sel.chosen = base;
   const std::set<int> runs(in.segment.begin(), in.segment.end());
-  const bool cv = runs.size() >= 2;
-  sel.method = cv ? "leave-one-run-out" : "likelihood ratio";
   CrossValidation current;
+  std::string no_cv;  // why leave-one-run-out could not decide
   sel.tried.emplace_back().spec = base;
-  if (cv) {
-    current = leave_one_run_out(in, base);
-    sel.tried.back().held_out_rms_dph = current.pooled_rms_dph;
-  } else {
-    (void)fit_model(in, base);  // the base must fit: its errors are what the caller reads
+  if (runs.size() >= 2) {
+    try {
+      current = leave_one_run_out(in, base);
+      sel.tried.back().held_out_rms_dph = current.pooled_rms_dph;
+    } catch (const std::exception& e) {
+      no_cv = std::string(" (leave-one-run-out not possible: ") + e.what() + ")";
+    }
   }
+  const bool cv = runs.size() >= 2 && no_cv.empty();
+  sel.method = cv ? "leave-one-run-out" : "likelihood ratio";
+  if (!cv) (void)fit_model(in, base);  // the base must fit: its errors are what the caller reads
   for (int step = 1;; ++step) {
-    const auto t = cv ? step_by_cv(in, sel, step, current) : step_by_lr(in, sel, step);
+    const auto t = cv ? step_by_cv(in, sel, step, current, allowed)
+                      : step_by_lr(in, sel, step, allowed);
     if (!t) break;
     sel.chosen = with(sel.chosen, *t);
   }
@@ -121,11 +139,11 @@ ModelSelection select_model(const ModelInput& in, const ModelSpec& base) {
   sel.reason =
       cv ? "held-out RMS " + num(current.pooled_rms_dph * 1e3) + " mdeg/h over " +
                std::to_string(runs.size()) +
-               " runs, each left out in turn; a term added only "
-               "where it lowered the held-out error by more than its standard error across the "
-               "runs"
-         : "one run: each term added only while its likelihood ratio (each model with its own "
-           "error model) passed the 1 % family-wise bound over the candidates left";
+               " runs, each left out in turn; a term added only where it lowered the held-out "
+               "error by more than its standard error across the runs and its likelihood ratio "
+               "passed the 1 % family-wise bound"
+         : "each term added only while its likelihood ratio (each model with its own error "
+           "model) passed the 1 % family-wise bound over the candidates left" + no_cv;
   sel.reason = spec_text(sel.chosen) + ": " + sel.reason;
   return sel;
 }

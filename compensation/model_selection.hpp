@@ -15,6 +15,7 @@
 #pragma once
 
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -40,8 +41,10 @@ struct ModelSelection {
   std::string reason;  ///< one line: why this model
 };
 
-/// Forward selection from `base` (see above). Throws DataError when the base model cannot be
-/// fitted.
-ModelSelection select_model(const ModelInput& in, const ModelSpec& base);
+/// Forward selection from `base` (see above) over the lack-of-fit candidates that are in
+/// `allowed` (empty: all of them; `fit --select` allows the terms a release can carry). Throws
+/// DataError when the base model cannot be fitted.
+ModelSelection select_model(const ModelInput& in, const ModelSpec& base,
+                            std::span<const Term> allowed = {});
 
 }  // namespace station::compensation

@@ -16,11 +16,6 @@ double log_normal(double x, double x0, double trust) {
   return d * d;
 }
 
-void check(const std::optional<double>& v, const char* name, bool zero_ok) {
-  if (v && (!std::isfinite(*v) || *v < 0 || (*v == 0 && !zero_ok)))
-    throw std::invalid_argument(std::string("noise ") + name + ": " + std::to_string(*v) +
-                                (zero_ok ? " (must be finite and >= 0)" : " (must be > 0)"));
-}
 
 }  // namespace
 
@@ -50,13 +45,5 @@ double noise_prior_penalty(const NoisePrior& prior, double white_sd_dph, double 
   return penalty;
 }
 
-void check_noise_prior(const NoisePrior& prior) {
-  check(prior.arw_deg_rt_h, "arw_deg_rt_h", false);
-  check(prior.bias_instability_dph, "bias_instability_dph", false);
-  check(prior.rrw_dph_rt_h, "rrw_dph_rt_h", true);
-  if (!(prior.trust_factor > 1) || !std::isfinite(prior.trust_factor))
-    throw std::invalid_argument("noise trust: " + std::to_string(prior.trust_factor) +
-                                " (must be a finite factor above 1)");
-}
 
 }  // namespace station::compensation

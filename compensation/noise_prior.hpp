@@ -28,6 +28,12 @@
 
 namespace station::compensation {
 
+/// The bounds a given noise term and trust factor must keep (the part file and `analyze` both
+/// check them): a term above 1e6 in its unit, or a trust of x1.01 or less or above x1000, is a
+/// typo, not a part.
+inline constexpr double kMaxNoiseTerm = 1e6;
+inline constexpr double kMinNoiseTrust = 1.01, kMaxNoiseTrust = 1000.0;
+
 struct NoisePrior {
   std::optional<double> arw_deg_rt_h;          ///< N, deg/sqrt(h)
   std::optional<double> bias_instability_dph;  ///< B, deg/h
@@ -50,8 +56,5 @@ double noise_prior_penalty(const NoisePrior& prior, double white_sd_dph, double 
 /// deg/h/sqrt(h); empty: no prior on the walk.
 std::optional<double> prior_walk_dph_rt_h(const NoisePrior& prior, double span_h);
 
-/// Throws std::invalid_argument naming the field when a value is negative or not finite, N or B
-/// is 0, or trust_factor is not above 1.
-void check_noise_prior(const NoisePrior& prior);
 
 }  // namespace station::compensation

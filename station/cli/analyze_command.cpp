@@ -38,13 +38,16 @@ struct AnalyzeOptions {
   /// model, in the part file's units (compensation/noise_prior.hpp).
   std::optional<double> arw_deg_rt_h, bias_instability_dph, rrw_dph_rt_h;
   double noise_trust = sc::NoisePrior{}.trust_factor;
+  bool noise_trust_given = false;
 };
 
 /// The prior the options give; empty when they give no term.
 std::optional<sc::NoisePrior> noise_prior_of(const AnalyzeOptions& o) {
   sc::NoisePrior p{o.arw_deg_rt_h, o.bias_instability_dph, o.rrw_dph_rt_h, o.noise_trust};
-  if (p.empty()) return std::nullopt;
-  return p;
+  if (!p.empty()) return p;
+  if (o.noise_trust_given)
+    throw InputError("--noise-trust: give the part's noise too (--arw, --bias-instability or --rrw)");
+  return std::nullopt;
 }
 
 /// Earth rate from the options: explicit value, or latitude + axis ("up", ..., "heading:DEG").
@@ -186,18 +189,18 @@ void print_table(const AnalyzeOptions& o, const Analysis& a) {
 void add_noise_options(CLI::App* cmd, AnalyzeOptions& o) {
   cmd->add_option("--arw", o.arw_deg_rt_h,
                   "the part's angle random walk N, deg/sqrt(h): a prior on the error model")
-      ->check(finite_positive(1e6, "deg/sqrt(h)"));
+      ->check(finite_positive(sc::kMaxNoiseTerm, "deg/sqrt(h)"));
   cmd->add_option("--bias-instability", o.bias_instability_dph,
                   "the part's bias instability B, deg/h: a prior on the error model")
-      ->check(finite_positive(1e6, "deg/h"));
+      ->check(finite_positive(sc::kMaxNoiseTerm, "deg/h"));
   cmd->add_option("--rrw", o.rrw_dph_rt_h,
                   "the part's rate random walk K, deg/h/sqrt(h) (0: none): a prior on the error "
                   "model")
-      ->check(finite_within(0.0, 1e6, "deg/h/sqrt(h)"));
+      ->check(finite_within(0.0, sc::kMaxNoiseTerm, "deg/h/sqrt(h)"));
   cmd->add_option("--noise-trust", o.noise_trust,
                   "how far to trust the part's noise: the true value within x/ this factor")
       ->capture_default_str()
-      ->check(finite_within(1.0001, 1e3, ""));
+      ->check(finite_within(sc::kMinNoiseTrust, sc::kMaxNoiseTrust, ""));
 }
 
 }  // namespace
@@ -239,7 +242,8 @@ void add_analyze_command(CLI::App& app, CommandStatus& status) {
       ->capture_default_str();
   add_noise_options(cmd, *o);
   cmd->add_flag("--json", o->json, "print one JSON object");
-  cmd->callback([o, &status] {
+  cmd->callback([o, cmd, &status] {
+    o->noise_trust_given = cmd->count("--noise-trust") > 0;
     const Analysis a = analyze(*o);
     if (o->json) {
       std::cout << to_json(a).dump(2) << '\n';

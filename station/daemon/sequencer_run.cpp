@@ -41,9 +41,14 @@ RunState Sequencer::finish(RunState end_state, double t_s) {
           fit_serial(store_, slot.serial, {run_id_}, part_model_spec(paper, limits, false),
                      it == lossy.end() ? std::vector<std::string>{} : std::vector{it->second});
       note_part_model(store_, f.fit_id, limits, false);
+      std::string coefs;  // by name: a part's model may lack k1 or k0, or order them otherwise
+      for (std::size_t i = 1; i < f.fit.names.size(); ++i) {
+        const std::string_view unit = compensation::coefficient_unit(f.fit.names[i]);
+        coefs += fmt::format("{} {:.4e} {}, ", f.fit.names[i], f.fit.coefficients[i],
+                             unit.substr(0, unit.find(" (")));  // "deg/h/C", as it always read
+      }
       emit(t_s, Severity::info, "seq", EventKind::fit,
-           fmt::format("{}: k1 {:.4e} deg/h/C, k0 {:.4e} deg/h/C, std ratio {} over {} bins",
-                       slot.serial, f.fit.coefficients[1], f.fit.coefficients[2],
+           fmt::format("{}: {}std ratio {} over {} bins", slot.serial, coefs,
                        std_ratio_text(f.eval), f.fit.n_points),
            {{"serial", slot.serial}});
       judge(t_s, f);

@@ -9,6 +9,7 @@
 
 #include "compensation/fit.hpp"
 #include "station/config/toml_reader.hpp"
+#include "station/parts/deliverable_terms.hpp"
 #include "station/store/fit_json.hpp"
 
 namespace station {
@@ -35,20 +36,32 @@ LimitRange read_range(const TomlView& part, std::string_view key) {
   return r;
 }
 
+/// A noise term of [noise]: above 0 (or 0 where `zero_ok`: K = 0, no walk) and at most
+/// kMaxNoiseTerm; -0 read as 0.
+std::optional<double> noise_term(const TomlView& t, std::string_view key, bool zero_ok) {
+  const auto x = t.opt_number(key);
+  if (!x) return x;
+  if (!(zero_ok ? *x >= 0 : *x > 0) || !(*x <= compensation::kMaxNoiseTerm))
+    throw t.error(key, fmt::format("{:g} is outside {}..{:g}", *x, zero_ok ? "0" : "(0", 
+                                   compensation::kMaxNoiseTerm));
+  return *x == 0 ? 0.0 : *x;
+}
+
+constexpr double kMinTrust = compensation::kMinNoiseTrust, kMaxTrust = compensation::kMaxNoiseTrust;
+
 /// [part."PN".noise]: the IEEE 952 terms the part's data sheet gives, and how far to trust them.
 std::optional<compensation::NoisePrior> read_noise(const TomlView& part) {
   const auto t = part.opt_table("noise");
   if (!t) return std::nullopt;
   t->allow_only({"arw_deg_rt_h", "bias_instability_dph", "rrw_dph_rt_h", "trust_factor"});
   compensation::NoisePrior n;
-  n.arw_deg_rt_h = positive(*t, "arw_deg_rt_h");
-  n.bias_instability_dph = positive(*t, "bias_instability_dph");
-  n.rrw_dph_rt_h = t->opt_number("rrw_dph_rt_h");
-  if (n.rrw_dph_rt_h && !(*n.rrw_dph_rt_h >= 0))
-    throw t->error("rrw_dph_rt_h",
-                   fmt::format("{:g} must be 0 (no walk) or above", *n.rrw_dph_rt_h));
+  n.arw_deg_rt_h = noise_term(*t, "arw_deg_rt_h", false);
+  n.bias_instability_dph = noise_term(*t, "bias_instability_dph", false);
+  n.rrw_dph_rt_h = noise_term(*t, "rrw_dph_rt_h", true);
   if (const auto f = t->opt_number("trust_factor")) {
-    if (!(*f > 1)) throw t->error("trust_factor", fmt::format("{:g} must be above 1", *f));
+    if (!(*f >= kMinTrust && *f <= kMaxTrust))
+      throw t->error("trust_factor",
+                     fmt::format("{:g} is outside {:g}..{:g}", *f, kMinTrust, kMaxTrust));
     n.trust_factor = *f;
   }
   if (n.empty())
@@ -60,11 +73,15 @@ std::optional<compensation::NoisePrior> read_noise(const TomlView& part) {
 std::optional<std::string> read_model(const TomlView& part) {
   const auto m = part.opt_string("model");
   if (!m) return std::nullopt;
+  std::vector<compensation::Term> terms;
   try {
-    (void)compensation::parse_terms(*m);
+    terms = compensation::parse_terms(*m);
   } catch (const std::invalid_argument& e) {
     throw part.error("model", e.what());
   }
+  if (terms.empty()) throw part.error("model", "names no term (B0 alone calibrates nothing)");
+  if (const auto bad = undeliverable_terms(terms))
+    throw part.error("model", *bad + ": a production model must be releasable");
   return m;
 }
 

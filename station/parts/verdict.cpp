@@ -98,9 +98,11 @@ json verdict_json(const Verdict& v) {
                       {"value", f.value ? json(*f.value) : json(nullptr)},
                       {"bound", f.bound}});
   }
-  json j{{"pass", v.pass}, {"failed", failed}, {"part", v.part_number}, {"checked", v.checked}};
-  if (!v.context.empty()) j["context"] = v.context;
-  return j;
+  return {{"pass", v.pass},
+          {"failed", failed},
+          {"part", v.part_number},
+          {"checked", v.checked},
+          {"context", v.context}};
 }
 
 Verdict verdict_from_json(const json& j) {

@@ -52,7 +52,8 @@ struct VerificationFigures {
 /// part sets neither. Pure.
 std::optional<Verdict> judge_verification(const PartLimits& limits, const VerificationFigures& in);
 
-/// {"pass": bool, "failed": [{"limit", "value", "bound"}], "part": number, "checked": n}.
+/// {"pass": bool, "failed": [{"limit", "value", "bound"}], "part": number, "checked": n,
+/// "context": text}.
 nlohmann::json verdict_json(const Verdict& v);
 /// The inverse of verdict_json; throws std::invalid_argument on a malformed object.
 Verdict verdict_from_json(const nlohmann::json& j);

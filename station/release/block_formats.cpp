@@ -106,6 +106,7 @@ json block_json(const CoefficientBlock& b) {
           {"std_after_dph", b.std_after_dph},
           {"std_ratio", b.std_ratio ? json(*b.std_ratio) : json(nullptr)},
           {"verdict", b.verdict_json ? json::parse(*b.verdict_json) : json(nullptr)},
+          {"model_choice", b.model_choice_json ? json::parse(*b.model_choice_json) : json(nullptr)},
           {"released", b.release.has_value()},
           {"release", b.release ? release_json(*b.release) : json(nullptr)},
           {"software_version", b.software_version},

@@ -1,6 +1,9 @@
 // Building a coefficient block from a stored fit, its runs' 1 Hz record and its release.
 #include "station/release/coefficient_block.hpp"
 
+#include "station/parts/deliverable_terms.hpp"
+#include "station/store/fit_model_choice.hpp"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -75,16 +78,7 @@ void check_finite(const CoefficientBlock& b) {
 }  // namespace
 
 std::optional<std::string> undeliverable_term(const sc::FitResult& fit) {
-  for (const auto t : fit.spec.terms) {
-    const bool in_block = t == sc::Term::dT || t == sc::Term::dT2 || t == sc::Term::dT3 ||
-                          t == sc::Term::dT4 || t == sc::Term::gradT;
-    if (!in_block)
-      return fmt::format(
-          "term {} cannot be delivered: gyro_tc_correct() applies B0, k1..k4 (dT..dT4) and k0 "
-          "(gradT) only",
-          sc::term_option_name(t));
-  }
-  return std::nullopt;
+  return undeliverable_terms(fit.spec.terms);
 }
 
 double CoefficientBlock::coefficient_or_zero(const std::string& name) const {
@@ -134,6 +128,7 @@ CoefficientBlock make_block(Store& store, const FitRecord& fit,
   const StoredVerdict v = load_fit_verdict(store, fit.id);
   b.part_number = v.part_number.value_or("");
   b.verdict_json = v.verdict_json;
+  if (const auto choice = load_fit_model_choice(store, fit.id)) b.model_choice_json = choice->dump();
   b.fit_id = fit.id;
   b.fit_created_utc = fit.created_utc;
   b.terms = fit.terms;

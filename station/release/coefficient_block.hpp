@@ -36,6 +36,8 @@ struct CoefficientBlock {
   std::optional<double> std_ratio;               ///< in-sample std after / before
   double std_after_dph = 0;                      ///< in-sample std after, deg/h
   std::optional<std::string> verdict_json;       ///< the fit's verdict (empty: none)
+  /// How the fit's model was chosen (fits.model_choice_json; empty: terms given by hand).
+  std::optional<std::string> model_choice_json;
   std::optional<ReleaseRow> release;             ///< empty: exported without release
   std::string software_version;                  ///< the station's version
   std::uint32_t crc32 = 0;                       ///< of canonical

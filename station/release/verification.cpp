@@ -33,7 +33,7 @@ void check_run(Store& store, const FitRecord& fit, std::int64_t run_id) {
 }
 
 /// Slope of `after` against T and its honest SE (the station's own fit, terms dT), under the
-/// part's noise when the fit had it (a prior on the error model: noise_prior.hpp).
+/// part's noise the verified fit was made with (a prior on the error model: noise_prior.hpp).
 void fit_drift(const sc::ModelData& bins, const std::vector<double>& after, double t_ref_c,
                const std::optional<sc::NoisePrior>& prior, VerificationResult& v) {
   sc::ModelData d = bins;
@@ -74,10 +74,7 @@ VerificationResult verify_fit(Store& store, const FitRecord& fit, std::int64_t r
   v.eval = sc::evaluate(v.before_dph, v.after_dph);
   v.mean_residual_dph =
       std::accumulate(v.after_dph.begin(), v.after_dph.end(), 0.0) / static_cast<double>(v.bins);
-  fit_drift(
-      bins, v.after_dph, block.t_ref_c,
-      fit.fit.spec.noise_prior ? fit.fit.spec.noise_prior : (limits ? limits->noise : std::nullopt),
-      v);
+  fit_drift(bins, v.after_dph, block.t_ref_c, fit.fit.spec.noise_prior, v);
   const sc::ModelData rec = record_model_data(store, run_id, fit.serial);
   std::vector<double> record(rec.bias_dph.size());
   for (std::size_t i = 0; i < record.size(); ++i)

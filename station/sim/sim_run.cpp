@@ -333,17 +333,22 @@ void print_sim_report(const nlohmann::json& r) {
       continue;
     }
     const auto& f = g["fitted"];
-    const auto& se = g["std_errors"];
     const auto& ratio = g["std_ratio"];
-    fmt::print("{:<10} {:>4} {:>11.4e} {:>11.4e} {:>9.4e} {:>9}  {:>9.5f} {:>9.5f} {:>6}\n", "",
-               "fit", f["B0"].get<double>(), f["k1"].get<double>(), f["k0"].get<double>(), "",
+    // A part's model may lack k1 or k0: "-" where the fit has no such coefficient.
+    const auto cell = [](const nlohmann::json& j, const char* name, const char* format) {
+      return j.contains(name) && j[name].is_number()
+                 ? fmt::format(fmt::runtime(format), j[name].get<double>())
+                 : std::string("-");
+    };
+    fmt::print("{:<10} {:>4} {:>11} {:>11} {:>9} {:>9}  {:>9.5f} {:>9.5f} {:>6}\n", "", "fit",
+               cell(f, "B0", "{:.4e}"), cell(f, "k1", "{:.4e}"), cell(f, "k0", "{:.4e}"), "",
                g["std_before_dph"].get<double>(), g["std_after_dph"].get<double>(),
                ratio.is_number() ? fmt::format("{:.3f}", ratio.get<double>()) : "undef");
-    fmt::print("{:<10} {:>4} {:>11.1e} {:>11.1e} {:>9.1e}\n", "", "+-", se["B0"].get<double>(),
-               se["k1"].get<double>(), se["k0"].get<double>());
-    const auto& ols = g["std_errors_ols"];
-    fmt::print("{:<10} {:>4} {:>11.1e} {:>11.1e} {:>9.1e}\n", "", "OLS", ols["B0"].get<double>(),
-               ols["k1"].get<double>(), ols["k0"].get<double>());
+    for (const auto& [label, key] : {std::pair{"+-", "std_errors"}, {"OLS", "std_errors_ols"}}) {
+      const auto& e = g[key];
+      fmt::print("{:<10} {:>4} {:>11} {:>11} {:>9}\n", "", label, cell(e, "B0", "{:.1e}"),
+                 cell(e, "k1", "{:.1e}"), cell(e, "k0", "{:.1e}"));
+    }
     const auto v = g.value("verdict", nlohmann::json());
     fmt::print("{:<10} {}\n", "",
                verdict_text(v.is_null() ? std::nullopt : std::optional(verdict_from_json(v))));

@@ -29,7 +29,7 @@ constexpr EventKindInfo kKinds[] = {
      "a gyro lost more than max_lost_share of its record window"},
     {K::fit, "fit", "info", "serial", "a gyro's thermal model was fitted"},
     {K::fit_skipped, "fit_skipped", "warn", "", "a gyro could not be fitted"},
-    {K::verdict, "verdict", "info|warn", "pass failed part checked",
+    {K::verdict, "verdict", "info|warn", "pass failed part checked context",
      "a fit judged against its part's limits"},
     {K::step_start, "step_start", "info", "step_index label line", "a protocol step begins"},
     {K::step_done, "step_done", "info", "step_index label after_s", "a protocol step is done"},

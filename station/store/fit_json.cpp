@@ -75,17 +75,22 @@ nlohmann::json fit_error_model_json(const compensation::FitResult& fit) {
   const auto& w = fit.error_model.walk_not_excluded;
   j["walk_not_excluded"] =
       w ? nlohmann::json{{"rrw_dph_per_sqrt_h", w->rrw_dph_per_sqrt_h},
+                         {"at_search_edge", fit.error_model.walk_bound_at_search_edge},
                          {"std_errors", keyed(fit, fit.std_errors_walk_not_excluded)}}
         : nlohmann::json();
+  j["walk_assessed"] = fit.error_model.walk_assessed;
   return j;
 }
 
 void read_walk_not_excluded(const nlohmann::json& j, compensation::FitResult& fit) {
+  // Fits stored before issue 32 carry neither: their walk was searched but not reported.
+  fit.error_model.walk_assessed = j.value("walk_assessed", true);
   if (!j.contains("walk_not_excluded") || j.at("walk_not_excluded").is_null()) return;
   const auto& w = j.at("walk_not_excluded");
   compensation::ErrorModel::Component c;
   c.rrw_dph_per_sqrt_h = w.at("rrw_dph_per_sqrt_h").get<double>();
   fit.error_model.walk_not_excluded = c;
+  fit.error_model.walk_bound_at_search_edge = w.value("at_search_edge", false);
   if (!w.at("std_errors").is_object()) return;
   for (const auto& n : fit.names)
     fit.std_errors_walk_not_excluded.push_back(w.at("std_errors").at(n));
@@ -98,11 +103,15 @@ std::string walk_text(const compensation::FitResult& fit) {
     const auto term = [](const char* name, const std::optional<double>& v, const char* unit) {
       return v ? fmt::format(" {} {:.3g} {}", name, *v, unit) : std::string();
     };
-    return fmt::format("noise: the part's{}{}{} (trust x{:g}) weighs the error model",
+    return fmt::format("noise: the part's{}{}{} (trust x{:g}) {}",
                        term("N", p.arw_deg_rt_h, "deg/sqrt(h)"),
                        term("B", p.bias_instability_dph, "deg/h"),
-                       term("K", p.rrw_dph_rt_h, "deg/h/sqrt(h)"), p.trust_factor);
+                       term("K", p.rrw_dph_rt_h, "deg/h/sqrt(h)"), p.trust_factor,
+                       m.walk_assessed ? "weighs the error model"
+                                       : "weighed nothing: too few bins for an error model");
   }
+  if (!m.walk_assessed)
+    return "walk: not assessed (too few bins for an error model, or none fits)";
   if (!m.walk_not_excluded) return "walk: the bins exclude a rate random walk (95 %)";
   std::string k1;
   for (std::size_t i = 0; i < fit.names.size() && i < fit.std_errors_walk_not_excluded.size(); ++i)
@@ -110,9 +119,10 @@ std::string walk_text(const compensation::FitResult& fit) {
       k1 = fmt::format("; under it k1 +- {:.2e} deg/h/C (reported +- {:.2e})",
                        fit.std_errors_walk_not_excluded[i], fit.std_errors[i]);
   return fmt::format(
-      "walk: the bins cannot exclude a rate random walk up to K = {:.2e} deg/h/sqrt(h) (95 %){}; "
+      "walk: the bins cannot exclude a rate random walk up to {}K = {:.2e} deg/h/sqrt(h) (95 %{}){}; "
       "no part noise given (a part file's [part.\"PN\".noise] decides it)",
-      m.walk_not_excluded->rrw_dph_per_sqrt_h, k1);
+      m.walk_bound_at_search_edge ? "at least " : "", m.walk_not_excluded->rrw_dph_per_sqrt_h,
+      m.walk_bound_at_search_edge ? ", the search's largest walk" : "", k1);
 }
 
 std::string error_model_text(const compensation::ErrorModel& m) {

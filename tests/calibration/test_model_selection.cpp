@@ -62,5 +62,23 @@ TEST(ModelSelection, OneRunChoosesByTheLikelihoodRatio) {
   EXPECT_GE(without.base, 0.9);
 }
 
+// Review of issue 32: a second run with a handful of bins cannot be left out and predicted; the
+// likelihood ratio decides over all the bins, and the reason says why (plain `fit` works there).
+TEST(ModelSelection, ARunTooShortToLeaveOutFallsBackToTheLikelihoodRatio) {
+  compensation::ModelData d = protocols_bins({Protocol{}, Protocol{.heat_c_per_h = 20}});
+  std::size_t keep = 0;  // run 0 whole, then 3 bins of run 1
+  while (keep < d.segment.size() && d.segment[keep] == 0) ++keep;
+  keep += 3;
+  for (auto* v : {&d.bias_dph, &d.temp_c, &d.grad_c, &d.dtdt_c_per_h, &d.channel, &d.t_mid_s})
+    v->resize(keep);
+  d.segment.resize(keep);
+  std::mt19937_64 rng(5);
+  for (std::size_t i = 0; i < keep; ++i) d.bias_dph[i] = kB0 + kK1 * (d.temp_c[i] - 25);
+  add_noise(d, {}, rng);
+  const auto sel = compensation::select_model(d.view(), {});
+  EXPECT_EQ(sel.method, "likelihood ratio");
+  EXPECT_NE(sel.reason.find("leave-one-run-out not possible"), std::string::npos) << sel.reason;
+}
+
 }  // namespace
 }  // namespace station::test::noise

@@ -216,6 +216,18 @@ trust_factor = 2
   EXPECT_EQ(sj["model_choice"]["method"], "likelihood ratio") << sj["model_choice"].dump();
   EXPECT_GE(sj["model_choice"]["tried"].size(), 2u);
 
+  // A part's model without k0 (or k1): the run's events and its table name what the fit has
+  // (review: the event read past the coefficients, the table threw), and a verdict event keeps
+  // to schemas/events.md.
+  const auto dt_parts = write_temp("dt_parts.toml", "[part.\"DT\"]\nmax_std_ratio = 10.0\n"
+                                                    "model = \"dT\"\n");
+  const auto dt_db = ts::fresh_db("cli-part-dt");
+  const auto dt_run = station_cmd("run --sim --gyros 1 --new --db " + dt_db + " --protocol " +
+                                  kShortCycle + " --parts " + dt_parts);
+  EXPECT_EQ(dt_run.status, 0) << dt_run.out;
+  EXPECT_EQ(dt_run.out.find("does not follow"), std::string::npos) << dt_run.out;
+  EXPECT_EQ(dt_run.out.find("error"), std::string::npos) << dt_run.out;
+
   const auto bare_db = ts::fresh_db("cli-no-part-walk");
   ASSERT_EQ(
       station_cmd("run --sim --gyros 1 --new --db " + bare_db + " --protocol " + kShortCycle, false)

@@ -131,7 +131,12 @@ TEST(Store, FitsRoundTrip) {
   fit.coefficients = {0.05, 1.2e-3, 0.012};
   fit.std_errors = {1e-3, 4e-5, 1e-4};
   fit.std_errors_ols = {7e-4, 3e-5, 6e-5};
-  fit.error_model = {"ar1+white (REML)", 3400.0, 0.2, 0.008, 0.84, false, 0.0, {}, {}, {}};
+  fit.error_model = {};
+  fit.error_model.method = "ar1+white (REML)";
+  fit.error_model.corr_time_s = 3400.0;
+  fit.error_model.correlated_share = 0.2;
+  fit.error_model.sigma_dph = 0.008;
+  fit.error_model.rho_per_bin = 0.84;
   fit.n_points = 66;
   fit.r2 = 0.99;
   const sc::Evaluation ev{0.12, 0.007, 0.0583, 94.17};
