@@ -11,6 +11,7 @@
 #include "station/cli/commands.hpp"
 #include "station/cli/exit_status.hpp"
 #include "station/common/input_error.hpp"
+#include "station/parts/deliverable_terms.hpp"
 #include "station/parts/judged_fit.hpp"
 #include "station/store/calibration.hpp"
 #include "station/store/fit_json.hpp"
@@ -124,7 +125,10 @@ sc::ModelSelection select_for(Store& store, const std::string& serial,
                               const std::vector<std::int64_t>& runs, const sc::ModelSpec& base) {
   const sc::ModelData data = store.model_data(serial, runs);
   try {
-    return sc::select_model(data.view(), base);
+    std::vector<sc::Term> every;
+    for (int t = 0; t <= static_cast<int>(sc::Term::gradTdT); ++t)
+      every.push_back(static_cast<sc::Term>(t));
+    return sc::select_model(data.view(), base, deliverable_only(every));  // a release can carry
   } catch (const std::invalid_argument& e) {
     throw InputError(fmt::format("{}: serial '{}', runs {}: --select: {}", store.db().path(),
                                  serial, fmt::join(runs, ","), e.what()));

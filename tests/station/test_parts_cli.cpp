@@ -211,6 +211,7 @@ trust_factor = 2
   ASSERT_EQ(sel.status, 0) << sel.out;
   EXPECT_NE(sel.out.find("model selection (likelihood ratio):"), std::string::npos) << sel.out;
   EXPECT_NE(sel.out.find("B0+dT+gradT+dT3"), std::string::npos) << sel.out;
+  EXPECT_EQ(sel.out.find("dTdt"), std::string::npos) << "a release could not carry it\n" << sel.out;
   const auto sj = nlohmann::json::parse(
       station_cmd("fit --db " + db + " --serial SIM-0001 --select --json", false).out);
   EXPECT_EQ(sj["model_choice"]["method"], "likelihood ratio") << sj["model_choice"].dump();
