@@ -139,6 +139,8 @@ sc::ModelSelection select_for(Store& store, const std::string& serial,
 JudgedFit fit_one(Store& store, const FitOptions& o, const sc::ModelSpec& spec,
                   const PartChoice& choice) {
   const auto runs = o.runs.empty() ? store.runs_of_serial(o.serial) : o.runs;
+  for (const auto id : o.runs)  // a fit "over runs 1,99" must not name a run that is not there
+    if (!store.find_run(id)) throw InputError(fmt::format("{}: no run {} (--runs)", o.db, id));
   const auto limits = runs.empty() ? std::nullopt : limits_for(store, o.serial, runs, choice);
   const sc::ModelSpec part_spec = part_model_spec(spec, limits, o.terms_given);
   std::optional<sc::ModelSelection> sel;
