@@ -158,32 +158,38 @@ double ml_deviance(const SmallMatrix& m, double sum_log_f, Eigen::Index n, const
 
 }  // namespace
 
-void ml_deviances(const RowMajor& z, const std::vector<double>& dt_h, std::span<const Model> models,
-                  std::span<const Columns> subsets, std::span<double> out) {
-  const std::size_t s = subsets.size();
+namespace {
+
+/// Every model's pass, kLanes at a time; `take(model index, gathered, lane)` for each.
+template <typename Take>
+void each_pass(const RowMajor& z, const std::vector<double>& dt_h, std::span<const Model> models,
+               Take take) {
   for (std::size_t first = 0; first < models.size(); first += L) {
     const std::size_t lanes = std::min<std::size_t>(L, models.size() - first);
     std::array<Model, L> md;
     for (std::size_t l = 0; l < L; ++l) md[l] = models[first + std::min(l, lanes - 1)];
     const Gathered g = pass_for(static_cast<int>(z.cols()), z.data(), z.rows(), dt_h, md,
                                 std::make_integer_sequence<int, kMaxColumns - 1>{});
-    for (std::size_t l = 0; l < lanes; ++l)
-      for (std::size_t j = 0; j < s; ++j)
-        out[(first + l) * s + j] = ml_deviance(g.m[l], g.sum_log_f[l], z.rows(), subsets[j]);
+    for (std::size_t l = 0; l < lanes; ++l) take(first + l, g, l);
   }
+}
+
+}  // namespace
+
+void ml_deviances(const RowMajor& z, const std::vector<double>& dt_h, std::span<const Model> models,
+                  std::span<const Columns> subsets, std::span<double> out) {
+  const std::size_t s = subsets.size();
+  each_pass(z, dt_h, models, [&](std::size_t i, const Gathered& g, std::size_t l) {
+    for (std::size_t j = 0; j < s; ++j)
+      out[i * s + j] = ml_deviance(g.m[l], g.sum_log_f[l], z.rows(), subsets[j]);
+  });
 }
 
 void profiles(const RowMajor& z, const std::vector<double>& dt_h, std::span<const Model> models,
               std::span<Profile> out) {
-  for (std::size_t first = 0; first < models.size(); first += L) {
-    const std::size_t lanes = std::min<std::size_t>(L, models.size() - first);
-    std::array<Model, L> md;
-    for (std::size_t l = 0; l < L; ++l) md[l] = models[first + std::min(l, lanes - 1)];
-    const Gathered g = pass_for(static_cast<int>(z.cols()), z.data(), z.rows(), dt_h, md,
-                                std::make_integer_sequence<int, kMaxColumns - 1>{});
-    for (std::size_t l = 0; l < lanes; ++l)
-      out[first + l] = finish(g.m[l], g.sum_log_f[l], z.rows());
-  }
+  each_pass(z, dt_h, models, [&](std::size_t i, const Gathered& g, std::size_t l) {
+    out[i] = finish(g.m[l], g.sum_log_f[l], z.rows());
+  });
 }
 
 }  // namespace station::compensation::reml

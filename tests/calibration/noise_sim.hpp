@@ -92,6 +92,25 @@ struct Levels {
   double rrw_dphpsh = 0;               ///< K, deg/h/sqrt(h)
 };
 
+/// A named noise row of the coverage tests: white ARW plus the row's term.
+struct NoiseRow {
+  const char* name;
+  Levels levels;
+};
+
+/// The rows NoiseCoverage and LackOfFit test: every noise a gyro shows, and a strong walk.
+inline constexpr NoiseRow kNoiseRows[] = {
+    {"white only", {}},
+    {"Gauss-Markov 0.004 deg/h, tau 1.5 h", {.gm_dph = 0.004, .gm_tau_s = 5400}},
+    {"simulator's levels (GM 0.003/1 h, RRW 1e-4)",
+     {.gm_dph = 0.003, .gm_tau_s = 3600, .rrw_dphpsh = 1e-4}},
+    {"flicker B 0.006 deg/h", {.flicker_b_dph = 0.006}},
+    {"rate random walk K 0.003", {.rrw_dphpsh = 0.003}},
+    {"rate random walk K 0.001", {.rrw_dphpsh = 0.001}},
+    {"mixture: GM 0.003/1.5 h + flicker 0.004 + RRW 0.001",
+     {.gm_dph = 0.003, .gm_tau_s = 5400, .flicker_b_dph = 0.004, .rrw_dphpsh = 0.001}},
+};
+
 /// Kasdin's flicker filter h_k = h_(k-1) (k - 1 + alpha/2) / k with alpha = 1, and the expected
 /// Allan variance at m bins of unit white input, computed from the filter exactly.
 class Flicker {

@@ -30,23 +30,8 @@ namespace {
 
 constexpr double kB0 = 0.02, kK1 = 1.5e-4, kK0 = 5.5e-3, kK2 = 1e-5, kKr = 0.004;
 
-struct Row {
-  const char* name;
-  Levels levels;
-};
-
-// NoiseCoverage's rows (test_noise_coverage.cpp).
-const Row kRows[] = {
-    {"white only", {}},
-    {"Gauss-Markov 0.004 deg/h, tau 1.5 h", {.gm_dph = 0.004, .gm_tau_s = 5400}},
-    {"simulator's levels (GM 0.003/1 h, RRW 1e-4)",
-     {.gm_dph = 0.003, .gm_tau_s = 3600, .rrw_dphpsh = 1e-4}},
-    {"flicker B 0.006 deg/h", {.flicker_b_dph = 0.006}},
-    {"rate random walk K 0.003", {.rrw_dphpsh = 0.003}},
-    {"rate random walk K 0.001", {.rrw_dphpsh = 0.001}},
-    {"mixture: GM 0.003/1.5 h + flicker 0.004 + RRW 0.001",
-     {.gm_dph = 0.003, .gm_tau_s = 5400, .flicker_b_dph = 0.004, .rrw_dphpsh = 0.001}},
-};
+using Row = NoiseRow;
+constexpr const auto& kRows = kNoiseRows;
 
 using Extra = std::function<double(const compensation::ModelData&, std::size_t)>;
 
