@@ -91,6 +91,18 @@ ErrorModel ols_only(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const No
   return model;
 }
 
+/// What the search says of a walk: without a prior the largest it does not exclude; with one,
+/// whether the prior's walk lies beyond the largest it spans.
+void assess_walk(ErrorModel& model, const std::vector<Point>& grid, const Point& best,
+                 const Problem& pb) {
+  model.walk_assessed = true;
+  model.walk_search_max_dph_rt_h = std::sqrt(best.profile.sigma2 * walk_per_h(pb, kWalkHi));
+  if (pb.prior == nullptr)
+    model.walk_not_excluded = largest_walk_not_excluded(grid, pb, model.walk_bound_at_search_edge);
+  else if (const auto k = prior_walk_dph_rt_h(*pb.prior, pb.span_h))
+    model.prior_walk_beyond_search = *k > pb.prior->trust_factor * model.walk_search_max_dph_rt_h;
+}
+
 }  // namespace
 
 ErrorModel estimate_error_model(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
@@ -118,13 +130,7 @@ ErrorModel estimate_error_model(const Eigen::MatrixXd& x, const Eigen::VectorXd&
   }
   model.sigma_dph = std::sqrt(best.profile.sigma2);
   add_mixture(model, grid, best, pb);
-  model.walk_assessed = true;
-  model.walk_search_max_dph_rt_h = std::sqrt(best.profile.sigma2 * walk_per_h(pb, kWalkHi));
-  if (pb.prior == nullptr)
-    model.walk_not_excluded =
-        largest_walk_not_excluded(grid, pb, model.walk_bound_at_search_edge);
-  else if (const auto k = prior_walk_dph_rt_h(*pb.prior, pb.span_h))
-    model.prior_walk_beyond_search = *k > pb.prior->trust_factor * model.walk_search_max_dph_rt_h;
+  assess_walk(model, grid, best, pb);
   if (best.q <= 0 && best.u <= kWalkLo && model.mixture.empty())
     return model;  // no correlated part: independent bins
   model.method = "white+gm+rrw (REML)";

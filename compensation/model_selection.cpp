@@ -130,8 +130,8 @@ ModelSelection select_model(const ModelInput& in, const ModelSpec& base,
   sel.method = cv ? "leave-one-run-out" : "likelihood ratio";
   if (!cv) (void)fit_model(in, base);  // the base must fit: its errors are what the caller reads
   for (int step = 1;; ++step) {
-    const auto t = cv ? step_by_cv(in, sel, step, current, allowed)
-                      : step_by_lr(in, sel, step, allowed);
+    const auto t =
+        cv ? step_by_cv(in, sel, step, current, allowed) : step_by_lr(in, sel, step, allowed);
     if (!t) break;
     sel.chosen = with(sel.chosen, *t);
   }
@@ -143,7 +143,8 @@ ModelSelection select_model(const ModelInput& in, const ModelSpec& base,
                "error by more than its standard error across the runs and its likelihood ratio "
                "passed the 1 % family-wise bound"
          : "each term added only while its likelihood ratio (each model with its own error "
-           "model) passed the 1 % family-wise bound over the candidates left" + no_cv;
+           "model) passed the 1 % family-wise bound over the candidates left" +
+               no_cv;
   sel.reason = spec_text(sel.chosen) + ": " + sel.reason;
   return sel;
 }

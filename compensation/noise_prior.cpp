@@ -16,7 +16,6 @@ double log_normal(double x, double x0, double trust) {
   return d * d;
 }
 
-
 }  // namespace
 
 std::optional<double> prior_walk_dph_rt_h(const NoisePrior& prior, double span_h) {
@@ -44,6 +43,5 @@ double noise_prior_penalty(const NoisePrior& prior, double white_sd_dph, double 
   }
   return penalty;
 }
-
 
 }  // namespace station::compensation

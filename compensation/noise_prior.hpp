@@ -56,5 +56,4 @@ double noise_prior_penalty(const NoisePrior& prior, double white_sd_dph, double 
 /// deg/h/sqrt(h); empty: no prior on the walk.
 std::optional<double> prior_walk_dph_rt_h(const NoisePrior& prior, double span_h);
 
-
 }  // namespace station::compensation

@@ -46,7 +46,8 @@ std::optional<sc::NoisePrior> noise_prior_of(const AnalyzeOptions& o) {
   sc::NoisePrior p{o.arw_deg_rt_h, o.bias_instability_dph, o.rrw_dph_rt_h, o.noise_trust};
   if (!p.empty()) return p;
   if (o.noise_trust_given)
-    throw InputError("--noise-trust: give the part's noise too (--arw, --bias-instability or --rrw)");
+    throw InputError(
+        "--noise-trust: give the part's noise too (--arw, --bias-instability or --rrw)");
   return std::nullopt;
 }
 

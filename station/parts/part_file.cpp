@@ -42,7 +42,7 @@ std::optional<double> noise_term(const TomlView& t, std::string_view key, bool z
   const auto x = t.opt_number(key);
   if (!x) return x;
   if (!(zero_ok ? *x >= 0 : *x > 0) || !(*x <= compensation::kMaxNoiseTerm))
-    throw t.error(key, fmt::format("{:g} is outside {}..{:g}", *x, zero_ok ? "0" : "(0", 
+    throw t.error(key, fmt::format("{:g} is outside {}..{:g}", *x, zero_ok ? "0" : "(0",
                                    compensation::kMaxNoiseTerm));
   return *x == 0 ? 0.0 : *x;
 }

@@ -1,9 +1,6 @@
 // Building a coefficient block from a stored fit, its runs' 1 Hz record and its release.
 #include "station/release/coefficient_block.hpp"
 
-#include "station/parts/deliverable_terms.hpp"
-#include "station/store/fit_model_choice.hpp"
-
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -11,7 +8,9 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 
+#include "station/parts/deliverable_terms.hpp"
 #include "station/store/calibration.hpp"
+#include "station/store/fit_model_choice.hpp"
 #include "station/store/fit_verdicts.hpp"
 
 namespace station {
@@ -128,7 +127,8 @@ CoefficientBlock make_block(Store& store, const FitRecord& fit,
   const StoredVerdict v = load_fit_verdict(store, fit.id);
   b.part_number = v.part_number.value_or("");
   b.verdict_json = v.verdict_json;
-  if (const auto choice = load_fit_model_choice(store, fit.id)) b.model_choice_json = choice->dump();
+  if (const auto choice = load_fit_model_choice(store, fit.id))
+    b.model_choice_json = choice->dump();
   b.fit_id = fit.id;
   b.fit_created_utc = fit.created_utc;
   b.terms = fit.terms;

@@ -38,10 +38,10 @@ struct CoefficientBlock {
   std::optional<std::string> verdict_json;       ///< the fit's verdict (empty: none)
   /// How the fit's model was chosen (fits.model_choice_json; empty: terms given by hand).
   std::optional<std::string> model_choice_json;
-  std::optional<ReleaseRow> release;             ///< empty: exported without release
-  std::string software_version;                  ///< the station's version
-  std::uint32_t crc32 = 0;                       ///< of canonical
-  std::string canonical;                         ///< gyro_tc_canonical's text
+  std::optional<ReleaseRow> release;  ///< empty: exported without release
+  std::string software_version;       ///< the station's version
+  std::uint32_t crc32 = 0;            ///< of canonical
+  std::string canonical;              ///< gyro_tc_canonical's text
 
   /// The block as gyro_tc.h holds it; points into this object's strings.
   gyro_tc_block c_block() const;

@@ -234,8 +234,7 @@ json replayed_fits_as_recorded(const json& rec_fits, json rep_fits, ReplayReport
   std::set<std::string> cut;
   for (std::size_t i = 0; i < rep_fits.size() && i < rec_fits.size(); ++i)
     rep_fits[i] = recorded_keys_only(rec_fits[i], rep_fits[i], "", cut);
-  for (const auto& key : cut)
-    r.notes.push_back("not in the recording, not compared: fit " + key);
+  for (const auto& key : cut) r.notes.push_back("not in the recording, not compared: fit " + key);
   return rep_fits;
 }
 

@@ -110,8 +110,7 @@ std::string walk_text(const compensation::FitResult& fit) {
                        m.walk_assessed ? "weighs the error model"
                                        : "weighed nothing: too few bins for an error model");
   }
-  if (!m.walk_assessed)
-    return "walk: not assessed (too few bins for an error model, or none fits)";
+  if (!m.walk_assessed) return "walk: not assessed (too few bins for an error model, or none fits)";
   if (!m.walk_not_excluded) return "walk: the bins exclude a rate random walk (95 %)";
   std::string k1;
   for (std::size_t i = 0; i < fit.names.size() && i < fit.std_errors_walk_not_excluded.size(); ++i)
@@ -119,7 +118,8 @@ std::string walk_text(const compensation::FitResult& fit) {
       k1 = fmt::format("; under it k1 +- {:.2e} deg/h/C (reported +- {:.2e})",
                        fit.std_errors_walk_not_excluded[i], fit.std_errors[i]);
   return fmt::format(
-      "walk: the bins cannot exclude a rate random walk up to {}K = {:.2e} deg/h/sqrt(h) (95 %{}){}; "
+      "walk: the bins cannot exclude a rate random walk up to {}K = {:.2e} deg/h/sqrt(h) (95 "
+      "%{}){}; "
       "no part noise given (a part file's [part.\"PN\".noise] decides it)",
       m.walk_bound_at_search_edge ? "at least " : "", m.walk_not_excluded->rrw_dph_per_sqrt_h,
       m.walk_bound_at_search_edge ? ", the search's largest walk" : "", k1);

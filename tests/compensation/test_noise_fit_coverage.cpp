@@ -5,8 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstdlib>
 #include <cstdio>
+#include <cstdlib>
 #include <numbers>
 #include <random>
 #include <vector>
@@ -162,7 +162,9 @@ TEST(NoiseFitCoverage, StandardErrorsCoverTheTrueTermsAndNoQuantizationIsInvente
     k.add(t.rate_random_walk_dph_rth, t.rate_random_walk_se, gyro.k_dph_rth);
     q_reported += t.quantization_arcsec ? 1 : 0;
   }
-  const auto frac = [kRealizations](int count) { return count / static_cast<double>(kRealizations); };
+  const auto frac = [kRealizations](int count) {
+    return count / static_cast<double>(kRealizations);
+  };
   std::printf(
       "%d realizations: +-1 SE covers N %.3f B %.3f K %.3f, +-2 SE %.3f %.3f %.3f, "
       "Q reported %.3f\n",

@@ -220,8 +220,9 @@ trust_factor = 2
   // A part's model without k0 (or k1): the run's events and its table name what the fit has
   // (review: the event read past the coefficients, the table threw), and a verdict event keeps
   // to schemas/events.md.
-  const auto dt_parts = write_temp("dt_parts.toml", "[part.\"DT\"]\nmax_std_ratio = 10.0\n"
-                                                    "model = \"dT\"\n");
+  const auto dt_parts = write_temp("dt_parts.toml",
+                                   "[part.\"DT\"]\nmax_std_ratio = 10.0\n"
+                                   "model = \"dT\"\n");
   const auto dt_db = ts::fresh_db("cli-part-dt");
   const auto dt_run = station_cmd("run --sim --gyros 1 --new --db " + dt_db + " --protocol " +
                                   kShortCycle + " --parts " + dt_parts);
