@@ -2,7 +2,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-
 #include <cmath>
 #include <random>
 #include <vector>
@@ -258,4 +257,39 @@ TEST(Fit, HonestErrorsStayPositiveOnAnIllConditionedDesign) {
                   (f.error_model.sigma_dph / (f.residual_rms_dph * std::sqrt(66.0 / 60.0))))
         << f.names[j];
   }
+}
+
+// Issue 32, the part's noise (noise_prior.hpp): the prior is kept with the error model; a walk
+// the search cannot reach is warned about rather than silently ignored; with too few bins the
+// prior weighs nothing and nothing about a walk is claimed.
+TEST(Fit, ThePartsNoiseIsKeptAndABoundItCannotReachIsSaid) {
+  const sc::ModelData d = scenario(0.02, 1.5e-4, 0, 5.5e-3, 0.007, 9);
+  sc::ModelSpec spec;
+  spec.noise_prior = sc::NoisePrior{0.003, std::nullopt, 1e-4, 2.0};
+  const auto fit = sc::fit_model(d.view(), spec);
+  ASSERT_TRUE(fit.error_model.prior);
+  EXPECT_EQ(*fit.error_model.prior->rrw_dph_rt_h, 1e-4);
+  EXPECT_TRUE(fit.error_model.walk_assessed);
+  EXPECT_FALSE(fit.error_model.walk_not_excluded) << "with a prior no bound is claimed";
+  EXPECT_FALSE(fit.error_model.prior_walk_beyond_search);
+
+  spec.noise_prior = sc::NoisePrior{std::nullopt, std::nullopt, 1e6, 2.0};
+  const auto far = sc::fit_model(d.view(), spec);
+  EXPECT_TRUE(far.error_model.prior_walk_beyond_search);
+  EXPECT_TRUE(std::any_of(far.warnings.begin(), far.warnings.end(), [](const std::string& w) {
+    return w.find("beyond the largest the error model searches") != std::string::npos;
+  }));
+
+  const auto bare = sc::fit_model(d.view(), {});
+  EXPECT_TRUE(bare.error_model.walk_assessed);
+  EXPECT_EQ(bare.std_errors_walk_not_excluded.size(),
+            bare.error_model.walk_not_excluded ? bare.names.size() : 0u);
+
+  sc::ModelData few = d;  // 7 bins: too few for an error model
+  for (auto* v : {&few.bias_dph, &few.temp_c, &few.grad_c, &few.dtdt_c_per_h, &few.channel})
+    v->resize(7);
+  spec.noise_prior = sc::NoisePrior{0.003, std::nullopt, 1e-4, 2.0};
+  const auto short_fit = sc::fit_model(few.view(), spec);
+  EXPECT_FALSE(short_fit.error_model.walk_assessed);
+  ASSERT_TRUE(short_fit.error_model.prior) << "kept, though it weighed nothing";
 }
