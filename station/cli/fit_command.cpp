@@ -145,14 +145,16 @@ JudgedFit fit_one(Store& store, const FitOptions& o, const sc::ModelSpec& spec,
   const sc::ModelSpec part_spec = part_model_spec(spec, limits, o.terms_given);
   std::optional<sc::ModelSelection> sel;
   if (o.select && !runs.empty()) sel = select_for(store, o.serial, runs, part_spec);
+  // The fit, its verdict and how its model was chosen commit together, or none of them.
+  Transaction tx(store.db());
   JudgedFit out = judge_and_store(
       store, fit_serial(store, o.serial, runs, sel ? sel->chosen : part_spec), limits);
-  if (sel) {
+  if (sel)
     save_fit_model_choice(store, out.fit.fit_id, model_selection_json(*sel));
-    if (!o.json) fmt::print("{}", model_selection_text(*sel));
-  } else {
+  else
     note_part_model(store, out.fit.fit_id, limits, o.terms_given);
-  }
+  tx.commit();
+  if (sel && !o.json) fmt::print("{}", model_selection_text(*sel));
   return out;
 }
 
