@@ -45,6 +45,9 @@ struct ModelSpec {
   std::optional<NoisePrior> noise_prior;
 };
 
+/// A model's terms as one word, "B0+dT+gradT".
+std::string model_text(const ModelSpec& spec);
+
 /// Per-bin model inputs (all spans the same length; grad/dtdt/channel may be empty if unused).
 struct ModelInput {
   std::span<const double> bias_dph;      ///< bin mean rate minus Earth rate, deg/h

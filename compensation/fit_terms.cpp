@@ -176,6 +176,12 @@ std::optional<Term> term_from_option_name(std::string_view name) {
   return std::nullopt;
 }
 
+std::string model_text(const ModelSpec& spec) {
+  std::string out = "B0";
+  for (const Term t : spec.terms) out += "+" + std::string(term_option_name(t));
+  return out;
+}
+
 std::vector<Term> parse_terms(std::string_view list) {
   std::vector<Term> terms;
   while (!list.empty()) {

@@ -13,12 +13,6 @@
 namespace station::compensation {
 namespace {
 
-std::string spec_text(const ModelSpec& s) {
-  std::string out = "B0";
-  for (const Term t : s.terms) out += "+" + std::string(term_option_name(t));
-  return out;
-}
-
 std::string num(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.4g", v);
@@ -55,56 +49,41 @@ double help_beyond_one_se(const CrossValidation& without, const CrossValidation&
   return mean - sample_std(d) / std::sqrt(static_cast<double>(d.size()));
 }
 
-/// One step by held-out error: of the candidates that help beyond one standard error and whose
-/// likelihood ratio over all the runs passes the bound, the one with the lowest pooled RMS.
-std::optional<Term> step_by_cv(const ModelInput& in, ModelSelection& sel, int step,
-                               CrossValidation& current, std::span<const Term> allowed) {
-  std::optional<Term> best;
-  std::optional<CrossValidation> best_cv;
-  const std::vector<Term> cands = allowed_candidates(in, sel.chosen, allowed);
-  if (cands.empty()) return best;
-  const double bound = std::pow(candidate_z_critical(cands.size()), 2);
-  const std::vector<double> lr = extension_likelihood_ratios(in, sel.chosen, cands, bound);
-  for (std::size_t k = 0; k < cands.size(); ++k) {
-    const Term t = cands[k];
-    TriedModel m;
-    m.spec = with(sel.chosen, t);
-    m.step = step;
-    m.added = term_option_name(t);
-    m.likelihood_ratio = lr[k];
-    try {
-      CrossValidation cv = leave_one_run_out(in, m.spec);
-      m.held_out_rms_dph = cv.pooled_rms_dph;
-      if (lr[k] > bound && help_beyond_one_se(current, cv) > 0 &&
-          (!best_cv || cv.pooled_rms_dph < best_cv->pooled_rms_dph))
-        best = t, best_cv = std::move(cv);
-    } catch (const std::exception& e) {
-      m.not_fitted = e.what();
-    }
-    sel.tried.push_back(std::move(m));
-  }
-  if (best_cv) current = std::move(*best_cv);
-  return best;
-}
-
-/// One step by likelihood ratio: the candidate with the largest ratio, if beyond the bound.
-std::optional<Term> step_by_lr(const ModelInput& in, ModelSelection& sel, int step,
-                               std::span<const Term> allowed) {
+/// One forward step: every allowed candidate tried, its likelihood ratio taken. With `current`
+/// (two or more runs), of the candidates that help beyond one standard error and whose ratio
+/// passes the bound, the one with the lowest pooled held-out RMS (`current` becomes its
+/// cross-validation); without, the one with the largest ratio beyond the bound.
+std::optional<Term> step_forward(const ModelInput& in, ModelSelection& sel, int step,
+                                 std::span<const Term> allowed, CrossValidation* current) {
   const std::vector<Term> cands = allowed_candidates(in, sel.chosen, allowed);
   if (cands.empty()) return std::nullopt;
   const double bound = std::pow(candidate_z_critical(cands.size()), 2);
   const std::vector<double> lr = extension_likelihood_ratios(in, sel.chosen, cands, bound);
   std::optional<Term> best;
-  double best_lr = bound;
+  double best_score = INFINITY;  // held-out RMS, or minus the ratio
+  std::optional<CrossValidation> best_cv;
   for (std::size_t k = 0; k < cands.size(); ++k) {
     TriedModel m;
     m.spec = with(sel.chosen, cands[k]);
     m.step = step;
     m.added = term_option_name(cands[k]);
     m.likelihood_ratio = lr[k];
+    const bool passes = lr[k] > bound;
+    if (current == nullptr) {
+      if (passes && -lr[k] < best_score) best_score = -lr[k], best = cands[k];
+    } else {
+      try {
+        CrossValidation cv = leave_one_run_out(in, m.spec);
+        m.held_out_rms_dph = cv.pooled_rms_dph;
+        if (passes && help_beyond_one_se(*current, cv) > 0 && cv.pooled_rms_dph < best_score)
+          best_score = cv.pooled_rms_dph, best = cands[k], best_cv = std::move(cv);
+      } catch (const std::exception& e) {
+        m.not_fitted = e.what();
+      }
+    }
     sel.tried.push_back(std::move(m));
-    if (lr[k] > best_lr) best_lr = lr[k], best = cands[k];
   }
+  if (best_cv) *current = std::move(*best_cv);
   return best;
 }
 
@@ -130,12 +109,11 @@ ModelSelection select_model(const ModelInput& in, const ModelSpec& base,
   sel.method = cv ? "leave-one-run-out" : "likelihood ratio";
   if (!cv) (void)fit_model(in, base);  // the base must fit: its errors are what the caller reads
   for (int step = 1;; ++step) {
-    const auto t =
-        cv ? step_by_cv(in, sel, step, current, allowed) : step_by_lr(in, sel, step, allowed);
+    const auto t = step_forward(in, sel, step, allowed, cv ? &current : nullptr);
     if (!t) break;
     sel.chosen = with(sel.chosen, *t);
   }
-  for (auto& m : sel.tried) m.chosen = spec_text(m.spec) == spec_text(sel.chosen) && !m.not_fitted;
+  for (auto& m : sel.tried) m.chosen = m.spec.terms == sel.chosen.terms && !m.not_fitted;
   sel.reason =
       cv ? "held-out RMS " + num(current.pooled_rms_dph * 1e3) + " mdeg/h over " +
                std::to_string(runs.size()) +
@@ -145,7 +123,7 @@ ModelSelection select_model(const ModelInput& in, const ModelSpec& base,
          : "each term added only while its likelihood ratio (each model with its own error "
            "model) passed the 1 % family-wise bound over the candidates left" +
                no_cv;
-  sel.reason = spec_text(sel.chosen) + ": " + sel.reason;
+  sel.reason = model_text(sel.chosen) + ": " + sel.reason;
   return sel;
 }
 

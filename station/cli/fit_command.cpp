@@ -142,17 +142,17 @@ JudgedFit fit_one(Store& store, const FitOptions& o, const sc::ModelSpec& spec,
   for (const auto id : o.runs)  // a fit "over runs 1,99" must not name a run that is not there
     if (!store.find_run(id)) throw InputError(fmt::format("{}: no run {} (--runs)", o.db, id));
   const auto limits = runs.empty() ? std::nullopt : limits_for(store, o.serial, runs, choice);
-  const sc::ModelSpec part_spec = part_model_spec(spec, limits, o.terms_given);
   std::optional<sc::ModelSelection> sel;
-  if (o.select && !runs.empty()) sel = select_for(store, o.serial, runs, part_spec);
+  if (o.select && !runs.empty())
+    sel = select_for(store, o.serial, runs, part_model_spec(spec, limits, o.terms_given));
   // The fit, its verdict and how its model was chosen commit together, or none of them.
   Transaction tx(store.db());
-  JudgedFit out = judge_and_store(
-      store, fit_serial(store, o.serial, runs, sel ? sel->chosen : part_spec), limits);
-  if (sel)
-    save_fit_model_choice(store, out.fit.fit_id, model_selection_json(*sel));
-  else
-    note_part_model(store, out.fit.fit_id, limits, o.terms_given);
+  JudgedFit out =
+      judge_and_store(store,
+                      sel ? fit_serial(store, o.serial, runs, sel->chosen)
+                          : fit_serial_for_part(store, o.serial, runs, spec, limits, o.terms_given),
+                      limits);
+  if (sel) save_fit_model_choice(store, out.fit.fit_id, model_selection_json(*sel));
   tx.commit();
   if (sel && !o.json) fmt::print("{}", model_selection_text(*sel));
   return out;

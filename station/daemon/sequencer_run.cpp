@@ -37,10 +37,9 @@ RunState Sequencer::finish(RunState end_state, double t_s) {
           part == options_.part_limits.end() ? std::nullopt : std::optional{part->second};
       compensation::ModelSpec paper;  // B0 + k1 dT + k0 gradT
       paper.ref_temp_c = config_.ref_temp_c;
-      const auto f =
-          fit_serial(store_, slot.serial, {run_id_}, part_model_spec(paper, limits, false),
-                     it == lossy.end() ? std::vector<std::string>{} : std::vector{it->second});
-      note_part_model(store_, f.fit_id, limits, false);
+      const auto f = fit_serial_for_part(
+          store_, slot.serial, {run_id_}, paper, limits, false,
+          it == lossy.end() ? std::vector<std::string>{} : std::vector{it->second});
       std::string coefs;  // by name: a part's model may lack k1 or k0, or order them otherwise
       for (std::size_t i = 1; i < f.fit.names.size(); ++i) {
         const std::string_view unit = compensation::coefficient_unit(f.fit.names[i]);

@@ -88,10 +88,15 @@ sc::ModelSpec part_model_spec(sc::ModelSpec given, const std::optional<PartLimit
   return given;
 }
 
-void note_part_model(Store& store, std::int64_t fit_id, const std::optional<PartLimits>& limits,
-                     bool terms_given) {
+SerialFit fit_serial_for_part(Store& store, const std::string& serial,
+                              const std::vector<std::int64_t>& runs, const sc::ModelSpec& given,
+                              const std::optional<PartLimits>& limits, bool terms_given,
+                              std::vector<std::string> warnings) {
+  SerialFit f = fit_serial(store, serial, runs, part_model_spec(given, limits, terms_given),
+                           std::move(warnings));
   if (limits && limits->model && !terms_given)
-    save_fit_model_choice(store, fit_id, part_model_choice_json(limits->number, *limits->model));
+    save_fit_model_choice(store, f.fit_id, part_model_choice_json(limits->number, *limits->model));
+  return f;
 }
 
 FitAllResult fit_all(Store& store, std::optional<std::int64_t> run_id, const sc::ModelSpec& spec,
@@ -112,9 +117,7 @@ FitAllResult fit_all(Store& store, std::optional<std::int64_t> run_id, const sc:
     const auto limits = limits_for(store, serial, runs, choice);
     try {
       out.fits.push_back(judge_and_store(
-          store, fit_serial(store, serial, runs, part_model_spec(spec, limits, terms_given)),
-          limits));
-      note_part_model(store, out.fits.back().fit.fit_id, limits, terms_given);
+          store, fit_serial_for_part(store, serial, runs, spec, limits, terms_given), limits));
     } catch (const InputError& e) {
       out.skipped.emplace_back(e.what());
     }

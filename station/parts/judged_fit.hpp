@@ -40,10 +40,13 @@ std::optional<PartLimits> limits_for(Store& store, const std::string& serial,
 compensation::ModelSpec part_model_spec(compensation::ModelSpec given,
                                         const std::optional<PartLimits>& limits, bool terms_given);
 
-/// Stores with fit `fit_id` that its part fixed its model (migration 9), when part_model_spec
-/// took the part's model.
-void note_part_model(Store& store, std::int64_t fit_id, const std::optional<PartLimits>& limits,
-                     bool terms_given);
+/// fit_serial under part_model_spec, and, when the part's model was taken, that choice stored
+/// with the fit (migration 9): how fit, fit --all and run fit a gyro of a part.
+SerialFit fit_serial_for_part(Store& store, const std::string& serial,
+                              const std::vector<std::int64_t>& runs,
+                              const compensation::ModelSpec& given,
+                              const std::optional<PartLimits>& limits, bool terms_given,
+                              std::vector<std::string> warnings = {});
 
 /// The compensated 1 Hz record of `serial` in `run_id`: rate - Earth rate - model, over the
 /// samples that went into bins (gaps closed up). Empty when the model has a term the 1 Hz record

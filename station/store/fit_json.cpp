@@ -57,7 +57,8 @@ compensation::NoisePrior noise_prior_from_json(const nlohmann::json& j) {
   return n;
 }
 
-nlohmann::json error_model_json(const compensation::ErrorModel& m) {
+nlohmann::json fit_error_model_json(const compensation::FitResult& fit) {
+  const compensation::ErrorModel& m = fit.error_model;
   nlohmann::json j{{"method", m.method},
                    {"corr_time_s", m.corr_time_s},
                    {"correlated_share", m.correlated_share},
@@ -67,18 +68,13 @@ nlohmann::json error_model_json(const compensation::ErrorModel& m) {
                    {"models_averaged", m.mixture.size()},
                    {"on_search_boundary", m.on_search_boundary}};
   j["prior"] = m.prior ? noise_json(*m.prior) : nlohmann::json();
-  return j;
-}
-
-nlohmann::json fit_error_model_json(const compensation::FitResult& fit) {
-  nlohmann::json j = error_model_json(fit.error_model);
-  const auto& w = fit.error_model.walk_not_excluded;
+  const auto& w = m.walk_not_excluded;
   j["walk_not_excluded"] =
       w ? nlohmann::json{{"rrw_dph_per_sqrt_h", w->rrw_dph_per_sqrt_h},
-                         {"at_search_edge", fit.error_model.walk_bound_at_search_edge},
+                         {"at_search_edge", m.walk_bound_at_search_edge},
                          {"std_errors", keyed(fit, fit.std_errors_walk_not_excluded)}}
         : nlohmann::json();
-  j["walk_assessed"] = fit.error_model.walk_assessed;
+  j["walk_assessed"] = m.walk_assessed;
   return j;
 }
 

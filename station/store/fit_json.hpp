@@ -20,21 +20,19 @@ nlohmann::json std_errors_json(const compensation::FitResult& fit);
 /// {"B0": Newey-West std error, ...}
 /// {name: OLS standard error} (iid bins; kept for comparison).
 nlohmann::json std_errors_ols_json(const compensation::FitResult& fit);
-/// The error model behind std_errors: {"method","corr_time_s","correlated_share","sigma_dph",
-/// "rho_per_bin"}.
-nlohmann::json error_model_json(const compensation::ErrorModel& model);
 /// One line for people: "errors: white + Gauss-Markov noise, tau 3400 s, 21 % of the variance,
 /// neighbouring bins correlated 0.84 (REML)" or "errors: independent bins (OLS)".
 std::string error_model_text(const compensation::ErrorModel& model);
-/// Reads error_model_json back; missing keys stay at their defaults.
+/// Reads fit_error_model_json back; missing keys stay at their defaults.
 compensation::ErrorModel error_model_from_json(const nlohmann::json& j);
 /// {"arw_deg_rt_h", "bias_instability_dph", "rrw_dph_rt_h", "trust_factor"} (absent: not given).
 nlohmann::json noise_json(const compensation::NoisePrior& noise);
 /// The inverse of noise_json; throws nlohmann::json::exception on a malformed object.
 compensation::NoisePrior noise_prior_from_json(const nlohmann::json& j);
-/// error_model_json and the largest walk the bins do not exclude, with each coefficient's
-/// standard error under it: {..., "walk_not_excluded": {"rrw_dph_per_sqrt_h", "std_errors"}}
-/// (null with a prior, or when the bins exclude every walk). What the store keeps.
+/// The error model behind std_errors, what the store keeps: {"method", "corr_time_s",
+/// "correlated_share", "sigma_dph", "rho_per_bin", "rrw_dph_per_sqrt_h", "models_averaged",
+/// "on_search_boundary", "prior", "walk_not_excluded": {"rrw_dph_per_sqrt_h", "at_search_edge",
+/// "std_errors"} (null with a prior, or when the bins exclude every walk), "walk_assessed"}.
 nlohmann::json fit_error_model_json(const compensation::FitResult& fit);
 /// Reads fit_error_model_json's walk back into `fit` (its names set).
 void read_walk_not_excluded(const nlohmann::json& j, compensation::FitResult& fit);

@@ -12,16 +12,10 @@ nlohmann::json or_null(const std::optional<double>& v) {
 
 }  // namespace
 
-std::string model_text(const compensation::ModelSpec& spec) {
-  std::string out = "B0";
-  for (const auto t : spec.terms) out += "+" + std::string(compensation::term_option_name(t));
-  return out;
-}
-
 nlohmann::json model_selection_json(const compensation::ModelSelection& sel) {
   nlohmann::json tried = nlohmann::json::array();
   for (const auto& m : sel.tried)
-    tried.push_back({{"model", model_text(m.spec)},
+    tried.push_back({{"model", compensation::model_text(m.spec)},
                      {"step", m.step},
                      {"added", m.added},
                      {"held_out_rms_dph", or_null(m.held_out_rms_dph)},
@@ -29,7 +23,7 @@ nlohmann::json model_selection_json(const compensation::ModelSelection& sel) {
                      {"not_fitted", m.not_fitted ? nlohmann::json(*m.not_fitted) : nullptr},
                      {"chosen", m.chosen}});
   return {{"method", sel.method},
-          {"chosen", model_text(sel.chosen)},
+          {"chosen", compensation::model_text(sel.chosen)},
           {"reason", sel.reason},
           {"tried", tried}};
 }
@@ -39,7 +33,7 @@ nlohmann::json part_model_choice_json(const std::string& part_number, const std:
   spec.terms = compensation::parse_terms(model);
   return {{"method", "part file"},
           {"part_number", part_number},
-          {"chosen", model_text(spec)},
+          {"chosen", compensation::model_text(spec)},
           {"reason", fmt::format("part {} fixes the model for production", part_number)}};
 }
 
@@ -51,8 +45,8 @@ std::string model_selection_text(const compensation::ModelSelection& sel) {
         : m.held_out_rms_dph ? fmt::format("held-out RMS {:.5f} deg/h", *m.held_out_rms_dph)
         : m.likelihood_ratio ? fmt::format("likelihood ratio {:.1f}", *m.likelihood_ratio)
                              : std::string("the base");
-    out += fmt::format("  {} step {} {:<24} {}\n", m.chosen ? "*" : " ", m.step, model_text(m.spec),
-                       figure);
+    out += fmt::format("  {} step {} {:<24} {}\n", m.chosen ? "*" : " ", m.step,
+                       compensation::model_text(m.spec), figure);
   }
   return out + fmt::format("  chosen {}\n", sel.reason);
 }

@@ -23,9 +23,6 @@ nlohmann::json part_model_choice_json(const std::string& part_number, const std:
 /// The table people read: one line per model tried, the chosen one marked, then the reason.
 std::string model_selection_text(const compensation::ModelSelection& sel);
 
-/// "B0+dT+gradT": a model's terms as one word.
-std::string model_text(const compensation::ModelSpec& spec);
-
 /// Writes fit `fit_id`'s model_choice_json.
 void save_fit_model_choice(Store& store, std::int64_t fit_id, const nlohmann::json& choice);
 /// Reads it back (empty: the terms were given, or the fit is older than migration 9).
