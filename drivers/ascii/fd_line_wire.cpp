@@ -167,6 +167,24 @@ int FdLineWire::send(std::string_view bytes, double timeout_s) {
   return static_cast<int>(done);
 }
 
+int FdLineWire::fill(Steady::time_point deadline) {
+  for (;;) {
+    if (wait_for(fd_.get(), POLLIN, deadline) != 1) return -1;
+    char buf[512];
+    const ssize_t n = ::read(fd_.get(), buf, sizeof buf);
+    if (n == 0) {
+      errno = ECONNRESET;  // the peer closed the connection
+      return -1;
+    }
+    if (n < 0) {
+      if (errno == EINTR || errno == EAGAIN) continue;
+      return -1;
+    }
+    pending_.append(buf, static_cast<std::size_t>(n));
+    return 0;
+  }
+}
+
 int FdLineWire::receive(std::string& line, std::string_view terminator, double timeout_s,
                         std::size_t max_bytes) {
   if (!fd_.valid()) {
@@ -190,19 +208,26 @@ int FdLineWire::receive(std::string& line, std::string_view terminator, double t
       errno = EMSGSIZE;
       return -1;
     }
-    if (wait_for(fd_.get(), POLLIN, deadline) != 1) return -1;
-    char buf[512];
-    const ssize_t n = ::read(fd_.get(), buf, sizeof buf);
-    if (n == 0) {
-      errno = ECONNRESET;  // the peer closed the connection
-      return -1;
-    }
-    if (n < 0) {
-      if (errno == EINTR || errno == EAGAIN) continue;
-      return -1;
-    }
-    pending_.append(buf, static_cast<std::size_t>(n));
+    if (fill(deadline) == -1) return -1;
   }
+}
+
+int FdLineWire::receive_exact(std::string& bytes, std::size_t n, double timeout_s) {
+  if (!fd_.valid()) {
+    errno = ENOTCONN;
+    return -1;
+  }
+  const auto deadline = deadline_after(timeout_s);
+  while (pending_.size() < n) {
+    if (fill(deadline) == -1) {
+      // Part of it came, then the deadline: a reply cut short, not a silent device.
+      if (errno == ETIMEDOUT && !pending_.empty()) errno = EBADMSG;
+      return -1;
+    }
+  }
+  bytes = pending_.substr(0, n);
+  pending_.erase(0, n);
+  return static_cast<int>(n);
 }
 
 void FdLineWire::flush() {

@@ -3,14 +3,19 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <chrono>
 #include <cstring>
 #include <variant>
 
 namespace station::drivers::ascii {
 
 Error translate_line_error(int err, const std::string& what) {
-  std::string msg = what + ": " + (err == EMSGSIZE ? "reply line too long" : std::strerror(err));
+  std::string msg = what + ": " +
+                    (err == EMSGSIZE  ? "reply line too long"
+                     : err == EBADMSG ? "reply cut short at the deadline"
+                                      : std::strerror(err));
   switch (err) {
     case ETIMEDOUT:
     case EAGAIN:
@@ -69,6 +74,16 @@ void LineClient::disconnect() {
   state_.closed();
 }
 
+double LineClient::deadline_after(double timeout_s) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
+             .count() +
+         timeout_s;
+}
+
+double LineClient::seconds_left(double deadline_s) {
+  return std::max(0.0, deadline_s - deadline_after(0));
+}
+
 Result<void> LineClient::ensure_connected() {
   return state_.ensure(device_, [this] { return connect(); });
 }
@@ -89,13 +104,13 @@ Error LineClient::fail(int err, const std::string& what) {
   return e;
 }
 
-Result<void> LineClient::transmit(std::string_view command) {
+Result<void> LineClient::transmit(std::string_view command, double timeout_s) {
   if (auto c = ensure_connected(); !c) return c.error();
   wire_->flush();
   std::string bytes(command);
   bytes += framing_.command_terminator;
   tap(TapDirection::tx, "ascii", bytes, {});  // as sent, terminator included
-  if (wire_->send(bytes, timeout_s_) == -1) {
+  if (wire_->send(bytes, timeout_s) == -1) {
     const int err = errno;  // before anything allocates
     return fail(err, fmt::format("send '{}'", command));
   }
@@ -103,9 +118,11 @@ Result<void> LineClient::transmit(std::string_view command) {
 }
 
 Result<std::string> LineClient::query(std::string_view command) {
-  if (auto t = transmit(command); !t) return t.error();
+  const double deadline_s = deadline_after(timeout_s_);
+  if (auto t = transmit(command, seconds_left(deadline_s)); !t) return t.error();
   std::string line;
-  if (wire_->receive(line, framing_.reply_terminator, timeout_s_, framing_.max_reply_bytes) == -1) {
+  if (wire_->receive(line, framing_.reply_terminator, seconds_left(deadline_s),
+                     framing_.max_reply_bytes) == -1) {
     const int err = errno;
     return fail(err, fmt::format("reply to '{}'", command));
   }
@@ -115,7 +132,7 @@ Result<std::string> LineClient::query(std::string_view command) {
 }
 
 Result<void> LineClient::send(std::string_view command) {
-  if (auto t = transmit(command); !t) return t;
+  if (auto t = transmit(command, timeout_s_); !t) return t;
   link_.answered();
   return {};
 }

@@ -3,6 +3,7 @@
 // LineClient's error translation, reconnect and back-off run the same over both.
 #pragma once
 
+#include <chrono>
 #include <string>
 #include <string_view>
 
@@ -25,6 +26,9 @@ class LineWire {
   /// a line longer than `max_bytes` is EMSGSIZE.
   virtual int receive(std::string& line, std::string_view terminator, double timeout_s,
                       std::size_t max_bytes) = 0;
+  /// Reads exactly `n` bytes into `bytes` within `timeout_s` (a length-prefixed frame's parts;
+  /// bytes already read past a line come first); some but not all of them by then is EBADMSG.
+  virtual int receive_exact(std::string& bytes, std::size_t n, double timeout_s) = 0;
   /// Discards unread input (before a request, after a timeout).
   virtual void flush() = 0;
 };
@@ -38,11 +42,14 @@ class FdLineWire final : public LineWire {
   int send(std::string_view bytes, double timeout_s) override;
   int receive(std::string& line, std::string_view terminator, double timeout_s,
               std::size_t max_bytes) override;
+  int receive_exact(std::string& bytes, std::size_t n, double timeout_s) override;
   void flush() override;
 
  private:
   int open_tcp(const LineTcp& ep, double timeout_s);
   int open_serial(const LineSerial& ep);
+  /// Reads what the descriptor has into pending_, waiting until `deadline`.
+  int fill(std::chrono::steady_clock::time_point deadline);
 
   LineEndpoint endpoint_;
   UniqueFd fd_;

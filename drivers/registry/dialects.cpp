@@ -16,6 +16,7 @@
 #include "drivers/chamber/watlow_f4t/f4t_map.hpp"
 #include "drivers/chamber/watlow_f4t/watlow_f4t_chamber.hpp"
 #include "drivers/turntable/acutrol3000/acutrol3000_table.hpp"
+#include "drivers/turntable/acutrol3000/acutrol_wire.hpp"
 #include "drivers/turntable/generic_plc/generic_plc_map.hpp"
 #include "drivers/turntable/generic_plc/modbus_turntable.hpp"
 
@@ -138,10 +139,12 @@ const std::vector<TurntableDialect> kTables{
     {"acutrol3000", Transport::ascii, "Acutronic ACUTROL3000, ASCII over TCP 9878 or serial", "",
      false, nullptr,
      [](const DeviceSpec& s, const LinkOptions& o) -> std::unique_ptr<Turntable> {
-       return hooked_line(
-           std::make_unique<Acutrol3000Table>(s.name, line_ep(s), s.timeout_s, line_wire(s, o)), s,
-           o);
-     }},
+       const auto framing = acutrol3000::framing_from_name(s.framing.empty() ? "auto" : s.framing);
+       return hooked_line(std::make_unique<Acutrol3000Table>(s.name, line_ep(s), s.timeout_s,
+                                                             line_wire(s, o), framing.value()),
+                          s, o);
+     },
+     acutrol3000::kFramingNames},
 };
 
 // Whether `model` is one of the row's comma-separated aliases.
@@ -199,6 +202,12 @@ void validate(const Dialect<Device>& dialect, const DeviceSpec& spec) {
     throw std::invalid_argument(fmt::format(
         "run_event: model '{}' has no event outputs (only {} do)", dialect.model, with));
   }
+  if (!spec.framing.empty() && !is_alias(dialect.framings, spec.framing))
+    throw std::invalid_argument(
+        dialect.framings.empty()
+            ? fmt::format("framing: model '{}' has no reply framing to choose", dialect.model)
+            : fmt::format("framing '{}': model '{}' takes one of {}", spec.framing, dialect.model,
+                          dialect.framings));
   if (dialect.transport == Transport::modbus) {
     (void)modbus::parse_endpoint(spec.endpoint);
     if (spec.run_event < 1 || spec.run_event > 8)

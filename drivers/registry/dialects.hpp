@@ -38,6 +38,8 @@ struct DeviceSpec {
   int readback_every = modbus::ReadbackSchedule::kDefaultEvery;
   std::vector<modbus::PointOverride> overrides;  ///< Modbus dialects: point overrides
   int run_event = 1;  ///< Watlow F4/F4T: event output that runs the chamber (builder's wiring)
+  /// ASCII dialects with a choice of reply framing (the row's `framings`): "" is the default.
+  std::string framing;
 };
 
 /// Makes the link under a device's client (replay passes recorded ones); empty: the real link.
@@ -68,6 +70,9 @@ struct Dialect {
   std::function<modbus::RegisterMap(const DeviceSpec&)> map;
   /// Builds the driver; no I/O. Throws std::invalid_argument on a bad spec.
   std::function<std::unique_ptr<Device>(const DeviceSpec&, const LinkOptions&)> make;
+  /// The reply framings `framing` may name, comma-separated, the first the default (empty: the
+  /// key is not taken).
+  std::string_view framings = {};
 };
 
 using ChamberDialect = Dialect<Chamber>;

@@ -61,7 +61,7 @@ mb::PointOverride read_override(const TomlView& v) {
 // endpoint and keys it takes; everything is checked here, before anything moves.
 DeviceConfig read_device(const TomlView& v, bool is_chamber) {
   v.allow_only({"endpoint", "model", "preset", "unit_id", "timeout_s", "readback_every", "point",
-                "run_event"});
+                "run_event", "framing"});
   DeviceConfig d;
   d.name = is_chamber ? "chamber" : "turntable";
   if (v.opt_string("model") && v.opt_string("preset"))
@@ -75,6 +75,7 @@ DeviceConfig read_device(const TomlView& v, bool is_chamber) {
   d.readback_every =
       static_cast<int>(v.opt_integer_in("readback_every", 1, 600).value_or(d.readback_every));
   d.run_event = static_cast<int>(v.opt_integer_in("run_event", 1, 8).value_or(1));
+  d.framing = v.opt_string("framing").value_or("");
   for (const auto& p : v.table_array("point")) d.overrides.push_back(read_override(p));
   const auto check = [&](const auto* dialect) {
     d.model = std::string(dialect->model);
@@ -85,8 +86,9 @@ DeviceConfig read_device(const TomlView& v, bool is_chamber) {
         (void)drivers::ascii::parse_line_endpoint(d.endpoint);
       return 0;
     });
-    // The dialect checks run_event and the point overrides; the message names the key given.
-    at_key(v, d.run_event != 1 ? "run_event" : "point", [&] {
+    // The dialect checks run_event, framing and the point overrides; the message names the key
+    // given.
+    at_key(v, d.run_event != 1 ? "run_event" : !d.framing.empty() ? "framing" : "point", [&] {
       drivers::validate(*dialect, d);
       return 0;
     });

@@ -50,6 +50,8 @@ void RecordedLineWire::close() {
 }
 
 int RecordedLineWire::send(std::string_view bytes, double) {
+  reply_open_ = false;  // what was left unread is discarded, as the real link flushes it
+  reply_.clear();
   const SessionLogLine* l = peek();
   const auto sent = bytes_of(bytes);
   if (l == nullptr || l->direction != "tx" || l->kind != "ascii" || l->bytes != sent)
@@ -60,15 +62,40 @@ int RecordedLineWire::send(std::string_view bytes, double) {
   return static_cast<int>(bytes.size());
 }
 
-int RecordedLineWire::receive(std::string& line, std::string_view, double, std::size_t) {
-  if (recorded_error(" reply to '")) return -1;
+bool RecordedLineWire::open_reply() {
+  if (reply_open_) return true;
+  if (recorded_error(" reply to '")) return false;
   const SessionLogLine* l = peek();
   if (l == nullptr || l->direction != "rx" || l->kind != "ascii")
     throw ReplayDivergence(device_, l ? describe(*l) : "no more exchanges", "the reply",
                            l ? l->t_s : 0);
   ++next_;
-  line.assign(l->bytes.begin(), l->bytes.end());
+  reply_.assign(l->bytes.begin(), l->bytes.end());
+  reply_open_ = true;
+  return true;
+}
+
+int RecordedLineWire::receive(std::string& line, std::string_view terminator, double, std::size_t) {
+  if (!open_reply()) return -1;
+  // A reply recorded with its terminator (read in parts) gives it back without.
+  if (reply_.ends_with(terminator)) reply_.resize(reply_.size() - terminator.size());
+  line = std::move(reply_);
+  reply_.clear();
+  reply_open_ = false;
   return static_cast<int>(line.size());
+}
+
+int RecordedLineWire::receive_exact(std::string& bytes, std::size_t n, double) {
+  if (!open_reply()) return -1;
+  if (reply_.size() < n) {
+    const SessionLogLine* l = next_ > 0 ? &lines_[next_ - 1] : nullptr;
+    throw ReplayDivergence(device_, l ? describe(*l) : "no more exchanges",
+                           fmt::format("{} more reply bytes", n), l ? l->t_s : 0);
+  }
+  bytes = reply_.substr(0, n);
+  reply_.erase(0, n);
+  reply_open_ = !reply_.empty();
+  return static_cast<int>(n);
 }
 
 }  // namespace station

@@ -1,6 +1,7 @@
 // A recorded session's ascii.log as a LineWire: the daemon's LineClient sends, the recording
-// checks the bytes and answers with the recorded line, exchange by exchange. Sending anything
-// else is a divergence (ReplayDivergence), as for Modbus (replay_modbus.hpp).
+// checks the bytes and answers with the recorded line, exchange by exchange. A reply read in
+// parts (a frame's header, then its payload) is served from one recorded rx line in order. Sending
+// anything else is a divergence (ReplayDivergence), as for Modbus (replay_modbus.hpp).
 #pragma once
 
 #include <string>
@@ -22,6 +23,7 @@ class RecordedLineWire final : public drivers::ascii::LineWire {
   int send(std::string_view bytes, double timeout_s) override;
   int receive(std::string& line, std::string_view terminator, double timeout_s,
               std::size_t max_bytes) override;
+  int receive_exact(std::string& bytes, std::size_t n, double timeout_s) override;
   void flush() override {}
   std::size_t remaining() const { return lines_.size() - next_; }
   std::vector<SessionLogLine> consumed() const {
@@ -33,10 +35,15 @@ class RecordedLineWire final : public drivers::ascii::LineWire {
   /// The next line is a recorded failure whose message contains `what` (" send '", " reply to
   /// '", " connect "): consumed, errno set, true.
   bool recorded_error(std::string_view what);
+  /// The next recorded reply, or what is left of the one being read: false and errno set for a
+  /// recorded failure; throws ReplayDivergence when the log has no reply there.
+  bool open_reply();
 
   std::string device_;
   std::vector<SessionLogLine> lines_;
   std::size_t next_ = 0;
+  std::string reply_;        // what is left of the reply being read in parts
+  bool reply_open_ = false;  // a reply is being read in parts
 };
 
 }  // namespace station

@@ -9,50 +9,53 @@
 
 namespace station::drivers {
 namespace ac = acutrol3000;
+namespace {
+
+// What each query's reply must be (acutrol_wire.hpp); anything else is no reading.
+bool is_number(std::string_view s) {
+  return ac::parse_number(s).has_value();
+}
+bool is_position_rate(std::string_view s) {
+  return ac::parse_position_rate(s).has_value();
+}
+bool is_mode(std::string_view s) {
+  return ac::parse_mode(s) != ac::Mode::unknown;
+}
+bool is_interlock(std::string_view s) {
+  return ac::parse_interlock(s) != ac::Interlock::unknown;
+}
+bool is_text(std::string_view s) {
+  return !s.empty();
+}
+
+}  // namespace
 
 Acutrol3000Table::Acutrol3000Table(std::string name, ascii::LineEndpoint endpoint, double timeout_s,
-                                   std::unique_ptr<ascii::LineWire> wire)
-    : name_(std::move(name)),
-      client_(name_, std::move(endpoint),
-              ascii::LineFraming{std::string(ac::kCommandTerminator),
-                                 std::string(ac::kReplyTerminator), 256},
-              std::move(wire), timeout_s) {}
-
-Result<std::string> Acutrol3000Table::ask(std::string_view command) {
-  auto reply = client_.query(command);
-  if (!reply) return reply;
-  if (ac::is_error(reply.value()))
-    return make_error(ErrorKind::exception,
-                      fmt::format("{}: '{}' refused: {}", name_, command, reply.value()));
-  return reply;
-}
-
-// A command without data: the unit answers an empty line ([RN] p. 5).
-Result<void> Acutrol3000Table::set(std::string_view command) {
-  auto reply = ask(command);
-  if (!reply) return reply.error();
-  return {};
-}
+                                   std::unique_ptr<ascii::LineWire> wire, ac::Framing framing)
+    : name_(name),
+      link_(std::move(name), std::move(endpoint), timeout_s, framing, std::move(wire)) {}
 
 Result<double> Acutrol3000Table::number(std::string_view query) {
-  auto reply = ask(query);
+  auto reply = link_.query(query, is_number);
   if (!reply) return reply.error();
-  auto v = ac::parse_number(reply.value());
-  if (!v)
-    return make_error(ErrorKind::protocol, fmt::format("{}: reply '{}' to '{}' is not a number",
-                                                       name_, reply.value(), query));
-  return *v;
+  return *ac::parse_number(reply.value());
+}
+
+Result<ac::Interlock> Acutrol3000Table::interlock() {
+  auto reply = link_.query(ac::kInterlockQuery, is_interlock);
+  if (!reply) return reply.error();
+  return ac::parse_interlock(reply.value());
 }
 
 Result<void> Acutrol3000Table::connect() {
-  if (auto c = client_.connect(); !c) return c;
+  if (auto c = link_.connect(); !c) return c;
   return read_rate_limit();
 }
 
 // The unit's rate limit, read on every new connection (the unit may have been reconfigured or
 // restarted); until it is known no rate demand is sent.
 Result<void> Acutrol3000Table::read_rate_limit() {
-  limit_connects_ = client_.connects();
+  limit_connects_ = link_.connects();
   auto limit = number(ac::kRateLimitQuery);
   if (!limit) {
     rate_limit_dps_.reset();
@@ -63,26 +66,18 @@ Result<void> Acutrol3000Table::read_rate_limit() {
 }
 
 Result<TurntableState> Acutrol3000Table::read() {
-  const bool full = readback_.due(client_.connects());
-  auto pr = ask(ac::kReadPositionRate);
-  auto mode = pr ? ask(ac::kModeQuery) : pr;
-  auto il = mode ? ask(ac::kInterlockQuery) : mode;
+  const bool full = readback_.due(link_.connects());
+  auto pr = link_.query(ac::kReadPositionRate, is_position_rate);
+  auto mode = pr ? link_.query(ac::kModeQuery, is_mode) : pr;
+  auto il = mode ? interlock() : Result<ac::Interlock>(mode.error());
   Result<double> pd = il ? (full ? number(ac::kPositionDemandQuery) : Result<double>(0.0))
                          : Result<double>(il.error());
   Result<double> rd = pd ? (full ? number(ac::kRateDemandQuery) : Result<double>(0.0)) : pd;
-  if (!rd) {
-    readback_.read_done(false, full, client_.connects());
-    return rd.error();
-  }
+  readback_.read_done(rd.ok(), full, link_.connects());
+  if (!rd) return rd.error();
   const auto p = ac::parse_position_rate(pr.value());
   const auto m = ac::parse_mode(mode.value());
-  const auto i = ac::parse_interlock(il.value());
-  const bool parsed = p && m != ac::Mode::unknown && i != ac::Interlock::unknown;
-  readback_.read_done(parsed, full, client_.connects());
-  if (!parsed)
-    return make_error(ErrorKind::protocol,
-                      fmt::format("{}: replies '{}' / '{}' / '{}' do not parse", name_, pr.value(),
-                                  mode.value(), il.value()));
+  const auto i = il.value();
   if (full) position_demand_deg_ = pd.value(), rate_demand_dps_ = rd.value();
   TurntableState s;
   s.angle_deg = ac::wrap_deg(p->first);
@@ -106,7 +101,7 @@ Result<TurntableState> Acutrol3000Table::read() {
 
 Result<void> Acutrol3000Table::command(const TurntableCommand& c) {
   readback_.invalidate();
-  if (c.rate_dps && (!rate_limit_dps_ || limit_connects_ != client_.connects())) {
+  if (c.rate_dps && (!rate_limit_dps_ || limit_connects_ != link_.connects())) {
     if (auto ok = read_rate_limit(); !ok) return ok;
   }
   if (c.rate_dps && (!std::isfinite(*c.rate_dps) || std::abs(*c.rate_dps) > *rate_limit_dps_))
@@ -115,41 +110,45 @@ Result<void> Acutrol3000Table::command(const TurntableCommand& c) {
                                   *c.rate_dps, rate_limit_dps_.value_or(0)));
   if (c.position_deg && !std::isfinite(*c.position_deg))
     return make_error(ErrorKind::range, fmt::format("{}: position demand not finite", name_));
-  if (c.mode == TurntableMode::off) return set(ac::kModeOff);
-  auto il = ask(ac::kInterlockQuery);
-  if (!il) return il.error();
-  const auto state = ac::parse_interlock(il.value());
-  if (state == ac::Interlock::fault)
+  if (c.mode == TurntableMode::off) return link_.command(ac::kModeOff);
+  auto state = interlock();
+  if (!state) return state.error();
+  if (state.value() == ac::Interlock::fault)
     return make_error(ErrorKind::exception,
                       fmt::format("{}: interlock fault latched: clear the cause, then "
                                   ":Interlock:Reset at the table",
                                   name_));
-  if (state != ac::Interlock::closed) {
-    if (auto ok = set(ac::kInterlockClose); !ok) return ok;
+  if (state.value() != ac::Interlock::closed) {
+    if (auto ok = link_.command(ac::kInterlockClose); !ok) return ok;
   }
   if (c.mode == TurntableMode::position) {
     if (c.position_deg) {
-      if (auto ok = set(ac::position_demand(ac::wrap_deg(*c.position_deg))); !ok) return ok;
+      if (auto ok = link_.command(ac::position_demand(ac::wrap_deg(*c.position_deg))); !ok)
+        return ok;
     }
-    return set(ac::kModePosition);
+    return link_.command(ac::kModePosition);
   }
   if (c.rate_dps) {
-    if (auto ok = set(ac::rate_demand(*c.rate_dps)); !ok) return ok;
+    if (auto ok = link_.command(ac::rate_demand(*c.rate_dps)); !ok) return ok;
   }
-  return set(ac::kModeRate);
+  return link_.command(ac::kModeRate);
 }
 
 Result<void> Acutrol3000Table::stop() {
   readback_.invalidate();
-  return set(ac::kModeOff);
+  return link_.command(ac::kModeOff);
 }
 
 Result<std::string> Acutrol3000Table::identify() {
-  auto idn = ask(ac::kIdentify);
+  auto idn = link_.query(ac::kIdentify, is_text);
   if (!idn) return idn;
   auto limit = number(ac::kRateLimitQuery);
   if (!limit) return limit.error();
-  return fmt::format("{} (rate limit {} deg/s)", idn.value(), limit.value());
+  const ac::Framing used = link_.framing_in_use().value_or(link_.framing());
+  return fmt::format(
+      "{} (framing {}, {}; rate limit {} deg/s)", idn.value(), ac::to_string(used),
+      link_.framing() == ac::Framing::automatic ? "recognized at connect" : "as configured",
+      limit.value());
 }
 
 }  // namespace station::drivers

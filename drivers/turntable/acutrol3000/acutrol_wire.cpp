@@ -1,4 +1,4 @@
-// ACUTROL3000 command spellings and strict reply parsers.
+// ACUTROL3000 command spellings, framing names and strict reply parsers.
 #include "drivers/turntable/acutrol3000/acutrol_wire.hpp"
 
 #include <fmt/format.h>
@@ -62,8 +62,39 @@ std::optional<std::pair<double, double>> parse_position_rate(std::string_view re
   return std::pair{*p, *r};
 }
 
-bool is_error(std::string_view reply) {
-  return lower(reply).rfind("error", 0) == 0;
+std::optional<Framing> framing_from_name(std::string_view name) {
+  if (name == "auto") return Framing::automatic;
+  if (name == "bare") return Framing::bare;
+  if (name == "header") return Framing::header;
+  return std::nullopt;
+}
+
+const char* to_string(Framing f) {
+  switch (f) {
+    case Framing::automatic:
+      return "auto";
+    case Framing::bare:
+      return "bare";
+    case Framing::header:
+      return "header";
+  }
+  return "?";
+}
+
+std::uint32_t frame_error_code(std::string_view header) {
+  std::uint32_t v = 0;
+  for (int i = 3; i >= 0; --i) v = (v << 8) | static_cast<unsigned char>(header.at(i));
+  return v;
+}
+
+std::string error_text_query(std::uint32_t code) {
+  return fmt::format(":Query:Error? {}", code);
+}
+
+std::optional<unsigned> parse_status_byte(std::string_view reply) {
+  const auto v = parse_number(reply);
+  if (!v || *v < 0 || *v > 255 || *v != std::floor(*v)) return std::nullopt;
+  return static_cast<unsigned>(*v);
 }
 
 double wrap_deg(double deg) {
