@@ -28,6 +28,9 @@ constexpr CommandDoc kCommands[] = {
     {"table fault on|off", "turntable drive fault bit (drive disabled)"},
     {"chamber|table stall SECONDS", "no reply to any request for SECONDS (0 ends it)"},
     {"chamber|table exception CODE [N|always]", "exception CODE (1..11) to the next N requests"},
+    {"chamber|table refuse SECONDS",
+     "every request refused for SECONDS: Modbus exception 6 (busy), an ACUTROL's ACL error "
+     "(ILLEGAL CMD in its error queue / header), a P300's NA: line"},
     {"chamber|table disconnect [SECONDS]", "close connections, refuse new ones for SECONDS"},
     {"chamber|table clear", "end that device's Modbus faults"},
     {"can drop|duplicate|corrupt N", "the next N counter-board frames on the bus"},
@@ -87,7 +90,7 @@ bool pick(std::string_view s, std::string_view on, std::string_view off, std::st
 }
 
 std::string modbus_fault(SimServer& server, const Args& a, std::string_view dev) {
-  const std::string syntax = fmt::format("{} stall|exception|disconnect|clear ...", dev);
+  const std::string syntax = fmt::format("{} stall|exception|refuse|disconnect|clear ...", dev);
   if (a.size() < 2) usage(syntax);
   if (a[1] == "stall" && a.size() == 3) {
     server.stall_for(number(a[2], "seconds", 0, 1e6));
@@ -95,6 +98,10 @@ std::string modbus_fault(SimServer& server, const Args& a, std::string_view dev)
     const int code = integer(a[2], "exception code", 1, 11);
     const int n = a.size() == 3 ? 1 : a[3] == "always" ? -1 : integer(a[3], "count", 1, 1000000);
     server.inject_exception(code, n);
+  } else if (a[1] == "refuse" && a.size() == 3) {
+    // Modbus Application Protocol v1.1b3 §7: 06 "Server Device Busy" (a line device refuses
+    // in its own words: LineDevice::error_reply).
+    server.refuse_for(number(a[2], "seconds", 0, 1e6), 6);
   } else if (a[1] == "disconnect" && a.size() <= 3) {
     server.disconnect_for(a.size() == 3 ? number(a[2], "seconds", 0, 1e6) : 0.0);
   } else if (a[1] == "clear" && a.size() == 2) {

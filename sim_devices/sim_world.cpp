@@ -103,7 +103,8 @@ SimWorld::SimWorld(const SimWorldConfig& config) : config_(config) {
   table_sim_ = std::make_unique<TurntableSim>(drivers::turntable_map::generic_plc(1));
   chamber_ =
       serve_chamber(config_.chamber_model, *chamber_sim_, config_.panel, config_.chamber_port);
-  table_ = serve_turntable(config_.turntable_model, *table_sim_, config_.turntable_port);
+  table_ = serve_turntable(config_.turntable_model, *table_sim_, config_.turntable_port,
+                           config_.acutrol_framing);
   // Link faults last seconds of the world's time (simulated under run --sim, wall under simrig).
   const auto world_s = [this] { return now_s_.load(); };
   chamber_.server->set_time_source(world_s);

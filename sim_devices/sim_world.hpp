@@ -51,6 +51,7 @@ struct SimWorldConfig {
   std::string chamber_model = "generic_plc";
   std::string turntable_model = "generic_plc";
   WatlowPanel panel;  ///< a simulated Watlow's decimals, units and run event
+  AclFraming acutrol_framing = AclFraming::bare;  ///< how a simulated ACUTROL frames replies
 };
 
 /// One simulated gyro as the station will see it.

@@ -41,6 +41,7 @@ struct Options {
   int turntable_port = 0;
   std::string chamber_model = "generic_plc";    // dialect the chamber speaks
   std::string turntable_model = "generic_plc";  // dialect the table speaks
+  std::string acutrol_framing = "bare";         // an ACUTROL's reply framing: bare or header
   std::string can_socket = "/tmp/simrig-can.sock";
   double latitude_deg = 39.9;
   std::string control;            // fault-injection control socket, "" = none
@@ -168,6 +169,11 @@ void add_options(CLI::App& app, Options& o) {
   app.add_option("--turntable", o.turntable_model,
                  "turntable dialect: " + station::drivers::turntable_models())
       ->capture_default_str();
+  app.add_option("--acutrol-framing", o.acutrol_framing,
+                 "acutrol3000: replies as bare CR LF lines, or with the error/length header the "
+                 "manual gives non-GPIB links (docs/DEVICES.md)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"bare", "header"}));
   app.add_option("--chamber-port", o.chamber_port, "chamber Modbus TCP port, 0 = ephemeral")
       ->capture_default_str()
       ->check(CLI::Range(0, 65535));
@@ -192,6 +198,7 @@ sim::SimWorldConfig world_config(const Options& o) {
   sim::SimWorldConfig c;
   c.chamber_model = o.chamber_model;
   c.turntable_model = o.turntable_model;
+  c.acutrol_framing = sim::acl_framing_from_name(o.acutrol_framing).value();
   c.gyros = o.gyros;
   c.seed = o.seed;
   c.chamber_port = o.chamber_port;

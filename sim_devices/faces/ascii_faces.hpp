@@ -1,6 +1,6 @@
-// The chamber and table models served on the ASCII dialects: an ESPEC P300 and an Acutronic
-// ACUTROL3000, answering as their sources say the devices do (drivers/chamber/espec_p300/
-// p300_wire.hpp, drivers/turntable/acutrol3000/acutrol_wire.hpp and the documents they cite).
+// The chamber model served on the ESPEC P300's ASCII dialect, answering as its source says the
+// device does (sim_devices/sources/espec_p300_sources.hpp). The ACUTROL3000 table:
+// acutrol_face.hpp.
 #pragma once
 
 #include <optional>
@@ -9,7 +9,6 @@
 
 #include "sim_devices/chamber_sim.hpp"
 #include "sim_devices/servers/line_server.hpp"
-#include "sim_devices/turntable_sim.hpp"
 
 namespace station::sim {
 
@@ -22,7 +21,7 @@ class P300Face final : public LineDevice {
   std::string request_terminator() const override { return "\r\n"; }
   std::string reply_terminator() const override { return "\r\n"; }
   std::optional<std::string> handle(std::string_view request) override;
-  std::string error_reply(std::string_view request, int code) const override;
+  std::string error_reply(std::string_view request, int code) override;
 
  private:
   std::string answer(std::string_view command);
@@ -31,25 +30,6 @@ class P300Face final : public LineDevice {
 
   ChamberSim& chamber_;
   int address_;
-};
-
-/// ACUTROL3000 (axis 1): *IDN?, :Mode..., :Demand..., :Read..., :Interlock..., :Limit:Rate,
-/// case-insensitive prefixes, ';'-chained commands. Commands without data answer an empty line.
-class AcutrolFace final : public LineDevice {
- public:
-  explicit AcutrolFace(TurntableSim& table, double rate_limit_dps = 1000.0)
-      : table_(table), rate_limit_dps_(rate_limit_dps) {}
-  std::string request_terminator() const override { return "\n"; }
-  std::string reply_terminator() const override { return "\n"; }
-  std::optional<std::string> handle(std::string_view request) override;
-  std::string error_reply(std::string_view request, int code) const override;
-
- private:
-  std::optional<std::string> one(const std::string& path, std::string_view args);
-
-  TurntableSim& table_;
-  double rate_limit_dps_;
-  bool interlock_closed_ = false;
 };
 
 }  // namespace station::sim

@@ -59,10 +59,12 @@ ServedDevice serve_chamber(std::string_view name, ChamberSim& chamber, const Wat
       fmt::format("no simulated chamber '{}' (known: {})", model, drivers::chamber_models()));
 }
 
-ServedDevice serve_turntable(std::string_view name, TurntableSim& table, int port) {
+ServedDevice serve_turntable(std::string_view name, TurntableSim& table, int port,
+                             AclFraming acutrol_framing) {
   const std::string_view model = drivers::turntable_dialect(name).model;
   if (model == "generic_plc") return generic(table, port);
-  if (model == "acutrol3000") return lines(std::make_unique<AcutrolFace>(table), port);
+  if (model == "acutrol3000")
+    return lines(std::make_unique<AcutrolFace>(table, 1000.0, acutrol_framing), port);
   throw std::invalid_argument(
       fmt::format("no simulated turntable '{}' (known: {})", model, drivers::turntable_models()));
 }

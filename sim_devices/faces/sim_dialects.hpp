@@ -7,6 +7,7 @@
 #include <string_view>
 
 #include "sim_devices/chamber_sim.hpp"
+#include "sim_devices/faces/acutrol_face.hpp"
 #include "sim_devices/faces/watlow_faces.hpp"
 #include "sim_devices/servers/sim_server.hpp"
 #include "sim_devices/turntable_sim.hpp"
@@ -23,8 +24,9 @@ struct ServedDevice {
 /// std::invalid_argument for a model without a simulator face.
 ServedDevice serve_chamber(std::string_view model, ChamberSim& chamber, const WatlowPanel& panel,
                            int port);
-/// The table model served as `model`.
-ServedDevice serve_turntable(std::string_view model, TurntableSim& table, int port);
+/// The table model served as `model`; an ACUTROL frames its replies as `acutrol_framing` says.
+ServedDevice serve_turntable(std::string_view model, TurntableSim& table, int port,
+                             AclFraming acutrol_framing = AclFraming::bare);
 /// The [chamber] / [turntable] table text a station config needs for a served model.
 std::string device_toml(const char* section, std::string_view model, const std::string& endpoint,
                         const WatlowPanel* panel);

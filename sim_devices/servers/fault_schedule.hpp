@@ -44,6 +44,11 @@ class FaultSchedule {
     std::lock_guard lock(mutex_);
     drops_ = n;
   }
+  void refuse_for(double seconds, int code) {
+    std::lock_guard lock(mutex_);
+    refuse_until_s_ = after(seconds);
+    refuse_code_ = code;
+  }
   void stall_for(double seconds) {
     std::lock_guard lock(mutex_);
     stall_until_s_ = after(seconds);
@@ -56,7 +61,7 @@ class FaultSchedule {
   void clear() {
     std::lock_guard lock(mutex_);
     timeouts_ = exceptions_ = drops_ = 0;
-    stall_until_s_ = down_until_s_ = kNever;
+    stall_until_s_ = down_until_s_ = refuse_until_s_ = kNever;
   }
   /// What the request just received gets; `code` is set for an exception. While stalled or
   /// down (a serial line is silent when its device is off) nothing answers.
@@ -65,6 +70,10 @@ class FaultSchedule {
     const double now = now_s_();
     if (now < stall_until_s_ || now < down_until_s_) return Fault::timeout;
     if (timeouts_ > 0) return --timeouts_, Fault::timeout;
+    if (now < refuse_until_s_) {
+      code = refuse_code_;
+      return Fault::exception;
+    }
     if (drops_ > 0) return --drops_, Fault::drop;
     if (exceptions_ != 0) {
       code = exception_code_;
@@ -92,7 +101,8 @@ class FaultSchedule {
   mutable std::mutex mutex_;
   TimeSource now_s_ = steady_s;
   int timeouts_ = 0, exceptions_ = 0, exception_code_ = 0, drops_ = 0;
-  double stall_until_s_ = kNever, down_until_s_ = kNever;
+  double stall_until_s_ = kNever, down_until_s_ = kNever, refuse_until_s_ = kNever;
+  int refuse_code_ = 0;
   std::uint64_t kicks_ = 0;
 };
 

@@ -142,7 +142,6 @@ void LineServer::serve_bytes(int fd, std::string& buffer, bool& close_it) {
   if (n < 0) return;
   buffer.append(chunk, static_cast<std::size_t>(n));
   const std::string term = device_.request_terminator();
-  const std::string reply_end = device_.reply_terminator();
   for (auto end = buffer.find(term); end != std::string::npos; end = buffer.find(term)) {
     const std::string request = buffer.substr(0, end);
     buffer.erase(0, end + term.size());
@@ -156,12 +155,12 @@ void LineServer::serve_bytes(int fd, std::string& buffer, bool& close_it) {
         if (close_it) return;
         continue;
       case FaultSchedule::Fault::exception:
-        write_all(fd, device_.error_reply(request, code) + reply_end);
+        write_all(fd, device_.encode(device_.error_reply(request, code)));
         continue;
       case FaultSchedule::Fault::none:
         break;
     }
-    if (auto reply = device_.handle(request)) write_all(fd, *reply + reply_end);
+    if (auto reply = device_.handle(request)) write_all(fd, device_.encode(std::move(*reply)));
   }
   if (buffer.size() > kMaxLine) buffer.clear();
 }

@@ -28,7 +28,10 @@ class LineDevice {
   /// The reply to one request (terminator removed); nullopt: the device stays silent.
   virtual std::optional<std::string> handle(std::string_view request) = 0;
   /// The reply the device gives when it fails a request (an injected exception `code`).
-  virtual std::string error_reply(std::string_view request, int code) const = 0;
+  virtual std::string error_reply(std::string_view request, int code) = 0;
+  /// The bytes that carry a reply on the wire: by default the reply and reply_terminator(); a
+  /// device with a framing of its own (a length-prefixed header) says so here.
+  virtual std::string encode(std::string reply) const { return reply + reply_terminator(); }
 };
 
 /// Serves one LineDevice. start_*() spawns the thread; the destructor stops and joins it.

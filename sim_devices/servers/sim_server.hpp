@@ -38,6 +38,9 @@ class SimServer {
   /// The next `n` requests make the server close the connection without replying (on a serial
   /// line: no reply).
   void inject_drop(int n = 1) { faults_.inject_drop(n); }
+  /// Every request in the next `seconds` gets the device's refusal (the error reply of an
+  /// exception `code`); 0 ends it.
+  void refuse_for(double seconds, int code) { faults_.refuse_for(seconds, code); }
   /// Every request in the next `seconds` gets no reply; 0 ends a stall.
   void stall_for(double seconds) { faults_.stall_for(seconds); }
   /// Closes every connection now and refuses new ones for `seconds` (a powered-off device; a

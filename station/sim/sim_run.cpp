@@ -125,6 +125,11 @@ sim::SimWorldConfig world_config(const SimRunOptions& o) {
   wc.preset = *preset;
   wc.chamber_model = o.chamber_model;
   wc.turntable_model = o.turntable_model;
+  const auto framing = sim::acl_framing_from_name(o.acutrol_framing);
+  if (!framing)
+    throw InputError(
+        fmt::format("acutrol framing '{}': expected bare or header", o.acutrol_framing));
+  wc.acutrol_framing = *framing;
   wc.earth_rate_dph = compensation::earth_rate_along_axis_dph(o.latitude_deg, {0, 0, 1});
   return wc;
 }

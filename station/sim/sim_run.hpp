@@ -27,6 +27,7 @@ struct SimRunOptions {
   std::uint64_t noise_run = 0;  ///< sim::SimWorldConfig::noise_run (same gyros, new noise)
   std::string chamber_model = "generic_plc";    ///< dialect the simulated chamber speaks
   std::string turntable_model = "generic_plc";  ///< dialect the simulated table speaks
+  std::string acutrol_framing = "bare";  ///< a simulated ACUTROL's replies: "bare" or "header"
   std::string gyro_preset = "station";          ///< sim::GyroPreset by name: "station" or "paper"
   double latitude_deg = 39.9;
   std::string protocol = "paper";  ///< shipped name or file
