@@ -18,6 +18,8 @@
 #include "drivers/chamber/watlow_f4p/f4p_map.hpp"
 #include "drivers/chamber/watlow_f4t/f4t_map.hpp"
 #include "drivers/turntable/acutrol3000/acutrol_wire.hpp"
+#include "sim_devices/faces/acl_parser.hpp"
+#include "sim_devices/sources/acutrol_sources.hpp"
 #include "sim_devices/sources/espec_p300_sources.hpp"
 #include "sim_devices/sources/watlow_sources.hpp"
 
@@ -200,6 +202,46 @@ TEST(Conformance, Acutrol3000MatchesItsCommandLanguage) {
   EXPECT_EQ(a::parse_mode("Rate\r"), a::Mode::rate);
   EXPECT_EQ(a::parse_interlock("Fault"), a::Interlock::fault);  // py :41
   EXPECT_DOUBLE_EQ(a::wrap_deg(-90.0), 270.0);  // +-180 reported, [0, 360) inside the station
+}
+
+// The driver's spellings, read by the simulator's own transcription of the ACL command tree
+// (sim_devices/sources/acutrol_sources.cpp): each names the command it means, in the form it
+// means, and the framing and error-reading constants agree with the transcribed ones.
+TEST(Conformance, Acutrol3000CommandsResolveInTheTranscribedTree) {
+  namespace a = station::drivers::acutrol3000;
+  namespace src = station::sim::sources::acutrol;
+  const auto resolved = [](std::string_view command) {
+    std::string out;
+    for (const auto& u : station::sim::parse_acl(command)) {
+      EXPECT_EQ(u.error, 0u) << command << ": " << u.why;
+      out += (out.empty() ? "" : " ") + u.path + (u.query ? "?" : "");
+      for (const auto& arg : u.args) out += " " + arg;
+    }
+    return out;
+  };
+  EXPECT_EQ(resolved(a::kIdentify), "*IDN?");
+  EXPECT_EQ(resolved(a::kModeOff), ":Mode:Off 1");
+  EXPECT_EQ(resolved(a::kModePosition), ":Mode:Position 1");
+  EXPECT_EQ(resolved(a::kModeRate), ":Mode:Rate 1");
+  EXPECT_EQ(resolved(a::kModeQuery), ":Mode? 1");
+  EXPECT_EQ(resolved(a::kReadPositionRate), ":Read:Position? 1 :Read:Rate? 1");
+  EXPECT_EQ(resolved(a::kInterlockQuery), ":Interlock? 1");
+  EXPECT_EQ(resolved(a::kInterlockClose), ":Interlock:Close 1");
+  EXPECT_EQ(resolved(a::kInterlockReset), ":Interlock:Reset");
+  EXPECT_EQ(resolved(a::kRateLimitQuery), ":Limit:Rate? R 1");
+  EXPECT_EQ(resolved(a::kPositionDemandQuery), ":Demand:Position? 1");
+  EXPECT_EQ(resolved(a::kRateDemandQuery), ":Demand:Rate? 1");
+  EXPECT_EQ(resolved(a::position_demand(1.5)), ":Demand:Position 1 1.50000");
+  EXPECT_EQ(resolved(a::rate_demand(-2)), ":Demand:Rate 1 -2.00000");
+  EXPECT_EQ(resolved(a::kClearStatus), "*CLS");
+  EXPECT_EQ(resolved(a::kStatusByteQuery), "*STB?");
+  EXPECT_EQ(resolved(a::kErrorQueueRead), ":Status:MSG? " + std::string(src::kErrorQueueId));
+  EXPECT_EQ(resolved(a::error_text_query(3)), ":Query:Error? 3");
+  EXPECT_EQ(a::kErrorQueueBit, src::kStbErrorQueue);
+  EXPECT_EQ(a::kFrame.header_bytes, src::kHeaderBytes);
+  EXPECT_EQ(a::kFrame.max_payload_bytes, src::kMaxResponseChars);
+  EXPECT_EQ(a::kCommandTerminator, src::kBareEnd);  // CR LF both ways ([ACL] p. 4, [RN] p. 5)
+  EXPECT_TRUE(src::kBareEnd.ends_with(a::kReplyTerminator));
 }
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include "drivers/turntable/acutrol3000/acutrol3000_table.hpp"
 #include "drivers/turntable/generic_plc/generic_plc_map.hpp"
 #include "sim_devices/chamber_sim.hpp"
+#include "sim_devices/faces/acutrol_face.hpp"
 #include "sim_devices/faces/ascii_faces.hpp"
 #include "sim_devices/faces/watlow_faces.hpp"
 #include "sim_devices/servers/line_server.hpp"
@@ -140,7 +141,7 @@ class Flood final : public sim::LineDevice {
   std::optional<std::string> handle(std::string_view r) override {
     return r == "FLOOD" ? std::string(4000, 'x') : std::string("ok");
   }
-  std::string error_reply(std::string_view, int) const override { return "NA:"; }
+  std::string error_reply(std::string_view, int) override { return "NA:"; }
 };
 
 TEST(LineClient, OverlongReplyIsProtocolErrorAndTimeoutsReconnect) {

@@ -1,5 +1,6 @@
 // Fuzz target: the ASCII dialects' reply parsers (ESPEC P300 p300_wire, ACUTROL3000
-// acutrol_wire, the shared number_field) and the simulator faces that read command lines.
+// acutrol_wire: replies, status byte, a frame's error code; the shared number_field) and the
+// simulator faces that read command lines (the ACUTROL's ACL parser, bare and framed replies).
 // Input: one reply or request line as a device or station could send it.
 // Properties: no crash or UB; a parsed number is finite; a parsed TEMP? reply's fields are
 // finite; a face answers any line with a bounded reply and never throws.
@@ -14,6 +15,7 @@
 #include "drivers/turntable/acutrol3000/acutrol_wire.hpp"
 #include "drivers/turntable/generic_plc/generic_plc_map.hpp"
 #include "fuzz_check.hpp"
+#include "sim_devices/faces/acutrol_face.hpp"
 #include "sim_devices/faces/ascii_faces.hpp"
 
 namespace p3 = station::drivers::espec_p300;
@@ -36,14 +38,19 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     check(std::isfinite(pr->first) && std::isfinite(pr->second), "position;rate finite");
   (void)ac::parse_mode(line);
   (void)ac::parse_interlock(line);
+  if (auto b = ac::parse_status_byte(line)) check(*b <= 255, "status byte");
+  if (line.size() >= 8) (void)ac::frame_error_code(line);
   check(ac::wrap_deg(static_cast<double>(size) * 37.5 - 1000.0) < 360.0, "wrap");
   static station::sim::ChamberSim chamber{station::drivers::chamber_map::generic_plc(1)};
   static station::sim::TurntableSim table{station::drivers::turntable_map::generic_plc(1)};
   static station::sim::P300Face p300(chamber, 1);
   static station::sim::AcutrolFace acutrol(table, 100.0);
-  for (station::sim::LineDevice* face :
-       {static_cast<station::sim::LineDevice*>(&p300), static_cast<station::sim::LineDevice*>(&acutrol)}) {
-    if (auto reply = face->handle(line)) check(reply->size() < 4096, "face reply bounded");
+  static station::sim::AcutrolFace framed(table, 100.0, station::sim::AclFraming::header);
+  for (station::sim::LineDevice* face : {static_cast<station::sim::LineDevice*>(&p300),
+                                         static_cast<station::sim::LineDevice*>(&acutrol),
+                                         static_cast<station::sim::LineDevice*>(&framed)}) {
+    if (auto reply = face->handle(line))
+      check(face->encode(*reply).size() < 4096, "face reply bounded");
   }
   return 0;
 }
