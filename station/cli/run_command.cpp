@@ -52,6 +52,7 @@ struct RunOptions {
   std::string gyro_preset = "station";
   std::string chamber_model = "generic_plc";
   std::string turntable_model = "generic_plc";
+  std::string acutrol_framing = "bare";  ///< --sim: a simulated ACUTROL's reply framing
   double latitude_deg = 39.9;
   double speed = 0;  ///< --sim: simulated s per wall s (0: as fast as possible)
   std::string http;  ///< --http HOST:PORT (empty: no HTTP service)
@@ -194,6 +195,7 @@ SimRunOptions sim_options(const RunOptions& o, const std::string& db) {
   so.gyro_preset = o.gyro_preset;
   so.chamber_model = o.chamber_model;
   so.turntable_model = o.turntable_model;
+  so.acutrol_framing = o.acutrol_framing;
   so.latitude_deg = o.latitude_deg;
   so.protocol = o.protocol;
   so.db_path = db;
@@ -250,6 +252,11 @@ void add_sim_world_options(CLI::App* cmd, RunOptions& o) {
   cmd->add_option(
          "--turntable", o.turntable_model,
          "--sim: the dialect the simulated table speaks (" + drivers::turntable_models() + ")")
+      ->capture_default_str();
+  cmd->add_option("--acutrol-framing", o.acutrol_framing,
+                  "--sim, acutrol3000: replies as bare CR LF lines, or with the error/length "
+                  "header (docs/DEVICES.md)")
+      ->check(CLI::IsMember({"bare", "header"}))
       ->capture_default_str();
   cmd->add_option("--gyro-preset", o.gyro_preset,
                   "simulated gyros: station (strong thermal effect) or paper (the paper's "

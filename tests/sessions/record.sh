@@ -33,11 +33,11 @@ record door_mid_record --fault "1800:door open" --fault "1860:door close"
 record link_faults --fault "1500:chamber stall 2" --fault "2000:can drop 3" \
   --fault "2300:can duplicate 5" --fault "2600:table disconnect"
 # One session per device dialect (docs/DEVICES.md), each device served by its simulator face on
-# its real transport: Watlow F4 (station-made ramps), F4T Data Map 1 + ACUTROL3000 with a chamber
-# stall and a table disconnect, F4T in F4-compatibility map, F4P, ESPEC P300 (ascii.log) with
-# error replies.
+# its real transport: Watlow F4 (station-made ramps), F4T Data Map 1 + ACUTROL3000 (replies in the
+# error/length header) with a chamber stall and a table disconnect, F4T in F4-compatibility map,
+# F4P, ESPEC P300 (ascii.log) with error replies + ACUTROL3000 (bare CR LF replies).
 record dialect_f4 --chamber watlow_f4
-record dialect_f4t_acutrol --chamber watlow_f4t --turntable acutrol3000 \
+record dialect_f4t_acutrol --chamber watlow_f4t --turntable acutrol3000 --acutrol-framing header \
   --fault "400:table disconnect 0.02" --fault "1500:chamber stall 2"
 record dialect_f4t_map2 --chamber watlow_f4t_map2
 record dialect_f4p --chamber watlow_f4p
