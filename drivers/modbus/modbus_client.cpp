@@ -11,6 +11,19 @@
 
 namespace station::drivers::modbus {
 
+namespace {
+
+// The one rule for a decoded value: a non-finite one is a protocol error, unless the point is a
+// process value that reads NaN when its input fails (Point::nan_on_input_error).
+Result<double> checked(const std::string& device, const Point& p, double v) {
+  if (!std::isfinite(v) && !p.nan_on_input_error)
+    return make_error(ErrorKind::protocol,
+                      fmt::format("{} point '{}' is not finite ({})", device, p.name, v));
+  return v;
+}
+
+}  // namespace
+
 Error translate_modbus_error(int err, const std::string& what) {
   std::string msg = what + ": " + modbus_strerror(err);
   if (err == ETIMEDOUT || err == EAGAIN) return make_error(ErrorKind::timeout, msg);
@@ -134,10 +147,7 @@ Result<void> ModbusClient::write_registers(int unit, std::uint16_t addr,
 Result<double> ModbusClient::read(const Point& p) {
   auto words = read_registers(p.function, p.unit_id, p.pdu_address(), p.word_count());
   if (!words) return words.error();
-  double v = decode_point(p, words.value().data());
-  if (!std::isfinite(v))
-    return make_error(ErrorKind::protocol, device_ + " point '" + p.name + "' is not finite");
-  return v;
+  return checked(device_, p, decode_point(p, words.value().data()));
 }
 
 Result<void> ModbusClient::write(const Point& p, double value) {
@@ -166,11 +176,10 @@ Result<std::vector<double>> ModbusClient::read_points(std::span<const Point> poi
     if (!words) return words.error();
     for (std::size_t i : b.points) {
       const Point& p = points[i];
-      v[i] = decode_point(p, words.value().data() + (p.pdu_address() - b.start));
-      if (!std::isfinite(v[i])) {
-        return make_error(ErrorKind::protocol,
-                          fmt::format("{} point '{}' is not finite", device(), p.name));
-      }
+      auto value =
+          checked(device_, p, decode_point(p, words.value().data() + (p.pdu_address() - b.start)));
+      if (!value) return value.error();
+      v[i] = value.value();
     }
   }
   return v;

@@ -35,6 +35,10 @@ struct Point {
   int unit_id = 1;                                ///< Modbus unit (slave) id
   bool one_based = false;                         ///< manual numbers registers from 1
   Access access = Access::ro;                     ///< ro or rw
+  /// A process value the device reports as NaN when its input fails (an open sensor): a
+  /// non-finite reading reaches the driver as a reading. False: a non-finite value is a
+  /// protocol error (a setpoint, a limit, a rate can never legitimately be NaN).
+  bool nan_on_input_error = false;
 
   /// Number of 16-bit registers the point occupies (1 or 2).
   int word_count() const { return type == PointType::float32 ? 2 : 1; }

@@ -103,7 +103,11 @@ void F4tFace::publish(modbus_mapping_t& regs) {
   put(regs, f4t::kRampScale, ramp_scale_);
   put(regs, f4t::kRampRate, ramp_rate_);
   put(regs, f4t::kProfileState, chamber_.status() == 3 ? f4t::kProfilePaused : 0);
-  put(regs, f4t::kAlarm1, (chamber_.alarms() & 1u) != 0 ? kAlarmHigh : f4t::kAlarmNone);
+  // Alarm 1 watches the air loop: with its input broken its state is "error" (A, DEVICES.md).
+  put(regs, f4t::kAlarm1,
+      chamber_.air_sensor_failed()    ? f4t::kAlarmError
+      : (chamber_.alarms() & 1u) != 0 ? kAlarmHigh
+                                      : f4t::kAlarmNone);
   put(regs, f4t::kRunEvent, chamber_.run() ? f4t::kOn : f4t::kOff);
   put(regs, f4t::kUnits, panel_.fahrenheit ? f4t::kFahrenheit : f4t::kCelsius);
   for (int i = 0; i < f4t::kPartNumberRegisters; ++i)

@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <stdexcept>
 #include <utility>
@@ -44,6 +45,11 @@ int register_count(const drivers::modbus::RegisterMap& map) {
 
 void put_point(modbus_mapping_t& regs, const drivers::modbus::Point& p, double value) {
   auto words = drivers::modbus::encode_point(p, value);
+  if (!words && p.type == drivers::modbus::PointType::float32 && !std::isfinite(value)) {
+    // A float register carries NaN as IEEE-754 does: the words a controller sends for a process
+    // value whose input failed (docs/DEVICES.md), not a value to drop or saturate.
+    words = drivers::modbus::float_to_words(static_cast<float>(value), p.order);
+  }
   if (!words) {
     // Saturate like a controller display would rather than publish garbage.
     double lim = p.type == drivers::modbus::PointType::uint16 ? 65535.0 : 32767.0;

@@ -24,7 +24,8 @@ mb::RegisterMap register_map(const std::string& device, int unit_id,
   std::vector<mb::Point> points;
   for (const auto& r : rows)
     points.push_back(mb::Point{r.name, r.address, r.type, 1.0, r.order, mb::FunctionCode::holding,
-                               unit_id, false, r.writable ? mb::Access::rw : mb::Access::ro});
+                               unit_id, false, r.writable ? mb::Access::rw : mb::Access::ro,
+                               r.nan_on_input_error});
   return mb::RegisterMap(device, std::move(points));
 }
 
@@ -77,8 +78,10 @@ std::vector<SourcePoint> f4t::points(int run_event, bool rtu, int loop) {
   // Profile events 1..8 (CCL get_event:499-506).
   constexpr int kEvents[] = {16594, 16596, 16598, 16600, 16822, 16824, 16826, 16828};
   std::vector<SourcePoint> rows{
-      {kAir, u16(2820 + o), F32, CDAB, RO, "CCL watlowf4t.py get_loop_pv:243"},
-      {kProduct, u16(2980 + o), F32, CDAB, RO, "CCL get_loop_pv:243 (the next loop)"},
+      // NaN on an input error: no source gives the value (A); Watlow F4T Setup & Operations
+      // p. 83: a signal in error "cannot be relied on" (Open, Shorted, ... not None).
+      {kAir, u16(2820 + o), F32, CDAB, RO, "CCL watlowf4t.py get_loop_pv:243", true},
+      {kProduct, u16(2980 + o), F32, CDAB, RO, "CCL get_loop_pv:243 (the next loop)", true},
       {kSetpoint, u16(2782 + o), F32, CDAB, RW, "CCL get_loop_sp:234, set_loop_sp:241"},
       {kWorkingSetpoint, u16(2810 + o), F32, CDAB, RO, "CCL get_loop_sp:235"},
       {kSetpointLow, u16(2774 + o), F32, CDAB, RO, "CCL get_loop_range:256"},

@@ -26,6 +26,8 @@ struct SourcePoint {
   drivers::modbus::WordOrder order = drivers::modbus::WordOrder::abcd;
   bool writable = false;
   std::string source;  ///< document and page, or file:line
+  /// A process value that reads NaN when its input fails (Point::nan_on_input_error).
+  bool nan_on_input_error = false;
 };
 
 /// The rows as a register map of unit `unit_id` (holding registers, raw values: scale 1).
@@ -79,6 +81,9 @@ inline constexpr int kRampSetpoint = 85;               // CCL dictionary "setpoi
 inline constexpr int kStartup = 88, kRampBoth = 13;    // CCL dictionary ("startup", "both")
 inline constexpr int kProfilePaused = 146;             // CCL get_status:528-546
 inline constexpr int kAlarmNone = 61;                  // CCL get_alarm_status:552 (inactive)
+/// Alarm state "error": its source signal has an input error (CCL dictionary:81, 28 'error';
+/// Watlow F4T Setup & Operations p. 83: a signal in error "cannot be relied on").
+inline constexpr int kAlarmError = 28;
 }  // namespace f4t
 
 /// Series F4P ([F4P] chapter 9 and the parameter tables of chapter 6).

@@ -47,6 +47,8 @@ void check(const mb::RegisterMap& map, const std::vector<src::SourcePoint>& rows
     EXPECT_EQ(p->function, mb::FunctionCode::holding);  // all three use holding registers only
     EXPECT_EQ(p->access == mb::Access::rw, r.writable);
     EXPECT_EQ(p->scale, 1.0);  // raw on the wire; decimals/units are read from the unit
+    // Which points read NaN on an input failure (a reading) and which never may (an error).
+    EXPECT_EQ(p->nan_on_input_error, r.nan_on_input_error);
   }
   for (const auto& [name, p] : map.points())
     EXPECT_EQ(named.count(name), 1u)
@@ -91,6 +93,7 @@ TEST(Conformance, WatlowF4tMatchesDataMap1) {
   EXPECT_EQ(t::kRampSetpoint, src::f4t::kRampSetpoint);
   EXPECT_EQ(t::kAlarmInactive, (std::array<int, 3>{88, 61, 12}));  // CCL get_alarm_status:552
   EXPECT_EQ(t::kAlarmInactive[1], src::f4t::kAlarmNone);
+  EXPECT_EQ(t::kAlarmError, src::f4t::kAlarmError);  // CCL dictionary:81
   EXPECT_EQ(t::kPartNumberRegisters, src::f4t::kPartNumberRegisters);
   // A float goes low word first (CCL modbus.py read_holding_float:157-173): 25.0 = 0x41C80000.
   const auto w = mb::float_to_words(25.0f, WordOrder::cdab);

@@ -67,6 +67,10 @@ enum Enum : int {
 };
 /// Alarm state codes that mean "not active" (CCL get_alarm_status:552-556: startup, none, 12).
 inline constexpr std::array<int, 3> kAlarmInactive{88, 61, 12};
+/// Alarm state "error" (CCL dictionary:81, 28 'error'; get_alarm_status:558 reads a limit in
+/// state 'error' as active): alarm 1's source, the air loop, has an input error -> sensor break
+/// (Watlow F4T Install & Troubleshooting p. 34 "Error Input"; the code on alarm 1: A).
+inline constexpr int kAlarmError = 28;
 
 /// Name of the i-th part-number register (0..14).
 inline std::string part_number_point(int i) {
@@ -101,6 +105,13 @@ inline RegisterMap map(int unit_id = 1, int run_event = 1, bool rtu = false, int
   for (int i = 0; i < kPartNumberRegisters; ++i)
     m.set(p(part_number_point(i).c_str(), static_cast<std::uint16_t>(kPartNumberAddress + i), U,
             Access::ro));
+  // A loop's process value on an input error (open sensor) is NaN (docs/DEVICES.md: A): a
+  // reading the driver judges, not a protocol error.
+  for (const char* pv : {kAir, kProduct}) {
+    Point pt = m.at(pv);
+    pt.nan_on_input_error = true;
+    m.set(pt);
+  }
   return m;
 }
 

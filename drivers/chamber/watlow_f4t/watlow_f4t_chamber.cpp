@@ -111,8 +111,10 @@ Result<ChamberState> WatlowF4tChamber::read() {
   readback_.read_done(cmds.ok(), full, client_.connects());
   if (!cmds) return cmds.error();
   ChamberState s;
-  s.alarms.deviation = alarm_active(static_cast<int>(alarm.value()));
-  s.alarms.sensor_break = !std::isfinite(air.value());
+  // A broken air sensor: the loop's PV reads NaN, or alarm 1 (sourced from it) is in error.
+  const int alarm_state = static_cast<int>(alarm.value());
+  s.alarms.sensor_break = !std::isfinite(air.value()) || alarm_state == f4t::kAlarmError;
+  s.alarms.deviation = alarm_state != f4t::kAlarmError && alarm_active(alarm_state);
   s.air_c = s.alarms.sensor_break ? std::numeric_limits<double>::quiet_NaN() : air.value();
   s.setpoint_c = sp.value();
   s.product_c = product_c_;
