@@ -103,6 +103,8 @@ struct CauseWords {
 };
 constexpr CauseWords kCauseWords[] = {
     {&SafetyCauses::chamber_high_limit, "chamber high-limit trip", "chamber high-limit trip reset"},
+    {&SafetyCauses::chamber_sensor_break, "chamber air sensor break",
+     "chamber air sensor reads again"},
     {&SafetyCauses::estop_pressed, "e-stop pressed", "e-stop released"},
     {&SafetyCauses::chamber_door_open, "chamber door open", "chamber door closed"},
     {&SafetyCauses::door_open, "interlock open", "interlock closed"},
@@ -168,13 +170,28 @@ SafetyDecision Safety::decide(const SafetyInputs& in) {
   if (in.chamber) {
     c.chamber_door_open = in.chamber->alarms.door_open;
     c.chamber_high_limit = in.chamber->alarms.high_limit_trip;
+    c.chamber_sensor_break = in.chamber->alarms.sensor_break;
     c.out_of_limits = judge(in.chamber);
   }
   c.inputs_unreadable = blind_ticks_ >= kBlindTicks;
+  if (c.chamber_sensor_break != causes_.chamber_sensor_break)
+    d.events.push_back(sensor_event(c.chamber_sensor_break));
+  // A broken sensor's air is no reading to hold at (nor to resume a ramp from).
+  const auto air_c = c.chamber_sensor_break ? std::nullopt : in.air_c;
   const bool was = holding_;
   const auto change = update(std::move(c));
-  finish(d, was, change, in.chamber, in.air_c);
+  finish(d, was, change, in.chamber, air_c);
   return d;
+}
+
+SafetyEvent Safety::sensor_event(bool broken) {
+  const nlohmann::json data{{"device", "chamber"}, {"sensor", "air"}};
+  if (broken)
+    return {Severity::error, EventKind::sensor_fault,
+            "chamber air sensor break: no air reading (samples keep air empty); held until it "
+            "reads again",
+            data};
+  return {Severity::info, EventKind::sensor_fault_cleared, "chamber air sensor reads again", data};
 }
 
 SafetyDecision Safety::decide_between_ticks(std::optional<bool> door_closed,
@@ -214,7 +231,8 @@ void Safety::finish(SafetyDecision& d, bool was, const std::optional<std::string
     d.events.push_back({Severity::error, EventKind::safe_hold_changed, *change});
   } else if (change && was) {
     d.cleared = true;
-    d.hold_air_c = hold_air_c_;
+    // A hold that never had a trustworthy air reading (a sensor break) resumes from this one.
+    d.hold_air_c = hold_air_c_ ? hold_air_c_ : air_c;
     d.events.push_back(
         {Severity::info, EventKind::safe_hold_cleared, *change + ": resuming the protocol step"});
   }
@@ -246,10 +264,10 @@ SafetyOutputs idle_outputs(bool fault) {
 
 SafetyOutputs Safety::outputs() const {
   SafetyOutputs o;
-  // Red: a fault (e-stop, readings out of limits); amber: safe hold; green: running. The gyros
-  // are powered while the run goes on and cut in every safe hold (the RLG's discharge supply is
-  // high voltage; a hold is when a person may reach into the chamber).
-  o.red = limits_fault_ || causes_.estop();
+  // Red: a fault (e-stop, readings out of limits, a broken sensor); amber: safe hold; green:
+  // running. The gyros are powered while the run goes on and cut in every safe hold (the RLG's
+  // discharge supply is high voltage; a hold is when a person may reach into the chamber).
+  o.red = limits_fault_ || causes_.estop() || causes_.sensor_fault();
   o.amber = holding_ && !o.red;
   o.green = !holding_;
   o.gyro_power = !holding_;

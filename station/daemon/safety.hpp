@@ -52,13 +52,18 @@ struct SafetyCauses {
   bool chamber_door_open = false;          ///< the chamber's own door alarm
   bool estop_pressed = false;              ///< the GPIO e-stop line
   bool chamber_high_limit = false;         ///< the chamber's high-limit (over-temperature) trip
+  bool chamber_sensor_break = false;       ///< the chamber's air sensor broken: no air reading
   bool inputs_unreadable = false;          ///< interlock / e-stop unreadable for kBlindTicks
   std::vector<std::string> out_of_limits;  ///< the chamber's readings outside the limits
   bool interlock_open() const {
     return table_interlock_open || door_open || chamber_door_open || inputs_unreadable;
   }
   bool estop() const { return estop_pressed || chamber_high_limit; }
-  bool any() const { return interlock_open() || estop() || !out_of_limits.empty(); }
+  /// A device fault someone must repair (tower lamp red): a broken sensor.
+  bool sensor_fault() const { return chamber_sensor_break; }
+  bool any() const {
+    return interlock_open() || estop() || sensor_fault() || !out_of_limits.empty();
+  }
   /// The active causes in words ("chamber high-limit trip; GPIO e-stop pressed"), or "none".
   std::string text() const;
   /// What each cause that is on reads once it clears ("interlock closed", "e-stop released").
@@ -108,7 +113,9 @@ class Safety {
 
   /// One tick: every source's report in, the hold state, commands, events and outputs out. A
   /// source that could not be read keeps its last known value; unreadable for kBlindTicks in a
-  /// row it counts as open (fail safe); a hold clears only on positive readings.
+  /// row it counts as open (fail safe); a hold clears only on positive readings. A broken air
+  /// sensor is a sensor fault (its own event) that holds: the hold takes no setpoint from an air
+  /// reading it cannot trust, and a ramp resumes from the air read once the sensor reads again.
   SafetyDecision decide(const SafetyInputs& in);
   /// Between ticks (a GPIO edge): may enter the hold, never clears it.
   SafetyDecision decide_between_ticks(std::optional<bool> door_closed,
@@ -131,6 +138,8 @@ class Safety {
   /// Takes the new causes; a message when any cause changed.
   std::optional<std::string> update(SafetyCauses causes);
   bool blind(const SafetyInputs& in) const;
+  /// The event of the chamber's air sensor breaking (`broken`) or reading again.
+  static SafetyEvent sensor_event(bool broken);
   /// Applies a state change (or none) to `d`, and the hold's commands.
   void finish(SafetyDecision& d, bool was_holding, const std::optional<std::string>& change,
               const std::optional<drivers::ChamberState>& chamber, std::optional<double> air_c);

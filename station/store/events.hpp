@@ -59,6 +59,8 @@ enum class EventKind {
   safe_hold,
   safe_hold_changed,
   safe_hold_cleared,
+  sensor_fault,
+  sensor_fault_cleared,
   // The service, releases and verification
   listen,
   idle_fault,
