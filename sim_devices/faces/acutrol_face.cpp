@@ -92,13 +92,9 @@ std::string AcutrolFace::run(const AclUnit& u, std::uint32_t& error, std::string
   if (!p.empty() && p.front() == '*') return common(u, error, why);
   if (p == ":Mode" || p.starts_with(":Mode:")) return mode(u, error, why);
   if (p.starts_with(":Status:") || p == ":Query:Error") return status(u, error, why);
-  for (const char* m :
-       {":Demand:Position", ":Demand:Rate", ":Read:Position", ":Read:Rate", ":Interlock",
-        ":Interlock:Close", ":Interlock:Open", ":Interlock:Reset", ":Limit:Rate"})
-    if (p == m) return motion(u, error, why);
-  error = src::kIllegalCommand.code;
-  why = std::string(kNotSimulated);
-  return {};
+  if (p == ":Demand:Position" || p == ":Demand:Rate") return demand(u, error, why);
+  // The rest motion() serves, or refuses as not simulated.
+  return motion(u, error, why);
 }
 
 std::string AcutrolFace::common(const AclUnit& u, std::uint32_t& error, std::string& why) {

@@ -55,6 +55,7 @@ class AcutrolFace final : public LineDevice {
   std::string common(const AclUnit& u, std::uint32_t& error, std::string& why);
   std::string mode(const AclUnit& u, std::uint32_t& error, std::string& why);
   std::string motion(const AclUnit& u, std::uint32_t& error, std::string& why);
+  std::string demand(const AclUnit& u, std::uint32_t& error, std::string& why);
   std::string status(const AclUnit& u, std::uint32_t& error, std::string& why);
   /// Queues the error, sets the status byte's bit and the reply's error code.
   void raise(std::uint32_t code, const std::string& path, const std::string& why);

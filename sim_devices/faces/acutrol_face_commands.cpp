@@ -103,8 +103,14 @@ std::string AcutrolFace::motion(const AclUnit& u, std::uint32_t& error, std::str
     rate_limit_dps_[*m] = *v;
     return {};
   }
-  // :Demand:Position[?] and :Demand:Rate[?] <axis>[,<value>] (p. 112-113)
-  const bool position = p == ":Demand:Position";
+  error = src::kIllegalCommand.code;
+  why = "not simulated";
+  return {};
+}
+
+// :Demand:Position[?] and :Demand:Rate[?] <axis>[,<value>] (p. 112-113).
+std::string AcutrolFace::demand(const AclUnit& u, std::uint32_t& error, std::string& why) {
+  const bool position = u.path == ":Demand:Position";
   if (!axis_args(u, 0, u.query ? 1 : 2, error, why)) return {};
   if (u.query) return fmt5(position ? table_.position_demand_deg() : table_.rate_demand_dps());
   const auto v = drivers::ascii::number_field(u.args[1]);
