@@ -3,8 +3,8 @@
 
 Two rigs run the same short protocol side by side: a reference left alone, and a victim that
 gets, at seeded random instants, SIGKILL + restart of the daemon, Modbus stalls and disconnects
-of chamber and turntable, door open, e-stop, a broken chamber air sensor, dropped and corrupted
-CAN frames. A second phase restarts the simulator itself under a running daemon. Checked:
+of chamber and turntable, door open, e-stop, a broken chamber air sensor, an ACUTROL refusing
+every command for a while, dropped and corrupted CAN frames. A second phase restarts the simulator itself under a running daemon. Checked:
 
   * zero committed samples lost or changed (a snapshot of the database after every kill, and
     before every simulator restart, is compared with the final file);
@@ -40,7 +40,12 @@ FAULTS = ["kill9", "door", "estop", "chamber_sensor", "chamber_stall", "chamber_
 # limits, docs/DEVICES.md).
 SENSOR_BREAK_CHAMBERS = {"generic_plc", "watlow_f4", "watlow_f4t", "watlow_f4t_map2", "watlow_f4p"}
 # Faults that must end in a safe hold, and how fast (time_to_safe_s).
-HOLD_FAULTS = ("door", "estop", "chamber_sensor")
+HOLD_FAULTS = ("door", "estop", "chamber_sensor", "table_refuse")
+# An ACUTROL that refuses every command for 7 s (simrig `table refuse`: an ACL error on each, read
+# from its error queue or header): one outage_start naming the refusal, and a safe hold once its
+# interlock has gone unread for the safety layer's 5 blind ticks.
+REFUSING_TABLES = {"acutrol3000"}
+REFUSE_S = 7
 
 
 def free_port():
@@ -197,12 +202,13 @@ def inject(kind, rig, daemon, db, rng, log):
                                                "inputs_unreadable"}),
         "table_disconnect": (["table disconnect 2"], [], {"outage", "read_failed", "safe_hold",
                                                          "inputs_unreadable"}),
+        "table_refuse": (["table refuse %d" % REFUSE_S], [], {"outage_start"}),
         "can_drop": (["can drop 6"], [], {"outage", "tick_failed"}),
         "can_corrupt": (["can corrupt 6"], [], {"outage", "tick_failed"}),
     }[kind]
     replies = rig.send(*commands[0])
     log.append("%s -> %s" % (commands[0], replies))
-    time.sleep(3.5)
+    time.sleep(REFUSE_S + 0.5 if kind == "table_refuse" else 3.5)
     if commands[1]:
         rig.send(*commands[1])
     return snap, t0, commands[2]
@@ -247,6 +253,9 @@ def campaign(args, work):
         "estop" if f == "door" else f for f in FAULTS]
     if args.chamber not in SENSOR_BREAK_CHAMBERS:
         faults = [f for f in faults if f != "chamber_sensor"]
+    if args.turntable in REFUSING_TABLES:
+        at = faults.index("table_disconnect") + 1
+        faults = faults[:at] + ["table_refuse"] + faults[at:]
     kinds = (faults * (args.faults // len(faults) + 1))[:args.faults]
     rng.shuffle(kinds)
     slots = sorted(rng.uniform(8, args.duration_s - 15) for _ in kinds)
@@ -273,6 +282,12 @@ def campaign(args, work):
             row["sensor_faults"] = sum(e[4] == "sensor_fault" for e in new)
             holds += [wall(e[1]) - t0 for e in new if e[4] == "safe_hold_changed"]
             row["event_expected"] = row["sensor_faults"] == 1 and bool(holds)
+        if kind == "table_refuse":
+            # One clear event: the table's outage_start naming the unit's refusal.
+            row["refusal_events"] = sum(e[4] == "outage_start" and e[3] == "turntable" and
+                                        "refused by the unit" in e[5] for e in new)
+            row["event_expected"] = row["refusal_events"] == 1
+            holds += [wall(e[1]) - t0 for e in new if e[4] == "safe_hold_changed"]
         if kind in HOLD_FAULTS:
             row["time_to_safe_s"] = round(min(holds), 3) if holds else None
         rows.append(row)
