@@ -4,7 +4,8 @@
 Two rigs run the same short protocol side by side: a reference left alone, and a victim that
 gets, at seeded random instants, SIGKILL + restart of the daemon, Modbus stalls and disconnects
 of chamber and turntable, door open, e-stop, a broken chamber air sensor, an ACUTROL refusing
-every command for a while, dropped and corrupted CAN frames. A second phase restarts the simulator itself under a running daemon. Checked:
+every command for a while, dropped and corrupted CAN frames. A second phase restarts the
+simulator itself under a running daemon. Checked:
 
   * zero committed samples lost or changed (a snapshot of the database after every kill, and
     before every simulator restart, is compared with the final file);
