@@ -26,6 +26,10 @@ constexpr int kPollMs = 100;
 // once within microseconds, so a few ms of silence delimit frames without splitting one.
 constexpr int kRtuSilenceMs = 5;
 
+double steady_now_s() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
 [[noreturn]] void sys_fail(const std::string& what) {
   throw std::runtime_error("modbus server: " + what + ": " + std::strerror(errno));
 }
@@ -89,9 +93,11 @@ void ModbusServer::make_mapping() {
   if (!mapping_) sys_fail("modbus_mapping_new");
 }
 
-void ModbusServer::start_tcp(int port) {
+void ModbusServer::start_tcp(int port, UnitLink link) {
   if (port < 0 || port > 65535)
     throw std::runtime_error("modbus server: port " + std::to_string(port) + " not 0..65535");
+  if (link == UnitLink::rtu) throw std::runtime_error("modbus server: TCP needs a TCP link");
+  link_ = link;
   make_mapping();
   ctx_.reset(modbus_new_tcp("127.0.0.1", port));
   if (!ctx_) sys_fail("modbus_new_tcp");
@@ -107,6 +113,7 @@ void ModbusServer::start_tcp(int port) {
 }
 
 void ModbusServer::start_rtu_pty(int baud) {
+  link_ = UnitLink::rtu;
   make_mapping();
   baud_ = baud;
   pty_master_ = posix_openpt(O_RDWR | O_NOCTTY | O_CLOEXEC);
@@ -200,8 +207,9 @@ void ModbusServer::run_rtu() {
   while (!stop_) {
     pollfd pfd{pty_master_, POLLIN, 0};
     if (poll(&pfd, 1, kPollMs) <= 0 || !(pfd.revents & POLLIN)) continue;
+    const double arrived_s = steady_now_s();
     const int len = read_rtu_frame(pty_master_, frame, sizeof frame, kRtuSilenceMs);
-    if (rtu_frame_for({frame, static_cast<std::size_t>(len)}, unit_id_)) handle(frame, len);
+    if (rtu_frame_ok({frame, static_cast<std::size_t>(len)})) dispatch(frame, len, arrived_s);
   }
 }
 
@@ -226,7 +234,7 @@ bool ModbusServer::serve_one(int fd) {
     std::copy_n(buf.begin(), 6 + length, query);
     buf.erase(buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(6 + length));
     modbus_set_socket(ctx_.get(), fd);
-    if (!handle(query, static_cast<int>(6 + length))) return forget(fd);
+    if (!dispatch(query, static_cast<int>(6 + length), steady_now_s())) return forget(fd);
   }
   return true;
 }
@@ -236,7 +244,28 @@ bool ModbusServer::forget(int fd) {
   return false;
 }
 
-bool ModbusServer::handle(const std::uint8_t* query, int len) {
+std::vector<double> ModbusServer::request_arrivals_s() const {
+  const std::lock_guard<std::mutex> lock(arrivals_mutex_);
+  return arrivals_s_;
+}
+
+// The unit id decides first (unit_address.hpp): another unit's frame is not a request to this one.
+bool ModbusServer::dispatch(const std::uint8_t* query, int len, double arrived_s) {
+  const int header = modbus_get_header_length(ctx_.get());  // the unit id is its last byte
+  if (len < header + 1) return true;
+  const UnitAnswer a = unit_answer(link_, unit_id_, query[header - 1], query[header]);
+  if (a == UnitAnswer::silence) return true;
+  if (a == UnitAnswer::gateway_error)
+    return modbus_reply_exception(ctx_.get(), query, kGatewayTargetFailed) != -1;
+  {
+    const std::lock_guard<std::mutex> lock(arrivals_mutex_);
+    arrivals_s_.push_back(arrived_s);
+  }
+  return handle(query, len, a == UnitAnswer::serve);
+}
+
+// `reply` false: a broadcast, executed and never answered.
+bool ModbusServer::handle(const std::uint8_t* query, int len, bool reply) {
   ++requests_;
   int code = 0;
   switch (faults_.take(code)) {
@@ -245,7 +274,7 @@ bool ModbusServer::handle(const std::uint8_t* query, int len) {
     case FaultSchedule::Fault::drop:
       return pty_master_ != -1;  // TCP: close; RTU: just stay silent
     case FaultSchedule::Fault::exception:
-      return modbus_reply_exception(ctx_.get(), query, static_cast<unsigned>(code)) != -1;
+      return !reply || modbus_reply_exception(ctx_.get(), query, static_cast<unsigned>(code)) != -1;
     case FaultSchedule::Fault::none:
       break;
   }
@@ -255,12 +284,12 @@ bool ModbusServer::handle(const std::uint8_t* query, int len) {
   const std::span<const std::uint8_t> pdu(query + header,
                                           static_cast<std::size_t>(len - header - crc));
   if (const std::uint8_t e = strict_exception(pdu); e != 0)
-    return modbus_reply_exception(ctx_.get(), query, e) != -1;
+    return !reply || modbus_reply_exception(ctx_.get(), query, e) != -1;
   model_.publish(*mapping_);
   // Apply a write to the model BEFORE the reply leaves, so a client that has its reply sees the
   // model already changed (no race with the next step_to()).
   apply_writes(pdu);
-  return modbus_reply(ctx_.get(), query, len, mapping_.get()) != -1;
+  return !reply || modbus_reply(ctx_.get(), query, len, mapping_.get()) != -1;
 }
 
 std::uint8_t ModbusServer::strict_exception(std::span<const std::uint8_t> pdu) const {

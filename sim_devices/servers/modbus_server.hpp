@@ -19,6 +19,7 @@
 #include "sim_devices/servers/fault_schedule.hpp"
 #include "sim_devices/servers/modbus_strict.hpp"
 #include "sim_devices/servers/sim_server.hpp"
+#include "sim_devices/servers/unit_address.hpp"
 
 namespace station::sim {
 
@@ -47,9 +48,11 @@ class ModbusDeviceModel {
   virtual void on_write(const modbus_mapping_t& regs, std::uint16_t pdu_address, int count) = 0;
 };
 
-/// Serves one model as a strict device: requests outside its map get exception 01/02/03, and on
-/// RTU a request for another unit id gets no answer at all. start_*() spawns the thread; the
-/// destructor stops and joins it (the loop polls with a 100 ms timeout, so shutdown never hangs).
+/// Serves one model as a strict device: requests outside its map get exception 01/02/03, and a
+/// request for another unit id is answered as the unit's link does (unit_address.hpp: silence on
+/// a serial line or the unit's own TCP port, exception 0x0B from a gateway). start_*() spawns the
+/// thread; the destructor stops and joins it (the loop polls with a 100 ms timeout, so shutdown
+/// never hangs).
 class ModbusServer final : public SimServer {
  public:
   /// Stores the model (not owned; must outlive the server) and unit id; no I/O.
@@ -58,8 +61,9 @@ class ModbusServer final : public SimServer {
   ModbusServer(const ModbusServer&) = delete;
   ModbusServer& operator=(const ModbusServer&) = delete;
 
-  /// Listens on 127.0.0.1:port (0 = ephemeral) and starts serving; throws std::runtime_error.
-  void start_tcp(int port = 0);
+  /// Listens on 127.0.0.1:port (0 = ephemeral) and starts serving as `link` (the unit's own TCP
+  /// port, or a TCP-to-RTU gateway in front of it); throws std::runtime_error.
+  void start_tcp(int port = 0, UnitLink link = UnitLink::tcp_device);
   /// Opens a pty pair and serves RTU on its master; clients open pty_path(). Throws on failure.
   void start_rtu_pty(int baud = 19200);
   /// Stops the thread and closes every descriptor; blocks at most ~100 ms. Idempotent.
@@ -73,6 +77,11 @@ class ModbusServer final : public SimServer {
   std::string endpoint() const override;
   /// Requests received so far (including faulted ones).
   std::uint64_t requests() const override { return requests_.load(); }
+  /// When each of those requests began to arrive, steady-clock seconds (RTU: the first byte of
+  /// the frame; TCP: the whole frame). Thread-safe.
+  std::vector<double> request_arrivals_s() const;
+  /// How the unit is reached (set by start_*()).
+  UnitLink link() const { return link_; }
 
  private:
   struct FreeServerCtx {
@@ -89,12 +98,14 @@ class ModbusServer final : public SimServer {
   void accept_client(std::vector<int>& clients);
   bool serve_one(int fd);
   bool forget(int fd);  ///< drops a client's partial frame; false (close it)
-  bool handle(const std::uint8_t* query, int len);
+  bool dispatch(const std::uint8_t* query, int len, double arrived_s);
+  bool handle(const std::uint8_t* query, int len, bool reply);
   std::uint8_t strict_exception(std::span<const std::uint8_t> pdu) const;
   void apply_writes(std::span<const std::uint8_t> pdu);
 
   ModbusDeviceModel& model_;
   int unit_id_;
+  UnitLink link_ = UnitLink::tcp_device;
   std::unique_ptr<modbus_t, FreeServerCtx> ctx_;
   std::unique_ptr<modbus_mapping_t, FreeMapping> mapping_;
   int listen_fd_ = -1;
@@ -105,6 +116,8 @@ class ModbusServer final : public SimServer {
   std::string pty_path_;
   std::atomic<bool> stop_{false};
   std::atomic<std::uint64_t> requests_{0};
+  mutable std::mutex arrivals_mutex_;
+  std::vector<double> arrivals_s_;  // guarded by arrivals_mutex_
   std::thread thread_;
   std::map<int, std::vector<std::uint8_t>> pending_;  // per TCP client: bytes of a partial frame
 };

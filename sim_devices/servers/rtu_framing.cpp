@@ -1,4 +1,4 @@
-// RTU framing: CRC-16, silence-delimited frame reads and the unit-id filter.
+// RTU framing: CRC-16 and silence-delimited frame reads.
 #include "sim_devices/servers/rtu_framing.hpp"
 
 #include <poll.h>
@@ -27,9 +27,9 @@ int read_rtu_frame(int fd, std::uint8_t* buf, int cap, int silence_ms) {
   return len;
 }
 
-bool rtu_frame_for(std::span<const std::uint8_t> frame, int unit) {
+bool rtu_frame_ok(std::span<const std::uint8_t> frame) {
   // Unit id, function code and the two CRC bytes at least.
-  if (frame.size() < 4 || frame[0] != unit || unit == 0) return false;
+  if (frame.size() < 4) return false;
   const std::uint16_t crc = modbus_crc16(frame.first(frame.size() - 2));
   // The CRC goes low byte first (spec 6.2.2).
   return frame[frame.size() - 2] == (crc & 0xFF) && frame[frame.size() - 1] == (crc >> 8);

@@ -1,5 +1,5 @@
 // Modbus RTU framing as a serial device does it (Modbus over Serial Line v1.02, 2.5.1): a frame
-// ends at a silence, carries a CRC-16, and a device answers only its own unit id.
+// ends at a silence and carries a CRC-16; which unit id a device answers is unit_address.hpp.
 #pragma once
 
 #include <cstdint>
@@ -14,9 +14,8 @@ std::uint16_t modbus_crc16(std::span<const std::uint8_t> bytes);
 /// none (the spec's 3.5-character gap) or `cap` bytes. Returns the bytes read (0 if none).
 int read_rtu_frame(int fd, std::uint8_t* buf, int cap, int silence_ms);
 
-/// True when device `unit` must answer `frame`: long enough, its CRC right and addressed to
-/// `unit`. A frame for another unit, a broadcast (unit 0, not implemented here) or a damaged
-/// frame gets no answer at all.
-bool rtu_frame_for(std::span<const std::uint8_t> frame, int unit);
+/// True when `frame` is a whole RTU frame: unit id, function code and CRC at least, its CRC
+/// right. A damaged frame gets no answer at all (spec 2.5.1.2).
+bool rtu_frame_ok(std::span<const std::uint8_t> frame);
 
 }  // namespace station::sim
