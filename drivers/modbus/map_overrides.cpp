@@ -68,6 +68,28 @@ WordOrder parse_word_order(std::string_view s) {
   bad("word order", s, "ABCD or CDAB");
 }
 
+WordOrder parse_float_word_order(std::string_view s) {
+  if (s == "low_high") return WordOrder::cdab;
+  if (s == "high_low") return WordOrder::abcd;
+  bad("word order", s, "\"low_high\" (low word first) or \"high_low\"");
+}
+
+const char* float_word_order_name(WordOrder order) {
+  return order == WordOrder::cdab ? "low_high" : "high_low";
+}
+
+int set_float_word_order(RegisterMap& map, WordOrder order) {
+  int n = 0;
+  for (const auto& [name, point] : map.points()) {
+    if (point.type != PointType::float32) continue;
+    Point p = point;
+    p.order = order;
+    map.set(std::move(p));
+    ++n;
+  }
+  return n;
+}
+
 FunctionCode parse_function_code(std::string_view s) {
   auto l = lower(s);
   if (l == "3" || l == "holding") return FunctionCode::holding;

@@ -31,6 +31,14 @@ void apply_overrides(RegisterMap& map, const std::vector<PointOverride>& overrid
 PointType parse_point_type(std::string_view s);
 /// "ABCD" | "CDAB" (case-insensitive); throws std::invalid_argument otherwise.
 WordOrder parse_word_order(std::string_view s);
+/// A unit's float word order as its panel names it (TestEquity F4T manual p. 14, "Modbus Word
+/// Order: Low High, High Low"): "low_high" = low word first (CDAB), "high_low" (ABCD); throws
+/// std::invalid_argument otherwise.
+WordOrder parse_float_word_order(std::string_view s);
+/// "low_high" or "high_low".
+const char* float_word_order_name(WordOrder order);
+/// Gives every float32 point of `map` the word order `order`; returns how many points it set.
+int set_float_word_order(RegisterMap& map, WordOrder order);
 /// "3" | "holding" | "4" | "input"; throws std::invalid_argument otherwise.
 FunctionCode parse_function_code(std::string_view s);
 /// "ro" | "rw"; throws std::invalid_argument otherwise.

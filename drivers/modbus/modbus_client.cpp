@@ -82,6 +82,7 @@ Result<void> ModbusClient::connect() {
     return e;
   }
   state_.connect_succeeded();
+  unit_answered_ = false;
   tap(TapDirection::event, "connect", {}, to_string(endpoint_));
   return {};
 }
@@ -96,8 +97,28 @@ Result<void> ModbusClient::ensure_connected() {
   return state_.ensure(device_, [this] { return connect(); });
 }
 
-Error ModbusClient::fail(int err, const std::string& what) {
+// What a failure says about the unit id: a gateway's exception names the unit nothing answered;
+// a timeout before the unit ever answered on this link is a wrong address or no unit at all (a
+// unit is silent for another address: Modbus over Serial Line v1.02 §2.2, docs/DEVICES.md).
+std::string ModbusClient::unit_hint(int err, int unit) const {
+  if (err == EMBXGTAR || err == EMBXGPATH)
+    return fmt::format(
+        " (a gateway's exception: no device answered unit {} behind it; check "
+        "unit_id)",
+        unit);
+  if ((err == ETIMEDOUT || err == EAGAIN) && !unit_answered_)
+    return fmt::format(
+        " (unit {} has not answered since the link opened, {:.2f} s each: check "
+        "unit_id against the unit's Modbus address)",
+        unit, timeout_s_);
+  return {};
+}
+
+Error ModbusClient::fail(int err, int unit, const std::string& what) {
   Error e = translate_modbus_error(err, device_ + " " + what);
+  e.message += unit_hint(err, unit);
+  // An exception reply from the unit itself is an answer (not one from a gateway in front).
+  if (e.kind == ErrorKind::exception && err != EMBXGTAR && err != EMBXGPATH) unit_answered_ = true;
   const bool reopen = link_.must_reopen(e.kind, std::holds_alternative<TcpEndpoint>(endpoint_));
   if (reopen && link_.stale_timeouts() > 0)
     e.message += fmt::format(" ({} timeouts in a row: reconnecting)", link_.stale_timeouts());
@@ -119,10 +140,13 @@ Result<std::vector<std::uint16_t>> ModbusClient::read_registers(FunctionCode fc,
       fmt::format("unit={} fc={} addr={} count={}", unit, code, addr, count));
   std::vector<std::uint16_t> words(static_cast<std::size_t>(count));
   int rc = wire_->read(fc, unit, addr, count, words.data());
-  if (rc == -1) return fail(errno, fmt::format("read fc={} addr={} count={}", code, addr, count));
+  if (rc == -1)
+    return fail(errno, unit, fmt::format("read fc={} addr={} count={}", code, addr, count));
   if (rc != count)
-    return fail(EMBBADDATA, fmt::format("read addr={}: {} registers, wanted {}", addr, rc, count));
+    return fail(EMBBADDATA, unit,
+                fmt::format("read addr={}: {} registers, wanted {}", addr, rc, count));
   link_.answered();
+  unit_answered_ = true;
   tap(TapDirection::rx, "modbus-read", read_reply_adu(unit, code, words),
       fmt::format("unit={} addr={}", unit, addr));
   return words;
@@ -136,8 +160,10 @@ Result<void> ModbusClient::write_registers(int unit, std::uint16_t addr,
   tap(TapDirection::tx, "modbus-write", write_request_adu(unit, addr, words),
       fmt::format("unit={} fc={} addr={} count={}", unit, code, addr, n));
   int rc = wire_->write(unit, addr, words);
-  if (rc == -1) return fail(errno, fmt::format("write fc={} addr={} count={}", code, addr, n));
+  if (rc == -1)
+    return fail(errno, unit, fmt::format("write fc={} addr={} count={}", code, addr, n));
   link_.answered();
+  unit_answered_ = true;
   tap(TapDirection::rx, "modbus-write",
       n == 1 ? write_request_adu(unit, addr, words) : read_request_adu(unit, code, addr, n),
       fmt::format("unit={} addr={} ok", unit, addr));

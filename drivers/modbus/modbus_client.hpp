@@ -72,15 +72,28 @@ class ModbusClient {
   const std::string& device() const { return device_; }
   /// Response timeout in seconds.
   double response_timeout_s() const { return timeout_s_; }
+  /// Keeps at least `gap_s` seconds of quiet between one exchange and the next request (a
+  /// dialect's pause on a serial line, drivers/registry/dialects.cpp); 0: none. No I/O.
+  void set_request_gap_s(double gap_s) {
+    gap_s_ = gap_s;
+    wire_->set_request_gap_s(gap_s);
+  }
+  /// The pause set by set_request_gap_s, seconds.
+  double request_gap_s() const { return gap_s_; }
+  /// True once the unit itself answered (a reply or its own exception) since the link opened.
+  bool unit_answered() const { return unit_answered_; }
 
  private:
   Result<void> ensure_connected();
-  Error fail(int err, const std::string& what);
+  Error fail(int err, int unit, const std::string& what);
+  std::string unit_hint(int err, int unit) const;
   void tap(TapDirection dir, const char* kind, std::vector<std::uint8_t> bytes, std::string detail);
 
   std::string device_;
   Endpoint endpoint_;
   double timeout_s_;
+  double gap_s_ = 0;
+  bool unit_answered_ = false;  ///< the unit answered since the link opened
   std::unique_ptr<ModbusWire> wire_;
   Tap* tap_ = nullptr;
   StaleLink link_;   ///< the stale-link rule (drivers/common/stale_link.hpp)

@@ -3,6 +3,7 @@
 
 #include <cerrno>
 #include <cmath>
+#include <thread>
 
 namespace station::drivers::modbus {
 
@@ -26,15 +27,28 @@ int LibmodbusWire::open(double timeout_s) {
   return 0;
 }
 
+void LibmodbusWire::rest() {
+  if (gap_ > SteadyClock::duration::zero()) std::this_thread::sleep_until(last_end_ + gap_);
+}
+
+int LibmodbusWire::ended(int rc) {
+  const int err = errno;
+  last_end_ = SteadyClock::now();
+  errno = err;
+  return rc;
+}
+
 int LibmodbusWire::read(FunctionCode fc, int unit, std::uint16_t addr, int count,
                         std::uint16_t* dest) {
   if (!ctx_) {
     errno = ENOTCONN;
     return -1;
   }
+  rest();
   modbus_set_slave(ctx_.get(), unit);
-  return fc == FunctionCode::holding ? modbus_read_registers(ctx_.get(), addr, count, dest)
-                                     : modbus_read_input_registers(ctx_.get(), addr, count, dest);
+  return ended(fc == FunctionCode::holding
+                   ? modbus_read_registers(ctx_.get(), addr, count, dest)
+                   : modbus_read_input_registers(ctx_.get(), addr, count, dest));
 }
 
 int LibmodbusWire::write(int unit, std::uint16_t addr, std::span<const std::uint16_t> words) {
@@ -42,10 +56,11 @@ int LibmodbusWire::write(int unit, std::uint16_t addr, std::span<const std::uint
     errno = ENOTCONN;
     return -1;
   }
+  rest();
   modbus_set_slave(ctx_.get(), unit);
   const int n = static_cast<int>(words.size());
-  return n == 1 ? modbus_write_register(ctx_.get(), addr, words[0])
-                : modbus_write_registers(ctx_.get(), addr, n, words.data());
+  return ended(n == 1 ? modbus_write_register(ctx_.get(), addr, words[0])
+                      : modbus_write_registers(ctx_.get(), addr, n, words.data()));
 }
 
 void LibmodbusWire::flush() {

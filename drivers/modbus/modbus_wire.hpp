@@ -3,6 +3,7 @@
 // (replay). ModbusClient's error translation, reconnect and back-off run the same over both.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <span>
 
@@ -28,6 +29,10 @@ class ModbusWire {
   virtual int write(int unit, std::uint16_t addr, std::span<const std::uint16_t> words) = 0;
   /// Discards unread input (after a timeout or a garbled reply).
   virtual void flush() = 0;
+  /// Keeps at least `gap_s` seconds between the end of one exchange (reply, exception or
+  /// timeout) and the next request: the pause a dialect's source asks on a serial line
+  /// (drivers/registry/dialects.cpp). Only a real line waits; a recording has no line to rest.
+  virtual void set_request_gap_s(double /*gap_s*/) {}
 };
 
 /// The real link: libmodbus over TCP or RTU. The constructor does no I/O.
@@ -39,10 +44,22 @@ class LibmodbusWire final : public ModbusWire {
   int read(FunctionCode fc, int unit, std::uint16_t addr, int count, std::uint16_t* dest) override;
   int write(int unit, std::uint16_t addr, std::span<const std::uint16_t> words) override;
   void flush() override;
+  void set_request_gap_s(double gap_s) override { gap_ = to_steady(gap_s); }
 
  private:
+  using SteadyClock = std::chrono::steady_clock;
+  static SteadyClock::duration to_steady(double s) {
+    return std::chrono::duration_cast<SteadyClock::duration>(std::chrono::duration<double>(s));
+  }
+  /// Sleeps out what is left of the gap since the last exchange ended.
+  void rest();
+  /// Marks the end of an exchange; returns `rc`.
+  int ended(int rc);
+
   Endpoint endpoint_;
   ModbusHandle ctx_;
+  SteadyClock::duration gap_{0};
+  SteadyClock::time_point last_end_{};
 };
 
 }  // namespace station::drivers::modbus
