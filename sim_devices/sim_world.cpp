@@ -101,8 +101,8 @@ SimWorld::SimWorld(const SimWorldConfig& config) : config_(config) {
   chamber_sim_ =
       std::make_unique<ChamberSim>(drivers::chamber_map::generic_plc(1), config_.chamber);
   table_sim_ = std::make_unique<TurntableSim>(drivers::turntable_map::generic_plc(1));
-  chamber_ =
-      serve_chamber(config_.chamber_model, *chamber_sim_, config_.panel, config_.chamber_port);
+  chamber_ = serve_chamber(config_.chamber_model, *chamber_sim_, config_.panel,
+                           config_.chamber_port, config_.chamber_gateway);
   table_ = serve_turntable(config_.turntable_model, *table_sim_, config_.turntable_port,
                            config_.acutrol_framing);
   // Link faults last seconds of the world's time (simulated under run --sim, wall under simrig).
@@ -247,8 +247,9 @@ void SimWorld::advance_to(double t_s) {
 namespace station::sim {
 
 std::string SimWorld::devices_toml() const {
-  return device_toml("chamber", config_.chamber_model, chamber_endpoint(), &config_.panel) + "\n" +
-         device_toml("turntable", config_.turntable_model, turntable_endpoint(), nullptr);
+  return device_toml("chamber", config_.chamber_model, chamber_endpoint(), &config_.panel,
+                     config_.chamber_gateway) +
+         "\n" + device_toml("turntable", config_.turntable_model, turntable_endpoint(), nullptr);
 }
 
 }  // namespace station::sim

@@ -52,6 +52,8 @@ struct SimWorldConfig {
   std::string turntable_model = "generic_plc";
   WatlowPanel panel;  ///< a simulated Watlow's decimals, units and run event
   AclFraming acutrol_framing = AclFraming::bare;  ///< how a simulated ACUTROL frames replies
+  /// The chamber is a serial unit behind a TCP-to-RTU gateway (serve_chamber).
+  bool chamber_gateway = false;
 };
 
 /// One simulated gyro as the station will see it.

@@ -46,6 +46,11 @@ struct Options {
   double latitude_deg = 39.9;
   std::string control;            // fault-injection control socket, "" = none
   std::vector<std::string> send;  // client mode: commands for a running simrig's control socket
+  bool chamber_humidity = false;  // a Watlow temperature/humidity chamber (input/loop 2 %RH)
+  bool chamber_cascade = false;   // an F4T with cascade control
+  int chamber_unit = 1;           // the chamber's Modbus address (set at its panel)
+  std::string chamber_word_order = "low_high";  // F4T floats as set at its panel
+  bool chamber_gateway = false;                 // the chamber behind a TCP-to-RTU gateway
 };
 
 /// Earth rate along a local-vertical input axis, deg/h: Omega * sin(lat) with the WGS-84
@@ -185,6 +190,23 @@ void add_options(CLI::App& app, Options& o) {
   app.add_option("--latitude", o.latitude_deg, "site latitude, deg (Earth rate in the gyros)")
       ->capture_default_str()
       ->check(CLI::Range(-90.0, 90.0));
+  app.add_flag("--chamber-humidity", o.chamber_humidity,
+               "Watlow: a temperature/humidity chamber (input / loop 2 reads %RH, humidity on "
+               "event 2, left on at the panel)");
+  app.add_flag("--chamber-cascade", o.chamber_cascade,
+               "Watlow F4T: cascade control (its part number says so; no Data Map 2)");
+  app.add_option(
+         "--chamber-unit", o.chamber_unit,
+         "Modbus chamber: its address (unit id) set at the panel; another id is not answered")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 247));
+  app.add_option("--chamber-word-order", o.chamber_word_order,
+                 "Watlow F4T: the float word order set at the panel")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"low_high", "high_low"}));
+  app.add_flag("--chamber-gateway", o.chamber_gateway,
+               "Modbus chamber: a serial unit behind a TCP-to-RTU gateway (its RTU registers; "
+               "exception 0x0B for another unit id)");
   app.add_option("--control", o.control,
                  "unix stream socket for fault commands, one per line, one reply line each");
   app.add_option("--send", o.send,
@@ -204,6 +226,11 @@ sim::SimWorldConfig world_config(const Options& o) {
   c.chamber_port = o.chamber_port;
   c.turntable_port = o.turntable_port;
   c.can_unix_path = o.can_socket;
+  c.panel.humidity = o.chamber_humidity;
+  c.panel.cascade = o.chamber_cascade;
+  c.panel.modbus_address = o.chamber_unit;
+  c.panel.float_words = station::drivers::modbus::parse_float_word_order(o.chamber_word_order);
+  c.chamber_gateway = o.chamber_gateway;
   c.earth_rate_dph = earth_rate_up_dph(o.latitude_deg);
   return c;
 }

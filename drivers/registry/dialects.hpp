@@ -6,6 +6,7 @@
 
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -28,16 +29,40 @@ namespace station::drivers {
 /// How a dialect reaches its device.
 enum class Transport { modbus, ascii };
 
+/// How long a dialect waits for a reply and rests between requests: the station's defaults, each
+/// with its source beside its row (dialects.cpp) and in docs/DEVICES.md ("Timing"). The
+/// configuration's timeout_s and request_gap_s override them.
+struct LinkTiming {
+  double timeout_s = 0.5;           ///< bound on one transaction, s
+  double serial_request_gap_s = 0;  ///< Modbus: quiet between requests on a serial line, s
+};
+
 /// A configured device: which model, where, and the knobs its dialect reads.
 struct DeviceSpec {
-  std::string name;      ///< "chamber", "turntable": logs, records, tap device
-  std::string model;     ///< a dialect name (or alias)
-  std::string endpoint;  ///< tcp://H:P, rtu:/dev/X?... (Modbus), serial:/dev/X?... (ASCII)
-  int unit_id = 1;       ///< Modbus unit id, or an ASCII unit's RS-485 address
-  double timeout_s = 0.5;
+  std::string name;        ///< "chamber", "turntable": logs, records, tap device
+  std::string model;       ///< a dialect name (or alias)
+  std::string endpoint;    ///< tcp://H:P, rtu:/dev/X?... (Modbus), serial:/dev/X?... (ASCII)
+  int unit_id = 1;         ///< Modbus unit id, or an ASCII unit's RS-485 address
+  double timeout_s = 0.5;  ///< bound on one transaction, s (configured: the dialect's by default)
+  /// Modbus: quiet kept between one exchange and the next request, s (configured: the dialect's
+  /// for the unit's link by default, default_request_gap_s()).
+  double request_gap_s = 0;
+  /// Modbus: every float register's word order as the unit's panel sets it (unset: the map's).
+  std::optional<modbus::WordOrder> word_order;
+  /// Modbus TCP: the endpoint is a TCP-to-RTU gateway and the unit sits on its serial line; the
+  /// dialect reads it as a serial unit (F4T: units register 14080, the serial pause).
+  bool gateway = false;
   int readback_every = modbus::ReadbackSchedule::kDefaultEvery;
   std::vector<modbus::PointOverride> overrides;  ///< Modbus dialects: point overrides
   int run_event = 1;  ///< Watlow F4/F4T: event output that runs the chamber (builder's wiring)
+  /// Watlow F4/F4T: the input (F4) or loop (F4T) carrying the product temperature; 0: none. An
+  /// explicit choice: a humidity input is never read as a temperature (docs/DEVICES.md).
+  int product_input = 0;
+  /// Watlow F4/F4T: the event output wired to humidity (TestEquity: event 2), kept off during a
+  /// run on a humidity chamber; 0: none.
+  int humidity_event = 2;
+  /// The chamber's setpoint limits, °C, where the unit serves none (F4T Data Map 2).
+  std::optional<double> setpoint_low_c, setpoint_high_c;
   /// ASCII dialects with a choice of reply framing (the row's `framings`): "" is the default.
   std::string framing;
 };
@@ -70,6 +95,10 @@ struct Dialect {
   std::function<modbus::RegisterMap(const DeviceSpec&)> map;
   /// Builds the driver; no I/O. Throws std::invalid_argument on a bad spec.
   std::function<std::unique_ptr<Device>(const DeviceSpec&, const LinkOptions&)> make;
+  /// The highest input (F4) or loop (F4T) `product_input` may name (0: the key is not taken).
+  int product_inputs = 0;
+  /// Reply timeout and serial pause (LinkTiming; sources in dialects.cpp).
+  LinkTiming timing{};
   /// The reply framings `framing` may name, comma-separated, the first the default (empty: the
   /// key is not taken).
   std::string_view framings = {};
@@ -89,6 +118,13 @@ const TurntableDialect& turntable_dialect(std::string_view model);
 /// overrides valid on its map; throws std::invalid_argument naming what is wrong.
 template <typename Device>
 void validate(const Dialect<Device>& dialect, const DeviceSpec& spec);
+/// Whether the unit of a Modbus `spec` sits on a serial line: an rtu: endpoint, or behind a
+/// gateway. Throws std::invalid_argument for an endpoint that is not Modbus.
+bool serial_unit(const DeviceSpec& spec);
+/// The pause `spec` gets when the configuration sets none: the dialect's serial pause for a unit
+/// on a serial line, else none (a unit on its own TCP port needs none: docs/DEVICES.md).
+template <typename Device>
+double default_request_gap_s(const Dialect<Device>& dialect, const DeviceSpec& spec);
 /// "a, b, c" of the model names.
 std::string chamber_models();
 std::string turntable_models();

@@ -20,15 +20,18 @@ struct ServedDevice {
   std::unique_ptr<SimServer> server;
 };
 
-/// The chamber model served as `model` (a drivers/registry chamber model); throws
-/// std::invalid_argument for a model without a simulator face.
+/// The chamber model served as `model` (a drivers/registry chamber model) at the panel's Modbus
+/// address; `gateway`: a serial unit behind a TCP-to-RTU gateway (its RTU registers, exception
+/// 0x0B for another unit id), else the unit's own TCP port. Throws std::invalid_argument for a
+/// model without a simulator face, or a gateway in front of an ASCII unit.
 ServedDevice serve_chamber(std::string_view model, ChamberSim& chamber, const WatlowPanel& panel,
-                           int port);
+                           int port, bool gateway = false);
 /// The table model served as `model`; an ACUTROL frames its replies as `acutrol_framing` says.
 ServedDevice serve_turntable(std::string_view model, TurntableSim& table, int port,
                              AclFraming acutrol_framing = AclFraming::bare);
-/// The [chamber] / [turntable] table text a station config needs for a served model.
+/// The [chamber] / [turntable] table text a station config needs for a served model (its
+/// run event, unit id, word order and gateway as the panel and the serving say).
 std::string device_toml(const char* section, std::string_view model, const std::string& endpoint,
-                        const WatlowPanel* panel);
+                        const WatlowPanel* panel, bool gateway = false);
 
 }  // namespace station::sim

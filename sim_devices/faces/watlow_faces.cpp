@@ -2,6 +2,9 @@
 #include "sim_devices/faces/watlow_faces.hpp"
 
 #include <cmath>
+#include <optional>
+#include <string_view>
+#include <vector>
 
 #include "sim_devices/sources/watlow_sources.hpp"
 
@@ -12,8 +15,25 @@ namespace f4p = sources::f4p;
 
 namespace {
 // The part number the simulated F4T reports: character 6 'D' = profiles, 6 alarms; character
-// 11 '2' = two loops (CCL watlowf4t.py process_controller:861-921). Synthetic.
+// 11 '2' = two loops, or '7' = one loop and one cascade (CCL watlowf4t.py
+// process_controller:861-921). Synthetic.
 constexpr const char* kF4tPartNumber = "F4T1L2DAA0A2AAA";
+constexpr const char* kF4tCascadePartNumber = "F4T1L2DAA0A7AAA";
+
+// The rows an F4 face serves: the F4's, or an F4T's Data Map 2 (none on a cascade unit).
+std::vector<sources::SourcePoint> f4_rows(const char* name, const WatlowPanel& panel) {
+  if (std::string_view(name) != "watlow_f4t_map2") return sources::f4::points(panel.run_event);
+  if (panel.cascade) return {};
+  return sources::f4t_map2::points(panel.run_event);
+}
+// The F4T's rows with its floats in the word order set at the panel ([TE] 746854 p. 14; the
+// rows say low word first, the default: [TE] p. 46).
+std::vector<sources::SourcePoint> f4t_rows(const WatlowPanel& panel, bool rtu) {
+  auto rows = f4t::points(panel.run_event, rtu);
+  for (auto& r : rows)
+    if (r.type == drivers::modbus::PointType::float32) r.order = panel.float_words;
+  return rows;
+}
 // Alarm state "alarm high" shown while the deviation alarm is on (Watlow enumeration; the sources
 // only name the inactive codes 88, 61, 12: an assumption of the simulator).
 constexpr int kAlarmHigh = 7;
@@ -37,12 +57,14 @@ double WatlowFace::c_of_unit(double v) const {
 
 // ---------------------------------------------------------------------------------- F4
 F4Face::F4Face(ChamberSim& chamber, WatlowPanel panel, int unit_id, const char* name)
-    : WatlowFace(chamber, sources::register_map(name, unit_id, f4::points(panel.run_event)),
-                 panel) {}
+    : WatlowFace(chamber, sources::register_map(name, unit_id, f4_rows(name, panel)), panel) {}
 
 std::uint8_t F4Face::check_write(const RegisterWrite& write) const {
-  const auto ev = write.value_of(map_.at(f4::kRunEvent));
-  if (ev && *ev != f4::kEventOn && *ev != f4::kEventOff) return kIllegalDataValue;
+  for (const char* point : {f4::kRunEvent, f4::kHumidityEvent}) {
+    const auto* p = map_.find(point);
+    const auto ev = p != nullptr ? write.value_of(*p) : std::nullopt;
+    if (ev && *ev != f4::kEventOn && *ev != f4::kEventOff) return kIllegalDataValue;
+  }
   return 0;
 }
 
@@ -50,7 +72,9 @@ void F4Face::publish(modbus_mapping_t& regs) {
   const bool broken = chamber_.air_sensor_failed();
   put(regs, f4::kAir, broken ? 32767 : raw_temp(chamber_.air_c()));
   put(regs, f4::kAirError, broken ? f4::kInputOverRange : 0);
-  put(regs, f4::kProduct, raw_temp(chamber_.product_c()));
+  put(regs, f4::kProduct,
+      panel_.humidity ? std::nearbyint(kSimHumidityRh * std::pow(10.0, panel_.decimals))
+                      : raw_temp(chamber_.product_c()));
   put(regs, f4::kProductError, 0);
   put(regs, f4::kStatus, chamber_.status() == 3 ? f4::kStatusProfilePaused : f4::kStatusConstant);
   put(regs, f4::kSetpoint, raw_temp(chamber_.setpoint_c()));
@@ -60,6 +84,9 @@ void F4Face::publish(modbus_mapping_t& regs) {
   put(regs, f4::kDecimals2, panel_.decimals);
   put(regs, f4::kUnits, panel_.fahrenheit ? f4::kUnitsFahrenheit : f4::kUnitsCelsius);
   put(regs, f4::kRunEvent, chamber_.run() ? f4::kEventOn : f4::kEventOff);
+  put(regs, f4::kInput1Units, f4::kInputTemperature);
+  put(regs, f4::kInput2Units, panel_.humidity ? f4::kInputHumidity : f4::kInputTemperature);
+  put(regs, f4::kHumidityEvent, humidity_on_ ? f4::kEventOn : f4::kEventOff);
 }
 
 void F4Face::on_write(const modbus_mapping_t& regs, std::uint16_t pdu_address, int count) {
@@ -67,17 +94,21 @@ void F4Face::on_write(const modbus_mapping_t& regs, std::uint16_t pdu_address, i
   if (point_written(sp, pdu_address, count)) chamber_.set_setpoint_c(c_of_raw(get_point(regs, sp)));
   const auto& ev = map_.at(f4::kRunEvent);
   if (point_written(ev, pdu_address, count)) chamber_.set_run(get_point(regs, ev) == f4::kEventOn);
+  if (const auto* h = map_.find(f4::kHumidityEvent); h && point_written(*h, pdu_address, count))
+    humidity_on_ = get_point(regs, *h) == f4::kEventOn;
 }
 
 // --------------------------------------------------------------------------------- F4T
 F4tFace::F4tFace(ChamberSim& chamber, WatlowPanel panel, int unit_id, bool rtu)
-    : WatlowFace(chamber,
-                 sources::register_map("watlow_f4t", unit_id, f4t::points(panel.run_event, rtu)),
+    : WatlowFace(chamber, sources::register_map("watlow_f4t", unit_id, f4t_rows(panel, rtu)),
                  panel) {}
 
 std::uint8_t F4tFace::check_write(const RegisterWrite& write) const {
-  const auto ev = write.value_of(map_.at(f4t::kRunEvent));
-  if (ev && *ev != f4t::kOn && *ev != f4t::kOff) return kIllegalDataValue;
+  for (const char* point : {f4t::kRunEvent, f4t::kHumidityEvent}) {
+    const auto* p = map_.find(point);
+    const auto ev = p != nullptr ? write.value_of(*p) : std::nullopt;
+    if (ev && *ev != f4t::kOn && *ev != f4t::kOff) return kIllegalDataValue;
+  }
   const auto action = write.value_of(map_.at(f4t::kRampAction));
   if (action && *action != f4t::kOff && *action != f4t::kRampSetpoint && *action != f4t::kStartup &&
       *action != f4t::kRampBoth)
@@ -93,7 +124,10 @@ std::uint8_t F4tFace::check_write(const RegisterWrite& write) const {
 
 void F4tFace::publish(modbus_mapping_t& regs) {
   put(regs, f4t::kAir, chamber_.air_sensor_failed() ? NAN : unit(chamber_.air_c()));
-  put(regs, f4t::kProduct, unit(chamber_.product_c()));
+  put(regs, f4t::kProduct, panel_.humidity ? kSimHumidityRh : unit(chamber_.product_c()));
+  put(regs, f4t::kLoop1Kind, f4t::kAbsoluteTemperature);
+  put(regs, f4t::kLoop2Kind, panel_.humidity ? f4t::kHumidity : f4t::kAbsoluteTemperature);
+  put(regs, f4t::kHumidityEvent, humidity_on_ ? f4t::kOn : f4t::kOff);
   put(regs, f4t::kSetpoint, unit(chamber_.setpoint_c()));
   put(regs, f4t::kWorkingSetpoint, unit(chamber_.effective_setpoint_c()));
   put(regs, f4t::kSetpointLow, unit(chamber_.config().setpoint_low_c));
@@ -111,7 +145,8 @@ void F4tFace::publish(modbus_mapping_t& regs) {
   put(regs, f4t::kRunEvent, chamber_.run() ? f4t::kOn : f4t::kOff);
   put(regs, f4t::kUnits, panel_.fahrenheit ? f4t::kFahrenheit : f4t::kCelsius);
   for (int i = 0; i < f4t::kPartNumberRegisters; ++i)
-    put(regs, f4t::part_number_point(i).c_str(), kF4tPartNumber[i]);
+    put(regs, f4t::part_number_point(i).c_str(),
+        (panel_.cascade ? kF4tCascadePartNumber : kF4tPartNumber)[i]);
 }
 
 void F4tFace::on_write(const modbus_mapping_t& regs, std::uint16_t pdu_address, int count) {
@@ -127,6 +162,8 @@ void F4tFace::on_write(const modbus_mapping_t& regs, std::uint16_t pdu_address, 
   }
   if (written(f4t::kSetpoint)) chamber_.set_setpoint_c(c_of_unit(value(f4t::kSetpoint)));
   if (written(f4t::kRunEvent)) chamber_.set_run(value(f4t::kRunEvent) == f4t::kOn);
+  if (const auto* h = map_.find(f4t::kHumidityEvent); h && point_written(*h, pdu_address, count))
+    humidity_on_ = get_point(regs, *h) == f4t::kOn;
 }
 
 // --------------------------------------------------------------------------------- F4P

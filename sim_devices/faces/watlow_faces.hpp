@@ -18,7 +18,21 @@ struct WatlowPanel {
   int decimals = 1;         ///< F4/F4P register 606
   bool fahrenheit = false;  ///< F4/F4P 901 = 0, F4T units 30
   int run_event = 1;        ///< the event output the chamber builder wired to "run"
+  /// A temperature/humidity chamber: input 2 (F4) / loop 2 (F4T) reads %RH ([TE101H] p. 61),
+  /// humidity control on event output 2 ([TE] p. 51), left on at the panel.
+  bool humidity = false;
+  /// An F4T with cascade control: its part number says so, and it serves no Data Map 2 ([TE]
+  /// p. 47): every Data Map 2 request is answered exception 02.
+  bool cascade = false;
+  /// The Modbus address set at the panel ([TE] F4T manual 746854 p. 14: "Modbus Address: [1]").
+  int modbus_address = 1;
+  /// F4T: the float word order set at the panel ([TE] 746854 p. 14: "Modbus Word Order: [Low
+  /// High], High Low"): cdab = low word first, the default; abcd = High Low.
+  drivers::modbus::WordOrder float_words = drivers::modbus::WordOrder::cdab;
 };
+
+/// The relative humidity a simulated humidity chamber reads, %RH.
+inline constexpr double kSimHumidityRh = 45.0;
 
 /// Base: a face serves `map` from `chamber`.
 class WatlowFace : public ModbusDeviceModel {
@@ -27,11 +41,16 @@ class WatlowFace : public ModbusDeviceModel {
       : chamber_(chamber), map_(std::move(map)), panel_(panel) {}
   const drivers::modbus::RegisterMap& register_map() const override { return map_; }
   int register_count() const override { return sim::register_count(map_); }
+  /// Whether the humidity event output is on (a humidity chamber's humidity control).
+  bool humidity_on() const { return humidity_on_; }
 
  protected:
+  /// Publishes `point` if this face's map serves it (Data Map 2 serves a subset of the F4's).
   void put(modbus_mapping_t& regs, const char* point, double value) {
-    put_point(regs, map_.at(point), value);
+    if (const auto* p = map_.find(point)) put_point(regs, *p, value);
   }
+  /// The humidity event output's state (set at the panel: on), where the map serves one.
+  bool humidity_on_ = true;
   /// A temperature as the integer the controller shows (decimals, unit).
   double raw_temp(double c) const;
   double c_of_raw(double raw) const;

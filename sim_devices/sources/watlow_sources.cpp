@@ -50,8 +50,17 @@ double watlow_c_of_raw(std::int16_t raw, int decimals, bool fahrenheit) {
   return watlow_c(raw * std::pow(10.0, -decimals), fahrenheit);
 }
 
-std::vector<SourcePoint> f4::points(int run_event) {
-  return {
+namespace {
+// The humidity event output of a Watlow F4 map (2000 + 10 (n - 1)), unless it is the run event.
+void add_f4_humidity_event(std::vector<SourcePoint>& rows, int run_event, int humidity_event) {
+  if (humidity_event < 1 || humidity_event == run_event) return;
+  rows.push_back({f4::kHumidityEvent, u16(2000 + 10 * (humidity_event - 1)), U16, ABCD, RW,
+                  "TE p. 51: event 2 is humidity in humidity models; CCL get_event:533"});
+}
+}  // namespace
+
+std::vector<SourcePoint> f4::points(int run_event, int humidity_event) {
+  std::vector<SourcePoint> rows{
       {kAir, 100, I16, ABCD, RO, "CCL watlowf4.py get_loop_pv:349"},
       {kAirError, 101, U16, ABCD, RO, "F4P p. 9.6"},
       {kProduct, 104, I16, ABCD, RO, "CCL get_loop_pv:349 (loop 2)"},
@@ -65,18 +74,38 @@ std::vector<SourcePoint> f4::points(int run_event) {
       {kUnits, 901, U16, ABCD, RO, "CCL get_loop_units:396"},
       {kRunEvent, u16(2000 + 10 * (run_event - 1)), U16, ABCD, RW,
        "CCL get_event:533 (2000 + 10 (n - 1))"},
+      {kInput1Units, 608, U16, ABCD, RO, "CCL get_loop_units:394 (0 temp, 1 %RH, 2 PSI, 3 none)"},
+      {kInput2Units, 618, U16, ABCD, RO, "CCL get_loop_units:394"},
   };
+  add_f4_humidity_event(rows, run_event, humidity_event);
+  return rows;
+}
+
+std::vector<SourcePoint> f4t_map2::points(int run_event, int humidity_event) {
+  namespace f4 = sources::f4;
+  std::vector<SourcePoint> rows{
+      {f4::kAir, 100, I16, ABCD, RO, "TE p. 47, TE101H p. 61: actual chamber temperature"},
+      {f4::kAirError, 101, U16, ABCD, RO, "TE101H p. 61: temperature input error, 0 none, 1"},
+      {f4::kProduct, 104, I16, ABCD, RO, "TE p. 47, TE101H p. 61: actual chamber HUMIDITY"},
+      {f4::kProductError, 105, U16, ABCD, RO, "TE101H p. 61: humidity input error"},
+      {f4::kSetpoint, 300, I16, ABCD, RW, "TE p. 47, TE101H p. 61"},
+      {f4::kDecimals, 606, U16, ABCD, RO, "TE101H p. 61: temperature input precision"},
+      {f4::kDecimals2, 616, U16, ABCD, RO, "TE101H p. 61: humidity input precision"},
+      {f4::kUnits, 901, U16, ABCD, RO, "TE101H p. 61: C (1), F (0)"},
+      {f4::kRunEvent, u16(2000 + 10 * (run_event - 1)), U16, ABCD, RW,
+       "TE p. 47: events 1-7 at 2000 + 10 (n - 1), off 0, on 1"},
+  };
+  add_f4_humidity_event(rows, run_event, humidity_event);
+  return rows;
 }
 
 std::string f4t::part_number_point(int i) {
   return "part_number_" + std::to_string(i);
 }
 
-std::vector<SourcePoint> f4t::points(int run_event, bool rtu, int loop) {
+std::vector<SourcePoint> f4t::points(int run_event, bool rtu, int loop, int humidity_event) {
   // Loop n's registers are loop 1's + 160 (n - 1) (CCL get_loop_pv:243, get_loop_sp:234 ...).
   const int o = 160 * (loop - 1);
-  // Profile events 1..8 (CCL get_event:499-506).
-  constexpr int kEvents[] = {16594, 16596, 16598, 16600, 16822, 16824, 16826, 16828};
   std::vector<SourcePoint> rows{
       // NaN on an input error: no source gives the value (A); Watlow F4T Setup & Operations
       // p. 83: a signal in error "cannot be relied on" (Open, Shorted, ... not None).
@@ -87,14 +116,19 @@ std::vector<SourcePoint> f4t::points(int run_event, bool rtu, int loop) {
       {kSetpointLow, u16(2774 + o), F32, CDAB, RO, "CCL get_loop_range:256"},
       {kSetpointHigh, u16(2776 + o), F32, CDAB, RO, "CCL get_loop_range:256"},
       {kLoopMode, u16(2814 + o), U16, ABCD, RO, "CCL get_loop_en:264"},
-      {kRampAction, u16(2794 + o), U16, ABCD, RW, "TE (issue 20)"},
-      {kRampScale, u16(2796 + o), U16, ABCD, RW, "TE (issue 20)"},
-      {kRampRate, u16(2798 + o), F32, CDAB, RW, "TE (issue 20)"},
+      {kRampAction, u16(2794 + o), U16, ABCD, RW, "TE p. 46, 52"},
+      {kRampScale, u16(2796 + o), U16, ABCD, RW, "TE p. 46, 52"},
+      {kRampRate, u16(2798 + o), F32, CDAB, RW, "TE p. 46, 52"},
       {kProfileState, 16568, U16, ABCD, RO, "CCL get_status:528"},
       {kAlarm1, 1356, U16, ABCD, RO, "CCL get_alarm_status:552"},
       {kRunEvent, u16(kEvents[run_event - 1]), U16, ABCD, RW, "CCL get_event:499"},
       {kUnits, u16(rtu ? 14080 : 6730), U16, ABCD, RO, "CCL __profile_units:1003-1006"},
+      {kLoop1Kind, u16(16536 + 2 * (loop - 1)), U16, ABCD, RO, "CCL __profile_units:997"},
+      {kLoop2Kind, u16(16536 + 2 * loop), U16, ABCD, RO, "CCL __profile_units:997 (next loop)"},
   };
+  if (humidity_event >= 1 && humidity_event != run_event)
+    rows.push_back({kHumidityEvent, u16(kEvents[humidity_event - 1]), U16, ABCD, RW,
+                    "TE p. 51: event 2 (16596) is humidity in humidity models"});
   for (int i = 0; i < kPartNumberRegisters; ++i)
     rows.push_back({part_number_point(i), u16(16 + i), U16, ABCD, RO,
                     "CCL process_controller:861 (one character per register)"});

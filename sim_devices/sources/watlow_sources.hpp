@@ -6,7 +6,9 @@
 //
 // [CCL] ESPEC North America ChamberConnectLibrary (MIT) @1d2deb8, chamberconnectlibrary/
 // watlowf4.py, watlowf4t.py, modbus.py. [F4P] Watlow Series F4P User's Manual 0600-0032-0013
-// Rev E, pages as printed. [TE] TestEquity F4T controller manual, as issue 20 quotes it.
+// Rev E, pages as printed. [TE] TestEquity F4T Controller manual (easymanua.ls/testequity/f4t,
+// pages as printed: p. 46 Data Map 1, p. 47 Data Map 2, p. 51-52 programming syntax). [TE101H]
+// TestEquity 101H Temperature/Humidity Chamber manual, chapter 6 (manualshive.com, p. 60-61).
 // Addresses are 0-based PDU addresses (CCL modbus.py _make_packet:325-333; F4P p. 9.2).
 #pragma once
 
@@ -47,28 +49,53 @@ double watlow_c_delta(double unit_delta, bool fahrenheit);
 
 /// Series F4 ([CCL] watlowf4.py; [F4P] where CCL is silent).
 namespace f4 {
-std::vector<SourcePoint> points(int run_event);
+/// `humidity_event` (1..8; 0 none): the event output served as kHumidityEvent when it is not
+/// the run event.
+std::vector<SourcePoint> points(int run_event, int humidity_event = 2);
 inline constexpr const char *kAir = "input1_pv", *kAirError = "input1_err", *kProduct = "input2_pv",
                             *kProductError = "input2_err", *kStatus = "status",
                             *kSetpoint = "setpoint1", *kSetpointLow = "sp_low1",
                             *kSetpointHigh = "sp_high1", *kDecimals = "decimals1",
-                            *kDecimals2 = "decimals2", *kUnits = "units", *kRunEvent = "event";
+                            *kDecimals2 = "decimals2", *kUnits = "units", *kRunEvent = "event",
+                            *kInput1Units = "input1_units", *kInput2Units = "input2_units",
+                            *kHumidityEvent = "humidity_event";
 inline constexpr int kEventOff = 0, kEventOn = 1;                    // CCL set_event:539-543
+/// What an input measures, registers 608/618 (CCL get_loop_units:392-397).
+inline constexpr int kInputTemperature = 0, kInputHumidity = 1, kInputPressure = 2;
+/// The event output a TestEquity humidity chamber wires to humidity ([TE] p. 51: "Event 2 is
+/// Humidity in Humidity models"); the simulator serves it when the run event is another.
+inline constexpr int kHumidityEventNumber = 2;
 inline constexpr int kStatusConstant = 1, kStatusProfilePaused = 3;  // CCL get_status:545-554
 inline constexpr int kUnitsFahrenheit = 0, kUnitsCelsius = 1;        // F4P p. 6.11
 inline constexpr int kInputOverRange = 3;  // F4P p. 2.5: "SEnhi", input error 3
 }  // namespace f4
 
+/// An F4T in Data Map 2, F4 compatibility ([TE] p. 47, [TE101H] p. 61): a limited set of the F4
+/// registers — no status (200), no setpoint limits (602/603), no input units (608/618); input 2
+/// (104) is the chamber humidity. Not implemented on F4Ts with cascade control ([TE] p. 47, 52):
+/// the simulated cascade unit answers exception 02 to every Data Map 2 register.
+namespace f4t_map2 {
+std::vector<SourcePoint> points(int run_event, int humidity_event = 2);
+}  // namespace f4t_map2
+
 /// F4T Data Map 1 ([CCL] watlowf4t.py, modbus.py; [TE] for the ramp registers).
 namespace f4t {
 /// `loop` is the air loop (1..4), `rtu` picks the units register of a serial link.
-std::vector<SourcePoint> points(int run_event, bool rtu, int loop = 1);
+std::vector<SourcePoint> points(int run_event, bool rtu, int loop = 1, int humidity_event = 2);
 inline constexpr const char *kAir = "loop1_pv", *kProduct = "loop2_pv", *kSetpoint = "loop1_sp",
                             *kWorkingSetpoint = "loop1_wsp", *kSetpointLow = "loop1_sp_min",
                             *kSetpointHigh = "loop1_sp_max", *kLoopMode = "loop1_mode",
                             *kRampAction = "loop1_ramp_action", *kRampScale = "loop1_ramp_scale",
                             *kRampRate = "loop1_ramp_rate", *kProfileState = "profile_state",
-                            *kAlarm1 = "alarm1_state", *kRunEvent = "event", *kUnits = "units";
+                            *kAlarm1 = "alarm1_state", *kRunEvent = "event", *kUnits = "units",
+                            *kLoop1Kind = "loop1_pv_kind", *kLoop2Kind = "loop2_pv_kind",
+                            *kHumidityEvent = "humidity_event";
+/// What a loop's process value is (CCL __profile_units:991-1007, register 16536 + 2 (n - 1),
+/// codes from the __init__ dictionary:103-112); readable with the profile option only.
+inline constexpr int kAbsoluteTemperature = 1540, kRelativeTemperature = 1541, kNotSourced = 246,
+                     kHumidity = 1538;
+/// Part number characters (CCL process_controller:861-921): character 7 (index 6) 'D'..'F' =
+/// profiles; character 12 (index 11) the loops: '1'..'4' loops, '5' none, '6'..'C' cascade.
 /// Part number, one character per register from 16 (CCL process_controller:861-921).
 inline constexpr int kPartNumberRegisters = 15;
 std::string part_number_point(int i);
@@ -84,6 +111,8 @@ inline constexpr int kAlarmNone = 61;                  // CCL get_alarm_status:5
 /// Alarm state "error": its source signal has an input error (CCL dictionary:81, 28 'error';
 /// Watlow F4T Setup & Operations p. 83: a signal in error "cannot be relied on").
 inline constexpr int kAlarmError = 28;
+/// Event outputs 1..8 (CCL get_event:499-506).
+inline constexpr int kEvents[] = {16594, 16596, 16598, 16600, 16822, 16824, 16826, 16828};
 }  // namespace f4t
 
 /// Series F4P ([F4P] chapter 9 and the parameter tables of chapter 6).

@@ -57,11 +57,34 @@ mb::PointOverride read_override(const TomlView& v) {
   return o;
 }
 
+// The link keys of a device: unit id, float word order, a gateway in front, the timing given
+// (what is not given is the dialect's: link_defaults).
+void read_link(const TomlView& v, DeviceConfig& d) {
+  d.unit_id = static_cast<int>(v.opt_integer_in("unit_id", 0, 247).value_or(1));
+  if (auto t = v.opt_number("timeout_s")) {
+    if (!(*t > 0 && *t <= 10)) throw v.error("timeout_s", "must be in (0, 10] s");
+    d.timeout_s = *t;
+  }
+  d.request_gap_s = v.opt_number_in("request_gap_s", 0.0, 1.0, "s").value_or(0.0);
+  d.gateway = v.opt_bool("gateway").value_or(false);
+  if (auto w = v.opt_string("word_order"))
+    d.word_order = at_key(v, "word_order", [&] { return mb::parse_float_word_order(*w); });
+}
+
+// The dialect's timing where the file gives none (drivers/registry/dialects.cpp, "Timing").
+template <typename Dialect>
+void link_defaults(const TomlView& v, const Dialect& dialect, DeviceConfig& d) {
+  if (!v.table().contains("timeout_s")) d.timeout_s = dialect.timing.timeout_s;
+  if (!v.table().contains("request_gap_s"))
+    d.request_gap_s = drivers::default_request_gap_s(dialect, d);
+}
+
 // [chamber] / [turntable]: the model picks the dialect (drivers/registry), which says what
 // endpoint and keys it takes; everything is checked here, before anything moves.
 DeviceConfig read_device(const TomlView& v, bool is_chamber) {
   v.allow_only({"endpoint", "model", "preset", "unit_id", "timeout_s", "readback_every", "point",
-                "run_event", "framing"});
+                "run_event", "product_input", "humidity_event", "setpoint_low_c", "setpoint_high_c",
+                "request_gap_s", "word_order", "gateway", "framing"});
   DeviceConfig d;
   d.name = is_chamber ? "chamber" : "turntable";
   if (v.opt_string("model") && v.opt_string("preset"))
@@ -69,12 +92,14 @@ DeviceConfig read_device(const TomlView& v, bool is_chamber) {
   const char* model_key = v.opt_string("preset") ? "preset" : "model";
   d.model = v.opt_string(model_key).value_or("generic_plc");
   d.endpoint = v.get_string("endpoint");
-  d.unit_id = static_cast<int>(v.opt_integer_in("unit_id", 0, 247).value_or(1));
-  d.timeout_s = v.opt_number("timeout_s").value_or(0.5);
-  if (!(d.timeout_s > 0 && d.timeout_s <= 10)) throw v.error("timeout_s", "must be in (0, 10] s");
+  read_link(v, d);
   d.readback_every =
       static_cast<int>(v.opt_integer_in("readback_every", 1, 600).value_or(d.readback_every));
   d.run_event = static_cast<int>(v.opt_integer_in("run_event", 1, 8).value_or(1));
+  d.product_input = static_cast<int>(v.opt_integer_in("product_input", 0, 4).value_or(0));
+  d.humidity_event = static_cast<int>(v.opt_integer_in("humidity_event", 0, 8).value_or(2));
+  d.setpoint_low_c = v.opt_number("setpoint_low_c");
+  d.setpoint_high_c = v.opt_number("setpoint_high_c");
   d.framing = v.opt_string("framing").value_or("");
   for (const auto& p : v.table_array("point")) d.overrides.push_back(read_override(p));
   const auto check = [&](const auto* dialect) {
@@ -86,12 +111,17 @@ DeviceConfig read_device(const TomlView& v, bool is_chamber) {
         (void)drivers::ascii::parse_line_endpoint(d.endpoint);
       return 0;
     });
-    // The dialect checks run_event, framing and the point overrides; the message names the key
-    // given.
-    at_key(v, d.run_event != 1 ? "run_event" : !d.framing.empty() ? "framing" : "point", [&] {
+    // The dialect checks its keys and the point overrides; the message names the key given.
+    try {
       drivers::validate(*dialect, d);
-      return 0;
-    });
+    } catch (const std::invalid_argument& e) {
+      const std::string_view what = e.what();
+      for (const char* key : {"product_input", "humidity_event", "setpoint_low_c", "run_event",
+                              "unit_id", "gateway", "word_order", "request_gap_s", "framing"})
+        if (what.rfind(key, 0) == 0 && v.table().contains(key)) throw v.error(key, what);
+      throw v.error(d.run_event != 1 ? "run_event" : "point", what);
+    }
+    link_defaults(v, *dialect, d);
   };
   if (is_chamber)
     check(at_key(v, model_key, [&] { return &drivers::chamber_dialect(d.model); }));

@@ -62,6 +62,19 @@ json finite_or_null(double v) {
   return std::isfinite(v) ? json(v) : json(nullptr);
 }
 
+// The link as configured: the unit id asked, the reply timeout, the pause between requests
+// (docs/DEVICES.md, "what to check on the real unit first").
+std::string link_text(const dr::DeviceSpec& d) {
+  return fmt::format("link: unit {}{}, timeout {:.2f} s, request gap {:.3f} s", d.unit_id,
+                     d.gateway ? " behind a gateway" : "", d.timeout_s, d.request_gap_s);
+}
+json link_json(const dr::DeviceSpec& d) {
+  return {{"unit_id", d.unit_id},
+          {"gateway", d.gateway},
+          {"timeout_s", d.timeout_s},
+          {"request_gap_s", d.request_gap_s}};
+}
+
 // What the controller says it is (dialect, identity, units, decimals, limits) before its values:
 // a unit the dialect cannot read correctly fails here with the dialect's one line.
 DeviceReport chamber_report(const dr::Result<dr::ChamberIdentity>& id, const RigReading& in,
@@ -74,11 +87,11 @@ DeviceReport chamber_report(const dr::Result<dr::ChamberIdentity>& id, const Rig
   DeviceReport d{"chamber", where, {}, {}, json::object()};
   d.summary = fmt::format(
       "air {:.1f} C, product {:.1f} C, setpoint {:.1f} C, ramp {:.2f} C/min, mode {}, "
-      "alarms {}, run {}; model {}: {}, units {}{}, setpoint limits {:.1f}..{:.1f} C; {}",
+      "alarms {}, run {}; model {}: {}, units {}{}, setpoint limits {:.1f}..{:.1f} C; {}; {}",
       s.air_c, s.product_c, s.setpoint_c, s.ramp_c_per_min, dr::to_string(s.mode),
       alarm_text(s.alarms), s.run_enabled ? "on" : "off", c.chamber.model, i.identity, i.units,
       i.decimals >= 0 ? fmt::format(", {} decimals", i.decimals) : "", i.setpoint_low_c,
-      i.setpoint_high_c, i.notes);
+      i.setpoint_high_c, i.notes, link_text(c.chamber));
   // NaN (sensor break, no product sensor) is not JSON: it becomes null.
   d.fields = {{"model", c.chamber.model},
               {"identity", i.identity},
@@ -86,6 +99,7 @@ DeviceReport chamber_report(const dr::Result<dr::ChamberIdentity>& id, const Rig
               {"decimals", i.decimals >= 0 ? json(i.decimals) : json(nullptr)},
               {"setpoint_limits_c", {i.setpoint_low_c, i.setpoint_high_c}},
               {"notes", i.notes},
+              {"link", link_json(c.chamber)},
               {"air_c", finite_or_null(s.air_c)},
               {"product_c", finite_or_null(s.product_c)},
               {"setpoint_c", s.setpoint_c},

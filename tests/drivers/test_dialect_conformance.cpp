@@ -62,13 +62,37 @@ TEST(Conformance, WatlowF4MatchesChamberConnectLibrary) {
     SCOPED_TRACE("run event " + std::to_string(event));
     check(d::map(1, event), src::f4::points(event));
   }
-  EXPECT_EQ(src::f4::points(3).back().address, 2020);  // CCL get_event:533, n = 3
+  for (const auto& r : src::f4::points(3))
+    if (r.name == src::f4::kRunEvent) EXPECT_EQ(r.address, 2020);  // CCL get_event:533, n = 3
+  for (int hum = 0; hum <= 8; ++hum) {
+    SCOPED_TRACE("humidity event " + std::to_string(hum));
+    check(d::map(1, 1, "watlow_f4", hum), src::f4::points(1, hum));
+  }
+  EXPECT_EQ(d::kTemperature, src::f4::kInputTemperature);  // CCL get_loop_units:394
+  EXPECT_EQ(d::kHumidity, src::f4::kInputHumidity);
+  EXPECT_EQ(d::kPressure, src::f4::kInputPressure);
+  EXPECT_EQ(d::kDefaultHumidityEvent, src::f4::kHumidityEventNumber);  // TestEquity p. 51
   EXPECT_EQ(d::kEventOn, src::f4::kEventOn);
   EXPECT_EQ(d::kEventOff, src::f4::kEventOff);
   EXPECT_EQ(d::kProfilePaused, src::f4::kStatusProfilePaused);
   EXPECT_EQ(d::kConstant1, src::f4::kStatusConstant);
   EXPECT_EQ(d::kProfileRunning, 2);  // CCL get_status:545-554
   EXPECT_EQ(d::kUnitsFahrenheit, src::f4::kUnitsFahrenheit);
+}
+
+// An F4T in Data Map 2: the limited set TestEquity lists (F4T manual p. 47, 101H manual p. 61),
+// nothing more: no status, no setpoint limits, no input units.
+TEST(Conformance, WatlowF4tMap2IsTheDocumentedSet) {
+  namespace d = station::drivers::watlow_f4;
+  for (int event = 1; event <= 8; ++event)
+    for (int hum : {0, 2, 3}) {
+      SCOPED_TRACE(fmt::format("run event {} humidity event {}", event, hum));
+      check(d::map2(1, event, hum), src::f4t_map2::points(event, hum));
+    }
+  const auto m = d::map2();
+  for (const char* absent : {d::kStatus, d::kSetpointLow, d::kSetpointHigh, d::kInput1Units,
+                             d::kInput2Units})
+    EXPECT_EQ(m.find(absent), nullptr) << absent << " is not in Data Map 2";
 }
 
 // CCL watlowf4t.py / modbus.py; ramp registers from the TestEquity F4T manual as issue 20 quotes.
@@ -95,6 +119,12 @@ TEST(Conformance, WatlowF4tMatchesDataMap1) {
   EXPECT_EQ(t::kAlarmInactive[1], src::f4t::kAlarmNone);
   EXPECT_EQ(t::kAlarmError, src::f4t::kAlarmError);  // CCL dictionary:81
   EXPECT_EQ(t::kPartNumberRegisters, src::f4t::kPartNumberRegisters);
+  EXPECT_EQ(t::kAbsoluteTemperature, src::f4t::kAbsoluteTemperature);  // CCL __init__:112
+  EXPECT_EQ(t::kRelativeTemperature, src::f4t::kRelativeTemperature);
+  EXPECT_EQ(t::kHumidity, src::f4t::kHumidity);
+  EXPECT_EQ(t::kDefaultHumidityEvent, src::f4::kHumidityEventNumber);  // TestEquity p. 51
+  for (int hum : {0, 1, 2, 5})
+    check(t::map(1, 1, false, 1, hum), src::f4t::points(1, false, 1, hum));
   // A float goes low word first (CCL modbus.py read_holding_float:157-173): 25.0 = 0x41C80000.
   const auto w = mb::float_to_words(25.0f, WordOrder::cdab);
   EXPECT_EQ(w[0], 0x0000);

@@ -7,7 +7,9 @@
 #include <cmath>
 #include <limits>
 
+#include "drivers/chamber/float_word_order.hpp"
 #include "drivers/chamber/watlow_f4t/f4t_map.hpp"
+#include "drivers/modbus/map_overrides.hpp"
 
 namespace station::drivers {
 namespace f4t = watlow_f4t;
@@ -31,12 +33,13 @@ ChamberMode mode_of(int loop_mode, int profile_state, bool ramping) {
 
 WatlowF4tChamber::WatlowF4tChamber(std::string name, modbus::Endpoint endpoint,
                                    modbus::RegisterMap map, double response_timeout_s,
-                                   std::unique_ptr<modbus::ModbusWire> wire)
+                                   std::unique_ptr<modbus::ModbusWire> wire, WatlowInputs inputs)
     : name_(std::move(name)),
       map_(std::move(map)),
       client_(name_, endpoint,
               wire ? std::move(wire) : std::make_unique<modbus::LibmodbusWire>(endpoint),
-              response_timeout_s) {
+              response_timeout_s),
+      inputs_(inputs) {
   for (const char* p :
        {f4t::kAir, f4t::kProduct, f4t::kSetpoint, f4t::kWorkingSetpoint, f4t::kSetpointLow,
         f4t::kSetpointHigh, f4t::kLoopMode, f4t::kRampAction, f4t::kRampScale, f4t::kRampRate,
@@ -53,21 +56,25 @@ Result<double> WatlowF4tChamber::value(const char* point) {
 Result<TemperatureScale> WatlowF4tChamber::scale() {
   if (scale_ && scale_connects_ == client_.connects()) return *scale_;
   auto u = value(f4t::kUnits);
-  if (!u) return u.error();
+  if (!u) return units_error(u.error());
   const int units = static_cast<int>(u.value());
   if (units != f4t::kCelsius && units != f4t::kFahrenheit)
     return make_error(ErrorKind::protocol,
                       fmt::format("{}: units register {} = {} (F4T: 15 deg C, 30 deg F): refusing "
                                   "to read temperatures",
                                   name_, map_.at(f4t::kUnits).address, units));
+  if (auto c = check_controller(); !c) return c.error();
   scale_ = TemperatureScale{-1, units == f4t::kFahrenheit};
   scale_connects_ = client_.connects();
   return *scale_;
 }
 
+// A unit set to the other word order is refused, never read as 2.4e-41 (float_word_order.hpp).
 Result<double> WatlowF4tChamber::temperature_c(const char* point, const TemperatureScale& s) {
   auto v = value(point);
   if (!v) return v.error();
+  if (auto wrong = word_order_mismatch(map_.at(point), v.value()))
+    return make_error(ErrorKind::protocol, name_ + ": " + *wrong);
   return s.to_c(v.value());
 }
 
@@ -85,17 +92,12 @@ Result<void> WatlowF4tChamber::read_commands(const TemperatureScale& s) {
   ramp_c_per_min_ = ramp_on ? s.delta_to_c(rate.value()) * per : 0.0;
   run_enabled_ = static_cast<int>(run.value()) == f4t::kOn;
   mode_ = mode_of(static_cast<int>(mode.value()), static_cast<int>(profile.value()), false);
-  if (has_product_) {
+  if (inputs_.product_input != 0) {
     auto product = temperature_c(f4t::kProduct, s);
-    if (product) {
-      product_c_ = product.value();
-    } else if (product.error().kind == ErrorKind::exception) {
-      has_product_ = false;  // a one-loop controller: no loop 2 (Modbus exception 02)
-      product_c_ = std::numeric_limits<double>::quiet_NaN();
-    } else {
-      return product.error();
-    }
+    if (!product) return product.error();
+    product_c_ = product.value();
   }
+  if (run_enabled_ && humidity_chamber_) return humidity_off();
   return {};
 }
 
@@ -117,7 +119,7 @@ Result<ChamberState> WatlowF4tChamber::read() {
   s.alarms.deviation = alarm_state != f4t::kAlarmError && alarm_active(alarm_state);
   s.air_c = s.alarms.sensor_break ? std::numeric_limits<double>::quiet_NaN() : air.value();
   s.setpoint_c = sp.value();
-  s.product_c = product_c_;
+  s.product_c = inputs_.product_input != 0 ? product_c_ : std::numeric_limits<double>::quiet_NaN();
   s.ramp_c_per_min = ramp_c_per_min_;
   s.run_enabled = run_enabled_;
   // The working setpoint still moving towards the target: the controller ramps.
@@ -164,6 +166,9 @@ Result<void> WatlowF4tChamber::command(const ChamberCommand& c) {
     if (auto ok = client_.write(map_.at(f4t::kSetpoint), sp); !ok) return ok;
   }
   if (c.run) {
+    if (*c.run && humidity_chamber_) {
+      if (auto off = humidity_off(); !off) return off;
+    }
     const int v = *c.run ? f4t::kOn : f4t::kOff;
     if (auto ok = client_.write(map_.at(f4t::kRunEvent), v); !ok) return ok;
   }
@@ -173,12 +178,7 @@ Result<void> WatlowF4tChamber::command(const ChamberCommand& c) {
 Result<ChamberIdentity> WatlowF4tChamber::identify() {
   auto sc = scale();
   if (!sc) return sc.error();
-  auto words = client_.read_registers(modbus::FunctionCode::holding, map_.at(f4t::kUnits).unit_id,
-                                      f4t::kPartNumberAddress, f4t::kPartNumberRegisters);
-  if (!words) return words.error();
-  std::string part;
-  for (auto w : words.value())
-    if (w >= 0x20 && w < 0x7f) part += static_cast<char>(w);  // one character per register
+  const std::string& part = part_.text;  // read with the scale
   auto lo = temperature_c(f4t::kSetpointLow, sc.value());
   auto hi = lo ? temperature_c(f4t::kSetpointHigh, sc.value()) : lo;
   if (!hi) return hi.error();
@@ -188,10 +188,108 @@ Result<ChamberIdentity> WatlowF4tChamber::identify() {
   id.units = sc.value().fahrenheit ? "F" : "C";
   id.setpoint_low_c = lo.value();
   id.setpoint_high_c = hi.value();
-  id.notes = fmt::format("{}run = event output at register {}; ramps by the controller",
+  id.notes = fmt::format("{}run = event output at register {}; ramps by the controller; {}; {}",
                          sc.value().fahrenheit ? "deg F converted to deg C; " : "",
-                         map_.at(f4t::kRunEvent).address);
+                         map_.at(f4t::kRunEvent).address, input_notes(), link_notes());
   return id;
 }
 
+// The word order and the units register in use (docs/DEVICES.md, "what to check first").
+std::string WatlowF4tChamber::link_notes() const {
+  const modbus::Point& air = map_.at(f4t::kAir);
+  const modbus::Point& units = map_.at(f4t::kUnits);
+  return fmt::format("floats {} (word_order = \"{}\"); units register {} ({})",
+                     air.order == modbus::WordOrder::cdab ? "low word first" : "high word first",
+                     modbus::float_word_order_name(air.order), units.address,
+                     units.address == f4t::kUnitsRtu ? "the serial port's" : "the TCP port's");
+}
+
+// A units register the unit does not serve: an F4T behind a TCP-to-RTU gateway serves its serial
+// port's (14080, CCL __profile_units:1002), which `gateway = true` selects (docs/DEVICES.md).
+Error WatlowF4tChamber::units_error(Error e) const {
+  if (e.kind == ErrorKind::exception && client_.unit_answered() &&
+      map_.at(f4t::kUnits).address == f4t::kUnitsTcp)
+    e.message += fmt::format(
+        "; an F4T behind a TCP-to-RTU gateway serves its serial port's units at register {}: set "
+        "[chamber] gateway = true",
+        f4t::kUnitsRtu);
+  return e;
+}
+
+// The controller behind the map (CCL process_controller:861-921): a cascade unit serves its
+// loops at other registers (TestEquity F4T manual, cascade edition p. 15) and is refused, as is a
+// product loop the unit has not; with the profile option the air and product loops' kinds are
+// read (CCL __profile_units:991-1007), so a %RH loop is never read as a temperature.
+Result<void> WatlowF4tChamber::check_controller() {
+  auto words = client_.read_registers(modbus::FunctionCode::holding, map_.at(f4t::kUnits).unit_id,
+                                      f4t::kPartNumberAddress, f4t::kPartNumberRegisters);
+  if (!words) return words.error();
+  part_ = f4t::parse_part_number(words.value());
+  humidity_chamber_ = false;
+  const auto refuse = [&](const std::string& why) {
+    return make_error(ErrorKind::protocol,
+                      fmt::format("{}: part number '{}': {}", name_, part_.text, why));
+  };
+  if (part_.cascades > 0)
+    return refuse(fmt::format("{} cascade loop(s) (character 12, CCL process_controller:884-916): "
+                              "a cascade F4T serves its loops at other registers; not supported",
+                              part_.cascades));
+  if (inputs_.product_input > part_.loops)
+    return refuse(fmt::format("product_input = {} but the controller has {} loop(s)",
+                              inputs_.product_input, part_.loops));
+  if (!part_.profiles) return {};  // no profile option: the kinds are not served
+  const auto kind = [&](const char* p) -> Result<int> {
+    auto v = value(p);
+    if (!v) return v.error();
+    return static_cast<int>(v.value());
+  };
+  const auto is_temperature = [](int k) {
+    return k == f4t::kAbsoluteTemperature || k == f4t::kRelativeTemperature;
+  };
+  auto air = kind(f4t::kAirKind);
+  if (!air) return air.error();
+  if (!is_temperature(air.value()))
+    return refuse(fmt::format("the air loop reads kind {} (register {}): not a temperature",
+                              air.value(), map_.at(f4t::kAirKind).address));
+  if (part_.loops < 2 && inputs_.product_input == 0) return {};
+  auto product = kind(f4t::kProductKind);
+  if (!product) return product.error();
+  humidity_chamber_ = product.value() == f4t::kHumidity;
+  if (inputs_.product_input != 0 && !is_temperature(product.value()))
+    return refuse(fmt::format("loop {} reads {} (register {} = {}): product_input names no "
+                              "temperature; set product_input = 0",
+                              inputs_.product_input,
+                              product.value() == f4t::kHumidity ? "%RH" : "no temperature",
+                              map_.at(f4t::kProductKind).address, product.value()));
+  return {};
+}
+
+// Humidity control off: the humidity event output (TestEquity wiring, f4t_map.hpp), if mapped.
+Result<void> WatlowF4tChamber::humidity_off() {
+  const auto* ev = map_.find(f4t::kHumidityEvent);
+  if (ev == nullptr) return {};
+  auto now = client_.read(*ev);
+  if (!now) return now.error();
+  if (static_cast<int>(now.value()) == f4t::kOff) return {};
+  return client_.write(*ev, f4t::kOff);
+}
+
+std::string WatlowF4tChamber::input_notes() const {
+  const auto* hum = map_.find(f4t::kHumidityEvent);
+  std::string n = inputs_.product_input == 0
+                      ? "product: none configured (product_input = 0)"
+                      : fmt::format("product: loop {} (register {})", inputs_.product_input,
+                                    map_.at(f4t::kProduct).address);
+  if (!part_.profiles)
+    n += "; loop kinds not served (no profile option): a product loop is assumed a temperature";
+  if (humidity_chamber_)
+    n += hum != nullptr ? fmt::format("; humidity chamber (loop 2 reads %RH): humidity control "
+                                      "(event output at register {}) kept off during a run",
+                                      hum->address)
+                        : std::string("; humidity chamber (loop 2 reads %RH): no humidity event "
+                                      "configured, humidity control NOT switched off");
+  return n;
+}
+
 }  // namespace station::drivers
+
