@@ -62,8 +62,11 @@ TEST(Conformance, WatlowF4MatchesChamberConnectLibrary) {
     SCOPED_TRACE("run event " + std::to_string(event));
     check(d::map(1, event), src::f4::points(event));
   }
-  for (const auto& r : src::f4::points(3))
-    if (r.name == src::f4::kRunEvent) EXPECT_EQ(r.address, 2020);  // CCL get_event:533, n = 3
+  for (const auto& r : src::f4::points(3)) {
+    if (r.name == src::f4::kRunEvent) {
+      EXPECT_EQ(r.address, 2020);  // CCL get_event:533, n = 3
+    }
+  }
   for (int hum = 0; hum <= 8; ++hum) {
     SCOPED_TRACE("humidity event " + std::to_string(hum));
     check(d::map(1, 1, "watlow_f4", hum), src::f4::points(1, hum));
@@ -90,8 +93,8 @@ TEST(Conformance, WatlowF4tMap2IsTheDocumentedSet) {
       check(d::map2(1, event, hum), src::f4t_map2::points(event, hum));
     }
   const auto m = d::map2();
-  for (const char* absent : {d::kStatus, d::kSetpointLow, d::kSetpointHigh, d::kInput1Units,
-                             d::kInput2Units})
+  for (const char* absent :
+       {d::kStatus, d::kSetpointLow, d::kSetpointHigh, d::kInput1Units, d::kInput2Units})
     EXPECT_EQ(m.find(absent), nullptr) << absent << " is not in Data Map 2";
 }
 

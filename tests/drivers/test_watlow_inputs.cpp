@@ -9,11 +9,13 @@
 #include <cmath>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "drivers/chamber/generic_plc/generic_plc_map.hpp"
 #include "drivers/chamber/watlow_f4/f4_map.hpp"
 #include "drivers/chamber/watlow_f4/watlow_f4_chamber.hpp"
 #include "drivers/chamber/watlow_f4t/f4t_map.hpp"
+#include "drivers/chamber/watlow_f4t/f4t_part_number.hpp"
 #include "drivers/chamber/watlow_f4t/watlow_f4t_chamber.hpp"
 #include "drivers/modbus/endpoint.hpp"
 #include "sim_devices/chamber_sim.hpp"
@@ -165,6 +167,60 @@ TEST(WatlowInputs, F4tMap2OnACascadeUnitIsRefused) {
   EXPECT_TRUE(has(id.error().message, "Data Map 2")) << id.error().message;
   EXPECT_TRUE(has(id.error().message, "cascade")) << id.error().message;
   EXPECT_EQ(id.error().message.find('\n'), std::string::npos);
+}
+
+// A read writes nothing: probe and the idle watch leave a humidity test someone else runs from
+// the panel alone (the chamber running, humidity on); only the station's own start switches it.
+TEST(WatlowInputs, AReadNeverSwitchesHumidityOff) {
+  F4tRig rig({.humidity = true}, {});
+  rig.chamber.set_run(true);
+  ASSERT_TRUE(rig.driver->read());
+  ASSERT_TRUE(rig.driver->identify());
+  ASSERT_TRUE(rig.driver->read());
+  EXPECT_TRUE(rig.face.humidity_on());
+  F4Rig f4({.humidity = true}, {});
+  f4.chamber.set_run(true);
+  ASSERT_TRUE(f4.driver->read());
+  EXPECT_TRUE(f4.face.humidity_on());
+}
+
+// Data Map 2's input 2 is the chamber humidity by its documents: the humidity event is switched
+// off when the station starts the chamber, and probe says so whatever the limits.
+TEST(WatlowInputs, F4tMap2SwitchesHumidityOffAtTheStart) {
+  F4Rig rig({.humidity = true}, {.setpoint_low_c = -40.0, .setpoint_high_c = 80.0}, true);
+  auto id = rig.driver->identify();
+  ASSERT_TRUE(id) << id.error().message;
+  EXPECT_TRUE(has(id.value().notes, "humidity chamber")) << id.value().notes;
+  ASSERT_TRUE(rig.face.humidity_on());
+  ASSERT_TRUE(rig.driver->command({.run = true}));
+  EXPECT_FALSE(rig.face.humidity_on());
+}
+
+// A busy unit (exception 06) on Data Map 2 keeps its own message: only "illegal data address"
+// says the map is not served.
+TEST(WatlowInputs, F4tMap2BusyIsNotCalledACascadeUnit) {
+  F4Rig rig({}, {}, true);
+  rig.server.inject_exception(6, 1);
+  auto s = rig.driver->read();
+  ASSERT_FALSE(s);
+  EXPECT_FALSE(has(s.error().message, "cascade")) << s.error().message;
+  EXPECT_TRUE(rig.driver->read());
+}
+
+// The part number (CCL process_controller:861-921): character 7 says whether the loop kinds are
+// served (without them a product loop is refused: it could be %RH), character 12 the loops.
+TEST(WatlowInputs, F4tPartNumberSaysProfilesAndLoops) {
+  const auto parse = [](const std::string& pn) {
+    return station::drivers::watlow_f4t::parse_part_number(
+        std::vector<std::uint16_t>(pn.begin(), pn.end()));
+  };
+  EXPECT_FALSE(parse("F4T1L2AAA0A2AAA").profiles);
+  EXPECT_TRUE(parse("F4T1L2DAA0A2AAA").profiles);
+  EXPECT_EQ(parse("F4T1L2DAA0A3AAA").loops, 3);
+  const auto cascade = parse("F4T1L2DAA0A8AAA");
+  EXPECT_EQ(cascade.loops, 2);
+  EXPECT_EQ(cascade.cascades, 1);
+  EXPECT_EQ(parse("F4T1L2DAA0ABAAA").cascades, 2);
 }
 
 }  // namespace

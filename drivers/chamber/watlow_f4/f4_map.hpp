@@ -40,7 +40,7 @@ inline constexpr const char* kRunEvent = "event";       // 2000 + 10(n-1), CCL g
 inline constexpr const char* kInput1Units = "input1_units";  // 608, CCL get_loop_units:392-397
 inline constexpr const char* kInput2Units = "input2_units";  // 618, same
 /// The event output wired to humidity on a humidity chamber ([TE] p. 51: "Event 2 is Humidity
-/// in Humidity models"), kept off during a run.
+/// in Humidity models"), switched off when the station starts the chamber.
 inline constexpr const char* kHumidityEvent = "humidity_event";
 inline constexpr int kDefaultHumidityEvent = 2;
 

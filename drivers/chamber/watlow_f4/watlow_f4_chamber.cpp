@@ -3,6 +3,7 @@
 #include "drivers/chamber/watlow_f4/watlow_f4_chamber.hpp"
 
 #include <fmt/format.h>
+#include <modbus.h>
 
 #include <cmath>
 #include <limits>
@@ -81,7 +82,13 @@ Result<void> WatlowF4Chamber::read_input_kinds() {
                                     "must be a temperature",
                                     name_, kind_name(k1.value()), k1.value()));
   }
-  if (map_.find(f4::kInput2Units) == nullptr) return {};
+  if (map_.find(f4::kInput2Units) == nullptr) {
+    // Data Map 2: input 2 (104) is the chamber humidity by its documents (TestEquity F4T manual
+    // p. 47, 101H p. 61); its humidity event (if configured) is kept off like any humidity
+    // chamber's.
+    humidity_chamber_ = true;
+    return {};
+  }
   auto k2 = kind(f4::kInput2Units);
   if (!k2) return k2.error();
   humidity_chamber_ = k2.value() == f4::kHumidity;
@@ -101,7 +108,10 @@ Result<TemperatureScale> WatlowF4Chamber::scale() {
   std::vector<double> v;
   for (const char* p : {f4::kDecimals, f4::kDecimals2, f4::kUnits}) {
     auto r = client_.read(map_.at(p));
-    if (!r && r.error().kind == ErrorKind::exception && map_.find(f4::kStatus) == nullptr)
+    // Only the unit's own "illegal data address" (02) says the map is not served; a busy or
+    // failing unit (04, 06) or a gateway's 0x0B keeps its own message.
+    if (!r && r.error().kind == ErrorKind::exception && map_.find(f4::kStatus) == nullptr &&
+        r.error().message.find(modbus_strerror(EMBXILADD)) != std::string::npos)
       return make_error(ErrorKind::exception,
                         fmt::format("{} — the unit serves no Data Map 2 here: an F4T with cascade "
                                     "control has none (TestEquity F4T manual p. 47) and is not "
@@ -130,8 +140,7 @@ Result<double> WatlowF4Chamber::temperature_c(const char* point, const Temperatu
   return s.c_from_raw(static_cast<std::int16_t>(raw.value()));
 }
 
-// Status (where the map serves it), run event, the configured product input; on a humidity
-// chamber running, a humidity event found on is switched off again.
+// Status (where the map serves it), run event, the configured product input.
 Result<void> WatlowF4Chamber::read_commands() {
   auto run = client_.read(map_.at(f4::kRunEvent));
   if (!run) return run.error();
@@ -151,10 +160,7 @@ Result<void> WatlowF4Chamber::read_commands() {
     if (!product) return product.error();
     product_c_ = perr.value() != 0 ? std::numeric_limits<double>::quiet_NaN() : product.value();
   }
-  if (run_enabled_ && humidity_chamber_) {
-    if (auto off = humidity_off(); !off) return off;
-  }
-  return {};
+  return {};  // a read never writes: humidity control is switched off by command() only
 }
 
 Result<ChamberState> WatlowF4Chamber::read() {
@@ -241,24 +247,27 @@ Result<ChamberIdentity> WatlowF4Chamber::identify() {
   id.setpoint_low_c = limits.value().first;
   id.setpoint_high_c = limits.value().second;
   const auto* hum = map_.find(f4::kHumidityEvent);
+  const std::string humidity =
+      !humidity_chamber_ ? std::string()
+      : hum != nullptr   ? fmt::format(
+                               "humidity chamber (input 2 is %RH): humidity control (event "
+                                 "output at register {}) switched off when the station "
+                                 "starts the chamber; ",
+                               hum->address)
+                       : std::string(
+                             "humidity chamber (input 2 is %RH): no humidity event "
+                             "configured, humidity control NOT switched off; ");
   id.notes = fmt::format(
       "{}run = event output at register {}; no constant-mode ramp: the station ramps the "
       "setpoint; product: {}; {}{}",
       sc.value().fahrenheit ? "deg F converted to deg C; " : "", map_.at(f4::kRunEvent).address,
       inputs_.product_input == 0 ? "none configured (product_input = 0)" : "input 2 (104)",
-      humidity_chamber_
-          ? (hum != nullptr ? fmt::format("humidity chamber (input 2 is %RH): humidity control "
-                                          "(event output at register {}) kept off during a run; ",
-                                          hum->address)
-                            : std::string("humidity chamber (input 2 is %RH): no humidity event "
-                                          "configured, humidity control NOT switched off; "))
-          : std::string(),
+      humidity,
       served ? "setpoint limits read from 602/603"
              : (inputs_.setpoint_low_c || inputs_.setpoint_high_c
                     ? "Data Map 2 serves no setpoint limits: the configured ones apply"
                     : "Data Map 2 serves no setpoint limits (set setpoint_low_c/high_c): the "
-                      "station's [limits] apply; input 2 (104) is the chamber humidity, not "
-                      "read"));
+                      "station's [limits] apply"));
   return id;
 }
 

@@ -3,7 +3,7 @@
 // event output. The F4 has no constant-mode ramp: controller_ramp() is false and the station
 // ramps by moving the setpoint. What each input measures (608/618) is read at connect: the air
 // input must be a temperature, the product input (configured, WatlowInputs) too; on a humidity
-// chamber the humidity event output is kept off during a run. Data Map 2 serves fewer registers
+// chamber the humidity event output is switched off when the station starts the chamber. Data Map 2 serves fewer registers
 // (no status, limits or input units): the driver uses what the map has. Constructor does no I/O.
 #pragma once
 

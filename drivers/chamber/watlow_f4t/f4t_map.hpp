@@ -43,7 +43,7 @@ inline constexpr const char* kUnits =
 inline constexpr const char* kAirKind = "loop1_pv_kind";
 inline constexpr const char* kProductKind = "loop2_pv_kind";
 /// The event output wired to humidity on a humidity chamber ([TE] TestEquity F4T manual p. 51:
-/// "Event 2 is Humidity in Humidity models"), kept off during a run.
+/// "Event 2 is Humidity in Humidity models"), switched off when the station starts the chamber.
 inline constexpr const char* kHumidityEvent = "humidity_event";
 inline constexpr int kDefaultHumidityEvent = 2;
 

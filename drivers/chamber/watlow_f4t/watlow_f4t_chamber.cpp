@@ -97,8 +97,7 @@ Result<void> WatlowF4tChamber::read_commands(const TemperatureScale& s) {
     if (!product) return product.error();
     product_c_ = product.value();
   }
-  if (run_enabled_ && humidity_chamber_) return humidity_off();
-  return {};
+  return {};  // a read never writes: humidity control is switched off by command() only
 }
 
 Result<ChamberState> WatlowF4tChamber::read() {
@@ -231,12 +230,19 @@ Result<void> WatlowF4tChamber::check_controller() {
                       fmt::format("{}: part number '{}': {}", name_, part_.text, why));
   };
   if (part_.cascades > 0)
-    return refuse(fmt::format("{} cascade loop(s) (character 12, CCL process_controller:884-916): "
-                              "a cascade F4T serves its loops at other registers; not supported",
-                              part_.cascades));
+    return refuse(
+        fmt::format("{} cascade loop(s) (character 12, CCL process_controller:884-916): "
+                    "a cascade F4T serves its loops at other registers; not supported",
+                    part_.cascades));
   if (inputs_.product_input > part_.loops)
     return refuse(fmt::format("product_input = {} but the controller has {} loop(s)",
                               inputs_.product_input, part_.loops));
+  if (!part_.profiles && inputs_.product_input != 0)
+    return refuse(
+        fmt::format("product_input = {}: without the profile option (character 7) the "
+                    "loops' kinds are not served, so a %RH loop cannot be told from a "
+                    "temperature; not read",
+                    inputs_.product_input));
   if (!part_.profiles) return {};  // no profile option: the kinds are not served
   const auto kind = [&](const char* p) -> Result<int> {
     auto v = value(p);
@@ -244,7 +250,9 @@ Result<void> WatlowF4tChamber::check_controller() {
     return static_cast<int>(v.value());
   };
   const auto is_temperature = [](int k) {
-    return k == f4t::kAbsoluteTemperature || k == f4t::kRelativeTemperature;
+    // CCL __profile_units:1000 reads these three as temperatures.
+    return k == f4t::kAbsoluteTemperature || k == f4t::kRelativeTemperature ||
+           k == f4t::kNotSourced;
   };
   auto air = kind(f4t::kAirKind);
   if (!air) return air.error();
@@ -256,11 +264,11 @@ Result<void> WatlowF4tChamber::check_controller() {
   if (!product) return product.error();
   humidity_chamber_ = product.value() == f4t::kHumidity;
   if (inputs_.product_input != 0 && !is_temperature(product.value()))
-    return refuse(fmt::format("loop {} reads {} (register {} = {}): product_input names no "
-                              "temperature; set product_input = 0",
-                              inputs_.product_input,
-                              product.value() == f4t::kHumidity ? "%RH" : "no temperature",
-                              map_.at(f4t::kProductKind).address, product.value()));
+    return refuse(fmt::format(
+        "loop {} reads {} (register {} = {}): product_input names no "
+        "temperature; set product_input = 0",
+        inputs_.product_input, product.value() == f4t::kHumidity ? "%RH" : "no temperature",
+        map_.at(f4t::kProductKind).address, product.value()));
   return {};
 }
 
@@ -281,15 +289,17 @@ std::string WatlowF4tChamber::input_notes() const {
                       : fmt::format("product: loop {} (register {})", inputs_.product_input,
                                     map_.at(f4t::kProduct).address);
   if (!part_.profiles)
-    n += "; loop kinds not served (no profile option): a product loop is assumed a temperature";
+    n += "; loop kinds not served (no profile option): no product loop, humidity not managed";
   if (humidity_chamber_)
-    n += hum != nullptr ? fmt::format("; humidity chamber (loop 2 reads %RH): humidity control "
-                                      "(event output at register {}) kept off during a run",
-                                      hum->address)
-                        : std::string("; humidity chamber (loop 2 reads %RH): no humidity event "
-                                      "configured, humidity control NOT switched off");
+    n += hum != nullptr ? fmt::format(
+                              "; humidity chamber (loop 2 reads %RH): humidity control "
+                              "(event output at register {}) switched off when the "
+                              "station starts the chamber",
+                              hum->address)
+                        : std::string(
+                              "; humidity chamber (loop 2 reads %RH): no humidity event "
+                              "configured, humidity control NOT switched off");
   return n;
 }
 
 }  // namespace station::drivers
-

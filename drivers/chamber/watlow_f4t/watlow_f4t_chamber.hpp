@@ -4,7 +4,7 @@
 // alarm. At connect the part number (16..30) is read: a cascade controller (other registers) is
 // refused; with the profile option the loops' process-value kinds (16536+) are read, so the air
 // and a configured product loop must be temperatures and a %RH loop makes this a humidity chamber,
-// whose humidity event output is kept off during a run. A temperature that reads as no
+// whose humidity event output is switched off when the station starts the chamber. A temperature that reads as no
 // temperature while the other word order would is refused (float_word_order.hpp); the units
 // register is the TCP port's (6730) or, on a serial link or behind a gateway, the serial port's
 // (14080). Constructor does no I/O.
