@@ -5,14 +5,11 @@
 #include <fmt/format.h>
 #include <sys/file.h>
 #include <sys/stat.h>
-#include <sys/sysmacros.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
-#include <sstream>
 #include <utility>
 
 #include "station/common/input_error.hpp"
@@ -74,95 +71,29 @@ ProcessLock ProcessLock::acquire(const std::string& lock_path, const std::string
   return ProcessLock(fd, lock_path);
 }
 
-std::string flock_holder(unsigned long long dev, unsigned long long ino) {
-  // proc(5), /proc/locks: "1: FLOCK  ADVISORY  WRITE 4242 fd:01:1234567 0 EOF"; a waiter's line
-  // has "->" after the number. The device is MAJOR:MINOR in hex, the inode in decimal.
-  const std::string want =
-      fmt::format("{:02x}:{:02x}:{}", major(static_cast<dev_t>(dev)),
-                  minor(static_cast<dev_t>(dev)), ino);
-  std::ifstream locks("/proc/locks");
-  std::string line;
-  while (std::getline(locks, line)) {
-    std::istringstream in(line);
-    std::string number, type, advisory, mode, pid, where;
-    in >> number >> type;
-    if (type == "->" || type != "FLOCK") continue;
-    in >> advisory >> mode >> pid >> where;
-    if (where == want) return pid;
-  }
-  return "unknown";
-}
-
-namespace {
-int open_database_file(const std::string& path, bool& created) {
-  created = false;
-  for (int attempt = 0; attempt < 3; ++attempt) {
-    int fd = ::open(path.c_str(), O_RDWR | O_CLOEXEC);
-    if (fd < 0 && (errno == EACCES || errno == EROFS))
-      fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);  // flock works on a read-only descriptor
-    if (fd >= 0 || errno != ENOENT) return fd;
-    fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
-    if (fd >= 0) {
-      created = true;
-      return fd;
-    }
-    if (errno != EEXIST) return fd;  // another process created it just now: open that one
-  }
-  return -1;
-}
-}  // namespace
-
 ProcessLock ProcessLock::acquire_database(const std::string& db_path) {
-  bool created = false;
-  const int fd = open_database_file(db_path, created);
-  if (fd < 0) {
-    throw InputError(fmt::format("{}: cannot open the database: {}", db_path,
-                                 std::strerror(errno)));
-  }
-  struct stat st {};
-  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-    ::close(fd);
-    throw InputError(fmt::format("{}: not a regular file; a database is one", db_path));
-  }
-  if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
-    const int err = errno;
-    ::close(fd);
-    if (err == EWOULDBLOCK) {
-      throw InputError(fmt::format(
-          "{}: database is in use by another station process (pid {}); nothing was touched",
-          db_path, flock_holder(st.st_dev, st.st_ino)));
-    }
-    throw InputError(fmt::format("{}: cannot lock the database: {}", db_path, std::strerror(err)));
-  }
-  return ProcessLock(fd, db_path, created);
+  ProcessLock lock(-1, db_path);
+  lock.database_ = DatabaseHold::writer(db_path, true);
+  return lock;
 }
 
 ProcessLock::ProcessLock(ProcessLock&& other) noexcept
     : fd_(std::exchange(other.fd_, -1)),
       path_(std::move(other.path_)),
-      created_(std::exchange(other.created_, false)) {}
+      database_(std::exchange(other.database_, std::nullopt)) {}
 
 ProcessLock& ProcessLock::operator=(ProcessLock&& other) noexcept {
   if (this != &other) {
     if (fd_ >= 0) ::close(fd_);
     fd_ = std::exchange(other.fd_, -1);
     path_ = std::move(other.path_);
-    created_ = std::exchange(other.created_, false);
+    database_ = std::exchange(other.database_, std::nullopt);
   }
   return *this;
 }
 
 ProcessLock::~ProcessLock() {
-  if (fd_ < 0) return;
-  // A database file this lock made and nothing wrote (a run refused before its first write)
-  // leaves no empty file behind; only while the name still points at the same empty inode.
-  struct stat mine {}, named {};
-  if (created_ && ::fstat(fd_, &mine) == 0 && mine.st_size == 0 &&
-      ::stat(path_.c_str(), &named) == 0 && named.st_ino == mine.st_ino &&
-      named.st_dev == mine.st_dev) {
-    (void)::unlink(path_.c_str());
-  }
-  ::close(fd_);  // closing the last fd releases the flock
+  if (fd_ >= 0) ::close(fd_);  // closing the last fd releases the flock
 }
 
 std::string device_lock_path(const std::string& endpoint) {

@@ -3,7 +3,10 @@
 // blocks a restart). The holder's PID is written into the file so a refusal can name it.
 #pragma once
 
+#include <optional>
 #include <string>
+
+#include "station/common/database_lock.hpp"
 
 namespace station {
 
@@ -13,13 +16,12 @@ class ProcessLock {
   /// Takes the lock on `lock_path` (created 0644 when missing) without waiting; throws InputError
   /// "PATH: held by pid N (WHAT)" when another process holds it, or naming the OS error.
   static ProcessLock acquire(const std::string& lock_path, const std::string& what);
-  /// Takes the lock on the database file itself (its inode: every name of it — a hard link, a
-  /// symlink, `./`, `..` — is the same lock), before anything reads or writes it. A missing file
-  /// is created empty (0644), and removed again on release if nothing was ever written to it.
-  /// The refusal names the holder's PID (read from /proc/locks). SQLite's own locks are POSIX
-  /// record locks, independent of flock(2) on Linux, so this lock does not disturb them; the
-  /// descriptor must stay open while the process has the database open (closing any descriptor
-  /// of a file drops the process's POSIX locks on it), so hold it for the process's life.
+  /// Takes the writer's lock on the database file itself (DatabaseHold::writer: its inode, so
+  /// every name of it — a hard link, a symlink, `./`, `..` — is the same lock), before anything
+  /// reads or writes it. A missing file is created empty (0644), and removed again on release if
+  /// nothing was ever written to it. The refusal names the holder's command and PID (from
+  /// /proc/locks). SQLite's own locks are POSIX record locks, independent of flock(2) on Linux,
+  /// so this lock does not disturb them; every connection of this process on the file shares it.
   static ProcessLock acquire_database(const std::string& db_path);
   ProcessLock(ProcessLock&& other) noexcept;
   ProcessLock& operator=(ProcessLock&& other) noexcept;
@@ -29,16 +31,11 @@ class ProcessLock {
   const std::string& path() const { return path_; }
 
  private:
-  ProcessLock(int fd, std::string path, bool created = false)
-      : fd_(fd), path_(std::move(path)), created_(created) {}
+  ProcessLock(int fd, std::string path) : fd_(fd), path_(std::move(path)) {}
   int fd_ = -1;
   std::string path_;
-  bool created_ = false;  ///< this lock made the (empty) file: remove it if still empty
+  std::optional<DatabaseHold> database_;  ///< a database file's lock (fd_ unused)
 };
-
-/// The PID holding a flock(2) on the file (device, inode), from /proc/locks; "unknown" if none
-/// is listed.
-std::string flock_holder(unsigned long long dev, unsigned long long ino);
 
 /// The lock file of a device endpoint ("tcp://127.0.0.1:5020", "rtu:/dev/ttyUSB0?baud=9600",
 /// "unix:/run/x.sock"): one per device, in /run/lock (or $TMPDIR, /tmp when that is not

@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "schemas/migrations.hpp"
+#include "station/store/database_access.hpp"
 
 namespace station {
 
@@ -71,11 +72,15 @@ std::string Statement::column_text(int c) const {
 }
 
 Database::Database(const std::string& path, OpenMode mode) : path_(path), mode_(mode) {
+  DatabaseAccess access = claim_database_file(path, mode);
+  hold_ = std::move(access.hold);
   const int flags = mode == OpenMode::create     ? SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE
                     : mode == OpenMode::existing ? SQLITE_OPEN_READWRITE
                                                  : SQLITE_OPEN_READONLY;
+  const std::string name = access.immutable ? immutable_uri(path) : path;
   sqlite3* raw = nullptr;
-  const int rc = sqlite3_open_v2(path.c_str(), &raw, flags, nullptr);
+  const int rc = sqlite3_open_v2(name.c_str(), &raw,
+                                 flags | (access.immutable ? SQLITE_OPEN_URI : 0), nullptr);
   db_.reset(raw);
   if (rc != SQLITE_OK) {
     throw SqliteError(fmt::format("{}: cannot open{}: {}", path,

@@ -12,6 +12,8 @@
 #include <string>
 #include <string_view>
 
+#include "station/common/database_lock.hpp"
+
 namespace station {
 
 /// A SQLite failure: database path, statement and sqlite3_errmsg.
@@ -82,8 +84,9 @@ enum class OpenMode {
   read_only,  ///< readers (export, replay, report): SQLITE_OPEN_READONLY, never written
 };
 
-/// A database file. Checked with PRAGMA quick_check before anything else touches it; opened in
-/// WAL mode with a busy timeout when writable; applies migrations on request.
+/// A database file. Locked before SQLite opens it (a writer exclusively, a reader shared:
+/// database_access.hpp); checked with PRAGMA quick_check before anything else touches it; opened
+/// in WAL mode with a busy timeout when writable; applies migrations on request.
 /// PRAGMA application_id of a station database ("GTCL", gyro thermal calibration): a file's
 /// header says whose it is (sqlite.org/fileformat2.html, "Application ID"). Files written before
 /// it was set are recognised by their schema version and tables, and get it at the next write.
@@ -92,7 +95,8 @@ inline constexpr std::int32_t kStationApplicationId = 0x4754434C;
 class Database {
  public:
   /// Opens `path` as `mode` allows; throws SqliteError naming the path (missing, not a
-  /// database, corrupt).
+  /// database, corrupt), InputError when another process writes it and `mode` writes, or when it
+  /// is reached by another name than its write-ahead log's.
   explicit Database(const std::string& path, OpenMode mode = OpenMode::create);
   /// Runs one or more statements without results.
   void exec(std::string_view sql);
@@ -124,6 +128,8 @@ class Database {
   int check_schema_version(int have, int known) const;
   /// VACUUM INTO `path.schema-vHAVE.STAMP.bak` (via a .tmp and a rename) before migrating.
   void backup_before_migrating(int have);
+  /// This process's lock on the file (database_access.hpp), released after the connection closes.
+  std::optional<DatabaseHold> hold_;
   std::unique_ptr<sqlite3, SqliteClose> db_;
   std::string path_;
   OpenMode mode_;

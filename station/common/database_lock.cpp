@@ -1,0 +1,251 @@
+// One flock(2) per database file per process: exclusive for writers, shared for readers.
+#include "station/common/database_lock.hpp"
+
+#include <dirent.h>
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <sys/sysmacros.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <mutex>
+#include <sstream>
+#include <thread>
+#include <utility>
+
+#include "station/common/input_error.hpp"
+
+namespace station {
+
+using Key = std::pair<unsigned long long, unsigned long long>;  // (st_dev, st_ino)
+
+struct HeldDatabase {
+  int fd = -1;
+  Key key;
+  bool exclusive = false;
+  bool created = false;  ///< this hold made the (empty) file: remove it if still empty
+  std::string path;
+  ~HeldDatabase();
+};
+
+namespace {
+
+// Every hold of this process, by file. The mutex is held across a whole acquisition (waiting
+// included) and across a release: no descriptor of a file is opened or closed by another thread
+// while a hold on it is being decided.
+std::mutex& registry_mutex() {
+  static std::mutex m;
+  return m;
+}
+std::map<Key, std::weak_ptr<HeldDatabase>>& registry() {
+  static std::map<Key, std::weak_ptr<HeldDatabase>> r;
+  return r;
+}
+
+int open_database_file(const std::string& path, bool create, bool& created) {
+  created = false;
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    int fd = ::open(path.c_str(), O_RDWR | O_CLOEXEC);
+    if (fd < 0 && (errno == EACCES || errno == EROFS))
+      fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);  // flock works on a read-only descriptor
+    if (fd >= 0 || errno != ENOENT || !create) return fd;
+    fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+    if (fd >= 0) {
+      created = true;
+      return fd;
+    }
+    if (errno != EEXIST) return fd;  // another process created it just now: open that one
+  }
+  return -1;
+}
+
+Key key_of(int fd, const std::string& path) {
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    ::close(fd);
+    throw InputError(fmt::format("{}: not a regular file; a database is one", path));
+  }
+  return {static_cast<unsigned long long>(st.st_dev), static_cast<unsigned long long>(st.st_ino)};
+}
+
+std::string holders_text(const std::vector<FlockHolder>& holders) {
+  std::string out;
+  for (const auto& h : holders) {
+    out += (out.empty() ? "" : ", ") + describe_process(h.pid);
+    if (!h.write) out += ", reading";
+  }
+  return out.empty() ? "another station process" : out;
+}
+
+// Takes LOCK_EX on `fd`: at once, or after readers finish (bounded); throws naming the holders.
+void lock_exclusive(int fd, const std::string& path, Key key) {
+  using Clock = std::chrono::steady_clock;
+  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                           std::chrono::duration<double>(kWaitForReadersS));
+  for (;;) {
+    if (::flock(fd, LOCK_EX | LOCK_NB) == 0) return;
+    const int err = errno;
+    if (err != EWOULDBLOCK)
+      throw InputError(fmt::format("{}: cannot lock the database: {}", path, std::strerror(err)));
+    const auto holders = flock_holders(key.first, key.second);
+    const bool writer = !holders.empty() && holders.front().write;
+    if (writer || Clock::now() >= deadline) {
+      throw InputError(fmt::format(
+          "{}: database is in use by {}{}; nothing was touched (one writer at a time: a "
+          "daemon holds it for its whole life, a writing command while it runs)",
+          path, holders_text(holders),
+          writer ? "" : fmt::format(" for more than {:.0f} s", kWaitForReadersS)));
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+}
+
+}  // namespace
+
+HeldDatabase::~HeldDatabase() {
+  const std::lock_guard<std::mutex> guard(registry_mutex());
+  const auto it = registry().find(key);
+  if (it != registry().end() && it->second.expired()) registry().erase(it);
+  // A database file this hold made and nothing wrote (a run refused before its first write)
+  // leaves no empty file behind; only while the name still points at the same empty inode.
+  struct stat mine {
+  }, named{};
+  if (created && ::fstat(fd, &mine) == 0 && mine.st_size == 0 &&
+      ::stat(path.c_str(), &named) == 0 && named.st_ino == mine.st_ino &&
+      named.st_dev == mine.st_dev) {
+    (void)::unlink(path.c_str());
+  }
+  ::close(fd);  // the last descriptor of the hold: releases the flock
+}
+
+namespace {
+
+// The hold this process already has on the file at `path`, found by stat(2): no descriptor of the
+// file is opened (closing one would drop the POSIX locks of this process's connections on it).
+std::shared_ptr<HeldDatabase> held_here(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) return nullptr;
+  const auto it = registry().find(
+      {static_cast<unsigned long long>(st.st_dev), static_cast<unsigned long long>(st.st_ino)});
+  return it == registry().end() ? nullptr : it->second.lock();
+}
+
+std::shared_ptr<HeldDatabase> new_hold(int fd, Key key, bool exclusive, bool created,
+                                       const std::string& path) {
+  auto held = std::make_shared<HeldDatabase>();
+  held->fd = fd;
+  held->key = key;
+  held->exclusive = exclusive;
+  held->created = created;
+  held->path = path;
+  registry()[key] = held;
+  return held;
+}
+
+}  // namespace
+
+DatabaseHold DatabaseHold::writer(const std::string& path, bool create) {
+  const std::lock_guard<std::mutex> guard(registry_mutex());
+  if (auto held = held_here(path)) {
+    if (!held->exclusive) {
+      lock_exclusive(held->fd, path, held->key);  // a reader of this process becomes the writer
+      held->exclusive = true;
+    }
+    return DatabaseHold(held);
+  }
+  bool created = false;
+  const int fd = open_database_file(path, create, created);
+  if (fd < 0) {
+    throw InputError(fmt::format("{}: cannot open the database: {}", path, std::strerror(errno)));
+  }
+  const Key key = key_of(fd, path);
+  try {
+    lock_exclusive(fd, path, key);
+  } catch (...) {
+    ::close(fd);  // this process has no connection on the file: nothing else to drop
+    if (created) (void)::unlink(path.c_str());
+    throw;
+  }
+  return DatabaseHold(new_hold(fd, key, true, created, path));
+}
+
+std::optional<DatabaseHold> DatabaseHold::reader(const std::string& path) {
+  const std::lock_guard<std::mutex> guard(registry_mutex());
+  if (auto held = held_here(path)) return DatabaseHold(held);
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return std::nullopt;
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || ::flock(fd, LOCK_SH | LOCK_NB) != 0) {
+    ::close(fd);  // this process has no connection on the file: nothing else to drop
+    return std::nullopt;
+  }
+  const Key key{static_cast<unsigned long long>(st.st_dev),
+                static_cast<unsigned long long>(st.st_ino)};
+  return DatabaseHold(new_hold(fd, key, false, false, path));
+}
+
+bool DatabaseHold::exclusive() const {
+  return held_ && held_->exclusive;
+}
+
+std::vector<FlockHolder> flock_holders(unsigned long long dev, unsigned long long ino) {
+  // proc(5), /proc/locks: "1: FLOCK  ADVISORY  WRITE 4242 fd:01:1234567 0 EOF"; a waiter's line
+  // has "->" after the number. The device is MAJOR:MINOR in hex, the inode in decimal.
+  const std::string want = fmt::format("{:02x}:{:02x}:{}", major(static_cast<dev_t>(dev)),
+                                       minor(static_cast<dev_t>(dev)), ino);
+  std::ifstream locks("/proc/locks");
+  std::vector<FlockHolder> out;
+  std::string line;
+  while (std::getline(locks, line)) {
+    std::istringstream in(line);
+    std::string number, type, advisory, mode, pid, where;
+    in >> number >> type;
+    if (type != "FLOCK") continue;  // a waiter ("->") or a POSIX lock (SQLite's own)
+    in >> advisory >> mode >> pid >> where;
+    if (where == want) out.push_back({pid, mode == "WRITE"});
+  }
+  std::stable_sort(out.begin(), out.end(),
+                   [](const FlockHolder& a, const FlockHolder& b) { return a.write && !b.write; });
+  return out;
+}
+
+std::string describe_process(const std::string& pid) {
+  std::ifstream in("/proc/" + pid + "/cmdline", std::ios::binary);
+  std::vector<std::string> argv;
+  for (std::string arg; std::getline(in, arg, '\0');) argv.push_back(arg);
+  if (argv.empty()) return fmt::format("pid {}", pid);
+  const std::string program = argv[0].substr(argv[0].find_last_of('/') + 1);
+  if (program == "station" && argv.size() > 1)
+    return fmt::format("station {} (pid {})", InputError::one_line(argv[1]), pid);
+  return fmt::format("{} (pid {})", InputError::one_line(program), pid);
+}
+
+std::string name_opened_by(const std::string& pid, unsigned long long dev, unsigned long long ino) {
+  const std::string dir = "/proc/" + pid + "/fd";
+  DIR* d = ::opendir(dir.c_str());
+  if (d == nullptr) return {};
+  std::string found;
+  while (const dirent* e = ::readdir(d)) {
+    const std::string fd_path = dir + "/" + e->d_name;
+    struct stat st {};
+    if (e->d_name[0] == '.' || ::stat(fd_path.c_str(), &st) != 0) continue;
+    if (static_cast<unsigned long long>(st.st_dev) != dev ||
+        static_cast<unsigned long long>(st.st_ino) != ino)
+      continue;
+    char target[4096] = {};
+    const ssize_t n = ::readlink(fd_path.c_str(), target, sizeof target - 1);
+    if (n > 0) found.assign(target, static_cast<std::size_t>(n));
+    break;
+  }
+  ::closedir(d);
+  return found;
+}
+
+}  // namespace station
