@@ -36,6 +36,9 @@ constexpr CommandDoc kCommands[] = {
     {"chamber|table clear", "end that device's Modbus faults"},
     {"can drop|duplicate|corrupt N", "the next N counter-board frames on the bus"},
     {"can drop|duplicate|corrupt rate P", "each frame with probability P (0..1) from now on"},
+    {"chamber|table drip SECONDS [MS]",
+     "every reply in the next SECONDS leaves one byte every MS ms (default 300: a slow proxy), "
+     "replies behind it queued in order (0 ends it)"},
     {"can clear", "end the CAN faults"},
     {"board NODE reset", "board power cycle: counters and board clock restart from 0"},
     {"board NODE silent|answer", "the board stops / resumes answering SYNC"},
@@ -51,6 +54,10 @@ Args split(std::string_view line) {
   Args out;
   std::size_t i = 0;
   while (i < line.size()) {
+// The drip of issue 34: a proxy forwarding one byte every 0.3 s, under libmodbus's 0.5 s byte
+// timeout, so only a deadline for the whole exchange ends it.
+constexpr double kDripMs = 300;
+
     while (i < line.size() && std::isspace(static_cast<unsigned char>(line[i]))) ++i;
     std::size_t j = i;
     while (j < line.size() && !std::isspace(static_cast<unsigned char>(line[j]))) ++j;
@@ -91,7 +98,8 @@ bool pick(std::string_view s, std::string_view on, std::string_view off, std::st
 }
 
 std::string modbus_fault(SimServer& server, const Args& a, std::string_view dev) {
-  const std::string syntax = fmt::format("{} stall|exception|refuse|disconnect|clear ...", dev);
+  const std::string syntax =
+      fmt::format("{} stall|exception|refuse|drip|disconnect|clear ...", dev);
   if (a.size() < 2) usage(syntax);
   if (a[1] == "stall" && a.size() == 3) {
     server.stall_for(number(a[2], "seconds", 0, 1e6));
@@ -107,6 +115,9 @@ std::string modbus_fault(SimServer& server, const Args& a, std::string_view dev)
     server.disconnect_for(a.size() == 3 ? number(a[2], "seconds", 0, 1e6) : 0.0);
   } else if (a[1] == "clear" && a.size() == 2) {
     server.clear_faults();
+  } else if (a[1] == "drip" && (a.size() == 3 || a.size() == 4)) {
+    const double ms = a.size() == 4 ? number(a[3], "milliseconds", 1, 60000) : kDripMs;
+    server.drip_for(number(a[2], "seconds", 0, 1e6), ms / 1000.0);
   } else {
     usage(syntax);
   }

@@ -1,22 +1,87 @@
-// libmodbus as a ModbusWire: one context per open link, both timeouts set.
+// LibmodbusWire: libmodbus opens the link; every exchange is a poll() on its descriptor against
+// one deadline for the whole transaction (modbus_frame.hpp: why, and what libmodbus does).
 #include "drivers/modbus/modbus_wire.hpp"
 
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <thread>
+#include <variant>
+
+#include "drivers/modbus/modbus_adu.hpp"
 
 namespace station::drivers::modbus {
+namespace {
+
+using Steady = std::chrono::steady_clock;
+
+// Replies abandoned before their first byte whose ids are still remembered (TCP): a server
+// answers in order, so a handful covers every late reply still on its way.
+constexpr std::size_t kLateIdsKept = 8;
+
+// Waits for `events` on fd until `deadline`: 1 ready, -1 with errno (ETIMEDOUT at the deadline).
+// Bytes already there are taken even at or past the deadline (a flush that must not wait).
+int wait_for(int fd, short events, Steady::time_point deadline) {
+  for (;;) {
+    const auto left = std::chrono::ceil<std::chrono::milliseconds>(deadline - Steady::now());
+    pollfd p{fd, events, 0};
+    const int rc = ::poll(&p, 1, static_cast<int>(std::max<std::int64_t>(0, left.count())));
+    if (rc < 0 && errno == EINTR) continue;
+    if (rc < 0) return -1;
+    if (rc == 0 && Steady::now() >= deadline) {
+      errno = ETIMEDOUT;
+      return -1;
+    }
+    if (rc == 0) continue;
+    if ((p.revents & (POLLERR | POLLNVAL)) != 0 && (p.revents & events) == 0) {
+      errno = EIO;
+      return -1;
+    }
+    return 1;
+  }
+}
+
+// Reads at most `n` bytes onto `out` by the deadline; -1 with errno (ECONNRESET: the peer
+// closed). A serial line is a descriptor, not a socket: read() serves both.
+int read_some(int fd, std::vector<std::uint8_t>& out, std::size_t n, Steady::time_point deadline) {
+  for (;;) {
+    if (wait_for(fd, POLLIN, deadline) == -1) return -1;
+    std::uint8_t buf[256];
+    const ssize_t got = ::read(fd, buf, std::min(n, sizeof buf));
+    if (got == 0) {
+      errno = ECONNRESET;
+      return -1;
+    }
+    if (got < 0 && (errno == EINTR || errno == EAGAIN)) continue;
+    if (got < 0) return -1;
+    out.insert(out.end(), buf, buf + got);
+    return 0;
+  }
+}
+
+// Bytes still to read of the frame begun in `frame` (0: it is whole), or -1: it frames nothing.
+int still_needed(Framing f, const std::vector<std::uint8_t>& frame) {
+  const int whole = reply_frame_length(f, frame);
+  if (whole < 0) return -1;
+  if (whole > 0) return std::max(0, whole - static_cast<int>(frame.size()));
+  return f == Framing::tcp ? 6 - static_cast<int>(frame.size()) : 1;  // until its length shows
+}
+
+}  // namespace
 
 int LibmodbusWire::open(double timeout_s) {
+  close();
   ctx_ = make_context(endpoint_);
   const double whole = std::floor(timeout_s);
   const auto sec = static_cast<std::uint32_t>(whole);
   const auto usec = static_cast<std::uint32_t>(std::lround((timeout_s - whole) * 1e6));
+  // libmodbus waits only in the connect now (its response timeout bounds a TCP connect); the
+  // exchanges are bounded here, as a whole, by the same timeout.
   modbus_set_response_timeout(ctx_.get(), sec, usec);
-  // libmodbus waits byte_timeout (default 0.5 s) for each later chunk of a reply: a device that
-  // sends part of a reply and stalls would hold the call that long whatever the response
-  // timeout. The same bound applies to both (found by fuzz_modbus_replies). Never 0: libmodbus
-  // reads a zero byte timeout as "wait forever".
   modbus_set_byte_timeout(ctx_.get(), sec, usec);
   if (modbus_connect(ctx_.get()) == -1) {
     const int err = errno;
@@ -24,7 +89,19 @@ int LibmodbusWire::open(double timeout_s) {
     errno = err;
     return -1;
   }
+  timeout_ = to_steady(timeout_s);
   return 0;
+}
+
+void LibmodbusWire::close() {
+  ctx_.reset();
+  tid_ = 0;
+  late_.clear();
+  late_ids_.clear();
+}
+
+Framing LibmodbusWire::framing() const {
+  return std::holds_alternative<TcpEndpoint>(endpoint_) ? Framing::tcp : Framing::rtu;
 }
 
 void LibmodbusWire::rest() {
@@ -38,33 +115,109 @@ int LibmodbusWire::ended(int rc) {
   return rc;
 }
 
-int LibmodbusWire::read(FunctionCode fc, int unit, std::uint16_t addr, int count,
-                        std::uint16_t* dest) {
+int LibmodbusWire::send_frame(const std::vector<std::uint8_t>& frame,
+                              SteadyClock::time_point deadline) {
+  const int fd = modbus_get_socket(ctx_.get());
+  std::size_t done = 0;
+  while (done < frame.size()) {
+    const std::size_t left = frame.size() - done;
+    ssize_t n = ::send(fd, frame.data() + done, left, MSG_NOSIGNAL | MSG_DONTWAIT);
+    if (n < 0 && errno == ENOTSOCK) n = ::write(fd, frame.data() + done, left);
+    if (n > 0) {
+      done += static_cast<std::size_t>(n);
+    } else if (n < 0 && errno != EINTR && errno != EAGAIN) {
+      return -1;
+    } else if (n < 0 && errno == EAGAIN && wait_for(fd, POLLOUT, deadline) == -1) {
+      return -1;
+    }
+  }
+  return 0;
+}
+
+int LibmodbusWire::receive_frame(std::vector<std::uint8_t>& frame,
+                                 SteadyClock::time_point deadline) {
+  const int fd = modbus_get_socket(ctx_.get());
+  for (;;) {
+    const int need = still_needed(framing(), frame);
+    if (need < 0) {
+      errno = EMBBADDATA;  // as libmodbus: "too many data", or no reply has this function
+      return -1;
+    }
+    if (need == 0) return 0;
+    if (read_some(fd, frame, static_cast<std::size_t>(need), deadline) == -1) return -1;
+  }
+}
+
+int LibmodbusWire::drop_late(SteadyClock::time_point deadline) {
+  if (late_.empty()) return 0;
+  const int rc = receive_frame(late_, deadline);
+  if (rc == -1 && errno == ETIMEDOUT) return -1;  // still dripping: this exchange waited for it
+  if (rc == -1) modbus_flush(ctx_.get());         // it frames nothing: drop what is there
+  late_.clear();
+  return 0;
+}
+
+int LibmodbusWire::exchange(const std::vector<std::uint8_t>& adu,
+                            std::vector<std::uint8_t>& reply) {
   if (!ctx_) {
     errno = ENOTCONN;
     return -1;
   }
   rest();
-  modbus_set_slave(ctx_.get(), unit);
-  return ended(fc == FunctionCode::holding
-                   ? modbus_read_registers(ctx_.get(), addr, count, dest)
-                   : modbus_read_input_registers(ctx_.get(), addr, count, dest));
+  const auto deadline = SteadyClock::now() + timeout_;
+  if (drop_late(deadline) == -1) return ended(-1);
+  // On a serial line a late reply has no id to tell it by: what came between exchanges goes.
+  if (framing() == Framing::rtu) modbus_flush(ctx_.get());
+  tid_ = static_cast<std::uint16_t>(tid_ + 1);
+  const auto request = request_frame(framing(), tid_, adu);
+  if (send_frame(request, deadline) == -1) return ended(-1);
+  for (;;) {
+    reply.clear();
+    if (receive_frame(reply, deadline) == -1) {
+      if (errno == ETIMEDOUT && !reply.empty()) late_ = reply;  // its rest is dropped later
+      if (errno == ETIMEDOUT && reply.empty() && framing() == Framing::tcp) {
+        if (late_ids_.size() == kLateIdsKept) late_ids_.erase(late_ids_.begin());
+        late_ids_.push_back(tid_);
+      }
+      return ended(-1);
+    }
+    // TCP: a whole late reply to an exchange abandoned before its first byte is dropped by its
+    // transaction id, which exists for this (Implementation Guide §3.1.3); libmodbus would fail.
+    const auto late = std::find(late_ids_.begin(), late_ids_.end(), transaction_id(reply));
+    if (framing() == Framing::tcp && transaction_id(reply) != tid_ && late != late_ids_.end()) {
+      late_ids_.erase(late);
+      continue;
+    }
+    late_ids_.clear();  // a server answers in order: nothing older is still coming
+    if (const int err = check_reply(framing(), request, reply); err != 0) {
+      errno = err;
+      return ended(-1);
+    }
+    return ended(0);
+  }
+}
+
+int LibmodbusWire::read(FunctionCode fc, int unit, std::uint16_t addr, int count,
+                        std::uint16_t* dest) {
+  std::vector<std::uint8_t> reply;
+  if (exchange(read_request_adu(unit, static_cast<int>(fc), addr, count), reply) == -1) return -1;
+  const std::size_t data = header_length(framing()) + 2;  // function, byte count
+  for (int i = 0; i < count; ++i)
+    dest[i] = static_cast<std::uint16_t>((reply[data + 2 * i] << 8) | reply[data + 2 * i + 1]);
+  return count;
 }
 
 int LibmodbusWire::write(int unit, std::uint16_t addr, std::span<const std::uint16_t> words) {
-  if (!ctx_) {
-    errno = ENOTCONN;
-    return -1;
-  }
-  rest();
-  modbus_set_slave(ctx_.get(), unit);
-  const int n = static_cast<int>(words.size());
-  return ended(n == 1 ? modbus_write_register(ctx_.get(), addr, words[0])
-                      : modbus_write_registers(ctx_.get(), addr, n, words.data()));
+  std::vector<std::uint8_t> reply;
+  if (exchange(write_request_adu(unit, addr, words), reply) == -1) return -1;
+  return static_cast<int>(words.size());
 }
 
 void LibmodbusWire::flush() {
-  if (ctx_) modbus_flush(ctx_.get());
+  if (!ctx_) return;
+  // What has come of an abandoned reply is framed and dropped now (no wait); its rest later.
+  if (!late_.empty() && drop_late(SteadyClock::now()) == -1) return;
+  modbus_flush(ctx_.get());
 }
 
 }  // namespace station::drivers::modbus

@@ -6,8 +6,10 @@
 #include <chrono>
 #include <cstdint>
 #include <span>
+#include <vector>
 
 #include "drivers/modbus/endpoint.hpp"
+#include "drivers/modbus/modbus_frame.hpp"
 #include "drivers/modbus/modbus_handle.hpp"
 #include "drivers/modbus/register_map.hpp"
 
@@ -17,7 +19,8 @@ namespace station::drivers::modbus {
 class ModbusWire {
  public:
   virtual ~ModbusWire() = default;
-  /// Opens the link, each wait of every later call bounded by `timeout_s`. May throw
+  /// Opens the link, every later exchange bounded as a whole (request sent to the reply's last
+  /// byte) by `timeout_s`; the connect waits at most as long. May throw
   /// std::runtime_error for parameters the transport rejects (no I/O happened then).
   virtual int open(double timeout_s) = 0;
   /// Closes the link; nothing when it is closed.
@@ -35,12 +38,17 @@ class ModbusWire {
   virtual void set_request_gap_s(double /*gap_s*/) {}
 };
 
-/// The real link: libmodbus over TCP or RTU. The constructor does no I/O.
+/// The real link: libmodbus opens it (TCP connect, RTU serial setup); the exchanges are this
+/// class's own, each bounded as a whole: from the request sent to the last byte of its reply,
+/// one deadline of `timeout_s` (open()), however the reply's bytes are spaced (modbus_frame.hpp
+/// says why libmodbus cannot bound it so). A reply past its deadline is ETIMEDOUT; its late bytes
+/// are framed and dropped when they arrive, never read as the next reply. The constructor does no
+/// I/O.
 class LibmodbusWire final : public ModbusWire {
  public:
   explicit LibmodbusWire(Endpoint endpoint) : endpoint_(std::move(endpoint)) {}
   int open(double timeout_s) override;
-  void close() override { ctx_.reset(); }
+  void close() override;
   int read(FunctionCode fc, int unit, std::uint16_t addr, int count, std::uint16_t* dest) override;
   int write(int unit, std::uint16_t addr, std::span<const std::uint16_t> words) override;
   void flush() override;
@@ -55,11 +63,25 @@ class LibmodbusWire final : public ModbusWire {
   void rest();
   /// Marks the end of an exchange; returns `rc`.
   int ended(int rc);
+  /// Sends the request `adu` (unit id and PDU) and reads its reply into `reply` by one deadline;
+  /// 0, or -1 with errno set.
+  int exchange(const std::vector<std::uint8_t>& adu, std::vector<std::uint8_t>& reply);
+  /// Reads the rest of the frame begun in `frame` until the deadline; 0 or -1 with errno.
+  int receive_frame(std::vector<std::uint8_t>& frame, SteadyClock::time_point deadline);
+  /// Drops the rest of an abandoned reply (late_), reading until the deadline; 0 or -1.
+  int drop_late(SteadyClock::time_point deadline);
+  /// Writes the whole request frame by the deadline; 0 or -1 with errno.
+  int send_frame(const std::vector<std::uint8_t>& frame, SteadyClock::time_point deadline);
+  Framing framing() const;
 
   Endpoint endpoint_;
   ModbusHandle ctx_;
+  SteadyClock::duration timeout_{0};
   SteadyClock::duration gap_{0};
   SteadyClock::time_point last_end_{};
+  std::uint16_t tid_ = 0;                ///< the last request's transaction id (TCP)
+  std::vector<std::uint8_t> late_;       ///< the bytes read of a reply abandoned at its deadline
+  std::vector<std::uint16_t> late_ids_;  ///< transaction ids of replies abandoned before a byte
 };
 
 }  // namespace station::drivers::modbus

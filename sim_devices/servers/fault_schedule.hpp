@@ -53,6 +53,16 @@ class FaultSchedule {
     std::lock_guard lock(mutex_);
     stall_until_s_ = after(seconds);
   }
+  void drip_for(double seconds, double byte_interval_s) {
+    std::lock_guard lock(mutex_);
+    drip_until_s_ = after(seconds);
+    drip_interval_s_ = std::max(0.0, byte_interval_s);
+  }
+  /// Seconds between the bytes of a reply sent now (0: the reply leaves at once).
+  double drip_interval_s() const {
+    std::lock_guard lock(mutex_);
+    return now_s_() < drip_until_s_ ? drip_interval_s_ : 0.0;
+  }
   void disconnect_for(double seconds) {
     std::lock_guard lock(mutex_);
     down_until_s_ = after(seconds);
@@ -61,7 +71,7 @@ class FaultSchedule {
   void clear() {
     std::lock_guard lock(mutex_);
     timeouts_ = exceptions_ = drops_ = 0;
-    stall_until_s_ = down_until_s_ = refuse_until_s_ = kNever;
+    stall_until_s_ = down_until_s_ = refuse_until_s_ = drip_until_s_ = kNever;
   }
   /// What the request just received gets; `code` is set for an exception. While stalled or
   /// down (a serial line is silent when its device is off) nothing answers.
@@ -102,6 +112,7 @@ class FaultSchedule {
   TimeSource now_s_ = steady_s;
   int timeouts_ = 0, exceptions_ = 0, exception_code_ = 0, drops_ = 0;
   double stall_until_s_ = kNever, down_until_s_ = kNever, refuse_until_s_ = kNever;
+  double drip_until_s_ = kNever, drip_interval_s_ = 0;
   int refuse_code_ = 0;
   std::uint64_t kicks_ = 0;
 };

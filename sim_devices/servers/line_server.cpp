@@ -109,7 +109,7 @@ bool LineServer::link_up() {
   double down_until = 0;
   const std::uint64_t asked = faults_.kicks(down_until);
   if (asked != kicks_applied_.load()) {
-    for (auto& [fd, buf] : clients_) ::close(fd);
+    for (auto& [fd, buf] : clients_) ::close(fd), drips_.forget(fd);
     clients_.clear();
     if (listen_fd_ != -1) ::close(listen_fd_);
     listen_fd_ = -1;
@@ -155,14 +155,20 @@ void LineServer::serve_bytes(int fd, std::string& buffer, bool& close_it) {
         if (close_it) return;
         continue;
       case FaultSchedule::Fault::exception:
-        write_all(fd, device_.encode(device_.error_reply(request, code)));
+        reply(fd, device_.encode(device_.error_reply(request, code)));
         continue;
       case FaultSchedule::Fault::none:
         break;
     }
-    if (auto reply = device_.handle(request)) write_all(fd, device_.encode(std::move(*reply)));
+    if (auto r = device_.handle(request)) reply(fd, device_.encode(std::move(*r)));
   }
   if (buffer.size() > kMaxLine) buffer.clear();
+}
+
+void LineServer::reply(int fd, const std::string& bytes) {
+  const double interval_s = faults_.drip_interval_s();
+  if (interval_s <= 0 && !drips_.busy(fd)) return write_all(fd, bytes);
+  drips_.push(fd, {reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size()}, interval_s);
 }
 
 void LineServer::run() {
@@ -171,7 +177,9 @@ void LineServer::run() {
     std::vector<pollfd> fds;
     if (up && listen_fd_ != -1) fds.push_back({listen_fd_, POLLIN, 0});
     for (auto& [fd, buf] : clients_) fds.push_back({fd, POLLIN, 0});
-    if (::poll(fds.data(), fds.size(), 50) <= 0) continue;
+    const int ready = ::poll(fds.data(), fds.size(), drips_.poll_ms(50));
+    drips_.send_due();
+    if (ready <= 0) continue;
     for (const auto& p : fds) {
       if (p.revents == 0) continue;
       if (p.fd == listen_fd_) {
@@ -188,6 +196,7 @@ void LineServer::run() {
       bool close_it = false;
       serve_bytes(p.fd, it->second, close_it);
       if (close_it) {
+        drips_.forget(p.fd);
         ::close(p.fd);
         clients_.erase(it);
       }

@@ -13,6 +13,7 @@
 #include <thread>
 #include <vector>
 
+#include "sim_devices/servers/drip_queue.hpp"
 #include "sim_devices/servers/fault_schedule.hpp"
 #include "sim_devices/servers/sim_server.hpp"
 
@@ -62,6 +63,8 @@ class LineServer final : public SimServer {
   void run();
   bool link_up();
   void serve_bytes(int fd, std::string& buffer, bool& close_it);
+  /// Sends a reply's bytes: at once, or a byte at a time while a drip is on (or behind one).
+  void reply(int fd, const std::string& bytes);
 
   LineDevice& device_;
   int listen_fd_ = -1, pty_master_ = -1, pty_slave_ = -1, port_ = 0, baud_ = 9600;
@@ -70,6 +73,7 @@ class LineServer final : public SimServer {
   std::atomic<std::uint64_t> requests_{0};
   std::thread thread_;
   std::map<int, std::string> clients_;  // fd -> bytes of a partial line
+  DripQueue drips_;
 };
 
 }  // namespace station::sim

@@ -109,6 +109,7 @@ void ModbusServer::start_tcp(int port, UnitLink link) {
     sys_fail("getsockname");
   port_ = ntohs(addr.sin_port);
   tcp_ = listening_ = true;
+  open_capture();
   thread_ = std::thread([this] { run_tcp(); });
 }
 
@@ -131,6 +132,7 @@ void ModbusServer::start_rtu_pty(int baud) {
   ctx_.reset(modbus_new_rtu(name, baud, 'N', 8, 1));
   if (!ctx_) sys_fail("modbus_new_rtu");
   modbus_set_slave(ctx_.get(), unit_id_);
+  open_capture();
   thread_ = std::thread([this] { run_rtu(); });
 }
 
@@ -138,7 +140,7 @@ void ModbusServer::stop() {
   stop_ = true;
   tcp_ = false;  // nothing to settle any more
   if (thread_.joinable()) thread_.join();
-  for (int* fd : {&listen_fd_, &pty_master_, &pty_slave_}) {
+  for (int* fd : {&listen_fd_, &pty_master_, &pty_slave_, &capture_[0], &capture_[1]}) {
     if (*fd != -1) close(*fd);
     *fd = -1;
   }
@@ -148,6 +150,23 @@ std::string ModbusServer::endpoint() const {
   if (!pty_path_.empty())
     return "rtu:" + pty_path_ + "?baud=" + std::to_string(baud_) + "&parity=N&data=8&stop=1";
   return "tcp://127.0.0.1:" + std::to_string(port_);
+}
+
+void ModbusServer::open_capture() {
+  if (socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, capture_) == -1) sys_fail("socketpair");
+}
+
+bool ModbusServer::send_reply(const std::function<int()>& build) {
+  const int fd = modbus_get_socket(ctx_.get());
+  const double interval_s = faults_.drip_interval_s();
+  if (interval_s <= 0 && !drips_.busy(fd)) return build() != -1;
+  modbus_set_socket(ctx_.get(), capture_[0]);
+  const int rc = build();
+  modbus_set_socket(ctx_.get(), fd);
+  std::uint8_t bytes[MODBUS_TCP_MAX_ADU_LENGTH];
+  const ssize_t n = recv(capture_[1], bytes, sizeof bytes, MSG_DONTWAIT);
+  if (n > 0) drips_.push(fd, {bytes, static_cast<std::size_t>(n)}, interval_s);
+  return rc != -1;
 }
 
 void ModbusServer::accept_client(std::vector<int>& clients) {
@@ -161,7 +180,7 @@ bool ModbusServer::tcp_link_up(std::vector<int>& clients) {
   double down_until = 0;
   const std::uint64_t asked = faults_.kicks(down_until);
   if (asked != kicks_applied_.load()) {
-    for (int c : clients) close(c);
+    for (int c : clients) close(c), drips_.forget(c);
     clients.clear();
     pending_.clear();
     if (listen_fd_ != -1) close(listen_fd_);
@@ -186,15 +205,18 @@ void ModbusServer::run_tcp() {
     }
     std::vector<pollfd> fds{{listen_fd_, POLLIN, 0}};
     for (int c : clients) fds.push_back({c, POLLIN, 0});
-    if (poll(fds.data(), fds.size(), kPollMs) <= 0) continue;
+    const int ready = poll(fds.data(), fds.size(), drips_.poll_ms(kPollMs));
+    drips_.send_due();
+    if (ready <= 0) continue;
     if (fds[0].revents & POLLIN) accept_client(clients);
     for (std::size_t i = 1; i < fds.size(); ++i) {
       if (fds[i].revents == 0 || serve_one(fds[i].fd)) continue;
+      drips_.forget(fds[i].fd);
       close(fds[i].fd);
       clients.erase(std::find(clients.begin(), clients.end(), fds[i].fd));
     }
   }
-  for (int c : clients) close(c);
+  for (int c : clients) close(c), drips_.forget(c);
   pending_.clear();
 }
 
@@ -206,7 +228,9 @@ void ModbusServer::run_rtu() {
   modbus_set_socket(ctx_.get(), pty_master_);
   while (!stop_) {
     pollfd pfd{pty_master_, POLLIN, 0};
-    if (poll(&pfd, 1, kPollMs) <= 0 || !(pfd.revents & POLLIN)) continue;
+    const int ready = poll(&pfd, 1, drips_.poll_ms(kPollMs));
+    drips_.send_due();
+    if (ready <= 0 || !(pfd.revents & POLLIN)) continue;
     const double arrived_s = steady_now_s();
     const int len = read_rtu_frame(pty_master_, frame, sizeof frame, kRtuSilenceMs);
     if (rtu_frame_ok({frame, static_cast<std::size_t>(len)})) dispatch(frame, len, arrived_s);
@@ -256,7 +280,8 @@ bool ModbusServer::dispatch(const std::uint8_t* query, int len, double arrived_s
   const UnitAnswer a = unit_answer(link_, unit_id_, query[header - 1], query[header]);
   if (a == UnitAnswer::silence) return true;
   if (a == UnitAnswer::gateway_error)
-    return modbus_reply_exception(ctx_.get(), query, kGatewayTargetFailed) != -1;
+    return send_reply(
+        [&] { return modbus_reply_exception(ctx_.get(), query, kGatewayTargetFailed); });
   {
     const std::lock_guard<std::mutex> lock(arrivals_mutex_);
     arrivals_s_.push_back(arrived_s);
@@ -274,7 +299,9 @@ bool ModbusServer::handle(const std::uint8_t* query, int len, bool reply) {
     case FaultSchedule::Fault::drop:
       return pty_master_ != -1;  // TCP: close; RTU: just stay silent
     case FaultSchedule::Fault::exception:
-      return !reply || modbus_reply_exception(ctx_.get(), query, static_cast<unsigned>(code)) != -1;
+      return !reply || send_reply([&] {
+        return modbus_reply_exception(ctx_.get(), query, static_cast<unsigned>(code));
+      });
     case FaultSchedule::Fault::none:
       break;
   }
@@ -284,12 +311,12 @@ bool ModbusServer::handle(const std::uint8_t* query, int len, bool reply) {
   const std::span<const std::uint8_t> pdu(query + header,
                                           static_cast<std::size_t>(len - header - crc));
   if (const std::uint8_t e = strict_exception(pdu); e != 0)
-    return !reply || modbus_reply_exception(ctx_.get(), query, e) != -1;
+    return !reply || send_reply([&] { return modbus_reply_exception(ctx_.get(), query, e); });
   model_.publish(*mapping_);
   // Apply a write to the model BEFORE the reply leaves, so a client that has its reply sees the
   // model already changed (no race with the next step_to()).
   apply_writes(pdu);
-  return !reply || modbus_reply(ctx_.get(), query, len, mapping_.get()) != -1;
+  return !reply || send_reply([&] { return modbus_reply(ctx_.get(), query, len, mapping_.get()); });
 }
 
 std::uint8_t ModbusServer::strict_exception(std::span<const std::uint8_t> pdu) const {

@@ -7,6 +7,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -16,6 +17,7 @@
 #include <vector>
 
 #include "drivers/modbus/register_map.hpp"
+#include "sim_devices/servers/drip_queue.hpp"
 #include "sim_devices/servers/fault_schedule.hpp"
 #include "sim_devices/servers/modbus_strict.hpp"
 #include "sim_devices/servers/sim_server.hpp"
@@ -100,6 +102,10 @@ class ModbusServer final : public SimServer {
   bool forget(int fd);  ///< drops a client's partial frame; false (close it)
   bool dispatch(const std::uint8_t* query, int len, double arrived_s);
   bool handle(const std::uint8_t* query, int len, bool reply);
+  /// Sends the reply `build` makes (a libmodbus modbus_reply*): at once, or a byte at a time
+  /// while a drip is on (or queued behind one), captured from a socketpair first.
+  bool send_reply(const std::function<int()>& build);
+  void open_capture();
   std::uint8_t strict_exception(std::span<const std::uint8_t> pdu) const;
   void apply_writes(std::span<const std::uint8_t> pdu);
 
@@ -120,6 +126,8 @@ class ModbusServer final : public SimServer {
   std::vector<double> arrivals_s_;  // guarded by arrivals_mutex_
   std::thread thread_;
   std::map<int, std::vector<std::uint8_t>> pending_;  // per TCP client: bytes of a partial frame
+  int capture_[2] = {-1, -1};                         // socketpair a dripped reply is built into
+  DripQueue drips_;
 };
 
 }  // namespace station::sim

@@ -43,10 +43,16 @@ class SimServer {
   void refuse_for(double seconds, int code) { faults_.refuse_for(seconds, code); }
   /// Every request in the next `seconds` gets no reply; 0 ends a stall.
   void stall_for(double seconds) { faults_.stall_for(seconds); }
+  /// Every reply sent in the next `seconds` leaves one byte every `byte_interval_s` (a slow
+  /// proxy or a line that drips), the replies behind it queued in order; 0 s ends it (bytes
+  /// already queued still drip).
+  void drip_for(double seconds, double byte_interval_s) {
+    faults_.drip_for(seconds, byte_interval_s);
+  }
   /// Closes every connection now and refuses new ones for `seconds` (a powered-off device; a
   /// serial line is silent), then listens again on the same port.
   void disconnect_for(double seconds) { faults_.disconnect_for(seconds); }
-  /// Ends every injected fault (timeouts, exceptions, drops, stall, disconnect).
+  /// Ends every injected fault (timeouts, exceptions, drops, stall, drip, disconnect).
   void clear_faults() { faults_.clear(); }
 
   /// Returns once the server thread has done what the schedule says for now: every disconnect
