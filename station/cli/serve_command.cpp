@@ -220,8 +220,8 @@ std::unique_ptr<fleet::ForwarderThread> start_forwarder(const ServeOptions& o,
       fleet::ForwardOptions{config.fleet->samples, 50'000, config.name}, config.fleet->interval_s,
       [&live](const fleet::ForwarderStatus& f) {
         live.hub().fleet(f.to_json());
-        live.hub().metrics().fleet(f.backlog.runs, f.backlog.rows, f.last_success_unix_s,
-                                   f.errors_total);
+        live.hub().metrics().fleet({f.state, f.waiting_s, f.backlog.runs, f.backlog.rows,
+                                    f.last_success_unix_s, f.errors_total});
       });
 }
 

@@ -1,9 +1,12 @@
 // `station sync [--db DB] (--pg URL | --config FILE) [--init] [--samples]`: forwards what the
 // station's database holds to the fleet's PostgreSQL once, until nothing is pending (the
 // forwarder `serve` runs on its own thread, station/fleet/forwarder.hpp). --init creates or
-// migrates the central schema first. Exit 0: everything acknowledged; 1: the server refused
-// items (each outbox row says why) or could not be reached; 2: bad input.
+// migrates the central schema first. Every server call has a deadline (fleet/pg.hpp): a server
+// that stops answering ends the command with the call that timed out. Exit 0: everything
+// acknowledged; 1: the server refused items (each outbox row says why), could not be reached or
+// did not answer in time; 2: bad input.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -24,6 +27,7 @@ struct SyncOptions {
   std::string db, pg, config, station;
   bool init = false, samples = false, json = false, retry_held = false;
   std::int64_t batch_rows = 50'000;
+  std::optional<double> timeout_s;  ///< --timeout-s, else [fleet] timeout_s, else 60 s
 };
 
 /// The newest run's station name: what a fit with no runs left in the file is filed under.
@@ -53,6 +57,7 @@ Resolved resolve(const SyncOptions& o, Store* store) {
   if (r.target.url.empty()) throw InputError("--pg URL or --config FILE with [fleet] is required");
   r.forward.samples = r.forward.samples || o.samples;
   r.forward.batch_rows = o.batch_rows;
+  if (o.timeout_s) r.target.statement_timeout_s = *o.timeout_s;
   if (!o.station.empty()) r.forward.station = o.station;
   if (r.forward.station.empty() && store) r.forward.station = recorded_station(*store);
   return r;
@@ -66,9 +71,11 @@ int run_sync(const SyncOptions& o) {
   const Resolved r = resolve(o, store ? &*store : nullptr);
   if (o.init) {
     fleet::PgConnection pg(r.target);
-    const int before = fleet::init_fleet_schema(pg);
-    fmt::print(stderr, "fleet schema on {}: version {} -> {}\n", pg.where(), before,
-               fleet::fleet_schema_version());
+    std::vector<std::string> recreated;
+    const int before = fleet::init_fleet_schema(pg, &recreated);
+    fmt::print(stderr, "fleet schema on {}: version {} -> {}{}{}\n", pg.where(), before,
+               fleet::fleet_schema_version(),
+               recreated.empty() ? "" : "; re-created missing: ", fmt::join(recreated, ", "));
     if (o.db.empty()) return 0;
   }
   fleet::Forwarder fwd(o.db, r.target, r.forward);
@@ -110,8 +117,8 @@ void add_sync_command(CLI::App& app, CommandStatus& status) {
   cmd->footer(exit_status_footer(
       {{kExitOk, "everything pending was acknowledged by the server"},
        {kExitFailure,
-        "the server could not be reached, refused items, or holds a newer state of some "
-        "(a restored file: held)"}}));
+        "the server could not be reached, did not answer a call in time (--timeout-s), refused "
+        "items, or holds a newer state of some (a restored file: held)"}}));
   cmd->add_option("--db", o->db, "SQLite database of the station (optional with --init)");
   cmd->add_option("--pg", o->pg, "libpq connection URL (no password: PGPASSWORD or a passfile)");
   cmd->add_option("--config", o->config, "station configuration with a [fleet] table");
@@ -122,6 +129,10 @@ void add_sync_command(CLI::App& app, CommandStatus& status) {
                 "check items held (the server had a newer state) again");
   cmd->add_option("--batch-rows", o->batch_rows, "appended rows per transaction")
       ->check(CLI::Range(1, 10'000'000));
+  cmd->add_option("--timeout-s", o->timeout_s,
+                  "longest one server call may take ([fleet] timeout_s, default 60): the client "
+                  "gives up a little later, cancels it and exits 1 naming the call")
+      ->check(CLI::Range(0.5, 3600.0));
   cmd->add_flag("--json", o->json, "print the totals as JSON");
   cmd->callback([o, &status] { status.exit_code = run_sync(*o); });
 }

@@ -36,8 +36,8 @@ std::optional<std::string> pg_url_problem(const std::string& url) {
 }
 
 FleetConfig read_fleet_config(const TomlView& t, const std::string& path) {
-  t.allow_only({"pg", "password_file", "samples", "interval_s", "sslmode", "sslrootcert", "sslcert",
-                "sslkey", "sslcrl"});
+  t.allow_only({"pg", "password_file", "samples", "interval_s", "timeout_s", "sslmode",
+                "sslrootcert", "sslcert", "sslkey", "sslcrl"});
   FleetConfig f;
   f.pg = t.get_string("pg");
   if (auto why = pg_url_problem(f.pg)) throw t.error("pg", *why);
@@ -64,6 +64,7 @@ FleetConfig read_fleet_config(const TomlView& t, const std::string& path) {
   }
   f.samples = t.opt_bool("samples").value_or(f.samples);
   f.interval_s = t.opt_number_in("interval_s", 0.1, 3600.0, "s").value_or(f.interval_s);
+  f.timeout_s = t.opt_number_in("timeout_s", 0.5, 3600.0, "s").value_or(f.timeout_s);
   return f;
 }
 

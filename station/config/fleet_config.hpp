@@ -19,6 +19,9 @@ struct FleetConfig {
   std::vector<std::pair<std::string, std::string>> keywords;
   bool samples = false;     ///< forward the 1 Hz samples as well
   double interval_s = 5.0;  ///< pause between passes when nothing is pending, s
+  /// The longest one server call may take, s: the server's statement_timeout; the station gives
+  /// up a little later (PgTarget::call_timeout_s), cancels, reconnects after a back-off.
+  double timeout_s = 60.0;
 };
 
 /// Why `url` cannot be used (does not parse, or holds a password), empty when it can.

@@ -101,20 +101,57 @@ void stage_rows(PgConnection& pg, const FleetTable& t, const EncodedRows& rows) 
 
 // A staged row the server already holds with other content (or, for an item, at a higher
 // revision, or at the same revision with other content): the file and the server no longer
-// share a past.
-std::int64_t count_diverged(PgConnection& pg, const FleetTable& t) {
+// share a past. The first such row is named by its key, with the columns that differ
+// (array_to_string leaves out the NULLs of the columns that agree).
+std::optional<std::string> first_diverged(PgConnection& pg, const FleetTable& t) {
   const auto key = split_columns(t.key);
-  std::string on;
-  for (const auto& k : key) on += fmt::format("{0}s.{1} = c.{1}", on.empty() ? "" : " AND ", k);
+  std::string on, key_text;
+  for (const auto& k : key) {
+    on += fmt::format("{0}s.{1} = c.{1}", on.empty() ? "" : " AND ", k);
+    key_text += fmt::format("{0}'{1}=', s.{1}", key_text.empty() ? "" : ", ', ', ", k);
+  }
   const auto rest = non_key(t);
+  std::string which;
+  for (const auto& c : rest)
+    if (c != "rev")
+      which += fmt::format("{0}CASE WHEN s.{1} IS DISTINCT FROM c.{1} THEN '{1}' END",
+                           which.empty() ? "" : ", ", c);
   const std::string differs =
       fmt::format("({}) IS DISTINCT FROM ({})", prefixed(rest, "s."), prefixed(rest, "c."));
   const std::string when =
       has_rev(t) ? fmt::format("c.rev > s.rev OR (c.rev = s.rev AND {})", differs) : differs;
-  return pg
-      .exec(fmt::format("SELECT count(*) FROM stage_{0} AS s JOIN {0} AS c ON {1} WHERE {2}",
-                        t.name, on, when))
-      .integer(0, 0);
+  const std::string revs = has_rev(t) ? "c.rev, s.rev" : "0, 0";
+  auto r = pg.exec(fmt::format(
+      "SELECT concat({3}), array_to_string(ARRAY[{4}], ', '), {5} FROM stage_{0} AS s JOIN {0} "
+      "AS c ON {1} WHERE {2} LIMIT 1",
+      t.name, on, when, key_text, which, revs));
+  if (r.rows() == 0) return std::nullopt;
+  const std::string row = fmt::format("the server's {} row ({})", t.name, r.text(0, 0));
+  if (r.integer(0, 2) > r.integer(0, 3))
+    return fmt::format("{} is at revision {}, this file's at {}", row, r.integer(0, 2),
+                       r.integer(0, 3));
+  return fmt::format("{} differs from this file's in {}", row, r.text(0, 1));
+}
+
+std::optional<std::string> station_name_taken(PgConnection& pg, const FleetTable& t,
+                                              const std::string& station_uuid) {
+  pg.exec(fmt::format("INSERT INTO stations (name, station_uuid) SELECT DISTINCT station, "
+                      "$1::uuid FROM stage_{} ON CONFLICT (name) DO NOTHING",
+                      t.name),
+          {station_uuid});
+  auto r = pg.exec(
+      fmt::format("SELECT st.name, st.station_uuid, $1::uuid FROM stations AS st WHERE st.name "
+                  "IN (SELECT station FROM stage_{}) AND st.station_uuid <> $1::uuid "
+                  "ORDER BY 1 LIMIT 1",
+                  t.name),
+      {station_uuid});
+  if (r.rows() == 0) return std::nullopt;
+  return fmt::format(
+      "station name '{}' is held on the fleet server by station identity {}, and this file is "
+      "station identity {}: two stations under one [station] name would merge into one history; "
+      "refused, nothing of it written (give this station its own [station] name; a station moved "
+      "to a new file is released by deleting its row in the central `stations` table)",
+      r.text(0, 0), r.text(0, 1), r.text(0, 2));
 }
 
 std::int64_t merge_staged(PgConnection& pg, const FleetTable& t, const std::string& run_uuid) {

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "station/fleet/fleet_tables.hpp"
@@ -26,10 +27,16 @@ EncodedRows encode_rows(Statement& st, int watermark_col = -1);
 
 /// Copies `rows` into the transaction's staging table for `t` (emptied first).
 void stage_rows(PgConnection& pg, const FleetTable& t, const EncodedRows& rows);
-/// Staged rows the server holds with other content — or, for an item's own row (it has `rev`),
-/// at a higher revision or at the same one with other content: the station's file and the
-/// server have parted (a restored backup, a copied file).
-std::int64_t count_diverged(PgConnection& pg, const FleetTable& t);
+/// The first staged row the server holds with other content — or, for an item's own row (it has
+/// `rev`), at a higher revision or at the same one with other content: the station's file and
+/// the server have parted (a restored backup, a copied file, a row edited on the server). Says
+/// which: "the server's events row (run_uuid=…, local_id=12) differs from this file's in
+/// message"; empty when none.
+std::optional<std::string> first_diverged(PgConnection& pg, const FleetTable& t);
+/// Binds each station name of the staged item rows of `t` to `station_uuid` where the name is
+/// free (central `stations`); says which name another station identity holds, empty when none.
+std::optional<std::string> station_name_taken(PgConnection& pg, const FleetTable& t,
+                                              const std::string& station_uuid);
 /// Merges the staged rows into `t` by its Merge rule inside the caller's transaction; returns
 /// the rows the server inserted or changed. `run_uuid` scopes a replace_set's deletions.
 std::int64_t merge_staged(PgConnection& pg, const FleetTable& t, const std::string& run_uuid);

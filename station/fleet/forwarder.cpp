@@ -51,9 +51,9 @@ struct ItemRefused : std::runtime_error {
 };
 
 ItemRefused held(Item item, std::int64_t local_id, const std::string& what) {
-  return ItemRefused(fmt::format("{} {}: the server holds {} (restored from a backup?); held, "
-                                 "nothing of it written (`station sync --retry-held` checks "
-                                 "again)",
+  return ItemRefused(fmt::format("{} {}: {} (this file restored from a backup, or the server's "
+                                 "row edited?); held, nothing of it written (`station sync "
+                                 "--retry-held` checks again)",
                                  item_name(item), local_id, what),
                      true);
 }
@@ -97,22 +97,18 @@ double next_backoff_s(double previous_s) {
 void Forwarder::open() {
   if (!read_) read_.emplace(db_path_, OpenMode::read_only);
   if (!write_) write_.emplace(db_path_, OpenMode::existing);
-  if (!pg_) {
-    std::lock_guard lock(pg_mu_);
-    pg_.emplace(target_);
+  if (identity_.empty()) {
+    auto id = read_->prepare("SELECT uuid FROM station_identity");
+    if (!id.step()) throw SqliteError(db_path_ + ": no station identity (migration 10)");
+    identity_ = id.column_text(0);
   }
+  if (!pg_) pg_.emplace(target_, watch_);
   // Every pass: a server migrated meanwhile is seen (a cheap query).
   require_fleet_schema(*pg_);
 }
 
 void Forwarder::disconnect() {
-  std::lock_guard lock(pg_mu_);
   pg_.reset();
-}
-
-void Forwarder::cancel() {
-  std::lock_guard lock(pg_mu_);
-  if (pg_) pg_->cancel();
 }
 
 void Forwarder::release_held() {
@@ -194,8 +190,9 @@ std::string Forwarder::send_item_row(Item item, std::int64_t local_id, Sent& sen
                                   item_name(item), local_id),
                       false);
   stage_rows(*pg_, t, rows);
-  if (count_diverged(*pg_, t) > 0)
-    throw held(item, local_id, "a newer or different state of it than this file");
+  if (const auto taken = station_name_taken(*pg_, t, identity_))
+    throw ItemRefused(fmt::format("{} {}: {}", item_name(item), local_id, *taken), false);
+  if (const auto diverged = first_diverged(*pg_, t)) throw held(item, local_id, *diverged);
   sent.rows += merge_staged(*pg_, t, {});
   auto u = read_->prepare(fmt::format("SELECT uuid FROM {} WHERE id = ?", t.name));
   u.bind(1, local_id);
@@ -223,10 +220,11 @@ void Forwarder::append_from(const FleetTable& t, Statement& st, std::optional<do
                             std::optional<double>& reached) {
   const auto rows = encode_rows(st, mark_col);
   if (mark && rows.first != mark)
-    throw held(Item::run, run_id, fmt::format("{} this file does not have", t.name));
+    throw held(Item::run, run_id,
+               fmt::format("the server holds {} this file does not have", t.name));
   stage_rows(*pg_, t, rows);
-  if (mark && count_diverged(*pg_, t) > 0)
-    throw held(Item::run, run_id, fmt::format("other {} than this file", t.name));
+  if (const auto diverged = mark ? first_diverged(*pg_, t) : std::nullopt)
+    throw held(Item::run, run_id, *diverged);
   const std::int64_t fresh = rows.rows - (mark ? 1 : 0);
   sent.appended += fresh;
   budget -= fresh;
@@ -319,10 +317,10 @@ void Forwarder::record_error(Item item, std::int64_t local_id, const std::string
 // Rows behind the pending runs, by index ranges only: events by id, samples per serial by t_s
 // (the samples' key is run, serial, t_s) — no scan of what was sent.
 Backlog Forwarder::backlog() {
-  if (!read_) read_.emplace(db_path_, OpenMode::read_only);
-  ReadSnapshot snap(*read_);
+  if (!count_) count_.emplace(db_path_, OpenMode::read_only);
+  ReadSnapshot snap(*count_);
   Backlog b;
-  auto n = read_->prepare(
+  auto n = count_->prepare(
       "SELECT count(*) FILTER (WHERE item = 'run' AND held_reason IS NULL), "
       "count(*) FILTER (WHERE held_reason IS NULL), count(*) FILTER (WHERE held_reason IS NOT "
       "NULL) FROM fleet_outbox WHERE acked < changes OR (?1 AND item = 'run' AND samples_done = "
@@ -332,7 +330,7 @@ Backlog Forwarder::backlog() {
   b.runs = n.column_int(0);
   b.items = n.column_int(1);
   b.held = n.column_int(2);
-  auto rows = read_->prepare(
+  auto rows = count_->prepare(
       "SELECT coalesce(sum((SELECT count(*) FROM events AS e WHERE e.run_id = o.local_id AND "
       "e.id > coalesce(o.events_acked_id, 0)) + CASE WHEN ?1 THEN (SELECT count(*) FROM "
       "run_slots AS rs JOIN samples AS s ON s.run_id = rs.run_id AND s.serial = rs.serial AND "

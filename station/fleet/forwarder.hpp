@@ -11,7 +11,6 @@
 
 #include <cstdint>
 #include <functional>
-#include <mutex>
 #include <optional>
 #include <string>
 
@@ -30,7 +29,7 @@ struct ForwardOptions {
 
 /// Where [fleet] says to connect.
 inline PgTarget fleet_target(const FleetConfig& f) {
-  return {f.pg, f.keywords};
+  return {f.pg, f.keywords, kPgConnectTimeoutS, f.timeout_s};
 }
 
 /// What is still to send.
@@ -70,12 +69,12 @@ class Forwarder {
   /// fault. An item the server refuses, or holds a newer state of, is recorded in the outbox and
   /// the pass goes on.
   PassResult pass(std::int64_t max_items = 100, const std::function<bool()>& stop = {});
-  /// Reads the outbox (no server needed).
+  /// Reads the outbox (no server needed; its own connection, so a wait inside a pass may ask).
   Backlog backlog();
+  /// What the server connection's waits look at (a stop, a slow call): from the next connect.
+  void set_watch(PgWatch watch) { watch_ = std::move(watch); }
   /// Drops the server connection (the next pass reconnects).
   void disconnect();
-  /// Cancels the statement in flight (from another thread: a stopping service).
-  void cancel();
   /// Forwards held items again (`station sync --retry-held`): each is checked anew.
   void release_held();
 
@@ -104,9 +103,10 @@ class Forwarder {
   std::string db_path_;
   PgTarget target_;
   ForwardOptions options_;
-  std::optional<Database> read_, write_;
+  std::optional<Database> read_, write_, count_;
   std::optional<PgConnection> pg_;
-  std::mutex pg_mu_;  ///< guards pg_'s lifetime against cancel() from another thread
+  PgWatch watch_;
+  std::string identity_;  ///< the station's identity (station_identity.uuid, migration 10)
 };
 
 }  // namespace station::fleet

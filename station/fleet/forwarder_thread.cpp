@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include "station/common/logging.hpp"
 
@@ -17,6 +18,8 @@ nlohmann::json ForwarderStatus::to_json() const {
            last_success_unix_s > 0 ? nlohmann::json(last_success_unix_s) : nlohmann::json()},
           {"last_error", last_error},
           {"backoff_s", backoff_s},
+          {"waiting_s", waiting_s},
+          {"waiting_for", waiting_for},
           {"items_total", items_total},
           {"rows_total", rows_total},
           {"errors_total", errors_total}};
@@ -29,11 +32,11 @@ ForwarderThread::ForwarderThread(std::string db_path, PgTarget target, ForwardOp
       on_status_(std::move(on_status)),
       thread_([this](std::stop_token stop) { loop(stop); }) {}
 
-// A pass in flight is cut short: the stop is checked between items and the statement in flight
-// is cancelled, so a slow server cannot hold the service's shutdown.
+// A pass in flight is cut short: the stop is checked between items and by every wait on the
+// server (PgWatch), which cancels the call in flight, so a frozen server cannot hold the
+// service's shutdown (systemd's TimeoutStopSec, station/package/gyro-station.service).
 ForwarderThread::~ForwarderThread() {
   thread_.request_stop();
-  forwarder_.cancel();
   cv_.notify_all();
 }
 
@@ -60,14 +63,34 @@ bool ForwarderThread::pause(std::stop_token& stop, double seconds) {
   return !stop.stop_requested();
 }
 
+// A call unanswered for kPgSlowCallS: said as it is, with the backlog counted again every 5 s
+// (the run goes on adding to it; the count has its own SQLite connection).
+void ForwarderThread::waiting(ForwarderStatus& s, double waited_s, std::string_view what) {
+  if (s.state != "waiting on server" || waited_s - s.waiting_s >= 5) {
+    try {
+      s.backlog = forwarder_.backlog();
+    } catch (const std::exception&) {  // the local file answers later
+    }
+  }
+  s.state = "waiting on server";
+  s.waiting_s = std::floor(waited_s);
+  s.waiting_for = std::string(what.substr(0, std::min<std::size_t>(48, what.find('\n'))));
+  publish(s);
+}
+
 void ForwarderThread::loop(std::stop_token stop) {
   ForwarderStatus s;
   std::string logged_error;
+  forwarder_.set_watch(
+      {[stop] { return stop.stop_requested(); },
+       [this, &s](double waited_s, std::string_view what) { waiting(s, waited_s, what); }});
   auto backlog_at = std::chrono::steady_clock::time_point{};
   while (!stop.stop_requested()) {
     double wait_s = interval_s_;
     try {
       const PassResult p = forwarder_.pass(100, [&stop] { return stop.stop_requested(); });
+      s.waiting_s = 0;
+      s.waiting_for.clear();
       s.items_total += p.items;
       s.rows_total += p.rows;
       s.errors_total += p.failed;
@@ -87,6 +110,9 @@ void ForwarderThread::loop(std::stop_token stop) {
       logged_error = p.failed > 0 ? p.last_error : "";
     } catch (const std::exception& e) {
       forwarder_.disconnect();
+      if (stop.stop_requested()) break;  // the call given up for the stop: nothing to report
+      s.waiting_s = 0;
+      s.waiting_for.clear();
       s.backoff_s = next_backoff_s(s.backoff_s);
       s.state = "backing off";
       s.last_error = e.what();

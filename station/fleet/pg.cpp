@@ -1,13 +1,26 @@
-// libpq calls: PQconnectdbParams, PQexec / PQexecParams, COPY via PQputCopyData / PQputCopyEnd /
-// PQgetResult (postgresql.org/docs/15/libpq-copy.html).
+// libpq calls, all non-blocking under a deadline (pg.hpp): PQconnectStartParams / PQconnectPoll,
+// PQsendQuery / PQsendQueryParams with PQflush, PQconsumeInput, PQisBusy and PQgetResult
+// (postgresql.org/docs/15/libpq-async.html), COPY via PQputCopyData / PQputCopyEnd
+// (libpq-copy.html), PQcancel (libpq-cancel.html).
 #include "station/fleet/pg.hpp"
 
 #include <fmt/format.h>
+#include <poll.h>
 
+#include <cerrno>
+#include <cmath>
 #include <cstdlib>
+#include <future>
+#include <thread>
 
 namespace station::fleet {
 namespace {
+
+using Clock = std::chrono::steady_clock;
+
+Clock::duration seconds(double s) {
+  return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
+}
 
 std::string trimmed(const char* msg) {
   std::string s = msg != nullptr ? msg : "";
@@ -53,19 +66,21 @@ std::string url_options(const std::string& url) {
 // Keywords before "dbname" are defaults the URL may override; the configured ones come after it
 // and win (expand_dbname = 1: "later keywords override", libpq-connect.html, PQconnectdbParams).
 // client_min_messages: a NOTICE ("stage table exists, skipping") is not for the operator.
-PgConnection::PgConnection(const PgTarget& t) {
-  const std::string timeout = std::to_string(t.connect_timeout_s);
+// connect_timeout is ignored by PQconnectPoll (libpq-connect.html): the loop below keeps it.
+PgConnection::PgConnection(const PgTarget& t, PgWatch watch)
+    : call_timeout_s_(t.call_timeout_s()), watch_(std::move(watch)) {
   std::string options = url_options(t.url);
   options += fmt::format("{}-c statement_timeout={} -c client_min_messages=warning",
-                         options.empty() ? "" : " ", t.statement_timeout_ms);
+                         options.empty() ? "" : " ",
+                         static_cast<long long>(std::ceil(t.statement_timeout_s * 1000)));
+  const long long user_timeout_ms = std::llround(t.call_timeout_s() * 1000);
   std::vector<std::pair<std::string, std::string>> kv = {
-      {"connect_timeout", timeout},
       {"application_name", "gyro-station"},
       {"keepalives", "1"},
       {"keepalives_idle", "30"},
       {"keepalives_interval", "10"},
       {"keepalives_count", "3"},
-      {"tcp_user_timeout", std::to_string(t.connect_timeout_s * 3000)},
+      {"tcp_user_timeout", std::to_string(user_timeout_ms)},
       {"dbname", t.url}};
   kv.insert(kv.end(), t.keywords.begin(), t.keywords.end());
   kv.emplace_back("options", options);
@@ -77,32 +92,159 @@ PgConnection::PgConnection(const PgTarget& t) {
   }
   keys.push_back(nullptr);
   values.push_back(nullptr);
-  conn_.reset(PQconnectdbParams(keys.data(), values.data(), 1));
+  conn_.reset(PQconnectStartParams(keys.data(), values.data(), 1));
   if (!conn_) throw PgError("PostgreSQL: out of memory");
-  const char* host = PQhost(conn_.get());
-  where_ =
-      fmt::format("{}:{}/{}", host != nullptr ? host : "?", PQport(conn_.get()), PQdb(conn_.get()));
-  if (PQstatus(conn_.get()) != CONNECTION_OK)
-    throw PgError(fmt::format("PostgreSQL {}: {}", where_, trimmed(PQerrorMessage(conn_.get()))));
-  cancel_.reset(PQgetCancel(conn_.get()));
+  connect(t);
 }
 
-void PgConnection::cancel() const {
-  char err[256];
-  if (cancel_) PQcancel(cancel_.get(), err, sizeof err);
+// The PQconnectPoll loop (libpq-connect.html): start as if it had said "writing", then wait on
+// the socket for what it asks, until OK or FAILED; the socket may change between calls (another
+// host of a list), so it is read again each time.
+void PgConnection::connect(const PgTarget& t) {
+  const auto started = Clock::now();
+  const auto deadline = started + seconds(t.connect_timeout_s);
+  auto st = PQstatus(conn_.get()) == CONNECTION_BAD ? PGRES_POLLING_FAILED : PGRES_POLLING_WRITING;
+  while (st != PGRES_POLLING_OK && st != PGRES_POLLING_FAILED) {
+    set_where();
+    wait_socket(st == PGRES_POLLING_WRITING, deadline, "connect", started);
+    st = PQconnectPoll(conn_.get());
+  }
+  set_where();
+  if (st == PGRES_POLLING_FAILED || PQstatus(conn_.get()) != CONNECTION_OK)
+    throw PgError(fmt::format("PostgreSQL {}: {}", where_, trimmed(PQerrorMessage(conn_.get()))));
+  if (PQsetnonblocking(conn_.get(), 1) != 0) lost("set non-blocking");
+  cancel_.reset(PQgetCancel(conn_.get()), PgFreeCancel{});
+}
+
+void PgConnection::set_where() {
+  const char* host = PQhost(conn_.get());
+  const char* port = PQport(conn_.get());
+  const char* db = PQdb(conn_.get());
+  where_ = fmt::format("{}:{}/{}", host != nullptr ? host : "?", port != nullptr ? port : "?",
+                       db != nullptr ? db : "?");
+}
+
+// PQcancel blocks until the postmaster has read the request and closed the connection; it runs
+// on a thread of its own holding the PGcancel, so a postmaster that never answers costs a thread
+// until the process ends, never the caller's deadline.
+bool PgConnection::cancel() const {
+  if (!cancel_) return false;
+  auto done = std::make_shared<std::promise<void>>();
+  auto answered = done->get_future();
+  std::thread([c = cancel_, done] {
+    char err[256];
+    PQcancel(c.get(), err, sizeof err);
+    done->set_value();
+  }).detach();
+  return answered.wait_for(seconds(kPgCancelTimeoutS)) == std::future_status::ready;
+}
+
+// Past the deadline (or stopping): cancel, close (PQfinish on a non-blocking connection does not
+// wait to send its Terminate), and say what went unanswered. The server rolls back what was open.
+void PgConnection::abandon(std::string_view what, bool stopping, double limit_s) {
+  const bool cancelled = conn_ && cancel();
+  conn_.reset();
+  const std::string call(what.substr(0, 60));
+  if (stopping) throw PgTimeout(fmt::format("PostgreSQL {}: {} given up: stopping", where_, call));
+  throw PgTimeout(fmt::format(
+      "PostgreSQL {}: {}: timed out, no answer within {:.1f} s (server frozen, overloaded or cut "
+      "off?); {}, disconnected",
+      where_, call, limit_s, cancelled ? "cancelled" : "cancel unanswered"));
+}
+
+void PgConnection::lost(std::string_view what) {
+  const std::string msg = conn_ ? trimmed(PQerrorMessage(conn_.get())) : "connection closed";
+  conn_.reset();
+  throw PgError(fmt::format("PostgreSQL {}: {}: {}", where_, what.substr(0, 60), msg));
+}
+
+PGconn* PgConnection::live(std::string_view what) {
+  if (!conn_) throw PgError(fmt::format("PostgreSQL {}: {}: connection closed", where_, what));
+  return conn_.get();
+}
+
+PgConnection::Deadline PgConnection::call_deadline() const {
+  return Clock::now() + seconds(call_timeout_s_);
+}
+
+void PgConnection::wait_socket(bool write, Deadline deadline, std::string_view what,
+                               Deadline started) {
+  for (double next_report_s = kPgSlowCallS;;) {
+    if (watch_.stop && watch_.stop()) abandon(what, true, 0);
+    const auto now = Clock::now();
+    if (now >= deadline)
+      abandon(what, false, std::chrono::duration<double>(deadline - started).count());
+    const double waited_s = std::chrono::duration<double>(now - started).count();
+    if (waited_s >= next_report_s && watch_.waiting) {
+      watch_.waiting(waited_s, what);
+      next_report_s = waited_s + 1;
+    }
+    const auto slice = std::min<Clock::duration>(deadline - now, seconds(kPgPollSliceS));
+    pollfd p{PQsocket(conn_.get()), static_cast<short>(POLLIN | (write ? POLLOUT : 0)), 0};
+    if (p.fd < 0) lost(what);
+    const int ms = static_cast<int>(std::chrono::ceil<std::chrono::milliseconds>(slice).count());
+    const int n = ::poll(&p, 1, ms);
+    if (n > 0) return;
+    if (n < 0 && errno != EINTR) lost(what);
+  }
+}
+
+// PQflush until the output is sent; reading what the server sends meanwhile (it may wait for us
+// to read before it reads, libpq-async.html, PQflush).
+void PgConnection::flush(Deadline deadline, std::string_view what, Deadline started) {
+  for (;;) {
+    const int f = PQflush(live(what));
+    if (f == 0) return;
+    if (f < 0) lost(what);
+    wait_socket(true, deadline, what, started);
+    if (PQconsumeInput(conn_.get()) == 0) lost(what);
+  }
+}
+
+PGresult* PgConnection::next_result(Deadline deadline, std::string_view what, Deadline started) {
+  while (PQisBusy(live(what)) != 0) {
+    wait_socket(false, deadline, what, started);
+    if (PQconsumeInput(conn_.get()) == 0) lost(what);
+  }
+  return PQgetResult(conn_.get());
+}
+
+// Like PQexec: every result is read; the first error is the call's, else the last result (a COPY
+// stops at its COPY_IN result: the data follows).
+PgResult PgConnection::run(std::string_view what, const std::function<int(PGconn*)>& send) {
+  const auto started = Clock::now();
+  const auto deadline = call_deadline();
+  if (send(live(what)) != 1) lost(what);
+  flush(deadline, what, started);
+  std::unique_ptr<PGresult, PgClear> kept, failed;
+  while (PGresult* r = next_result(deadline, what, started)) {
+    const auto status = PQresultStatus(r);
+    if (status != PGRES_COMMAND_OK && status != PGRES_TUPLES_OK && status != PGRES_COPY_IN) {
+      if (!failed)
+        failed.reset(r);
+      else
+        PQclear(r);
+    } else {
+      kept.reset(r);
+    }
+    if (status == PGRES_COPY_IN) break;
+  }
+  return check(failed ? failed.release() : kept.release(), what);
 }
 
 PgResult PgConnection::check(PGresult* raw, std::string_view what) {
   PgResult r(raw);
   const auto status = raw != nullptr ? PQresultStatus(raw) : PGRES_FATAL_ERROR;
   if (status == PGRES_COMMAND_OK || status == PGRES_TUPLES_OK || status == PGRES_COPY_IN) return r;
-  const char* msg = raw != nullptr ? PQresultErrorMessage(raw) : PQerrorMessage(conn_.get());
+  const char* msg = raw != nullptr ? PQresultErrorMessage(raw)
+                    : conn_        ? PQerrorMessage(conn_.get())
+                                   : "connection closed";
   throw PgError(fmt::format("PostgreSQL {}: {}: {}", where_, what.substr(0, 60), trimmed(msg)));
 }
 
 PgResult PgConnection::exec(std::string_view sql) {
   const std::string text(sql);
-  return check(PQexec(conn_.get(), text.c_str()), sql);
+  return run(sql, [&text](PGconn* c) { return PQsendQuery(c, text.c_str()); });
 }
 
 PgResult PgConnection::exec(std::string_view sql,
@@ -110,24 +252,42 @@ PgResult PgConnection::exec(std::string_view sql,
   const std::string text(sql);
   std::vector<const char*> values;
   for (const auto& p : params) values.push_back(p ? p->c_str() : nullptr);
-  return check(PQexecParams(conn_.get(), text.c_str(), static_cast<int>(values.size()), nullptr,
-                            values.data(), nullptr, nullptr, 0),
-               sql);
+  return run(sql, [&](PGconn* c) {
+    return PQsendQueryParams(c, text.c_str(), static_cast<int>(values.size()), nullptr,
+                             values.data(), nullptr, nullptr, 0);
+  });
 }
 
+// The data goes in pieces (PQputCopyData returns 0 while libpq's buffer is full on a
+// non-blocking connection: wait until the socket takes more), then PQputCopyEnd, then the
+// COPY's own result, all under one deadline.
 long long PgConnection::copy_in(std::string_view table_and_columns, std::string_view data) {
   const std::string sql = fmt::format("COPY {} FROM STDIN", table_and_columns);
-  check(PQexec(conn_.get(), sql.c_str()), sql);
-  if (PQputCopyData(conn_.get(), data.data(), static_cast<int>(data.size())) != 1 ||
-      PQputCopyEnd(conn_.get(), nullptr) != 1) {
-    throw PgError(
-        fmt::format("PostgreSQL {}: {}: {}", where_, sql, trimmed(PQerrorMessage(conn_.get()))));
+  exec(sql);
+  const auto started = Clock::now();
+  const auto deadline = call_deadline();
+  constexpr std::size_t kPieceBytes = 64 * 1024;
+  for (std::size_t at = 0; at < data.size();) {
+    const auto piece = data.substr(at, kPieceBytes);
+    const int put = PQputCopyData(live(sql), piece.data(), static_cast<int>(piece.size()));
+    if (put < 0) lost(sql);
+    if (put == 0) {
+      wait_socket(true, deadline, sql, started);
+      if (PQconsumeInput(conn_.get()) == 0) lost(sql);
+      continue;
+    }
+    at += piece.size();
   }
-  PGresult* raw = PQgetResult(conn_.get());
+  for (int put; (put = PQputCopyEnd(live(sql), nullptr)) != 1;) {
+    if (put < 0) lost(sql);
+    wait_socket(true, deadline, sql, started);
+  }
+  flush(deadline, sql, started);
+  PGresult* raw = next_result(deadline, sql, started);
   const long long rows = raw != nullptr ? std::atoll(PQcmdTuples(raw)) : 0;
   check(raw, sql);
   // Drain: libpq returns NULL after the last result of the COPY.
-  while (PGresult* extra = PQgetResult(conn_.get())) PQclear(extra);
+  while (PGresult* extra = next_result(deadline, sql, started)) PQclear(extra);
   return rows;
 }
 

@@ -292,7 +292,10 @@ nlohmann::json LiveHub::status_locked() const {
 // A `fleet` stream message when the forwarder's state changes, not for the time of each pass.
 void LiveHub::fleet(const nlohmann::json& forwarder) {
   const auto without_time = [](nlohmann::json j) {
-    if (j.is_object()) j.erase("last_success_unix_s");
+    if (j.is_object()) {
+      j.erase("last_success_unix_s");
+      j.erase("waiting_s");  // a wait's seconds: in /api/status, not a message each second
+    }
     return j;
   };
   std::lock_guard lock(mu_);

@@ -162,10 +162,17 @@ std::string LiveMetrics::text() const {
 }
 
 // Registered only on a station that forwards, so a scrape of one that does not shows no fleet.
-void LiveMetrics::fleet(std::int64_t pending_runs, std::int64_t pending_rows,
-                        double last_success_unix_s, std::int64_t errors_total) {
+// The state as one series per state, 1 for the current one (the Prometheus way of an enum).
+void LiveMetrics::fleet(const FleetMetrics& f) {
   std::lock_guard lock(fleet_mu_);
   if (fleet_runs_ == nullptr) {
+    auto& state = gauge(*registry_, "station_fleet_state",
+                        "The fleet forwarder's state: 1 for the current one");
+    for (const char* s : kFleetStates) fleet_states_.emplace_back(s, &state.Add({{"state", s}}));
+    fleet_waiting_ = &gauge(*registry_, "station_fleet_waiting_seconds",
+                            "How long the forwarder's call in flight has waited on the server "
+                            "(0: none waiting)")
+                          .Add({});
     fleet_runs_ = &gauge(*registry_, "station_fleet_pending_runs",
                          "Runs the fleet forwarder has not delivered in their latest state")
                        .Add({});
@@ -179,12 +186,14 @@ void LiveMetrics::fleet(std::int64_t pending_runs, std::int64_t pending_rows,
                              "Forwarder failures: server unreachable or items refused")
                          .Add({});
   }
-  fleet_runs_->Set(static_cast<double>(pending_runs));
-  fleet_rows_->Set(static_cast<double>(pending_rows));
-  fleet_success_->Set(last_success_unix_s);
-  if (errors_total > fleet_errors_seen_) {
-    fleet_errors_->Increment(static_cast<double>(errors_total - fleet_errors_seen_));
-    fleet_errors_seen_ = errors_total;
+  for (auto& [name, g] : fleet_states_) g->Set(name == f.state ? 1 : 0);
+  fleet_waiting_->Set(f.waiting_s);
+  fleet_runs_->Set(static_cast<double>(f.pending_runs));
+  fleet_rows_->Set(static_cast<double>(f.pending_rows));
+  fleet_success_->Set(f.last_success_unix_s);
+  if (f.errors_total > fleet_errors_seen_) {
+    fleet_errors_->Increment(static_cast<double>(f.errors_total - fleet_errors_seen_));
+    fleet_errors_seen_ = f.errors_total;
   }
 }
 

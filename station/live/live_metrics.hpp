@@ -13,10 +13,25 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "station/daemon/sequencer.hpp"
 
 namespace station::live {
+
+/// The fleet forwarder's states (station/fleet/forwarder_thread.hpp, schemas/api.md).
+inline constexpr const char* kFleetStates[] = {
+    "starting", "idle", "sending", "waiting on server", "backing off", "refusing items"};
+
+/// What /metrics shows of the fleet forwarder.
+struct FleetMetrics {
+  std::string state;
+  double waiting_s = 0;
+  std::int64_t pending_runs = 0, pending_rows = 0;
+  double last_success_unix_s = 0;
+  std::int64_t errors_total = 0;
+};
 
 /// Every metric of the station.
 class LiveMetrics {
@@ -37,9 +52,9 @@ class LiveMetrics {
   /// The run's gyros: per-slot series labelled by serial and CAN node (old slots' series go).
   void set_slots(const std::vector<RunSlot>& slots);
   void stream_clients(int n);
-  /// The fleet forwarder ([fleet]): backlog, last success (Unix s, 0: none), failures so far.
-  void fleet(std::int64_t pending_runs, std::int64_t pending_rows, double last_success_unix_s,
-             std::int64_t errors_total);
+  /// The fleet forwarder ([fleet]): its state, the wait in flight, backlog, last success (Unix
+  /// s, 0: none), failures so far.
+  void fleet(const FleetMetrics& f);
   /// The exposition text (format 0.0.4).
   std::string text() const;
 
@@ -79,6 +94,8 @@ class LiveMetrics {
   prometheus::Gauge* fleet_success_ = nullptr;
   prometheus::Counter* fleet_errors_ = nullptr;
   std::int64_t fleet_errors_seen_ = 0;
+  std::vector<std::pair<std::string, prometheus::Gauge*>> fleet_states_;
+  prometheus::Gauge* fleet_waiting_ = nullptr;
   std::mutex fleet_mu_;
 };
 

@@ -9,9 +9,12 @@ backs off, the backlog grows and the run goes on, and the live page (headless Ch
 it; when the server returns the backlog drains;
 after the run every sample and event of the run is in PostgreSQL exactly once and the run's
 central state is its final one; no tick was slowed (the tick histogram has no tick over 0.25 s
-and no tick was missed). Exit 0 ok, 1 failure, 77 skip (no PostgreSQL 15 server binaries).
+and no tick was missed). Then the forwarder's backend is frozen (SIGSTOP): the status and
+/metrics say it waits on the server, and SIGTERM ends serve within the unit's TimeoutStopSec. Exit 0 ok, 1 failure, 77 skip (no PostgreSQL 15 server binaries).
 """
 import os
+import shutil
+import signal
 import sqlite3
 import subprocess
 import sys
@@ -59,6 +62,51 @@ def page_shows_fleet(base, artifacts):
             driver.save_screenshot(os.path.join(artifacts, "live_page_fleet.png"))
     finally:
         driver.quit()
+
+
+def stop_timeout_s():
+    """systemd's TimeoutStopSec of the shipped unit: how long a stop may take before SIGKILL."""
+    unit = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "station",
+                        "package", "gyro-station.service")
+    for line in open(unit):
+        if line.startswith("TimeoutStopSec="):
+            return float(line.split("=", 1)[1])
+    raise RuntimeError("no TimeoutStopSec in " + unit)
+
+
+def frozen_backend_then_stop(pg, serve, base):
+    """Issue 34 point 5: the forwarder's backend stopped (SIGSTOP: its connection stays up). The
+    status and /metrics say the forwarder waits on the server (not idle), the metrics still lint,
+    and SIGTERM ends serve within the unit's stop timeout while the backend is still frozen."""
+    pids = [int(p) for p in pg.query("SELECT pid FROM pg_stat_activity WHERE application_name "
+                                     "= 'gyro-station'").split()]
+    check(len(pids) == 1, "one forwarder connection: %s" % pids)
+    for pid in pids:
+        os.kill(pid, signal.SIGSTOP)
+    try:
+        f = wait_for(lambda: (lambda f: f if f["state"] == "waiting on server" else None)(
+            status(base)["fleet"]), 20, "the status saying the forwarder waits on the server")
+        check(f and f["waiting_s"] >= 1 and f["waiting_for"], "what it waits for: %s" % f)
+        check(metric(base, "station_fleet_state").get(
+            'station_fleet_state{state="waiting on server"}') == 1, "the state in /metrics")
+        check(max(metric(base, "station_fleet_waiting_seconds").values()) >= 1,
+              "the wait in /metrics")
+        promtool = shutil.which("promtool")
+        if promtool:
+            import urllib.request
+            text = urllib.request.urlopen(base + "/metrics", timeout=10).read()
+            p = subprocess.run([promtool, "check", "metrics"], input=text, capture_output=True)
+            check(p.returncode == 0, "promtool check metrics: %s" % p.stderr.decode())
+        serve.send_signal(signal.SIGTERM)
+        try:
+            rc = serve.wait(timeout=stop_timeout_s())
+            check(rc == 0, "serve stopped with %d" % rc)
+        except subprocess.TimeoutExpired:
+            check(False, "serve still running %.0f s after SIGTERM (the unit's stop timeout) "
+                  "with its PostgreSQL backend frozen" % stop_timeout_s())
+    finally:
+        for pid in pids:
+            os.kill(pid, signal.SIGCONT)
 
 
 def local(work, sql, *args):
@@ -152,6 +200,7 @@ def main():
         total = [k for k in h if 'le="+Inf"' in k]
         check(slow and total and h[slow[0]] == h[total[0]],
               "every tick under 0.25 s while the server went away and came back: %s" % h)
+        frozen_backend_then_stop(pg, serve, base)
     finally:
         for p in procs:
             p.kill()

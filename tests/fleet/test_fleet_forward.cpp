@@ -213,6 +213,62 @@ TEST_F(FleetForward, ARestoredBackupIsHeldAndWritesNothingOverTheServer) {
   std::remove(backup.c_str());
 }
 
+// Issue 34 point 7b: an event edited on the server. The run is held as before (the server and
+// the file have parted) and the error says which row and which column.
+TEST_F(FleetForward, AnEditedCentralEventIsNamedByItsKeyAndColumn) {
+  const auto db = simulated_station("fleet_edited_event", 1, 34);
+  forward_all(db, false);
+  fleet::PgConnection pg(target());
+  const auto edited = pg.exec(
+      "UPDATE events SET message = 'edited' WHERE local_id = (SELECT max(local_id) FROM "
+      "events) RETURNING run_uuid, local_id");
+  ASSERT_EQ(edited.rows(), 1);
+  {
+    Database w(db, OpenMode::existing);
+    w.exec(
+        "INSERT INTO events (run_id, t_s, wall_utc, severity, source, kind, message) SELECT "
+        "max(id), 9000, '2026-11-26T00:00:00Z', 'info', 'test', 'note', 'later' FROM runs");
+  }
+  const auto again = forward_all(db, false);
+  EXPECT_EQ(again.failed, 1) << again.last_error;
+  const std::string want = fmt::format(
+      "the server's events row (run_uuid={}, local_id={}) "
+      "differs from this file's in message",
+      edited.text(0, 0), edited.text(0, 1));
+  EXPECT_NE(again.last_error.find(want), std::string::npos) << again.last_error;
+}
+
+// Issue 34 point 7c: two station files under one [station] name. The first binds the name to its
+// identity; the second is refused naming both identities, and nothing of it reaches the server.
+TEST_F(FleetForward, ASecondStationUnderAHeldNameIsRefusedNamingBoth) {
+  const auto a = simulated_station("fleet_name_a", 1, 35);
+  const auto b = simulated_station("fleet_name_b", 1, 36);
+  std::vector<std::string> identities;
+  for (const auto& db : {a, b}) {
+    Database w(db, OpenMode::existing);
+    w.exec("UPDATE runs SET station = 'rig-x'");
+    auto id = w.prepare("SELECT uuid FROM station_identity");
+    ASSERT_TRUE(id.step());
+    identities.push_back(id.column_text(0));
+  }
+  ASSERT_NE(identities[0], identities[1]);
+  EXPECT_EQ(forward_all(a, false).failed, 0);
+  const std::int64_t runs = count("runs"), fits = count("fits"), events = count("events");
+  const auto second = forward_all(b, false);
+  EXPECT_GT(second.failed, 0);
+  const std::string& said = second.last_error;
+  EXPECT_NE(said.find("station name 'rig-x' is held"), std::string::npos) << said;
+  for (const auto& hex : identities) {  // as PostgreSQL writes a uuid: 8-4-4-4-12
+    const std::string uuid = fmt::format("{}-{}-{}-{}-{}", hex.substr(0, 8), hex.substr(8, 4),
+                                         hex.substr(12, 4), hex.substr(16, 4), hex.substr(20));
+    EXPECT_NE(said.find(uuid), std::string::npos) << said;
+  }
+  EXPECT_EQ(count("runs"), runs);
+  EXPECT_EQ(count("fits"), fits);
+  EXPECT_EQ(count("events"), events);
+  EXPECT_EQ(forward_all(a, false).failed, 0) << "the holder goes on";
+}
+
 // Samples not wanted at first (a pass without them acknowledges the run), wanted later: they go.
 TEST_F(FleetForward, SamplesWantedLaterAreSentForRunsAlreadyAcknowledged) {
   const auto db = simulated_station("fleet_samples_later", 1, 32);

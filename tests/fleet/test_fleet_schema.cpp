@@ -63,6 +63,45 @@ TEST_F(FleetSchema, EveryCentralColumnExistsOnAMigratedServer) {
   EXPECT_EQ(fleet::init_fleet_schema(pg), fleet::fleet_schema_version());
 }
 
+// Issue 34 point 7a: a table dropped on the server while the version row stays. The station
+// refuses to forward naming it; `--init` re-creates exactly it, with its indexes, and again
+// re-creates nothing.
+TEST_F(FleetSchema, InitReCreatesADroppedTableAndTheStationNamesIt) {
+  fleet::PgConnection pg(target());
+  pg.exec("DROP TABLE events");
+  try {
+    fleet::require_fleet_schema(pg);
+    ADD_FAILURE() << "a server without its events table was accepted";
+  } catch (const fleet::PgError& e) {
+    EXPECT_NE(std::string(e.what()).find("table events missing"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("--init"), std::string::npos) << e.what();
+  }
+  std::vector<std::string> recreated;
+  EXPECT_EQ(fleet::init_fleet_schema(pg, &recreated), fleet::fleet_schema_version());
+  EXPECT_EQ(recreated, std::vector<std::string>{"events"});
+  EXPECT_NO_THROW(fleet::require_fleet_schema(pg));
+  for (const auto& c : fleet::split_columns(fleet::fleet_table("events").columns)) {
+    auto r = pg.exec(
+        "SELECT count(*) FROM information_schema.columns WHERE table_schema = current_schema() "
+        "AND table_name = 'events' AND column_name = $1",
+        {std::string(c)});
+    EXPECT_EQ(r.integer(0, 0), 1) << "events." << c;
+  }
+  EXPECT_EQ(
+      pg.exec("SELECT count(*) FROM pg_namespace WHERE nspname LIKE 'fleet_init%'").integer(0, 0),
+      0)
+      << "the scratch schema is left behind";
+  EXPECT_EQ(fleet::init_fleet_schema(pg, &recreated), fleet::fleet_schema_version());
+  EXPECT_TRUE(recreated.empty());
+  // A table of a later version than the server's is migrated, not mended: drop stations (4) and
+  // say the server is at 3: --init runs migration 4.
+  pg.exec("DROP TABLE stations");
+  pg.exec("DELETE FROM fleet_schema WHERE version = 4");
+  EXPECT_EQ(fleet::init_fleet_schema(pg, &recreated), 3);
+  EXPECT_TRUE(recreated.empty());
+  EXPECT_TRUE(fleet::missing_fleet_tables(pg).empty());
+}
+
 TEST_F(FleetSchema, AnOlderServerIsRefusedInOneLineANewerOneAccepted) {
   fleet::PgConnection pg(target());
   pg.exec("DELETE FROM fleet_schema");
