@@ -225,15 +225,18 @@ TEST(FitCv, LeaveOneRunOutOverTwoRunsMatchesAFitOnTheOtherRun) {
   const auto j = nlohmann::json::parse(out);
   const auto& cv = j["cross_validation"];
   ASSERT_EQ(cv["held_out"].size(), 2u) << j.dump();
-  station::Store store(c.path, station::OpenMode::existing);
-  for (const auto& h : cv["held_out"]) {
-    const auto held = h["run_id"].get<std::int64_t>();
-    const auto other = held == c.calibration_run ? c.verification_run : c.calibration_run;
-    const auto train = store.model_data(sn, {other}), test = store.model_data(sn, {held});
-    const auto f = sc::fit_model(train.view(), {{sc::Term::dT, sc::Term::gradT}, 25.0});
-    double ss = 0;
-    for (const double e : sc::compensate(f, test.view())) ss += e * e;
-    EXPECT_NEAR(h["rms_dph"].get<double>(), std::sqrt(ss / test.bias_dph.size()), 1e-12);
+  {
+    // Closed before the next `station fit`: a writer waits for this process's readers.
+    station::Store store(c.path, station::OpenMode::read_only);
+    for (const auto& h : cv["held_out"]) {
+      const auto held = h["run_id"].get<std::int64_t>();
+      const auto other = held == c.calibration_run ? c.verification_run : c.calibration_run;
+      const auto train = store.model_data(sn, {other}), test = store.model_data(sn, {held});
+      const auto f = sc::fit_model(train.view(), {{sc::Term::dT, sc::Term::gradT}, 25.0});
+      double ss = 0;
+      for (const double e : sc::compensate(f, test.view())) ss += e * e;
+      EXPECT_NEAR(h["rms_dph"].get<double>(), std::sqrt(ss / test.bias_dph.size()), 1e-12);
+    }
   }
   EXPECT_GT(cv["pooled_rms_dph"].get<double>(), 0.0);
   // One run: no cross-validation, said in the output.
