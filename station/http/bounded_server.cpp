@@ -1,6 +1,8 @@
 // The bounded server (see bounded_server.hpp): a thread per connection up to a total, a cap per
-// client address, one request per connection whose head is read here under a deadline and the
-// head rules, then handed to httplib with the bytes already read in front of the socket.
+// client (all loopback one client), a slow connection's place taken when a cap is reached, a
+// share kept for the token holder, one request per connection whose head is read here under a
+// deadline and the head rules, then handed to httplib with the bytes already read in front of
+// the socket.
 #include "station/http/bounded_server.hpp"
 
 #include <arpa/inet.h>
@@ -19,21 +21,18 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-/// Set on a connection's thread when it was opened above the total: answer 503 and close.
+/// Set on a connection's thread when no thread could be had for it: answer 503 and close.
 thread_local bool over_capacity = false;
 
-/// A thread per connection (a slow client holds only its own); above `max` the connection still
-/// gets a thread, which only answers 503. shutdown() waits for every thread to end.
+/// A thread per connection (a slow client holds only its own; the caps are BoundedServer's, a
+/// connection beyond them gets a thread that only answers). shutdown() waits for every thread.
 class ConnectionQueue final : public httplib::TaskQueue {
  public:
-  explicit ConnectionQueue(int max) : max_(max) {}
   void enqueue(std::function<void()> fn) override {
     std::unique_lock lock(state_->mu);
-    const bool over = state_->running >= max_;
     ++state_->running;
     lock.unlock();
-    auto run = [st = state_, over](const std::function<void()>& f) {
-      over_capacity = over;
+    auto run = [st = state_](const std::function<void()>& f) {
       f();
       std::lock_guard done(st->mu);
       if (--st->running == 0) st->idle.notify_all();
@@ -58,7 +57,6 @@ class ConnectionQueue final : public httplib::TaskQueue {
     int running = 0;
   };
   std::shared_ptr<State> state_ = std::make_shared<State>();
-  int max_;
 };
 
 std::string address_of(const sockaddr_storage& sa) {
@@ -148,34 +146,108 @@ const char* reason_phrase(int status) {
 
 }  // namespace
 
-BoundedServer::BoundedServer(ConnectionLimits limits, std::function<void(int)> refused)
-    : limits_(limits), refused_(std::move(refused)) {
-  const int max = limits_.max_connections;
-  new_task_queue = [max] { return new ConnectionQueue(max); };
+std::string client_of(std::string_view address) {
+  std::string a(address);
+  if (a.starts_with("::ffff:") && a.find('.') != std::string::npos) a.erase(0, 7);
+  in_addr v4{};
+  if (::inet_pton(AF_INET, a.c_str(), &v4) == 1)
+    return (ntohl(v4.s_addr) >> 24) == 127 ? "loopback" : a;
+  in6_addr v6{};
+  if (::inet_pton(AF_INET6, a.c_str(), &v6) == 1 && IN6_IS_ADDR_LOOPBACK(&v6)) return "loopback";
+  return a;
+}
+
+BoundedServer::BoundedServer(ConnectionLimits limits, std::function<void(int)> refused,
+                             std::function<bool(std::string_view)> token_holder)
+    : limits_(limits), refused_(std::move(refused)), token_holder_(std::move(token_holder)) {
+  new_task_queue = [] { return new ConnectionQueue(); };
 }
 
 void BoundedServer::set_backlog(int connections) {
   if (svr_sock_ != INVALID_SOCKET) ::listen(svr_sock_, connections);
 }
 
-bool BoundedServer::admit(const std::string& address) {
+int BoundedServer::open_connections() {
   std::lock_guard lock(mu_);
-  int& n = per_address_[address];
-  if (n >= limits_.max_per_address) {
-    if (n == 0) per_address_.erase(address);
-    return false;
-  }
-  ++n;
-  return true;
+  return all_.open;
 }
 
-void BoundedServer::release(const std::string& address) {
+std::optional<BoundedServer::SlotRef> BoundedServer::victim(const std::string& client) {
+  std::optional<SlotRef> best;
+  int most = 0;
+  for (auto it = slots_.begin(); it != slots_.end(); ++it) {
+    if (it->stage != Slot::Stage::head || it->shed.load()) continue;
+    if (!client.empty() && it->client != client) continue;
+    const int held = held_[it->client].open;  // oldest first: a tie keeps the older one
+    if (held > most) best = it, most = held;
+  }
+  return best;
+}
+
+std::optional<BoundedServer::SlotRef> BoundedServer::admit(socket_t sock, const std::string& client,
+                                                           Slot::Stage stage, std::string& why) {
   std::lock_guard lock(mu_);
-  if (--per_address_[address] <= 0) per_address_.erase(address);
+  const bool client_full = held_[client].open >= limits_.max_per_client;
+  const bool all_full = all_.open >= limits_.max_connections;
+  if (client_full || all_full) {
+    const auto v = victim(client_full ? client : std::string());
+    if (!v) {
+      if (held_[client].open == 0) held_.erase(client);
+      why = client_full ? fmt::format("{} connections from {} are being served",
+                                      limits_.max_per_client, client)
+                        : fmt::format("{} connections are being served", limits_.max_connections);
+      return std::nullopt;
+    }
+    // Its place is taken: it stops counting now, and its thread answers 503 within a poll.
+    (*v)->shed.store(true);
+    --all_.open;
+    if (--held_[(*v)->client].open == 0) held_.erase((*v)->client);
+    ::shutdown((*v)->sock, SHUT_RD);
+  }
+  ++all_.open;
+  ++held_[client].open;
+  const auto slot = slots_.emplace(slots_.end(), sock, client);
+  slot->stage = stage;
+  return slot;
+}
+
+HeadVerdict BoundedServer::judge(SlotRef slot, bool token) {
+  std::lock_guard lock(mu_);
+  if (slot->shed.load())
+    return {503, "the service is full: a newer connection took this one's place"};
+  if (token) {
+    slot->stage = Slot::Stage::token;
+    return {};
+  }
+  Held& mine = held_[slot->client];
+  const int all_max = limits_.max_connections - limits_.token_reserve;
+  const int client_max = limits_.max_per_client - limits_.token_reserve;
+  if (all_.anonymous >= all_max || mine.anonymous >= client_max)
+    return {503, fmt::format("{} requests without the API token are being served{}; the other {} "
+                             "connections are kept for the token holder",
+                             all_.anonymous >= all_max ? all_max : client_max,
+                             all_.anonymous >= all_max ? "" : " from " + slot->client,
+                             limits_.token_reserve)};
+  slot->stage = Slot::Stage::anonymous;
+  ++all_.anonymous;
+  ++mine.anonymous;
+  return {};
+}
+
+void BoundedServer::release(SlotRef slot) {
+  std::lock_guard lock(mu_);
+  if (!slot->shed.load()) {
+    Held& mine = held_[slot->client];
+    const int anonymous = slot->stage == Slot::Stage::anonymous ? 1 : 0;
+    all_.open -= 1, all_.anonymous -= anonymous;
+    mine.open -= 1, mine.anonymous -= anonymous;
+    if (mine.open == 0) held_.erase(slot->client);
+  }
+  slots_.erase(slot);
 }
 
 HeadVerdict BoundedServer::read_head(socket_t sock, Clock::time_point deadline,
-                                     std::string& buffer) const {
+                                     const std::atomic<bool>& shed, std::string& buffer) const {
   char chunk[4096];
   while (true) {
     if (const auto end = head_end(buffer)) {
@@ -185,11 +257,13 @@ HeadVerdict BoundedServer::read_head(socket_t sock, Clock::time_point deadline,
     // In slices, so that a stopping server does not wait out a slow client's deadline.
     const auto slice = std::min(deadline, Clock::now() + std::chrono::milliseconds(100));
     if (!is_running()) return {-1, "the server is stopping"};
+    if (shed.load()) return {503, "the service is full: a newer connection took this one's place"};
     if (Clock::now() >= deadline)
       return {408, fmt::format("the request did not arrive within {} s",
                                limits_.request_deadline.count() / 1000.0)};
     if (!wait_for(sock, POLLIN, slice)) continue;
     const ssize_t n = ::recv(sock, chunk, sizeof chunk, 0);
+    if (n == 0 && shed.load()) continue;  // shut down for reading by the shed: answered above
     if (n <= 0) return {-1, "the client closed the connection"};
     buffer.append(chunk, static_cast<std::size_t>(n));
   }
@@ -207,28 +281,47 @@ void BoundedServer::refuse(socket_t sock, const HeadVerdict& v) const {
   if (refused_) refused_(v.status);
 }
 
+void BoundedServer::serve(SlotRef slot, Clock::time_point deadline, std::string buffer) {
+  HeadVerdict v;
+  if (slot->stage == Slot::Stage::head) v = read_head(slot->sock, deadline, slot->shed, buffer);
+  if (v.status == 0) {
+    const auto end = head_end(buffer);
+    const auto authorization =
+        field_value(std::string_view(buffer).substr(0, *end), "Authorization");
+    v = judge(slot, authorization && token_holder_ && token_holder_(*authorization));
+  }
+  if (v.status == 0) {
+    DeadlineStream stream(slot->sock, std::move(buffer), deadline);
+    bool closed = false;
+    process_request(stream, true, closed, nullptr);
+  } else if (v.status > 0) {
+    refuse(slot->sock, v);
+  }
+}
+
 bool BoundedServer::process_and_close_socket(socket_t sock) {
   const auto deadline = Clock::now() + limits_.request_deadline;
   sockaddr_storage peer{};
   socklen_t len = sizeof peer;
-  const std::string address =
-      ::getpeername(sock, reinterpret_cast<sockaddr*>(&peer), &len) == 0 ? address_of(peer) : "";
-  if (over_capacity) {
-    refuse(sock, {503, fmt::format("more than {} connections", limits_.max_connections)});
-  } else if (!admit(address)) {
-    refuse(sock, {503, fmt::format("more than {} connections from {}", limits_.max_per_address,
-                                   address)});
+  const std::string client = client_of(
+      ::getpeername(sock, reinterpret_cast<sockaddr*>(&peer), &len) == 0 ? address_of(peer) : "");
+  // The head that came with the connection, read before it counts (kFirstBytes): 408 here only
+  // means "not whole yet"; a malformed one is answered without taking a place.
+  std::string buffer, why;
+  const std::atomic<bool> never{false};
+  const HeadVerdict first =
+      over_capacity
+          ? HeadVerdict{503, "no thread for another connection"}
+          : read_head(sock, std::min(deadline, Clock::now() + kFirstBytes), never, buffer);
+  const bool whole = first.status == 0;
+  if (first.status != 0 && first.status != 408) {
+    if (first.status > 0) refuse(sock, first);
+  } else if (const auto slot =
+                 admit(sock, client, whole ? Slot::Stage::judging : Slot::Stage::head, why)) {
+    serve(*slot, deadline, std::move(buffer));
+    release(*slot);
   } else {
-    std::string buffer;
-    const HeadVerdict v = read_head(sock, deadline, buffer);
-    if (v.status == 0) {
-      DeadlineStream stream(sock, std::move(buffer), deadline);
-      bool closed = false;
-      process_request(stream, true, closed, nullptr);
-    } else if (v.status > 0) {
-      refuse(sock, v);
-    }
-    release(address);
+    refuse(sock, {503, "the service is full: " + why});
   }
   ::shutdown(sock, SHUT_RDWR);
   ::close(sock);

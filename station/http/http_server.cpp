@@ -24,9 +24,9 @@ namespace station::http {
 
 namespace {
 
+/// One rule for what loopback is: the per-client cap's (bounded_server.hpp).
 bool is_loopback(const std::string& addr) {
-  return addr == "127.0.0.1" || addr == "::1" || addr.rfind("127.", 0) == 0 ||
-         addr.rfind("::ffff:127.", 0) == 0;
+  return client_of(addr) == "loopback";
 }
 
 const char* mime_of(std::string_view name) {
@@ -225,7 +225,10 @@ int HttpServer::start() {
   // the event streams and slow clients hold only their own.
   const ConnectionLimits limits;
   auto bounded = std::make_unique<BoundedServer>(
-      limits, [this](int status) { hub_.metrics().http_request(status); });
+      limits, [this](int status) { hub_.metrics().http_request(status); },
+      [token = options_.token](std::string_view authorization) {
+        return !token.empty() && bearer_matches(authorization, token);
+      });
   BoundedServer& server = *bounded;
   server_ = std::move(bounded);
   routes();

@@ -128,6 +128,16 @@ HeadVerdict check_request_head(std::string_view head, const HeadLimits& limits) 
   return {};
 }
 
+std::optional<std::string_view> field_value(std::string_view head, std::string_view name) {
+  const auto lines = lines_of(head);
+  for (std::size_t i = 1; i < lines.size(); ++i) {
+    const auto colon = lines[i].find(':');
+    if (colon != std::string_view::npos && iequals(lines[i].substr(0, colon), name))
+      return trimmed(lines[i].substr(colon + 1));
+  }
+  return std::nullopt;
+}
+
 bool loopback_host(std::string_view host) {
   // Only what a loopback name, literal and port are made of: inet_pton reads a C string, so a
   // NUL ("127.0.0.1\0.evil.com", found by fuzz_request_head) must not reach it.

@@ -37,6 +37,10 @@ HeadVerdict oversized_head(std::string_view buffer, const HeadLimits& limits);
 /// whose repeats all agree (RFC 9110 §8.6), not beside Transfer-Encoding (RFC 9112 §6.3): 400.
 HeadVerdict check_request_head(std::string_view head, const HeadLimits& limits);
 
+/// The value of the first field called `name` (any case) of a complete head, trimmed; nullopt
+/// when it has none.
+std::optional<std::string_view> field_value(std::string_view head, std::string_view name);
+
 /// Whether a Host header value names this machine's loopback: exactly `localhost` (any case),
 /// an IPv4 literal in 127.0.0.0/8 or the IPv6 literal [::1] (or [::ffff:127.x.y.z]), each with
 /// an optional decimal port (RFC 9110 §7.2, RFC 3986 §3.2.2). A name that merely starts with
