@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <charconv>
 #include <cmath>
 #include <csignal>
 #include <cstdlib>
@@ -169,19 +170,25 @@ int run_real(const RunOptions& o) {
   return 0;
 }
 
-/// --fault TICK:COMMAND, each checked for its form.
+/// --fault TICK:COMMAND, each checked for its form: TICK whole seconds of the run in plain
+/// digits (no sign, exponent, fraction, hex or space: "1e99", "inf" and "0x10" are refused, not
+/// read as a time no run reaches); the run's end is checked against the protocol in sim_run.
 std::vector<std::pair<double, std::string>> parse_faults(const std::vector<std::string>& faults) {
   std::vector<std::pair<double, std::string>> out;
   for (const auto& f : faults) {
     const auto colon = f.find(':');
-    double at_s = -1;
-    try {
-      at_s = colon == std::string::npos ? -1 : std::stod(f.substr(0, colon));
-    } catch (const std::exception&) {
-    }
-    if (!(at_s >= 0) || std::floor(at_s) != at_s || colon + 1 >= f.size())
-      throw InputError(fmt::format("--fault '{}': expected TICK:COMMAND, e.g. 3000:door open", f));
-    out.emplace_back(at_s, f.substr(colon + 1));
+    const std::string tick = f.substr(0, colon);
+    std::int64_t at_s = -1;
+    const auto parsed = std::from_chars(tick.data(), tick.data() + tick.size(), at_s);
+    const bool digits = !tick.empty() && tick.size() <= 12 &&
+                        tick.find_first_not_of("0123456789") == std::string::npos;
+    if (colon == std::string::npos || !digits || parsed.ec != std::errc() ||
+        colon + 1 >= f.size())
+      throw InputError(fmt::format(
+          "--fault '{}': expected TICK:COMMAND, TICK the run's second in digits (at most 12), "
+          "e.g. 3000:door open",
+          f));
+    out.emplace_back(static_cast<double>(at_s), f.substr(colon + 1));
   }
   return out;
 }
@@ -278,7 +285,9 @@ void add_record_and_fault_options(CLI::App* cmd, RunOptions& o) {
       ->excludes(record);
   cmd->add_option(
       "--fault", o.faults,
-      "--sim: at tick T (s) inject a simrig fault command, T:COMMAND "
+      "--sim: at tick T (whole seconds, within the protocol's span: each step's timeout, or "
+      "its nominal duration and 7 days for a wait without one; one the run ends before is "
+      "warned about) inject a simrig fault command, T:COMMAND "
       "(docs/SIMRIG.md), e.g. '3000:door open', or T:kill (the daemon SIGKILLs "
       "itself before tick T, to record a killed and resumed run) or T:sigint (it raises SIGINT "
       "after tick T: the operator's stop); repeatable");

@@ -178,7 +178,7 @@ void idle_until_stopped(Service& s) {
     IdleReading r = s.host.look();
     r.fault = service_fault(s, r);
     s.live.hub().idle(r);
-    s.control.set_fault(r.fault);
+    s.control.set_fault(r.fault, s.unclosed.has_value() || !r.storage_error.empty());
     if (s.watchdog) sd_notify(0, "WATCHDOG=1");
     // The control refuses a start while the last look found a fault (the start check of a new
     // run); the one start rule (run_start.hpp) decides the rest.

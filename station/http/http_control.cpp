@@ -55,6 +55,10 @@ void HttpServer::start_run(const httplib::Request& req, httplib::Response& res) 
     return;
   }
   std::string error;
+  if (!known_keys_only(body, {"protocol", "operator"}, error)) {
+    send_json(res, 400, {{"error", error}});
+    return;
+  }
   const auto protocol = string_field(body, "protocol", 4096, error);
   const auto op = string_field(body, "operator", 200, error);
   if (!error.empty() || !protocol || protocol->empty()) {
@@ -80,6 +84,14 @@ void HttpServer::end_run(const httplib::Request& req, httplib::Response& res, bo
   if (!may_write(req, res)) return;
   const auto id = path_id(req, res, "run id");
   if (!id) return;
+  // No fields: an empty body or {} (a key it does not know is refused, as for every POST).
+  const auto body =
+      req.body.empty() ? nlohmann::json::object() : nlohmann::json::parse(req.body, nullptr, false);
+  std::string error;
+  if (body.is_discarded() || !body.is_object() || !known_keys_only(body, {}, error)) {
+    send_json(res, 400, {{"error", error.empty() ? "body: expected nothing, or {}" : error}});
+    return;
+  }
   if (hub_.current_run() != id) {
     bool exists = false;
     {
@@ -111,7 +123,7 @@ void HttpServer::release_fit(const httplib::Request& req, httplib::Response& res
   std::optional<std::string> by, note, override_reason;
   if (body.is_discarded() || !body.is_object()) {
     error = "body: expected a JSON object {\"by\": NAME, \"note\": TEXT, \"override\": REASON}";
-  } else {
+  } else if (known_keys_only(body, {"by", "note", "override"}, error)) {
     by = string_field(body, "by", 200, error);
     note = string_field(body, "note", 4096, error);
     override_reason = string_field(body, "override", 4096, error);

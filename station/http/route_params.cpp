@@ -2,7 +2,9 @@
 #include "station/http/route_params.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
+#include <algorithm>
 #include <charconv>
 
 #include "station/http/json_reply.hpp"
@@ -15,7 +17,8 @@ namespace station::http {
 std::optional<std::int64_t> positive_int(const std::string& text) {
   std::int64_t v = 0;
   const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
-  if (text.empty() || ec != std::errc() || end != text.data() + text.size() || v <= 0)
+  if (text.empty() || text.front() == '0' || ec != std::errc() ||
+      end != text.data() + text.size() || v <= 0)
     return std::nullopt;
   return v;
 }
@@ -42,6 +45,19 @@ std::optional<std::string> string_field(const nlohmann::json& body, const char* 
     return std::nullopt;
   }
   return body[key].get<std::string>();
+}
+
+bool known_keys_only(const nlohmann::json& body, std::initializer_list<const char*> known,
+                     std::string& error) {
+  for (const auto& [key, value] : body.items()) {
+    if (std::find(known.begin(), known.end(), key) != known.end()) continue;
+    error = known.size() == 0 ? fmt::format("field '{}': unknown (this request takes no fields)",
+                                            key.substr(0, 80))
+                              : fmt::format("field '{}': unknown (expected one of: {})",
+                                            key.substr(0, 80), fmt::join(known, ", "));
+    return false;
+  }
+  return true;
 }
 
 }  // namespace station::http

@@ -52,6 +52,10 @@ http::ControlReply ServeControl::start(const std::string& protocol,
   }
   std::unique_lock lock(mu_);
   if (busy_ || pending_) return {409, "a run is going on; stop it first"};
+  // A full disk is the server's own trouble, not a state of the run resource a client can
+  // change: 503 (RFC 9110 15.6.4), as when the run could not be created; a rig's fault is 409.
+  if (!fault_.empty() && storage_fault_)
+    return {503, fmt::format("the station cannot record a run now: {}", fault_)};
   if (!fault_.empty()) return {409, fmt::format("the rig is not ready: {}", fault_)};
   pending_ = ApiStart{std::move(p), operator_name};
   const std::uint64_t mine = ++requests_;
@@ -87,9 +91,10 @@ void ServeControl::set_busy(bool busy) {
   busy_ = busy;
 }
 
-void ServeControl::set_fault(const std::string& fault) {
+void ServeControl::set_fault(const std::string& fault, bool storage) {
   std::lock_guard lock(mu_);
   fault_ = fault;
+  storage_fault_ = storage;
 }
 
 void ServeControl::started(std::int64_t run_id) {

@@ -32,8 +32,9 @@ class ServeControl final : public http::RunControl {
   std::optional<ApiStart> next(std::chrono::milliseconds timeout);
   /// The serve loop: a run is going on (start requests are refused meanwhile).
   void set_busy(bool busy);
-  /// The serve loop: why the idle rig cannot start a run (empty: it can).
-  void set_fault(const std::string& fault);
+  /// The serve loop: why the idle rig cannot start a run (empty: it can); `storage`: the fault
+  /// is the store's (a start is then 503, the station cannot record; a rig's fault is 409).
+  void set_fault(const std::string& fault, bool storage = false);
   /// The serve loop: the run of the last request was created with this id (start() answers it).
   void started(std::int64_t run_id);
   /// The serve loop: the run of the last request could not be created (start() answers 503).
@@ -56,6 +57,7 @@ class ServeControl final : public http::RunControl {
   std::int64_t started_id_ = 0;
   std::string start_error_;  ///< why the last request's run was not created
   std::string fault_;
+  bool storage_fault_ = false;
 };
 
 }  // namespace station

@@ -31,10 +31,10 @@ struct MdCtxFree {
 };
 using MdCtx = std::unique_ptr<EVP_MD_CTX, MdCtxFree>;
 
-struct GzClose {
-  void operator()(gzFile f) const noexcept { gzclose(f); }
+/// What is wrong with a file's compressed data (the digest names it at the line it reached).
+struct DataError : std::runtime_error {
+  using std::runtime_error::runtime_error;
 };
-using GzHandle = std::unique_ptr<std::remove_pointer_t<gzFile>, GzClose>;
 
 MdCtx sha256_ctx() {
   MdCtx c(EVP_MD_CTX_new());
@@ -58,19 +58,64 @@ std::string resolved(const std::string& dir, const std::string& name) {
   return plain.string();
 }
 
-/// Calls `each` with the decompressed bytes of `file` (zlib reads a plain file as it is); throws
-/// InputError for corrupt compressed data after handing out what came before it.
+struct InflateEnd {
+  void operator()(z_stream* z) const noexcept { inflateEnd(z); }
+};
+
+/// Inflates the gzip members (RFC 1952 2.2: a file is one or more, concatenated) of `in`, whose
+/// first `raw` bytes are read already, into `each`. Throws DataError for corrupt compressed data,
+/// a member cut short, or bytes after the last member that begin none (zlib's gzread and gzip(1)
+/// skip them: they are not the run's).
+void inflate_members(std::ifstream& in, std::vector<char>& raw, std::size_t had,
+                     const std::function<void(std::string_view)>& each) {
+  z_stream z{};
+  if (inflateInit2(&z, 16 + MAX_WBITS) != Z_OK) throw std::runtime_error("zlib: inflateInit2");
+  const std::unique_ptr<z_stream, InflateEnd> end(&z);
+  std::vector<char> out(raw.size());
+  std::uint64_t consumed = 0;  // bytes of the file inflate has taken
+  bool in_member = true;       // bytes given to the member inflate is on
+  z.next_in = reinterpret_cast<Bytef*>(raw.data());
+  z.avail_in = static_cast<uInt>(had);
+  while (true) {
+    if (z.avail_in == 0) {
+      in.read(raw.data(), static_cast<std::streamsize>(raw.size()));
+      if (in.gcount() == 0) break;
+      z.next_in = reinterpret_cast<Bytef*>(raw.data());
+      z.avail_in = static_cast<uInt>(in.gcount());
+    }
+    const uInt before = z.avail_in;
+    z.next_out = reinterpret_cast<Bytef*>(out.data());
+    z.avail_out = static_cast<uInt>(out.size());
+    const int rc = inflate(&z, Z_NO_FLUSH);
+    each(std::string_view(out.data(), out.size() - z.avail_out));
+    if (rc == Z_DATA_ERROR && !in_member)
+      throw DataError(
+          fmt::format("bytes after the end of the compressed data (from byte {} of "
+                      "the file): not what the run wrote",
+                      consumed));
+    if (rc != Z_OK && rc != Z_STREAM_END && rc != Z_BUF_ERROR)
+      throw DataError("corrupt compressed data");
+    consumed += before - z.avail_in;
+    in_member = rc != Z_STREAM_END;
+    if (rc == Z_STREAM_END && inflateReset(&z) != Z_OK) throw DataError("corrupt compressed data");
+  }
+  if (in_member) throw DataError("corrupt compressed data (cut short)");
+}
+
+/// Calls `each` with the decompressed bytes of `file`: a gzip file inflated member by member, any
+/// other file as it is (as zlib's gzread reads it). Throws DataError for corrupt compressed data
+/// or bytes after its end, after handing out what came before it.
 void for_each_chunk(const std::string& file, const std::function<void(std::string_view)>& each) {
-  GzHandle in(gzopen(file.c_str(), "rb"));
+  std::ifstream in(file, std::ios::binary);
   if (!in) throw InputError(fmt::format("{}: cannot open", file));
-  std::vector<char> buf(std::size_t{1} << 16);
-  int n = 0;
-  while ((n = gzread(in.get(), buf.data(), static_cast<unsigned>(buf.size()))) > 0)
-    each(std::string_view(buf.data(), static_cast<std::size_t>(n)));
-  int err = Z_OK;
-  gzerror(in.get(), &err);
-  if (n < 0 || (err != Z_OK && err != Z_STREAM_END))
-    throw InputError(fmt::format("{}: corrupt compressed data", file));
+  std::vector<char> raw(std::size_t{1} << 16);
+  in.read(raw.data(), static_cast<std::streamsize>(raw.size()));
+  const auto had = static_cast<std::size_t>(in.gcount());
+  if (had >= 2 && raw[0] == '\x1f' && raw[1] == '\x8b') return inflate_members(in, raw, had, each);
+  for (std::size_t n = had; n > 0; n = static_cast<std::size_t>(in.gcount())) {
+    each(std::string_view(raw.data(), n));
+    in.read(raw.data(), static_cast<std::streamsize>(raw.size()));
+  }
 }
 
 FileDigest digest_path(const std::string& file, std::string name, std::string* corrupt) {
@@ -95,9 +140,9 @@ FileDigest digest_path(const std::string& file, std::string name, std::string* c
   };
   try {
     for_each_chunk(file, chunk);
-  } catch (const InputError& e) {
-    if (corrupt == nullptr) throw;
-    *corrupt = "corrupt compressed data";  // the complete lines before it are kept
+  } catch (const DataError& e) {
+    if (corrupt == nullptr) throw InputError(fmt::format("{}: {}", file, e.what()));
+    *corrupt = e.what();  // the complete lines before it are kept
     open_line = false;
   }
   if (open_line) end_line();  // a last line without its newline is a line too
@@ -107,6 +152,8 @@ FileDigest digest_path(const std::string& file, std::string name, std::string* c
     d.sha256_hex += fmt::format("{:02x}", md[static_cast<std::size_t>(i)]);
   return d;
 }
+
+}  // namespace
 
 std::string digest_text(const std::vector<FileDigest>& files) {
   std::string out =
@@ -124,7 +171,15 @@ std::string digest_text(const std::vector<FileDigest>& files) {
   return out;
 }
 
-}  // namespace
+std::string decompressed_bytes(const std::string& file) {
+  std::string out;
+  try {
+    for_each_chunk(file, [&out](std::string_view bytes) { out.append(bytes); });
+  } catch (const DataError& e) {
+    throw InputError(fmt::format("{}: {}", file, e.what()));
+  }
+  return out;
+}
 
 const std::vector<std::string>& digested_files() {
   // ascii.log: sessions since issue 20 (line devices); an older session has none and its digest

@@ -28,6 +28,16 @@ struct FileDigest {
 FileDigest digest_file(const std::string& dir, const std::string& name,
                        std::string* corrupt = nullptr);
 
+/// digest.txt's one form for `files` (schemas/session.md, "digest.txt"): two comment lines, a
+/// "file" line per file, then its "tags" lines of 64 tags, fields separated by one space,
+/// lower-case hex, LF line ends, nothing else. What write_session_digest writes and the only
+/// text verify_session_digest accepts.
+std::string digest_text(const std::vector<FileDigest>& files);
+
+/// All the decompressed bytes of `file` (gzip members inflated, any other file as it is). Throws
+/// InputError naming it for corrupt compressed data or bytes after the end of its last member.
+std::string decompressed_bytes(const std::string& file);
+
 /// Writes `dir`/digest.txt for every file of digested_files() as it is now (replacing it).
 /// Throws InputError naming the path.
 void write_session_digest(const std::string& dir);

@@ -2,6 +2,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <filesystem>
 #include <map>
@@ -103,6 +104,35 @@ std::optional<DigestMismatch> compare(const std::string& file, const FileDigest&
   return std::nullopt;
 }
 
+/// digest.txt in its one form (digest_text of what it says, the files in digested_files()'s
+/// order, hex in lower case): any other byte (a space, a comment, a case, a CR, an empty line,
+/// an unknown file) is named at its line, so that no edit of the digest replays silently.
+std::optional<DigestMismatch> not_canonical(const std::string& read_as,
+                                            const std::map<std::string, FileDigest>& recorded) {
+  std::vector<FileDigest> files;
+  for (const auto& name : digested_files()) {
+    if (const auto it = recorded.find(name); it != recorded.end()) files.push_back(it->second);
+  }
+  for (auto& f : files)
+    std::transform(f.sha256_hex.begin(), f.sha256_hex.end(), f.sha256_hex.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::string have;
+  try {
+    have = decompressed_bytes(read_as);
+  } catch (const InputError& e) {  // bytes after its compressed end: "FILE: what"
+    const std::string_view what(e.what());
+    return DigestMismatch{read_as, std::nullopt,
+                          std::string(what.substr(std::min(what.size(), read_as.size() + 2)))};
+  }
+  const std::string want = digest_text(files);
+  if (want == have) return std::nullopt;
+  const auto at = std::mismatch(want.begin(), want.end(), have.begin(), have.end());
+  const auto line = 1 + std::count(have.begin(), at.second, '\n');
+  return DigestMismatch{read_as, line,
+                        "not as the station writes digest.txt (its one form: schemas/session.md); "
+                        "an edited digest proves nothing"};
+}
+
 }  // namespace
 
 std::optional<DigestMismatch> verify_session_digest(const std::string& dir) {
@@ -113,6 +143,7 @@ std::optional<DigestMismatch> verify_session_digest(const std::string& dir) {
   std::string read_as;
   TagLines tag_lines;
   const auto recorded = read_digest(path, read_as, tag_lines);
+  if (auto m = not_canonical(read_as, recorded)) return m;
   for (const auto& name : digested_files()) {
     const auto it = recorded.find(name);
     const fs::path maybe = fs::path(dir) / name;

@@ -49,6 +49,11 @@ std::string sim_config_text(sim::SimWorld& world, const SimRunOptions& o,
         g.node, g.serial, g.pulse_weight_arcsec, i + 1);
     if (part) t += fmt::format("part = \"{}\"\n", *part);
   }
+  if (!o.on_foreign_setpoint.empty()) {
+    const auto at = t.find("[chamber]\n");
+    if (at != std::string::npos)
+      t.insert(at + 10, fmt::format("on_foreign_setpoint = \"{}\"\n", o.on_foreign_setpoint));
+  }
   return t;
 }
 
@@ -96,13 +101,49 @@ InputError fault_error(double at_s, const std::string& command, const std::strin
   return InputError(fmt::format("--fault {:.0f}:{}: {}", at_s, command, reply));
 }
 
+/// The longest a step that waits (for the air, for a soak) without a timeout is taken to last:
+/// the longest step a protocol may name (protocol.cpp, kMaxStepS).
+constexpr double kUntimedWaitS = 7 * 86400.0;
+
+/// The protocol's longest run from `start_c`, s: each step's timeout where it has one; else a
+/// step that waits counts its nominal duration plus kUntimedWaitS, any other its nominal
+/// duration (a ramp at its rate, a hold's time). A --fault past it is refused: it would never
+/// run (one within it that the run does not reach is reported when the run ends).
+double protocol_span_s(const Protocol& p, double start_c) {
+  const auto nominal = p.nominal_step_durations_s(start_c);
+  double span_s = 0;
+  for (std::size_t i = 0; i < p.steps.size(); ++i) {
+    const Step& s = p.steps[i];
+    const bool waits = s.kind == StepKind::soak || (s.kind == StepKind::set_temperature && s.wait);
+    const double d = nominal[i].value_or(0.0);
+    span_s += s.timeout_s > 0 ? std::max(s.timeout_s, d) : waits ? d + kUntimedWaitS : d;
+  }
+  return span_s;
+}
+
+/// The --fault commands whose tick the run ended before, each reported: never silently dropped.
+void report_faults_not_run(const SimRunOptions& o, double last_tick_s) {
+  for (const auto& [at_s, command] : o.faults)
+    if (at_s > last_tick_s)
+      log("sim")->warn("--fault {:.0f}:{} never ran: the run ended at t = {:.0f} s", at_s, command,
+                       last_tick_s);
+}
+
 /// Every --fault command tried on a throwaway world of the run's shape before the run exists:
-/// a command simrig would refuse is exit 2 with nothing recorded, not a 'running' run left
-/// behind at its tick.
-void check_fault_commands(const SimRunOptions& o, const sim::SimWorldConfig& wc) {
+/// a command simrig would refuse, or a time past the protocol's end, is exit 2 with nothing
+/// recorded, not a 'running' run left behind at its tick (nor a fault that never happens).
+void check_fault_commands(const SimRunOptions& o, const sim::SimWorldConfig& wc,
+                          const Protocol& protocol) {
   if (o.faults.empty()) return;
+  const double span_s = protocol_span_s(protocol, wc.initial_c);
   sim::SimWorld probe(wc);
   for (const auto& [at_s, command] : o.faults) {
+    if (!(at_s >= 0 && at_s <= span_s))
+      throw fault_error(at_s, command,
+                        fmt::format("tick {:.0f} s is past the end of protocol '{}' ({:.0f} s: "
+                                    "each step's timeout, or its nominal duration and 7 days for "
+                                    "a wait without one)",
+                                    at_s, protocol.name, span_s));
     if (command == "kill" || command == "sigint") continue;  // the daemon's own process, below
     const std::string reply = sim::run_fault_command(probe, command);
     if (reply.rfind("ok", 0) != 0) throw fault_error(at_s, command, reply);
@@ -258,7 +299,7 @@ nlohmann::json run_simulated(const SimRunOptions& o) {
   const auto part = sim_part_number(o);
   const Protocol protocol = load_protocol(o.protocol);
   const sim::SimWorldConfig wc = world_config(o);
-  check_fault_commands(o, wc);
+  check_fault_commands(o, wc, protocol);
   sim::SimWorld world(wc);
   const StationConfig config =
       parse_station_config(sim_config_text(world, o, part), "sim:station.toml");
@@ -287,6 +328,7 @@ nlohmann::json run_simulated(const SimRunOptions& o) {
   }
   if (o.extend) o.extend(so);
   const RunOutcome out = host.run(plan, std::move(so));
+  report_faults_not_run(o, out.t_s);
   if (rec.session) rec.session->finish(store, out.run_id);
   return sim_report(store, out, world, wall_start);
 }

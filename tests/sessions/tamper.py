@@ -208,6 +208,39 @@ try:
         r"^state = ", lambda l: b"state = 'completed'" if b"completed" not in l else b"state = 'stopped'"))
     tamper_lines("a tag of digest.txt changed", "digest.txt", json_line_edit(
         r"^tags modbus.log 65 ", lambda l: l[:-1] + (b"0" if l[-1:] != b"0" else b"1")))
+    # Issue 34 point 11: digest.txt has one form (schemas/session.md); an edit that leaves every
+    # number as it was (a space, a case, a comment, a CR, an empty line) is named at its line.
+    tamper_lines("a space at the end of a digest.txt line", "digest.txt",
+                 json_line_edit(r"^file can.log ", lambda l: l + b" "))
+    tamper_lines("two spaces between digest.txt fields", "digest.txt",
+                 json_line_edit(r"^file gpio.log ", lambda l: l.replace(b" ", b"  ", 1)))
+    tamper_lines("a digest.txt tags line in upper case", "digest.txt",
+                 json_line_edit(r"^tags modbus.log 65 [0-9a-f]*[a-f]", lambda l: l.upper().replace(
+                     b"TAGS MODBUS.LOG", b"tags modbus.log")))
+    tamper_lines("a digest.txt SHA-256 in upper case", "digest.txt",
+                 json_line_edit(r"^file result.json \d+ [0-9]*[a-f]",
+                                lambda l: l[:-64] + l[-64:].upper()))
+    tamper_lines("a comment added to digest.txt", "digest.txt",
+                 lambda l: l[:4] + [b"# checked by hand"] + l[4:])
+    tamper_lines("an empty line added to digest.txt", "digest.txt", lambda l: l[:5] + [b""] + l[5:])
+    tamper_lines("a CR at the end of a digest.txt line", "digest.txt",
+                 json_line_edit(r"^file session.toml ", lambda l: l + b"\r"))
+    tamper_lines("a leading zero in a digest.txt line count", "digest.txt",
+                 json_line_edit(r"^file can.log ", lambda l: l.replace(b"can.log ", b"can.log 0", 1)))
+    # Bytes after the end of a .gz member: gzip(1) and zlib skip them; they are not the run's.
+    for name, extra in (("garbage", b"not the run's bytes\n"), ("zeros", b"\0" * 512)):
+        d = fresh_copy()
+        gz = path_of(d, "modbus.log")
+        assert gz.endswith(".gz"), gz
+        with open(gz, "ab") as f:
+            f.write(extra)
+        check(f"{name} after the end of modbus.log.gz", d, 1,
+              ["modbus.log.gz:", "after the end of the compressed data"])
+    d = fresh_copy()
+    with open(path_of(d, "digest.txt"), "ab") as f:
+        f.write(b"trailing")
+    check("garbage after the end of digest.txt.gz", d, 1,
+          ["digest.txt.gz", "after the end of the compressed data"])
     d = fresh_copy()
     os.remove(path_of(d, "digest.txt"))
     check("digest.txt removed", d, 1, ["digest.txt: missing"])

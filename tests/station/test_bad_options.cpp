@@ -31,6 +31,12 @@ TEST(BadOptions, EachIsExit2NamingItBeforeAnyRunExists) {
   const std::vector<std::pair<std::string, std::string>> cases{
       {"--fault 10:explode", "--fault 10:explode: error: unknown command 'explode'"},
       {"--fault '20:board 99 reset'", "--fault 20:board 99 reset: error: node '99'"},
+      // Issue 34 point 11: a time no run reaches was accepted and never fired.
+      {"--fault '1e99:door open'", "--fault '1e99:door open': expected TICK:COMMAND"},
+      {"--fault 'inf:door open'", "--fault 'inf:door open': expected TICK:COMMAND"},
+      {"--fault '3000abc:door open'", "--fault '3000abc:door open': expected TICK:COMMAND"},
+      {"--fault '99999999:door open'",
+       "--fault 99999999:door open: tick 99999999 s is past the end of protocol 'paper'"},
       {"--speed nan", "--speed: 'nan' is not a finite number"},
       {"--seed -1", "--seed: '-1' is not an unsigned integer"},
       {"--protocol " + slow, slow + ":5: key 'step[0].ramp_c_per_h': 1e-300 C/h"},

@@ -745,12 +745,27 @@ def check_bad_requests(port, token, run_id):
                        ('{"operator": "ann"}', "protocol missing"),
                        ('{"protocol": 5, "operator": "ann"}', "protocol not a string"),
                        ('{"protocol": null}', "protocol null"),
-                       ('{"protocol": "paper", "operator": 7}', "operator not a string")]:
+                       ('{"protocol": "paper", "operator": 7}', "operator not a string"),
+                       # Issue 34 point 11: a key the route does not know (a typo) is refused.
+                       ('{"protocol": "paper", "operater": "ann"}', "an unknown key")]:
         r = request(port, "POST", "/api/runs", body=body, headers=js)
         expect_error(r, 400, f"POST /api/runs with {what}")
 
-    # Ids.
-    for path, status in [("/api/runs/999999", 404), ("/api/runs/999999/bins", 404),
+    r = request(port, "POST", "/api/runs", body='{"protocol": "paper", "operater": "ann"}',
+                headers=js)
+    check(r.status == 400 and "field 'operater': unknown" in ((r.json() or {}).get("error") or ""),
+          "POST /api/runs: an unknown key is 400 naming it", r.brief())
+    r = request(port, "POST", f"/api/runs/{run_id}/stop", body='{"force": true}', headers=js)
+    check(r.status == 400 and "field 'force': unknown" in ((r.json() or {}).get("error") or ""),
+          "POST /api/runs/{id}/stop with a field: 400 naming it (a stop takes none)", r.brief())
+
+    # Ids: one canonical decimal form (issue 34 point 11: 01 read as 1).
+    for path, status in [(f"/api/runs/0{run_id}", 400), (f"/api/runs/+{run_id}", 400),
+                         (f"/api/runs/{run_id}.0", 400), (f"/api/runs/%20{run_id}", 400),
+                         (f"/api/runs/0{run_id}/bins", 400),
+                         (f"/api/runs/{run_id}/events?since=00", 400),
+                         ("/api/runs?limit=010", 400),
+                         ("/api/runs/999999", 404), ("/api/runs/999999/bins", 404),
                          ("/api/runs/999999/events", 404),
                          ("/api/runs/abc", 400), ("/api/runs/0", 400), ("/api/runs/-1", 400),
                          ("/api/runs/1.5", 400), ("/api/runs/%201", 400),
@@ -1063,10 +1078,13 @@ def check_release(port, token, db, run_id):
     expect_error(request(port, "POST", path, body=b'{"by":"x"}', headers=auth(WRONG_TOKEN)), 403,
                  f"[R] POST {path} wrong token")
     for body, what in [(b"{", "bad JSON"), (b'{"note":"n"}', "no 'by'"), (b'{"by":""}', "empty 'by'"),
-                       (b'{"by":7}', "'by' not a string"), (b"[]", "not an object")]:
+                       (b'{"by":7}', "'by' not a string"), (b"[]", "not an object"),
+                       (b'{"by":"Ann","overide":"typo"}', "an unknown key")]:
         expect_error(request(port, "POST", path, body=body, headers=js), 400, f"[R] POST {path} {what}")
     for bad, status in [("/api/fits/999999/release", 404), ("/api/fits/abc/release", 400),
-                        ("/api/fits/0/release", 400)]:
+                        ("/api/fits/0/release", 400), (f"/api/fits/0{fit_id}/release", 400),
+                        (f"/api/fits/+{fit_id}/release", 400), (f"/api/fits/{fit_id}.0/release", 400),
+                        (f"/api/fits/%20{fit_id}/release", 400)]:
         expect_error(request(port, "POST", bad, body=b'{"by":"x"}', headers=js), status, f"[R] POST {bad}")
     r = request(port, "POST", path, body=json.dumps({"by": "api-test", "note": "from curl"}).encode(),
                 headers=js)
