@@ -3,7 +3,9 @@
 
 #include <fmt/format.h>
 
+#include <chrono>
 #include <cmath>
+#include <string_view>
 
 #include "station/daemon/stopwatch.hpp"
 
@@ -27,7 +29,29 @@ void read_counters(Rig& rig, std::uint8_t seq, RigReading& r) {
   }
 }
 
+// The budget of one reading (RigReadPlan::budget_s) on the steady clock: the exchanges it bounds
+// run on the wall, whatever clock the run keeps.
+class ReadBudget {
+ public:
+  explicit ReadBudget(std::optional<double> budget_s) : budget_s_(budget_s) {}
+  /// Why `device` is not read now (its turn came after the budget was spent), or nothing.
+  std::optional<dr::Error> spent(std::string_view device) const {
+    const double used_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    if (!budget_s_ || used_s < *budget_s_) return std::nullopt;
+    return dr::make_error(dr::ErrorKind::timeout,
+                          fmt::format("{} not read this tick: the chamber took {:.2f} s of the "
+                                      "tick's {:.2f} s for device exchanges",
+                                      device, used_s, *budget_s_));
+  }
+
+ private:
+  std::optional<double> budget_s_;
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
+
 void read_devices(Rig& rig, const RigReadPlan& plan, RigReading& r, RigReadTimes* times) {
+  const ReadBudget budget(plan.budget_s);  // from the chamber's turn: CAN has its own bound
   if (plan.chamber) {
     Stopwatch w(field(times, &RigReadTimes::chamber));
     if (auto c = rig.chamber->read(); c) {
@@ -39,12 +63,16 @@ void read_devices(Rig& rig, const RigReadPlan& plan, RigReading& r, RigReadTimes
   }
   Stopwatch w(field(times, &RigReadTimes::table));
   if (!rig.turntable || !plan.table) return;
-  if (auto t = rig.turntable->read(); t) {
-    r.table = t.value();
-    r.table_interlock_open = r.table->interlock_open;
-  } else {
-    r.io_errors.push_back({"turntable", dr::to_string(t.error().kind)});
-    r.table_error = t.error();
+  auto t = budget.spent("turntable");
+  if (!t) {
+    auto got = rig.turntable->read();
+    if (got) r.table = got.value();
+    if (got) r.table_interlock_open = r.table->interlock_open;
+    if (!got) t = got.error();
+  }
+  if (t) {
+    r.io_errors.push_back({"turntable", dr::to_string(t->kind)});
+    r.table_error = std::move(t);
   }
 }
 

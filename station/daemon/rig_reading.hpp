@@ -26,12 +26,26 @@ struct IoError {
   std::string device, kind;
 };
 
+/// Wall seconds the chamber's and the turntable's exchanges of one 1 s tick may take together
+/// (issue 34): each exchange has its own deadline (the device's timeout_s), but a chamber slow on
+/// every exchange, or configured with a long timeout, must not push the turntable's read, and
+/// with it the tick, past the tick's second. Of the second, the counter boards' latch before
+/// them has its own bound (`[can] tick_timeout_ms`, 0.2 s by default), 0.6 s is theirs, and
+/// 0.2 s is left for what follows the reading: the samples' store commit, safety and the
+/// commands it sends. A device whose turn comes after the budget is spent is not read this
+/// tick: a timeout, never its last state passed as fresh.
+inline constexpr double kTickReadBudgetS = 0.6;
+
 /// What to read. A run reads everything each tick; between ticks only the GPIO inputs.
 struct RigReadPlan {
   std::optional<std::uint8_t> latch_seq;  ///< SYNC the counter boards with it (none: no SYNC)
   bool chamber = true;                    ///< read the chamber
   bool table = true;                      ///< read the turntable (when configured)
   bool gpio_edges = true;                 ///< collect the GPIO bank's edges first
+  /// Wall seconds from the chamber's turn after which the chamber and the turntable are no longer
+  /// asked (none: no bound). The counter boards' latch has its own bound, and the GPIO lines
+  /// are local reads: both always read.
+  std::optional<double> budget_s;
 };
 
 /// Wall time per device of one reading, seconds (the sequencer's phase totals).

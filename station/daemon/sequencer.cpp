@@ -66,7 +66,9 @@ void Sequencer::connect_devices() {
 }
 
 void Sequencer::read_devices(double t_s, TickData& d) {
-  d.in = read_rig(rig_, RigReadPlan{latch_seq_++}, &phase_s_.rig);
+  RigReadPlan plan{latch_seq_++};
+  plan.budget_s = kTickReadBudgetS * options_.period_s;  // 0.6 s of the 1 s tick
+  d.in = read_rig(rig_, plan, &phase_s_.rig);
   note_counters(t_s, d, d.in.counters_error ? d.in.counters_error->message : std::string());
   note_link(t_s, "chamber", d.in.chamber.has_value(),
             d.in.chamber_error ? d.in.chamber_error->message : std::string());
