@@ -2,21 +2,25 @@
 """Fault campaign: the daemon on a real-transport rig (simrig, wall clock) under faults.
 
 Two rigs run the same short protocol side by side: a reference left alone, and a victim that
-gets, at seeded random instants, SIGKILL + restart of the daemon, Modbus stalls and disconnects
-of chamber and turntable, door open, e-stop, a broken chamber air sensor, an ACUTROL refusing
-every command for a while, dropped and corrupted CAN frames. A second phase restarts the
+gets, at seeded random instants, SIGKILL + restart of the daemon, Modbus stalls, disconnects and
+replies that drip (one byte every 0.3 s) of chamber and turntable, door open, e-stop, a broken
+chamber air sensor, an ACUTROL refusing every command for a while, dropped and corrupted CAN
+frames. A second phase restarts the
 simulator itself under a running daemon. Checked:
 
   * zero committed samples lost or changed (a snapshot of the database after every kill, and
     before every simulator restart, is compared with the final file);
   * safe state reached for every door / e-stop / chamber air sensor break (a safe_hold event;
     the break also one sensor_fault event), and how fast (event wall time - injection time);
-  * every fault leaves its event (resume, safe_hold, outage ...), counted per fault;
+  * every fault leaves its event (resume, safe_hold, outage ...), counted per fault; a drip
+    its outage's start and end and no tick lost (no tick_gap), the table's drip a safe hold
+    and its end;
   * the victim's final fit equals the reference's within the noise: for every coefficient
     |k_victim - k_reference| <= 5 * sqrt(se_victim^2 + se_reference^2) (two independent
     estimates of the same gyro; 5 sigma because OLS errors are optimistic for correlated bins).
 
 Usage: scripts/fault_campaign.py --build build [--duration-s 150] [--seed 1] [--faults N]
+(N: by default one fault of every kind the rig's dialects take)
                                  [--json OUT] [--keep DIR]
 Exit 0 when every check holds, 1 otherwise (the table says which), 2 on bad usage.
 """
@@ -35,7 +39,8 @@ import time
 from datetime import datetime, timezone
 
 FAULTS = ["kill9", "door", "estop", "chamber_sensor", "chamber_stall", "chamber_disconnect",
-          "table_stall", "table_disconnect", "can_drop", "can_corrupt"]
+          "table_stall", "table_disconnect", "can_drop", "can_corrupt", "chamber_drip",
+          "table_drip"]
 # The chamber dialects whose driver reports the simulator's air sensor break as one (an ESPEC
 # P300's alarm codes are in no source: its break reads as another alarm and an air value out of
 # limits, docs/DEVICES.md).
@@ -47,6 +52,11 @@ HOLD_FAULTS = ("door", "estop", "chamber_sensor", "table_refuse")
 # interlock has gone unread for the safety layer's 5 blind ticks.
 REFUSING_TABLES = {"acutrol3000"}
 REFUSE_S = 7
+# A device whose replies drip, one byte every 0.3 s (simrig `drip`: issue 34's proxy, under
+# libmodbus's 0.5 s byte timeout) for 6 s: an outage with its end and no tick lost (no tick_gap);
+# the table's also a safe hold and its end, its interlock unread for more than the 5 blind ticks.
+DRIP_FAULTS = ("chamber_drip", "table_drip")
+DRIP_S = 6
 
 
 def free_port():
@@ -153,8 +163,8 @@ def snapshot(db):
 
 def events(db):
     with ro(db) as c:
-        return c.execute("SELECT t_s, wall_utc, severity, source, kind, message FROM events "
-                         "WHERE run_id = 1 ORDER BY id").fetchall()
+        return c.execute("SELECT t_s, wall_utc, severity, source, kind, message, data_json "
+                         "FROM events WHERE run_id = 1 ORDER BY id").fetchall()
 
 
 def fits(db):
@@ -204,12 +214,16 @@ def inject(kind, rig, daemon, db, rng, log):
         "table_disconnect": (["table disconnect 2"], [], {"outage", "read_failed", "safe_hold",
                                                          "inputs_unreadable"}),
         "table_refuse": (["table refuse %d" % REFUSE_S], [], {"outage_start"}),
+        "chamber_drip": (["chamber drip %d" % DRIP_S], [], {"outage"}),
+        "table_drip": (["table drip %d" % DRIP_S], [], {"outage"}),
         "can_drop": (["can drop 6"], [], {"outage", "tick_failed"}),
         "can_corrupt": (["can corrupt 6"], [], {"outage", "tick_failed"}),
     }[kind]
     replies = rig.send(*commands[0])
     log.append("%s -> %s" % (commands[0], replies))
-    time.sleep(REFUSE_S + 0.5 if kind == "table_refuse" else 3.5)
+    # A drip's late bytes keep a link down a few ticks after it ends (till its reconnect).
+    time.sleep(REFUSE_S + 0.5 if kind == "table_refuse" else
+               DRIP_S + 3.5 if kind in DRIP_FAULTS else 3.5)
     if commands[1]:
         rig.send(*commands[1])
     return snap, t0, commands[2]
@@ -257,7 +271,8 @@ def campaign(args, work):
     if args.turntable in REFUSING_TABLES:
         at = faults.index("table_disconnect") + 1
         faults = faults[:at] + ["table_refuse"] + faults[at:]
-    kinds = (faults * (args.faults // len(faults) + 1))[:args.faults]
+    n = args.faults or len(faults)  # by default one of every kind this rig takes
+    kinds = (faults * (n // len(faults) + 1))[:n]
     rng.shuffle(kinds)
     slots = sorted(rng.uniform(8, args.duration_s - 15) for _ in kinds)
     log, rows, snaps = [], [], []
@@ -289,6 +304,17 @@ def campaign(args, work):
                                         "refused by the unit" in e[5] for e in new)
             row["event_expected"] = row["refusal_events"] == 1
             holds += [wall(e[1]) - t0 for e in new if e[4] == "safe_hold_changed"]
+        if kind in DRIP_FAULTS:
+            # The outage's start and end, no tick lost; the table's hold and its end.
+            device = "chamber" if kind == "chamber_drip" else "turntable"
+            row["ticks_lost"] = sum(json.loads(e[6] or "{}").get("ticks_lost", 0)
+                                    for e in new if e[4] == "tick_gap")
+            ends = {e[4] for e in new if e[3] == device} >= {"outage_start", "outage"}
+            held = kind == "chamber_drip" or seen >= {"safe_hold", "safe_hold_cleared"}
+            row["event_expected"] = ends and held and row["ticks_lost"] == 0
+            if kind == "table_drip":
+                holds += [wall(e[1]) - t0 for e in new if e[4] == "safe_hold_changed"]
+                row["time_to_safe_s"] = round(min(holds), 3) if holds else None
         if kind in HOLD_FAULTS:
             row["time_to_safe_s"] = round(min(holds), 3) if holds else None
         rows.append(row)
@@ -362,14 +388,16 @@ def main():
     p.add_argument("--build", default="build")
     p.add_argument("--duration-s", type=int, default=150)
     p.add_argument("--seed", type=int, default=1)
-    p.add_argument("--faults", type=int, default=9)
+    p.add_argument("--faults", type=int, help="faults injected (default: one of every kind the "
+                   "rig's dialects take, in seeded random order)")
     p.add_argument("--chamber", default="generic_plc", help="chamber dialect (docs/DEVICES.md)")
     p.add_argument("--turntable", default="generic_plc", help="turntable dialect")
     p.add_argument("--json")
     p.add_argument("--keep")
     args = p.parse_args()
     Rig.models = (args.chamber, args.turntable)
-    if args.duration_s < 60 or args.faults < 1 or args.faults * 8 > args.duration_s:
+    most = args.faults if args.faults is not None else len(FAULTS) + 1  # + a table's refusal
+    if args.duration_s < 60 or most < 1 or most * 8 > args.duration_s:
         print("fault_campaign: need --duration-s >= 60 and about 8 s per fault", file=sys.stderr)
         return 2
     work = args.keep or tempfile.mkdtemp(prefix="fault-campaign-")
