@@ -142,14 +142,18 @@ bool PgConnection::cancel() const {
 // Past the deadline (or stopping): cancel, close (PQfinish on a non-blocking connection does not
 // wait to send its Terminate), and say what went unanswered. The server rolls back what was open.
 void PgConnection::abandon(std::string_view what, bool stopping, double limit_s) {
-  const bool cancelled = conn_ && cancel();
+  const bool can_cancel = conn_ && cancel_;  // none before the connection is made
+  const bool cancelled = can_cancel && cancel();
   conn_.reset();
   const std::string call(what.substr(0, 60));
   if (stopping) throw PgTimeout(fmt::format("PostgreSQL {}: {} given up: stopping", where_, call));
   throw PgTimeout(fmt::format(
       "PostgreSQL {}: {}: timed out, no answer within {:.1f} s (server frozen, overloaded or cut "
-      "off?); {}, disconnected",
-      where_, call, limit_s, cancelled ? "cancelled" : "cancel unanswered"));
+      "off?); {}disconnected",
+      where_, call, limit_s,
+      !can_cancel ? ""
+      : cancelled ? "cancelled, "
+                  : "cancel unanswered, "));
 }
 
 void PgConnection::lost(std::string_view what) {
