@@ -1,4 +1,4 @@
-// One flock(2) per database file per process: exclusive for writers, shared for readers.
+// One exclusive flock(2) per database file per writing process.
 #include "station/common/database_lock.hpp"
 
 #include <dirent.h>
@@ -11,13 +11,11 @@
 
 #include <algorithm>
 #include <cerrno>
-#include <chrono>
 #include <cstring>
 #include <fstream>
 #include <map>
 #include <mutex>
 #include <sstream>
-#include <thread>
 #include <utility>
 
 #include "station/common/input_error.hpp"
@@ -29,7 +27,6 @@ using Key = std::pair<unsigned long long, unsigned long long>;  // (st_dev, st_i
 struct HeldDatabase {
   int fd = -1;
   Key key;
-  bool exclusive = false;
   bool created = false;  ///< this hold made the (empty) file: remove it if still empty
   std::string path;
   ~HeldDatabase();
@@ -37,9 +34,9 @@ struct HeldDatabase {
 
 namespace {
 
-// Every hold of this process, by file. The mutex is held across a whole acquisition (waiting
-// included) and across a release: no descriptor of a file is opened or closed by another thread
-// while a hold on it is being decided.
+// Every hold of this process, by file. The mutex is held across a whole acquisition and across a
+// release: no descriptor of a file is opened or closed by another thread while a hold on it is
+// being decided.
 std::mutex& registry_mutex() {
   static std::mutex m;
   return m;
@@ -79,32 +76,20 @@ std::string holders_text(const std::vector<FlockHolder>& holders) {
   std::string out;
   for (const auto& h : holders) {
     out += (out.empty() ? "" : ", ") + describe_process(h.pid);
-    if (!h.write) out += ", reading";
   }
   return out.empty() ? "another station process" : out;
 }
 
-// Takes LOCK_EX on `fd`: at once, or after readers finish (bounded); throws naming the holders.
+// Takes LOCK_EX on `fd` at once; throws naming the holder.
 void lock_exclusive(int fd, const std::string& path, Key key) {
-  using Clock = std::chrono::steady_clock;
-  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                           std::chrono::duration<double>(kWaitForReadersS));
-  for (;;) {
-    if (::flock(fd, LOCK_EX | LOCK_NB) == 0) return;
-    const int err = errno;
-    if (err != EWOULDBLOCK)
-      throw InputError(fmt::format("{}: cannot lock the database: {}", path, std::strerror(err)));
-    const auto holders = flock_holders(key.first, key.second);
-    const bool writer = !holders.empty() && holders.front().write;
-    if (writer || Clock::now() >= deadline) {
-      throw InputError(fmt::format(
-          "{}: database is in use by {}{}; nothing was touched (one writer at a time: a "
-          "daemon holds it for its whole life, a writing command while it runs)",
-          path, holders_text(holders),
-          writer ? "" : fmt::format(" for more than {:.0f} s", kWaitForReadersS)));
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
+  if (::flock(fd, LOCK_EX | LOCK_NB) == 0) return;
+  const int err = errno;
+  if (err != EWOULDBLOCK)
+    throw InputError(fmt::format("{}: cannot lock the database: {}", path, std::strerror(err)));
+  throw InputError(fmt::format(
+      "{}: database is in use by {}; nothing was touched (one writer at a time: a daemon holds "
+      "it for its whole life, a writing command while it runs)",
+      path, holders_text(flock_holders(key.first, key.second))));
 }
 
 }  // namespace
@@ -129,7 +114,7 @@ namespace {
 
 // The hold this process already has on the file at `path`, found by stat(2): no descriptor of the
 // file is opened (closing one would drop the POSIX locks of this process's connections on it).
-std::shared_ptr<HeldDatabase> held_here(const std::string& path) {
+std::shared_ptr<HeldDatabase> hold_of(const std::string& path) {
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) return nullptr;
   const auto it = registry().find(
@@ -137,12 +122,10 @@ std::shared_ptr<HeldDatabase> held_here(const std::string& path) {
   return it == registry().end() ? nullptr : it->second.lock();
 }
 
-std::shared_ptr<HeldDatabase> new_hold(int fd, Key key, bool exclusive, bool created,
-                                       const std::string& path) {
+std::shared_ptr<HeldDatabase> new_hold(int fd, Key key, bool created, const std::string& path) {
   auto held = std::make_shared<HeldDatabase>();
   held->fd = fd;
   held->key = key;
-  held->exclusive = exclusive;
   held->created = created;
   held->path = path;
   registry()[key] = held;
@@ -153,13 +136,7 @@ std::shared_ptr<HeldDatabase> new_hold(int fd, Key key, bool exclusive, bool cre
 
 DatabaseHold DatabaseHold::writer(const std::string& path, bool create) {
   const std::lock_guard<std::mutex> guard(registry_mutex());
-  if (auto held = held_here(path)) {
-    if (!held->exclusive) {
-      lock_exclusive(held->fd, path, held->key);  // a reader of this process becomes the writer
-      held->exclusive = true;
-    }
-    return DatabaseHold(held);
-  }
+  if (auto held = hold_of(path)) return DatabaseHold(held);
   bool created = false;
   const int fd = open_database_file(path, create, created);
   if (fd < 0) {
@@ -169,30 +146,17 @@ DatabaseHold DatabaseHold::writer(const std::string& path, bool create) {
   try {
     lock_exclusive(fd, path, key);
   } catch (...) {
-    ::close(fd);  // this process has no connection on the file: nothing else to drop
+    // The descriptor stays open: this process may read the file through SQLite, and closing a
+    // descriptor of a file drops all of the process's POSIX locks on it (SQLite's included).
     if (created) (void)::unlink(path.c_str());
     throw;
   }
-  return DatabaseHold(new_hold(fd, key, true, created, path));
+  return DatabaseHold(new_hold(fd, key, created, path));
 }
 
-std::optional<DatabaseHold> DatabaseHold::reader(const std::string& path) {
+bool DatabaseHold::held_here(const std::string& path) {
   const std::lock_guard<std::mutex> guard(registry_mutex());
-  if (auto held = held_here(path)) return DatabaseHold(held);
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) return std::nullopt;
-  struct stat st {};
-  if (::fstat(fd, &st) != 0 || ::flock(fd, LOCK_SH | LOCK_NB) != 0) {
-    ::close(fd);  // this process has no connection on the file: nothing else to drop
-    return std::nullopt;
-  }
-  const Key key{static_cast<unsigned long long>(st.st_dev),
-                static_cast<unsigned long long>(st.st_ino)};
-  return DatabaseHold(new_hold(fd, key, false, false, path));
-}
-
-bool DatabaseHold::exclusive() const {
-  return held_ && held_->exclusive;
+  return hold_of(path) != nullptr;
 }
 
 std::vector<FlockHolder> flock_holders(unsigned long long dev, unsigned long long ino) {

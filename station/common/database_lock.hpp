@@ -1,7 +1,7 @@
-// Who may touch a station database file, decided on the file itself (its device and inode: a hard
-// link, a symlink, `./` or `..` is the same lock). A writer holds an exclusive flock(2) — a daemon
-// for its whole life, a writing command (fit, release, verify, sync) while it runs — and a reader a
-// shared one while it reads with no writer about, so no writer can start under it.
+// Who may write a station database file, decided on the file itself (its device and inode: a hard
+// link, a symlink, `./` or `..` is the same lock): a writer holds an exclusive flock(2) — a daemon
+// for its whole life, a writing command (fit, release, verify, sync) while it runs. Readers take
+// no lock (SQLite's WAL lets them read beside a writer); they look at who holds it.
 #pragma once
 
 #include <memory>
@@ -11,27 +11,21 @@
 
 namespace station {
 
-/// Seconds a writer waits while only readers (shared holders) hold the file, before it refuses.
-inline constexpr double kWaitForReadersS = 30.0;
-
 struct HeldDatabase;
 
 /// This process's flock on one database file: one per file (inode) for the whole process, shared
-/// by every connection the process opens on it and released when the last one ends. Closing any
-/// descriptor of a file drops all of the process's POSIX locks on it, SQLite's included (fcntl(2),
-/// "Advisory record locking"), so the lock's descriptor is closed only when no connection remains.
+/// by every writing connection the process opens on it and released when the last one ends. Closing
+/// any descriptor of a file drops all of the process's POSIX locks on it, SQLite's included
+/// (fcntl(2), "Advisory record locking"), so the lock's descriptor is closed only when no
+/// connection remains.
 class DatabaseHold {
  public:
-  /// Exclusive. Waits up to kWaitForReadersS while only readers hold the file; refuses at once
-  /// (InputError "PATH: database is in use by station run (pid N) ...; nothing was touched") when
-  /// a writer holds it. `create`: a missing file is created empty (0644), and removed again when
-  /// the hold ends if nothing was ever written to it.
+  /// Exclusive, without waiting: refuses (InputError "PATH: database is in use by station run
+  /// (pid N); nothing was touched ...") when another process holds it. `create`: a missing file
+  /// is created empty (0644), and removed again when the hold ends if nothing was written to it.
   static DatabaseHold writer(const std::string& path, bool create);
-  /// Shared, without waiting. Empty when another process writes the file (the reader then reads
-  /// beside that writer through SQLite's WAL) or when the file cannot be opened.
-  static std::optional<DatabaseHold> reader(const std::string& path);
-  /// True when this process writes the file (its hold is exclusive).
-  bool exclusive() const;
+  /// True when this process holds the file at `path` (it writes it). Opens no descriptor.
+  static bool held_here(const std::string& path);
 
  private:
   explicit DatabaseHold(std::shared_ptr<HeldDatabase> held) : held_(std::move(held)) {}

@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <filesystem>
 
@@ -48,18 +49,22 @@ DatabaseAccess claim_database_file(const std::string& path, OpenMode mode) {
   if (mode != OpenMode::read_only) {
     if (!exists && mode != OpenMode::create) return {};  // SQLite says it must exist
     // The lock first: a refusal because another process writes it names that process.
-    DatabaseAccess access{DatabaseHold::writer(path, mode == OpenMode::create), false};
+    DatabaseAccess access{DatabaseHold::writer(path, mode == OpenMode::create)};
     refuse_log_of_another_name(path);
     return access;
   }
-  if (!exists) return {};  // SQLite says it must exist
-  DatabaseAccess access{DatabaseHold::reader(path), false};
+  if (!exists || DatabaseHold::held_here(path)) return {};  // missing, or this process writes it
   const std::string own = sqlite_name(path);
   const bool logs = beside(own, "-wal") || beside(own, "-shm");
-  if (!access.hold && !logs) refuse_other_writers_name(path, own);
+  const bool writer = !flock_holders(static_cast<unsigned long long>(st.st_dev),
+                                     static_cast<unsigned long long>(st.st_ino))
+                           .empty();
+  if (writer && !logs) refuse_other_writers_name(path, own);
   refuse_log_of_another_name(path);
-  access.immutable = access.hold && !access.hold->exclusive() && !logs;
-  return access;
+  if (writer || logs) return {};
+  const std::string dir = fs::path(own).parent_path().string();
+  return {std::nullopt,
+          ::access(dir.c_str(), W_OK) == 0 ? ReadWay::leave_nothing : ReadWay::immutable};
 }
 
 std::string immutable_uri(const std::string& path) {

@@ -1,16 +1,22 @@
-// How a process opens a station database file before SQLite does: the lock it takes on the file
-// (common/database_lock.hpp) and, for a reader, how SQLite is to read it.
+// How a process opens a station database file before SQLite does: the lock a writer takes on the
+// file (common/database_lock.hpp) and how a reader is to read it.
 //
 // A writer (OpenMode::create, existing) holds the file exclusively: every writing command, not
 // only the daemons, so no two processes ever write it at once, whatever name each uses.
-// A reader (OpenMode::read_only) never creates a file beside the database:
-// - when another process writes it, the reader reads beside that writer through its WAL and
-//   shared-memory index (they exist while it runs) with SQLITE_OPEN_READONLY;
-// - when no process writes it, the reader holds a shared lock (no writer can start under it) and,
-//   when no -wal or -shm lies beside it, reads it with `immutable=1` (sqlite.org/uri.html: no
-//   locks, no -shm, no -wal; sqlite.org/wal.html "Read-Only Databases": otherwise a WAL database on
-//   a read-only directory cannot be opened without its -shm), so it works on a read-only mount and
-//   leaves nothing behind; a leftover -wal (a writer was killed) is read as it is, never ignored.
+// A reader (OpenMode::read_only) takes no lock and leaves no file beside the database:
+// - beside a writer (another process holds the lock, or a -wal or -shm lies beside the file: a
+//   writer runs, or one was killed and its log must be read) it reads through the WAL with
+//   SQLITE_OPEN_READONLY, as SQLite's WAL lets readers do;
+// - with no writer about, on a directory it cannot write (a read-only mount), with
+//   `immutable=1` (sqlite.org/uri.html; sqlite.org/wal.html "Read-Only Databases": a WAL database
+//   there cannot be opened otherwise, its -shm cannot be made);
+// - with no writer about, elsewhere, with SQLITE_OPEN_READWRITE under PRAGMA query_only: SQLite
+//   makes the -wal and -shm it reads through and, the last connection closing, removes them
+//   (sqlite.org/wal.html: "When the last connection to a database closes, that connection does
+//   a checkpoint and then deletes the WAL and its associated shared-memory file"); a
+//   SQLITE_OPEN_READONLY connection cannot, and left them behind. query_only refuses every
+//   change to the data (sqlite.org/pragma.html#pragma_query_only); the WAL it checkpoints at
+//   close is empty, since it held no -wal when it opened and wrote nothing.
 #pragma once
 
 #include <optional>
@@ -22,10 +28,17 @@ namespace station {
 
 enum class OpenMode;
 
+/// How SQLite is to open the file for a reader.
+enum class ReadWay {
+  beside_writer,  ///< SQLITE_OPEN_READONLY, through the writer's -wal and -shm
+  immutable,      ///< `immutable=1`: no locks, no -wal, no -shm (a read-only directory)
+  leave_nothing,  ///< SQLITE_OPEN_READWRITE + query_only: the last close removes -wal and -shm
+};
+
 /// What opening a database file needs.
 struct DatabaseAccess {
-  std::optional<DatabaseHold> hold;  ///< none: ":memory:", a URI, a missing file, another's write
-  bool immutable = false;            ///< read with `immutable=1` (readers only)
+  std::optional<DatabaseHold> hold;  ///< a writer's (none: ":memory:", a URI, a missing file)
+  ReadWay read = ReadWay::beside_writer;
 };
 
 /// Takes what `mode` needs on `path` before SQLite opens it. Throws InputError when another

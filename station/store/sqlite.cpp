@@ -74,13 +74,16 @@ std::string Statement::column_text(int c) const {
 Database::Database(const std::string& path, OpenMode mode) : path_(path), mode_(mode) {
   DatabaseAccess access = claim_database_file(path, mode);
   hold_ = std::move(access.hold);
+  const bool immutable = mode == OpenMode::read_only && access.read == ReadWay::immutable;
+  const bool leave_nothing = mode == OpenMode::read_only && access.read == ReadWay::leave_nothing;
   const int flags = mode == OpenMode::create     ? SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE
                     : mode == OpenMode::existing ? SQLITE_OPEN_READWRITE
+                    : leave_nothing              ? SQLITE_OPEN_READWRITE  // query_only: below
+                    : immutable                  ? SQLITE_OPEN_READONLY | SQLITE_OPEN_URI
                                                  : SQLITE_OPEN_READONLY;
-  const std::string name = access.immutable ? immutable_uri(path) : path;
+  const std::string name = immutable ? immutable_uri(path) : path;
   sqlite3* raw = nullptr;
-  const int rc = sqlite3_open_v2(name.c_str(), &raw,
-                                 flags | (access.immutable ? SQLITE_OPEN_URI : 0), nullptr);
+  const int rc = sqlite3_open_v2(name.c_str(), &raw, flags, nullptr);
   db_.reset(raw);
   if (rc != SQLITE_OK) {
     throw SqliteError(fmt::format("{}: cannot open{}: {}", path,
@@ -89,6 +92,8 @@ Database::Database(const std::string& path, OpenMode mode) : path_(path), mode_(
   }
   // Every wait on a lock is bounded (5 s).
   sqlite3_busy_timeout(db_.get(), 5000);
+  // A reader changes nothing, whichever way it opened the file (database_access.hpp).
+  if (mode == OpenMode::read_only) exec("PRAGMA query_only=ON;");
   // Nothing is written to a file before it passes the check (a corrupt record must not grow).
   quick_check();
   // Whose file it is, before any PRAGMA that writes (journal_mode=WAL, a migration's copy).
@@ -98,10 +103,7 @@ Database::Database(const std::string& path, OpenMode mode) : path_(path), mode_(
                     "nothing was written to it",
                     path_));
   }
-  if (mode == OpenMode::read_only) {
-    exec("PRAGMA query_only=ON;");
-    return;
-  }
+  if (mode == OpenMode::read_only) return;
   // WAL with synchronous=NORMAL: a commit survives the process being killed at any instant (only
   // an OS crash can lose the last commits; SQLite docs, "Write-Ahead Logging", PRAGMA synchronous).
   exec("PRAGMA journal_mode=WAL; PRAGMA synchronous=NORMAL; PRAGMA foreign_keys=ON;");
