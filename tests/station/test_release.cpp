@@ -226,7 +226,7 @@ TEST(FitCv, LeaveOneRunOutOverTwoRunsMatchesAFitOnTheOtherRun) {
   const auto& cv = j["cross_validation"];
   ASSERT_EQ(cv["held_out"].size(), 2u) << j.dump();
   {
-    // Closed before the next `station fit`: a writer waits for this process's readers.
+    // Read-only: a writing Store here would hold the file's lock and refuse `station fit`.
     station::Store store(c.path, station::OpenMode::read_only);
     for (const auto& h : cv["held_out"]) {
       const auto held = h["run_id"].get<std::int64_t>();
