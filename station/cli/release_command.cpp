@@ -9,7 +9,9 @@
 
 #include "station/cli/commands.hpp"
 #include "station/cli/exit_status.hpp"
+#include "station/cli/text_options.hpp"
 #include "station/common/input_error.hpp"
+#include "station/common/text_rule.hpp"
 #include "station/parts/judged_fit.hpp"
 #include "station/release/block_formats.hpp"
 #include "station/release/releases.hpp"
@@ -110,7 +112,11 @@ void run_export(const ExportOptions& o) {
   } else {
     nlohmann::json arr = nlohmann::json::array();
     for (const auto& b : blocks) arr.push_back(block_json(b));
-    std::cout << (arr.size() == 1 ? arr[0] : arr).dump(2) << '\n';
+    // Valid UTF-8 out whatever an older record holds (a byte that is not UTF-8 becomes U+FFFD
+    // instead of ending the export in json's type_error.316).
+    std::cout << (arr.size() == 1 ? arr[0] : arr)
+                     .dump(2, ' ', false, nlohmann::json::error_handler_t::replace)
+              << '\n';
   }
 }
 
@@ -170,10 +176,12 @@ void add_release(CLI::App& app, CommandStatus& status) {
   c->footer(exit_status_footer({{0, "the fit is the released calibration"}}));
   c->add_option("--db", o->db, "SQLite database")->required();
   c->add_option("--fit", o->fit_id, "fit id (station fit / history)")->required();
-  c->add_option("--by", o->by, "who releases")->required();
-  c->add_option("--note", o->note, "free text stored with the release");
+  c->add_option("--by", o->by, "who releases")->required()->check(note_text(kMaxPersonBytes));
+  c->add_option("--note", o->note, "free text stored with the release")
+      ->check(note_text(kMaxNoteBytes));
   c->add_option("--override", o->override_reason,
-                "release a fit whose verdict failed (or is missing) anyway, for this reason");
+                "release a fit whose verdict failed (or is missing) anyway, for this reason")
+      ->check(note_text(kMaxNoteBytes));
   c->callback([o, &status] {
     run_release(*o);
     status.exit_code = 0;

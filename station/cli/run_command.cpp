@@ -22,8 +22,10 @@
 #include "station/cli/exit_status.hpp"
 #include "station/cli/number_options.hpp"
 #include "station/cli/progress_display.hpp"
+#include "station/cli/text_options.hpp"
 #include "station/common/logging.hpp"
 #include "station/common/process_lock.hpp"
+#include "station/common/text_rule.hpp"
 #include "station/daemon/daemon_setup.hpp"
 #include "station/daemon/host.hpp"
 #include "station/daemon/rig.hpp"
@@ -315,7 +317,8 @@ void add_run_command(CLI::App& app, CommandStatus& status) {
   cmd->add_option("--protocol", o->protocol, "protocol file or shipped name")
       ->capture_default_str();
   cmd->add_option("--db", o->db, "SQLite database (default with --sim: station-sim.db)");
-  cmd->add_option("--operator", o->operator_name, "operator recorded with the run");
+  cmd->add_option("--operator", o->operator_name, "operator recorded with the run")
+      ->check(note_text(kMaxPersonBytes));
   cmd->add_flag("--new", o->fresh, "start a new run even if one was left unfinished");
   add_sim_world_options(cmd, *o);
   cmd->add_option("--log-file", o->log_file, "rotating log file");

@@ -14,6 +14,7 @@
 
 #include "station/cli/commands.hpp"
 #include "station/cli/exit_status.hpp"
+#include "station/cli/text_options.hpp"
 #include "station/common/input_error.hpp"
 #include "station/config/config.hpp"
 #include "station/fleet/fleet_schema.hpp"
@@ -122,7 +123,8 @@ void add_sync_command(CLI::App& app, CommandStatus& status) {
   cmd->add_option("--db", o->db, "SQLite database of the station (optional with --init)");
   cmd->add_option("--pg", o->pg, "libpq connection URL (no password: PGPASSWORD or a passfile)");
   cmd->add_option("--config", o->config, "station configuration with a [fleet] table");
-  cmd->add_option("--station", o->station, "station name for fits whose runs are gone");
+  cmd->add_option("--station", o->station, "station name for fits whose runs are gone")
+      ->check(identifier_text());
   cmd->add_flag("--init", o->init, "create or migrate the central schema first");
   cmd->add_flag("--samples", o->samples, "forward the 1 Hz samples too");
   cmd->add_flag("--retry-held", o->retry_held,

@@ -13,6 +13,7 @@
 #include "compensation/limits.hpp"
 #include "drivers/can/can_transport.hpp"
 #include "drivers/modbus/endpoint.hpp"
+#include "station/common/text_rule.hpp"
 #include "station/config/toml_reader.hpp"
 
 namespace station {
@@ -132,6 +133,11 @@ DeviceConfig read_device(const TomlView& v, bool is_chamber) {
 
 SlotConfig read_slot(const TomlView& v) {
   v.allow_only({"node", "serial", "pulse_weight_arcsec", "axis", "relay", "part"});
+/// The text rule (common/text_rule.hpp) at `key`: "FILE:LINE: key 'K': U+XXXX at ...".
+void require_identifier_at(const TomlView& v, std::string_view key, const std::string& text) {
+  if (const auto problem = identifier_problem(text)) throw v.error(key, *problem);
+}
+
   SlotConfig s;
   const long long node = v.get_integer("node");
   if (node < 1 || node > 16) throw v.error("node", "CAN node must be 1..16");
@@ -140,6 +146,7 @@ SlotConfig read_slot(const TomlView& v) {
   if (s.serial.empty()) throw v.error("serial", "must not be empty");
   s.pulse_weight_arcsec = v.opt_number("pulse_weight_arcsec").value_or(1.5);
   if (!(s.pulse_weight_arcsec > 0 && s.pulse_weight_arcsec < 100)) {
+  require_identifier_at(v, "serial", s.serial);
     throw v.error("pulse_weight_arcsec", "must be in (0, 100) arcsec");
   }
   s.axis = v.opt_string("axis").value_or("up");
@@ -149,6 +156,7 @@ SlotConfig read_slot(const TomlView& v) {
     if (part->empty()) throw v.error("part", "must not be empty");
     s.part = *part;
     s.part_line = v.line_of("part");
+    require_identifier_at(v, "part", *part);
   }
   return s;
 }
@@ -216,6 +224,7 @@ void read_station_table(const TomlView& root, const std::string& path, StationCo
   c.name = st->opt_string("name").value_or(c.name);
   c.latitude_deg = st->get_number("latitude_deg");
   if (c.latitude_deg < -90 || c.latitude_deg > 90)
+  require_identifier_at(*st, "name", c.name);
     throw st->error("latitude_deg", "must be -90..90");
   c.ref_temp_c =
       st->opt_number_in("ref_temp_c", compensation::kMinTempC, compensation::kMaxTempC, "C")

@@ -10,6 +10,7 @@
 
 #include "compensation/limits.hpp"
 #include "station/builtin_protocols.hpp"
+#include "station/common/text_rule.hpp"
 #include "station/config/toml_reader.hpp"
 
 namespace station {
@@ -69,6 +70,7 @@ Step read_step(const TomlView& v) {
   s.kind = kind_of(v);
   s.line = static_cast<int>(v.table().source().begin.line);
   s.label = v.opt_string("label").value_or(to_string(s.kind));
+  if (const auto problem = note_problem(s.label, kMaxLabelBytes)) throw v.error("label", *problem);
   switch (s.kind) {
     case StepKind::set_temperature:
       read_set_temperature(v, s);
@@ -116,7 +118,12 @@ Protocol parse_protocol(const std::string& text, const std::string& path) {
   root.allow_only({"name", "description", "step"});
   Protocol p;
   p.name = root.get_string("name");
+  // The text rule (common/text_rule.hpp): the name is recorded with every run and reaches the
+  // report, the API and the fleet; the description is a note.
+  if (const auto problem = identifier_problem(p.name)) throw root.error("name", *problem);
   p.description = root.opt_string("description").value_or("");
+  if (const auto problem = note_problem(p.description, kMaxNoteBytes))
+    throw root.error("description", *problem);
   p.path = path;
   p.text = text;
   for (const auto& sv : root.table_array("step")) p.steps.push_back(read_step(sv));

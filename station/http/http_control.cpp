@@ -4,6 +4,7 @@
 
 #include "station/common/input_error.hpp"
 #include "station/common/logging.hpp"
+#include "station/common/text_rule.hpp"
 #include "station/http/api_runs.hpp"
 #include "station/http/http_server.hpp"
 #include "station/http/json_reply.hpp"
@@ -60,7 +61,7 @@ void HttpServer::start_run(const httplib::Request& req, httplib::Response& res) 
     return;
   }
   const auto protocol = string_field(body, "protocol", 4096, error);
-  const auto op = string_field(body, "operator", 200, error);
+  const auto op = string_field(body, "operator", kMaxPersonBytes, error);
   if (!error.empty() || !protocol || protocol->empty()) {
     send_json(res, 400, {{"error", error.empty() ? "field 'protocol' is required" : error}});
     return;
@@ -124,9 +125,9 @@ void HttpServer::release_fit(const httplib::Request& req, httplib::Response& res
   if (body.is_discarded() || !body.is_object()) {
     error = "body: expected a JSON object {\"by\": NAME, \"note\": TEXT, \"override\": REASON}";
   } else if (known_keys_only(body, {"by", "note", "override"}, error)) {
-    by = string_field(body, "by", 200, error);
-    note = string_field(body, "note", 4096, error);
-    override_reason = string_field(body, "override", 4096, error);
+    by = string_field(body, "by", kMaxPersonBytes, error);
+    note = string_field(body, "note", kMaxNoteBytes, error);
+    override_reason = string_field(body, "override", kMaxNoteBytes, error);
     if (error.empty() && (!by || by->empty())) error = "field 'by' is required";
   }
   if (!error.empty()) {

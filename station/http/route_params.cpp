@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <charconv>
 
+#include "station/common/text_rule.hpp"
 #include "station/http/json_reply.hpp"
 
 // Last: httplib.h pulls in <resolv.h>, whose `_res` macro breaks Eigen headers included after it.
@@ -41,10 +42,17 @@ std::optional<std::string> string_field(const nlohmann::json& body, const char* 
                                         std::size_t max_len, std::string& error) {
   if (!body.contains(key)) return std::nullopt;
   if (!body[key].is_string() || body[key].get<std::string>().size() > max_len) {
-    error = fmt::format("field '{}': expected a string of at most {} characters", key, max_len);
+    error = fmt::format("field '{}': expected a string of at most {} bytes", key, max_len);
     return std::nullopt;
   }
-  return body[key].get<std::string>();
+  std::string text = body[key].get<std::string>();
+  // The one text rule where text enters (common/text_rule.hpp): a NUL, a newline or a
+  // bidirectional control is refused here, as on the command line.
+  if (const auto problem = note_problem(text, max_len)) {
+    error = fmt::format("field '{}': {}", key, *problem);
+    return std::nullopt;
+  }
+  return text;
 }
 
 bool known_keys_only(const nlohmann::json& body, std::initializer_list<const char*> known,

@@ -27,7 +27,8 @@ std::optional<std::int64_t> path_id(const httplib::Request& req, httplib::Respon
                                     const char* what);
 
 /// A string field of a JSON object body: nullopt when absent or wrong (then `error` says why:
-/// not a string, or longer than `max_len` characters).
+/// not a string, longer than `max_len` bytes, or text the text rule refuses (note_problem:
+/// a control, a bidirectional control, naming it as U+XXXX and its position)).
 std::optional<std::string> string_field(const nlohmann::json& body, const char* key,
                                         std::size_t max_len, std::string& error);
 

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "compensation/fit.hpp"
+#include "station/common/text_rule.hpp"
 #include "station/config/toml_reader.hpp"
 #include "station/parts/deliverable_terms.hpp"
 #include "station/store/fit_json.hpp"
@@ -92,6 +93,8 @@ PartLimits read_part(const TomlView& v, const std::string& number) {
   PartLimits p;
   p.number = number;
   p.description = v.opt_string("description").value_or("");
+  if (const auto problem = note_problem(p.description, kMaxNoteBytes))
+    throw v.error("description", *problem);
   p.b0_dph = read_range(v, "B0_dph");
   p.k1_dph_per_c = read_range(v, "k1_dph_per_c");
   p.k0_dph_per_c = read_range(v, "k0_dph_per_c");
@@ -143,6 +146,10 @@ PartFile parse_part_file(const std::string& text, const std::string& path) {
     throw root.error("part", "no [part.\"NUMBER\"] tables: the file names no part");
   for (const auto& [key, node] : parts->table()) {
     const std::string number(key.str());
+    // A part number is an identifier (common/text_rule.hpp): it reaches every export.
+    if (const auto problem = identifier_problem(number))
+      throw InputError(fmt::format("{}:{}: key 'part.{}': {}", path, parts->line_of(number),
+                                   ascii_escaped(number), *problem));
     const auto part = parts->opt_table(number);
     f.parts.emplace(number, read_part(*part, number));
   }

@@ -9,6 +9,7 @@
 #include <numbers>
 
 #include "station/common/input_error.hpp"
+#include "station/common/text_rule.hpp"
 
 namespace station {
 namespace {
@@ -45,23 +46,28 @@ std::string c_string(const std::string& s) {
   return out + "\"";
 }
 
-/// Text for a comment line of a C header or a parameter file: no control character (a newline
-/// would end the comment), no "*/" or "/*", no '?' (a C99 trigraph "??/" is a backslash that
-/// splices the next line into the comment), no backslash; at most 200 characters.
+/// Text for a comment line of a C header or a parameter file: printable ASCII only (a newline
+/// would end the comment; a bidirectional control fails -Werror=bidi-chars and can hide code
+/// from a reviewer: every other character as "<U+XXXX>", common/text_rule.hpp), no "*/" or
+/// "/*", no '?' (a C99 trigraph "??/" is a backslash that splices the next line into the
+/// comment), no backslash; at most 200 characters.
 std::string comment_safe(const std::string& s) {
   std::string out;
-  for (const char ch : s.substr(0, 200)) {
-    const auto c = static_cast<unsigned char>(ch);
-    out += c < 0x20 || c == 0x7f || c == '?' || c == '\\' ? '.' : ch;
-  }
+  for (const char ch : ascii_escaped(s).substr(0, 200)) out += ch == '?' || ch == '\\' ? '.' : ch;
   for (const char* pair : {"*/", "/*"})
     for (auto at = out.find(pair); at != std::string::npos; at = out.find(pair, at))
       out[at + 1] = ' ';
   return out;
 }
 
-std::string csv_field(const std::string& s) {
-  if (s.find_first_of(",\"\r\n") == std::string::npos) return s;
+/// A CSV text cell (RFC 4180: quoted when it holds a comma, quote, CR or LF; quotes doubled), as
+/// valid UTF-8, and never a formula: a cell starting with = + - @ TAB or CR is what a spreadsheet
+/// evaluates (OWASP "CSV Injection"), so it gets a leading apostrophe and quotes.
+std::string csv_field(const std::string& text) {
+  std::string s = valid_utf8(text);
+  const bool formula = !s.empty() && std::string_view("=+-@\t\r").find(s[0]) != std::string::npos;
+  if (formula) s.insert(0, "'");
+  if (!formula && s.find_first_of(",\"\r\n") == std::string::npos) return s;
   std::string out = "\"";
   for (const char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c);
   return out + "\"";
@@ -173,7 +179,8 @@ std::string blocks_c_header(const std::vector<CoefficientBlock>& blocks, const s
         "    {{{:.17g}, {:.17g}, {:.17g}, {:.17g}}}, /* k1..k4 */\n"
         "    {:.17g}, /* k0_dph_per_c */\n"
         "    0x{:08x}u}};\n",
-        comment_safe(b.serial), b.fit_id, fmt::join(b.runs, ","), b.terms, release_summary(b),
+        comment_safe(b.serial), b.fit_id, fmt::join(b.runs, ","), comment_safe(b.terms),
+        release_summary(b),
         !b.verdict_json ? "none"
                         : (json::parse(*b.verdict_json).value("pass", false) ? "pass" : "FAIL"),
         c_identifier(name, b), c_string(b.serial), c_string(b.part_number), b.fit_id, c.released,

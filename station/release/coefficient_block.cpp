@@ -105,6 +105,14 @@ gyro_tc_block CoefficientBlock::c_block() const {
 }
 
 void seal_block(CoefficientBlock& b) {
+  // gyro_tc.h holds C strings: a NUL would end the serial the checksum covers ("GX\0-1" read
+  // as "GX") while the JSON and CSV carry the whole text.
+  for (const std::string* s : {&b.serial, &b.part_number})
+    if (s->find('\0') != std::string::npos)
+      throw InputError(
+          fmt::format("fit {}: serial or part number '{}' holds a NUL: a C string "
+                      "cannot carry it, nothing to deliver",
+                      b.fit_id, InputError::one_line(*s)));
   const gyro_tc_block c = b.c_block();
   std::string text(GYRO_TC_CANONICAL_MAX, '\0');
   const int n = gyro_tc_canonical(&c, text.data(), text.size());

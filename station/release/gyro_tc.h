@@ -18,6 +18,7 @@
 #include <locale.h>
 #include <stdint.h>
 #include <stdio.h>
+#include <string.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -76,9 +77,40 @@ static inline void gyro_tc_number(char *buf, size_t n, double v) {
       if (*p == point[0]) *p = '.';
 }
 
+/* Appends `s` to the text in buf (size n, length *len) with ';' written as "%3B" and '%' as
+ * "%25": a string field then never holds the separator, so the text is injective (a serial
+ * "X;part=Y" with part "" and a serial "X" with part "Y;part=" no longer read alike). Returns 0,
+ * or -1 when it does not fit. */
+static inline int gyro_tc_put_field(char *buf, size_t n, size_t *len, const char *s) {
+  for (; *s != '\0'; ++s) {
+    const char *esc = *s == ';' ? "%3B" : (*s == '%' ? "%25" : NULL);
+    const size_t k = esc != NULL ? 3u : 1u;
+    if (*len + k >= n) return -1;
+    if (esc != NULL)
+      memcpy(buf + *len, esc, 3);
+    else
+      buf[*len] = *s;
+    *len += k;
+  }
+  buf[*len] = '\0';
+  return 0;
+}
+
+/* Appends ";KEY=TEXT"; 0, or -1 when it does not fit. */
+static inline int gyro_tc_put_number(char *buf, size_t n, size_t *len, const char *key,
+                                     const char *num) {
+  const int w = snprintf(buf + *len, n - *len, ";%s=%s", key, num);
+  if (w < 0 || (size_t)w >= n - *len) return -1;
+  *len += (size_t)w;
+  return 0;
+}
+
 /* The canonical text the checksum covers, written into buf (size n); returns its length, or -1
  * when it does not fit. Numbers as %.17g: a double prints to the same text on every IEEE-754
- * machine with a correctly rounding printf (glibc, musl, newlib). */
+ * machine with a correctly rounding printf (glibc, musl, newlib). Version 3 escapes ';' and '%'
+ * in the serial and the part number (gyro_tc_put_field); a block whose strings hold neither has
+ * nothing to escape and its text is version 2's, byte for byte, under version 2's name: every
+ * checksum an earlier station wrote for such a block still verifies. */
 static inline int gyro_tc_canonical(const gyro_tc_block *b, char *buf, size_t n) {
   const double v[] = {b->t_ref_c,  b->t_min_c,  b->t_max_c,  b->grad_min_c, b->grad_max_c,
                       b->b0_dph,   b->k_dph[0], b->k_dph[1], b->k_dph[2],   b->k_dph[3],
@@ -86,17 +118,24 @@ static inline int gyro_tc_canonical(const gyro_tc_block *b, char *buf, size_t n)
   static const char *const key[] = {"t_ref_c", "t_min_c", "t_max_c", "grad_min_c", "grad_max_c",
                                     "b0_dph",  "k1",      "k2",      "k3",         "k4",
                                     "k0"};
+  const int escaped = strpbrk(b->serial, ";%") != NULL || strpbrk(b->part_number, ";%") != NULL;
   char num[40];
-  size_t len;
-  int i, w = snprintf(buf, n, "gyro_tc/2;serial=%s;part=%s;fit=%lld;released=%d", b->serial,
-                      b->part_number, b->fit_id, b->released);
-  if (w < 0 || (size_t)w >= n) return -1;
-  len = (size_t)w;
+  size_t len = 0;
+  int i, w;
+  if (n == 0) return -1;
+  buf[0] = '\0';
+  if (gyro_tc_put_field(buf, n, &len, escaped ? "gyro_tc/3" : "gyro_tc/2") != 0 ||
+      gyro_tc_put_number(buf, n, &len, "serial", "") != 0 ||
+      gyro_tc_put_field(buf, n, &len, b->serial) != 0 ||
+      gyro_tc_put_number(buf, n, &len, "part", "") != 0 ||
+      gyro_tc_put_field(buf, n, &len, b->part_number) != 0)
+    return -1;
+  w = snprintf(buf + len, n - len, ";fit=%lld;released=%d", b->fit_id, b->released);
+  if (w < 0 || (size_t)w >= n - len) return -1;
+  len += (size_t)w;
   for (i = 0; i < 11; ++i) {
     gyro_tc_number(num, sizeof num, v[i]);
-    w = snprintf(buf + len, n - len, ";%s=%s", key[i], num);
-    if (w < 0 || (size_t)w >= n - len) return -1;
-    len += (size_t)w;
+    if (gyro_tc_put_number(buf, n, &len, key[i], num) != 0) return -1;
   }
   return (int)len;
 }

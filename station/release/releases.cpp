@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <nlohmann/json.hpp>
 
+#include "station/common/text_rule.hpp"
 #include "station/parts/verdict.hpp"
 #include "station/release/coefficient_block.hpp"
 #include "station/store/fit_verdicts.hpp"
@@ -44,26 +45,21 @@ std::optional<std::string> needs_override(Store& store, const FitRecord& fit,
   return std::nullopt;
 }
 
-/// Free text of a release: no control character (it would hide text in a one-line audit trail
-/// or break an export's comment) and a bounded length; `required` refuses a blank one.
-void check_text(const char* what, const std::string& text, std::size_t max_len, bool required) {
+/// Free text of a release, by the text rule (common/text_rule.hpp): it reaches a one-line audit
+/// trail and every export; `required` refuses a blank one. `what` names the CLI option and the
+/// API's JSON field.
+void check_text(const char* what, const std::string& text, std::size_t max_bytes, bool required) {
   if (required && text.find_first_not_of(" \t\r\n") == std::string::npos)
     throw InputError(fmt::format("release: {}: must not be empty", what));
-  if (text.size() > max_len)
-    throw InputError(
-        fmt::format("release: {}: {} characters, at most {}", what, text.size(), max_len));
-  for (const char ch : text)
-    if (static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f)
-      throw InputError(fmt::format("release: {}: control character 0x{:02x} not allowed", what,
-                                   static_cast<unsigned char>(ch)));
+  require_note(fmt::format("release: {}", what), text, max_bytes);
 }
 
 void check_request(Store& store, const ReleaseRequest& req, const FitRecord& fit,
                    const StoredVerdict& v) {
-  check_text("--by NAME (who releases)", req.by, kMaxNameChars, true);
-  check_text("--note", req.note, kMaxNoteChars, false);
+  check_text("--by NAME (who releases; JSON 'by')", req.by, kMaxPersonBytes, true);
+  check_text("--note (JSON 'note')", req.note, kMaxNoteBytes, false);
   if (req.override_reason)
-    check_text("--override REASON", *req.override_reason, kMaxNoteChars, true);
+    check_text("--override REASON (JSON 'override')", *req.override_reason, kMaxNoteBytes, true);
   if (const auto bad = undeliverable_term(fit.fit))
     throw ReleaseRefused(fmt::format("fit {} of {}: {}", fit.id, fit.serial, *bad));
   if (const auto cur = current_release(store, fit.serial); cur && cur->fit_id == fit.id)

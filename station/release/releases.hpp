@@ -24,10 +24,6 @@ struct ReleaseRow {
   std::optional<std::string> verdict_json;  ///< the fit's verdict at the release (NULL: none)
 };
 
-/// Bounds of a release's free text (CLI and API alike).
-inline constexpr std::size_t kMaxNameChars = 200;
-inline constexpr std::size_t kMaxNoteChars = 4096;
-
 /// What a person asks for.
 struct ReleaseRequest {
   std::int64_t fit_id = 0;
@@ -48,8 +44,8 @@ struct ReleaseRefused : InputError {
 /// Releases a fit: checks the request, stores the release and an event ('release', on the
 /// newest run of the fit) in one transaction. Throws FitNotFound; ReleaseRefused (failed or
 /// missing verdict without an override, an override where none is needed, an undeliverable
-/// model, already released); InputError for a blank name or reason, text with a control
-/// character or longer than kMaxNameChars / kMaxNoteChars.
+/// model, already released); InputError for a blank name or reason, or text the text rule
+/// refuses (common/text_rule.hpp: kMaxPersonBytes for the name, kMaxNoteBytes for the others).
 ReleaseRow release_fit(Store& store, const ReleaseRequest& req);
 
 /// The released calibration of `serial` (its newest release); empty when none.

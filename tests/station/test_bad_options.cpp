@@ -5,6 +5,9 @@
 #include <unistd.h>
 
 #include <fstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "station/store/store.hpp"
 #include "tests/station/rig_process.hpp"
@@ -47,5 +50,43 @@ TEST(BadOptions, EachIsExit2NamingItBeforeAnyRunExists) {
     EXPECT_EQ(o.status, 2) << args << ": " << o.out;
     EXPECT_NE(o.out.find(says), std::string::npos) << args << ": " << o.out;
     EXPECT_EQ(runs_in(db), 0) << args << " left a run behind";
+  }
+}
+
+// Issue 34 points 10 and 11: the operator, who releases and the note are text someone else reads
+// (the report, the export, the fleet). A newline, 100 kB, a bidirectional override or a byte
+// that is not UTF-8 is refused at the option by the one text rule (common/text_rule.hpp), before
+// a run or a release exists; `--by $'\xff'` ended in json's type_error.316.
+TEST(BadOptions, TextOptionsFollowTheTextRuleBeforeAnythingIsStored) {
+  const std::string protocol = std::string(STATION_TEST_DATA_DIR) + "/short_cycle.toml";
+  const std::vector<std::pair<std::string, std::string>> runs{
+      {"--operator \"$(printf 'Ann\\nEve')\"",
+       "--operator: U+000A at character 4 (byte 3) is a control character"},
+      {"--operator \"$(head -c 100000 /dev/zero | tr '\\000' a)\"",
+       "--operator: 100000 bytes, at most 200"},
+      {"--operator \"$(printf 'Ann\\342\\200\\256')\"",
+       "--operator: U+202E at character 4 (byte 3) is a bidirectional control"},
+  };
+  for (const auto& [args, says] : runs) {
+    const auto db = ts::fresh_db("bad-text");
+    const auto o = ts::station_command(
+        "run --sim --gyros 1 --protocol " + protocol + " --db " + db + " " + args, "bad-text");
+    EXPECT_EQ(o.status, 2) << args << ": " << o.out.substr(0, 300);
+    EXPECT_NE(o.out.find(says), std::string::npos) << args << ": " << o.out.substr(0, 300);
+    EXPECT_LT(o.out.size(), 400u) << "the message quotes the value";
+    EXPECT_EQ(runs_in(db), 0) << args << " left a run behind";
+  }
+  const std::vector<std::pair<std::string, std::string>> releases{
+      {"--by \"$(printf '\\377')\"", "--by: byte 0xFF at byte 0 is not UTF-8"},
+      {"--by Ann --note \"$(printf 'ok\\342\\200\\256')\"",
+       "--note: U+202E at character 3 (byte 2) is a bidirectional control"},
+      {"--by Ann --override \"$(printf 'a\\rb')\"", "--override: U+000D at character 2"},
+  };
+  for (const auto& [args, says] : releases) {
+    const auto db = ts::fresh_db("bad-release-text");
+    const auto o = ts::station_command("release --db " + db + " --fit 1 " + args, "bad-text");
+    EXPECT_EQ(o.status, 2) << args << ": " << o.out;
+    EXPECT_NE(o.out.find(says), std::string::npos) << args << ": " << o.out;
+    EXPECT_EQ(o.out.find("type_error"), std::string::npos) << o.out;
   }
 }

@@ -5,6 +5,8 @@
 #include <cstdlib>
 #include <fstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "station/config/config.hpp"
 
@@ -173,4 +175,43 @@ TEST(Config, DuplicateSerialAndMissingTables) {
             std::string::npos);
   EXPECT_NE(error_of("[station\n").find("rig.toml:1:"), std::string::npos)
       << error_of("[station\n");
+}
+
+// Issue 34 point 10: a NUL, a newline or a bidirectional override in a configured serial was
+// accepted (221 samples stored, no fit; PostgreSQL kept "GX"). The text rule
+// (station/common/text_rule.hpp) refuses it at the key, naming the character and its position.
+TEST(Config, IdentifiersFollowTheTextRuleNamingKeyCharacterAndPosition) {
+  const auto with_serial = [](const std::string& toml_value) {
+    std::string t = kMinimal;
+    t.replace(t.find("serial = \"A\""), 12, "serial = \"" + toml_value + "\"");
+    return t;
+  };
+  const std::vector<std::pair<std::string, std::string>> serials{
+      {"GX\\u0000-1", "rig.toml:9: key 'slot[0].serial': U+0000 at character 3 (byte 2)"},
+      {"GX\\n1", "rig.toml:9: key 'slot[0].serial': U+000A at character 3 (byte 2)"},
+      {"GX\\u202E1", "rig.toml:9: key 'slot[0].serial': U+202E at character 3 (byte 2)"},
+      {"GX 1", "rig.toml:9: key 'slot[0].serial': U+0020 at character 3 (byte 2)"},
+      {"X;part=Y", "rig.toml:9: key 'slot[0].serial': U+003B at character 2 (byte 1)"},
+      {"=HYPERLINK(1)", "rig.toml:9: key 'slot[0].serial': U+003D at character 1 (byte 0)"},
+      {std::string(65, 'A'), "rig.toml:9: key 'slot[0].serial': 65 bytes"},
+  };
+  for (const auto& [value, says] : serials)
+    EXPECT_NE(error_of(with_serial(value)).find(says), std::string::npos)
+        << value << ": " << error_of(with_serial(value));
+  // The longest identifier and every punctuation it allows still load.
+  EXPECT_EQ(error_of(with_serial("G" + std::string(63, 'x'))), "");
+  EXPECT_EQ(error_of(with_serial("RLG-2311_0043.a:b/c+d#e")), "");
+  const std::string part = kMinimal + "part = \"P\\u2066N\"\n";
+  EXPECT_NE(error_of(part).find("rig.toml:10: key 'slot[0].part': U+2066 at character 2"),
+            std::string::npos)
+      << error_of(part);
+  std::string name = kMinimal;
+  name.insert(name.find("latitude_deg"), "name = \"line\\r2\"\n");
+  EXPECT_NE(error_of(name).find("rig.toml:2: key 'station.name': U+000D at character 5"),
+            std::string::npos)
+      << error_of(name);
+  // The JSON Schema says the same.
+  const std::string bad = ::testing::TempDir() + "bidi-serial.toml";
+  std::ofstream(bad) << with_serial("GX\\u202E1");
+  EXPECT_EQ(run_validator(bad), 1);
 }

@@ -13,10 +13,13 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "station/release/block_formats.hpp"
 #include "station/store/calibration.hpp"
 #include "tests/station/release_fixture.hpp"
+#include "tests/station/rig_process.hpp"
 
 namespace {
 
@@ -341,3 +344,100 @@ TEST(GyroTc, ClampsTemperatureAndGradientToTheSpanTheFitSaw) {
 }
 
 }  // namespace
+
+// Issue 34 point 10: whatever text a block carries (an older record, or one the text rule never
+// saw), each format escapes for its reader. A U+202E in a serial or a release note went raw into
+// the C header's comments (g++ -Werror=bidi-chars refused it) and a note starting "=HYPERLINK("
+// became a spreadsheet formula in the CSV.
+class HostileText : public ExportRoundTrip {
+ protected:
+  void SetUp() override {
+    ExportRoundTrip::SetUp();
+    hostile_ = block_;
+    hostile_.serial = "GX\u202E1;part=*/ ??/";
+    hostile_.part_number = "P\u2066N%3B";
+    hostile_.terms = "dT*/\u202Eq";
+    hostile_.release->note = "=HYPERLINK(\"http://x.example/\",\"ok\u202E\")\nnext */ line";
+    hostile_.release->released_by = "@SUM(1+1)\xff";
+    hostile_.release->override_reason = "-2+3";
+    station::seal_block(hostile_);
+  }
+  station::CoefficientBlock hostile_;
+};
+
+TEST_F(HostileText, CHeaderCompilesUnderBidiCharsErrorAndVerifies) {
+  const std::string cc = STATION_C_COMPILER;
+  if (cc.empty() || std::system((cc + " --version >/dev/null 2>&1").c_str()) != 0)
+    GTEST_SKIP() << "no C compiler (" << cc << ")";
+  const std::string dir = ::testing::TempDir() + "gyro_tc_bidi_" + std::to_string(getpid());
+  ASSERT_EQ(std::system(("mkdir -p " + dir).c_str()), 0);
+  // -Wbidi-chars is GCC 12's (CVE-2021-42574): a compiler without it cannot judge this header.
+  if (std::system((cc + " -Werror=bidi-chars -x c -fsyntax-only /dev/null 2>/dev/null").c_str()) !=
+      0)
+    GTEST_SKIP() << cc << " has no -Wbidi-chars";
+  const std::string header = station::blocks_c_header({hostile_, block_});
+  for (const unsigned char c : header)
+    ASSERT_TRUE(c == '\n' || (c >= 0x20 && c < 0x7f)) << "byte 0x" << std::hex << int{c};
+  std::ofstream(dir + "/calibrations.h") << header;
+  std::ofstream(dir + "/check.c") << R"(#include <string.h>
+#include "calibrations.h"
+int main(void) {
+  const gyro_tc_block *b = gyro_tc_calibrations_blocks[0];
+  return GYRO_TC_CALIBRATIONS_BLOCK_COUNT == 2 && gyro_tc_verify(b) &&
+         gyro_tc_verify(gyro_tc_calibrations_blocks[1]) &&
+         strcmp(b->serial, "GX\342\200\2561;part=*/ ?\?/") == 0 ? 0 : 3;
+}
+)";
+  const std::string build = cc + " -std=c99 -pedantic -Wall -Wextra -Werror -Werror=bidi-chars -I" +
+                            STATION_SOURCE_DIR + "/station/release " + dir + "/check.c -o " + dir +
+                            "/check 2>" + dir + "/cc.log";
+  ASSERT_EQ(std::system(build.c_str()), 0) << slurp(dir + "/cc.log") << header;
+  EXPECT_EQ(std::system((dir + "/check").c_str()), 0) << "the C program refused the block";
+  const std::string cxx = "g++ -Werror=bidi-chars -fsyntax-only -x c++ -I" +
+                          std::string(STATION_SOURCE_DIR) + "/station/release " + dir +
+                          "/calibrations.h 2>" + dir + "/cxx.log";
+  EXPECT_EQ(std::system(cxx.c_str()), 0) << slurp(dir + "/cxx.log");
+}
+
+TEST_F(HostileText, CsvCellsAreNeverFormulasAndStayOneRecordPerLine) {
+  const std::string csv = station::blocks_csv({hostile_});
+  EXPECT_NE(csv.find(",\"'=HYPERLINK(\"\"http://x.example/\"\",\"\"ok\u202E\"\")\nnext */ line\","),
+            std::string::npos)
+      << csv;
+  EXPECT_NE(csv.find(",\"'@SUM(1+1)\uFFFD\","), std::string::npos) << csv;  // and valid UTF-8
+  EXPECT_NE(csv.find(",\"'-2+3\","), std::string::npos) << csv;
+  // No cell's content starts with a formula character, quoted or not (a spreadsheet evaluates
+  // a quoted "=1+1" too): the cells read back by RFC 4180.
+  std::vector<std::string> cells{""};
+  bool quoted = false;
+  for (std::size_t i = 0; i < csv.size(); ++i) {
+    const char c = csv[i];
+    if (quoted && c == '"' && i + 1 < csv.size() && csv[i + 1] == '"') {
+      cells.back() += '"';
+      ++i;
+    } else if (c == '"') {
+      quoted = !quoted;
+    } else if (!quoted && (c == ',' || c == '\n')) {
+      cells.emplace_back();
+    } else {
+      cells.back() += c;
+    }
+  }
+  EXPECT_FALSE(quoted);
+  EXPECT_GT(cells.size(), 3 * 24u);
+  for (const auto& cell : cells)
+    if (!cell.empty() && (cell[0] < '0' || cell[0] > '9'))  // numbers may be negative
+      EXPECT_EQ(std::string("=+@\t\r").find(cell[0]), std::string::npos) << cell;
+  EXPECT_NE(std::find(cells.begin(), cells.end(), "'-2+3"), cells.end());
+}
+
+TEST_F(HostileText, JsonExportOfAnOlderRecordIsValidUtf8) {
+  // A release stored before the text rule, with a byte that is not UTF-8: the export ended in
+  // json's type_error.316.
+  store_->db().exec("UPDATE releases SET note = CAST(X'41FF42' AS TEXT) WHERE id = " +
+                    std::to_string(rel_->id));
+  const auto o = station::testing_support::station_command(
+      "export --db " + cal_.path + " --serial " + serial_ + " --format json", "json-utf8");
+  EXPECT_EQ(o.status, 0) << o.out;
+  EXPECT_NE(o.out.find("\"note\": \"A\uFFFDB\""), std::string::npos) << o.out;
+}

@@ -147,6 +147,42 @@ TEST(Release, AModelTheNavigationComputerCannotApplyIsRefused) {
   }
 }
 
+// Issue 34 point 10: who releases and the note reach every export and the fleet. A byte that is
+// not UTF-8 ended the release in json's type_error.316 (its event's data); a bidirectional
+// override was stored and went raw into the C header. Both refused by the text rule, naming the
+// field and the character; a name in any script still releases.
+TEST(Release, TextRuleRefusesNamesAndNotesNamingTheCharacter) {
+  const auto c = calibrated_db("release-text", 1);
+  station::Store store(c.path, station::OpenMode::existing);
+  const std::string sn = c.report["gyros"][0]["serial"].get<std::string>();
+  const auto fit = fit_of_run(store, sn, c.verification_run);
+  const auto refused = [&](const std::string& by, const std::string& note) {
+    try {
+      station::release_fit(store, {fit, by, note, std::nullopt});
+    } catch (const station::InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("released");
+  };
+  EXPECT_NE(refused("\xff", "")
+                .find("--by NAME (who releases; JSON 'by'): byte 0xFF at byte 0 "
+                      "is not UTF-8"),
+            std::string::npos)
+      << refused("\xff", "");
+  EXPECT_NE(refused("Ann", "ok \u202Etxt.exe").find("--note (JSON 'note'): U+202E at character 4"),
+            std::string::npos);
+  EXPECT_NE(refused("Ann\u200F", "").find("U+200F at character 4 (byte 3)"), std::string::npos);
+  EXPECT_NE(refused("Ann", "\xc2\x85").find("U+0085 at character 1 (byte 0) is a C1 control"),
+            std::string::npos);
+  EXPECT_NE(refused("Ann", "\xe0\x80\xaf").find("byte 0xE0 at byte 0 is not UTF-8"),
+            std::string::npos)
+      << "an overlong '/' is not UTF-8";
+  EXPECT_NE(refused("Ann", std::string(4097, 'x')).find("4097 bytes, at most 4096"),
+            std::string::npos);
+  EXPECT_EQ(station::releases_of(store, sn).size(), 1u) << "nothing was stored";
+  EXPECT_EQ(refused("J\u00fcrgen M\u00fcller", "5 \u00b0C, \u65e5\u672c"), "released");
+}
+
 TEST(Verify, RefusesARunTheFitUsedAndJudgesAgainstTheVerificationLimits) {
   const auto c = calibrated_db("verify-limits", 1);
   station::Store store(c.path, station::OpenMode::existing);

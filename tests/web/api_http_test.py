@@ -746,10 +746,17 @@ def check_bad_requests(port, token, run_id):
                        ('{"protocol": 5, "operator": "ann"}', "protocol not a string"),
                        ('{"protocol": null}', "protocol null"),
                        ('{"protocol": "paper", "operator": 7}', "operator not a string"),
+                       # Issue 34 points 10-11: the one text rule (station/common/text_rule.hpp).
+                       ('{"protocol": "paper", "operator": "ann\\nEve"}', "operator with a newline"),
+                       ('{"protocol": "paper", "operator": "ann\\u202e"}', "operator with U+202E"),
                        # Issue 34 point 11: a key the route does not know (a typo) is refused.
                        ('{"protocol": "paper", "operater": "ann"}', "an unknown key")]:
         r = request(port, "POST", "/api/runs", body=body, headers=js)
         expect_error(r, 400, f"POST /api/runs with {what}")
+    r = request(port, "POST", "/api/runs", body='{"protocol": "paper", "operator": "ann\\u202e"}',
+                headers=js)
+    check(r.status == 400 and "field 'operator': U+202E at character 4" in ((r.json() or {}).get("error") or ""),
+          "POST /api/runs: the refusal names the field, the character and its position", r.brief())
 
     r = request(port, "POST", "/api/runs", body='{"protocol": "paper", "operater": "ann"}',
                 headers=js)
@@ -1079,6 +1086,8 @@ def check_release(port, token, db, run_id):
                  f"[R] POST {path} wrong token")
     for body, what in [(b"{", "bad JSON"), (b'{"note":"n"}', "no 'by'"), (b'{"by":""}', "empty 'by'"),
                        (b'{"by":7}', "'by' not a string"), (b"[]", "not an object"),
+                       (b'{"by":"Ann\\u202e"}', "U+202E in 'by'"),
+                       (b'{"by":"Ann","note":"a\\u0000b"}', "NUL in 'note'"),
                        (b'{"by":"Ann","overide":"typo"}', "an unknown key")]:
         expect_error(request(port, "POST", path, body=body, headers=js), 400, f"[R] POST {path} {what}")
     for bad, status in [("/api/fits/999999/release", 404), ("/api/fits/abc/release", 400),
