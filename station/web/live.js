@@ -258,8 +258,11 @@
     if (!f) return;
     var pending = f.pending_rows > 0 ? ", " + f.pending_rows + " rows pending" : ", up to date";
     var held = f.held_items > 0 ? ", " + f.held_items + " held" : "";
-    text("fleet", f.state + (f.state === "backing off" ? " " + f.backoff_s + " s" : "") +
-         pending + held);
+    // Waiting on server: the call it waits for (its seconds are in /api/status, not streamed).
+    var detail = f.state === "backing off" ? " " + f.backoff_s + " s"
+               : f.state === "waiting on server" && f.waiting_for ? " (" + f.waiting_for + ")"
+               : "";
+    text("fleet", f.state + detail + pending + held);
     $("fleet").className = "fleet " + f.state.replace(/ /g, "-");
     $("fleet").title = f.last_error || "";
   }
