@@ -21,4 +21,10 @@ std::optional<std::string> log_of_another_name(const std::string& path);
 /// Throws InputError naming `path` and the other name when log_of_another_name finds one.
 void refuse_log_of_another_name(const std::string& path);
 
+/// For a writer: throws InputError when `path` has more names (hard links, st_nlink) than the
+/// directories log_of_another_name searches hold, since a log beside one of those could not be
+/// seen (SQLite: a database file whose link count is not 1 is undefined behaviour,
+/// howtocorrupt.html §2.5).
+void refuse_names_not_found(const std::string& path);
+
 }  // namespace station

@@ -5,6 +5,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 
 #include "station/common/database_names.hpp"
@@ -40,6 +42,20 @@ void refuse_other_writers_name(const std::string& path, const std::string& own) 
       theirs.empty() ? "the writer's name" : theirs));
 }
 
+// A writer on a file or directory it cannot write (a read-only mount) says so, instead of SQLite's
+// "unable to open database file" once its -shm cannot be made.
+void refuse_unwritable(const std::string& path) {
+  const std::string own = sqlite_name(path);
+  const std::string dir = fs::path(own).parent_path().string();
+  for (const std::string& where : {own, dir}) {
+    if (::access(where.c_str(), W_OK) == 0) continue;
+    throw InputError(fmt::format(
+        "{}: a writing command cannot write {} ({}); nothing was touched (read commands work "
+        "there)",
+        path, where, std::strerror(errno)));
+  }
+}
+
 }  // namespace
 
 DatabaseAccess claim_database_file(const std::string& path, OpenMode mode) {
@@ -51,6 +67,8 @@ DatabaseAccess claim_database_file(const std::string& path, OpenMode mode) {
     // The lock first: a refusal because another process writes it names that process.
     DatabaseAccess access{DatabaseHold::writer(path, mode == OpenMode::create)};
     refuse_log_of_another_name(path);
+    refuse_names_not_found(path);
+    refuse_unwritable(path);
     return access;
   }
   if (!exists || DatabaseHold::held_here(path)) return {};  // missing, or this process writes it
@@ -62,9 +80,10 @@ DatabaseAccess claim_database_file(const std::string& path, OpenMode mode) {
   if (writer && !logs) refuse_other_writers_name(path, own);
   refuse_log_of_another_name(path);
   if (writer || logs) return {};
+  // Only a connection that can write the file and its directory removes the -wal and -shm.
   const std::string dir = fs::path(own).parent_path().string();
-  return {std::nullopt,
-          ::access(dir.c_str(), W_OK) == 0 ? ReadWay::leave_nothing : ReadWay::immutable};
+  const bool writable = ::access(own.c_str(), W_OK) == 0 && ::access(dir.c_str(), W_OK) == 0;
+  return {std::nullopt, writable ? ReadWay::leave_nothing : ReadWay::immutable};
 }
 
 std::string immutable_uri(const std::string& path) {

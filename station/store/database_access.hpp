@@ -7,7 +7,7 @@
 // - beside a writer (another process holds the lock, or a -wal or -shm lies beside the file: a
 //   writer runs, or one was killed and its log must be read) it reads through the WAL with
 //   SQLITE_OPEN_READONLY, as SQLite's WAL lets readers do;
-// - with no writer about, on a directory it cannot write (a read-only mount), with
+// - with no writer about, on a file or directory it cannot write (a read-only mount), with
 //   `immutable=1` (sqlite.org/uri.html; sqlite.org/wal.html "Read-Only Databases": a WAL database
 //   there cannot be opened otherwise, its -shm cannot be made);
 // - with no writer about, elsewhere, with SQLITE_OPEN_READWRITE under PRAGMA query_only: SQLite

@@ -146,6 +146,24 @@ TEST(OneWriter, ADatabaseWhoseLogSitsBesideAnotherNameIsRefusedByEveryCommand) {
   EXPECT_EQ(count_rows(db, "kept"), 1);  // through its own name the commit is there
 }
 
+// Before: a hard link in another directory went unseen: a log a killed writer left beside one
+// name was missed by a writer through the other, which checkpointed over it.
+TEST(OneWriter, AWriterRefusesAFileWithANameInAnotherDirectory) {
+  const fs::path dir = fresh_dir("far-name"), far = fresh_dir("far-name-link");
+  const std::string db = (dir / "a.db").string(), link = (far / "b.db").string();
+  { station::Store s(db); }
+  fs::create_hard_link(db, link);
+  const auto names = names_in(far);
+  const auto o = ts::station_command("fit --all --db " + link, "far-name");
+  EXPECT_EQ(o.status, 2) << o.out;
+  EXPECT_NE(o.out.find("has 2 names (hard links) and only 1 are here"), std::string::npos) << o.out;
+  EXPECT_EQ(names_in(far), names) << "a -wal or -shm appeared beside the link";
+  // A read through it is harmless (it writes nothing) and leaves nothing.
+  EXPECT_EQ(ts::station_command("history --serial X --db " + link, "far-name").out.find("names"),
+            std::string::npos);
+  EXPECT_EQ(names_in(far), names);
+}
+
 // Before: export, history and report each left a.db-wal and a.db-shm beside the database.
 TEST(ReadOnlyCommands, LeaveNoFileBesideTheDatabase) {
   const auto calibrated = ts::calibrated_db("read-only-files", 1);
@@ -182,4 +200,13 @@ TEST(ReadOnlyCommands, ReadADatabaseOnAReadOnlyMount) {
     EXPECT_EQ(WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, 0) << cmd << ": " << ts::slurp(log);
     EXPECT_EQ(names_in(dir), before) << cmd;
   }
+  // A writer there says it cannot write, not that the file is unreadable.
+  const std::string log = (out / "fit.out").string();
+  const int rc = std::system(("unshare -m sh -c 'mount --bind -o ro " + dir.string() + " " +
+                              dir.string() + " || exit 90; exec " + ts::kStationBin +
+                              " fit --all --db " + db + "' >" + log + " 2>&1")
+                                 .c_str());
+  EXPECT_EQ(WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, 2) << ts::slurp(log);
+  EXPECT_NE(ts::slurp(log).find("a writing command cannot write"), std::string::npos)
+      << ts::slurp(log);
 }
