@@ -25,8 +25,11 @@ Result<double> checked(const std::string& device, const Point& p, double v) {
 }  // namespace
 
 Error translate_modbus_error(int err, const std::string& what) {
-  std::string msg = what + ": " + modbus_strerror(err);
-  if (err == ETIMEDOUT || err == EAGAIN) return make_error(ErrorKind::timeout, msg);
+  // ETIME: a reply began but was not whole by the exchange's deadline (LibmodbusWire).
+  std::string msg = what + ": " +
+                    (err == ETIME ? "reply not complete by the deadline (it came too slowly)"
+                                  : modbus_strerror(err));
+  if (err == ETIMEDOUT || err == EAGAIN || err == ETIME) return make_error(ErrorKind::timeout, msg);
   if (err >= EMBXILFUN && err <= EMBXGTAR) return make_error(ErrorKind::exception, msg);
   if (err >= EMBBADCRC && err <= EMBBADSLAVE) return make_error(ErrorKind::protocol, msg);
   switch (err) {

@@ -165,7 +165,10 @@ int LibmodbusWire::exchange(const std::vector<std::uint8_t>& adu,
   }
   rest();
   const auto deadline = SteadyClock::now() + timeout_;
-  if (drop_late(deadline) == -1) return ended(-1);
+  if (drop_late(deadline) == -1) {
+    errno = ETIME;  // the last reply still drips: this one cannot begin
+    return ended(-1);
+  }
   // On a serial line a late reply has no id to tell it by: what came between exchanges goes.
   if (framing() == Framing::rtu) modbus_flush(ctx_.get());
   tid_ = static_cast<std::uint16_t>(tid_ + 1);
@@ -174,10 +177,13 @@ int LibmodbusWire::exchange(const std::vector<std::uint8_t>& adu,
   for (;;) {
     reply.clear();
     if (receive_frame(reply, deadline) == -1) {
-      if (errno == ETIMEDOUT && !reply.empty()) late_ = reply;  // its rest is dropped later
       if (errno == ETIMEDOUT && reply.empty() && framing() == Framing::tcp) {
         if (late_ids_.size() == kLateIdsKept) late_ids_.erase(late_ids_.begin());
         late_ids_.push_back(tid_);
+      }
+      if (errno == ETIMEDOUT && !reply.empty()) {
+        late_ = reply;  // its rest is dropped as it comes
+        errno = ETIME;  // begun, not finished by the deadline
       }
       return ended(-1);
     }

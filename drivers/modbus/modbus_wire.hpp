@@ -41,9 +41,10 @@ class ModbusWire {
 /// The real link: libmodbus opens it (TCP connect, RTU serial setup); the exchanges are this
 /// class's own, each bounded as a whole: from the request sent to the last byte of its reply,
 /// one deadline of `timeout_s` (open()), however the reply's bytes are spaced (modbus_frame.hpp
-/// says why libmodbus cannot bound it so). A reply past its deadline is ETIMEDOUT; its late bytes
-/// are framed and dropped when they arrive, never read as the next reply. The constructor does no
-/// I/O.
+/// says why libmodbus cannot bound it so). No reply by the deadline is ETIMEDOUT, a reply begun
+/// but not finished by it (or one still arriving when the next request is due) ETIME; its late
+/// bytes are framed and dropped as they come, never read as the next reply. The constructor does
+/// no I/O.
 class LibmodbusWire final : public ModbusWire {
  public:
   explicit LibmodbusWire(Endpoint endpoint) : endpoint_(std::move(endpoint)) {}

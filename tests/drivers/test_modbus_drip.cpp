@@ -3,11 +3,13 @@
 // rest of it is dropped, never read as the next reply. Each driver against its simulator face over
 // real loopback TCP or RTU on a pty, the drip served by the simulator (`drip` fault).
 #include <gtest/gtest.h>
+#include <modbus/modbus.h>
 
 #include <chrono>
 #include <cmath>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "drivers/chamber/generic_plc/generic_plc_map.hpp"
 #include "drivers/chamber/generic_plc/modbus_chamber.hpp"
@@ -15,6 +17,7 @@
 #include "drivers/chamber/watlow_f4t/watlow_f4t_chamber.hpp"
 #include "drivers/common/stale_link.hpp"
 #include "drivers/modbus/endpoint.hpp"
+#include "drivers/modbus/modbus_frame.hpp"
 #include "drivers/turntable/generic_plc/generic_plc_map.hpp"
 #include "drivers/turntable/generic_plc/modbus_turntable.hpp"
 #include "sim_devices/chamber_sim.hpp"
@@ -102,6 +105,16 @@ TEST(ModbusDrip, GenericTableReplyThatDripsIsATimeout) {
   EXPECT_EQ(dripped.error().kind, dr::ErrorKind::timeout) << dripped.error().message;
   EXPECT_EQ(world.turntable_server().requests() - before, 1u);
   EXPECT_LT(took_s, kOneExchangeBoundS);
+  EXPECT_NE(dripped.error().message.find("too slowly"), std::string::npos)
+      << dripped.error().message;
+  // Still dripping, over the reconnect the stale-link rule makes: timeouts that say the reply
+  // came too slowly, never that the unit id is wrong (the unit did answer, byte by byte).
+  for (int i = 0; i < dr::kTimeoutsBeforeReconnect; ++i) {
+    auto again = table.read();
+    ASSERT_FALSE(again) << "read " << i;
+    EXPECT_EQ(again.error().kind, dr::ErrorKind::timeout) << again.error().message;
+    EXPECT_EQ(again.error().message.find("unit_id"), std::string::npos) << again.error().message;
+  }
   ASSERT_EQ(sim::run_fault_command(world, "table drip 0"), "ok");
   for (int i = 0; i < kReadsToRecover; ++i) {
     auto s = table.read();
@@ -146,4 +159,58 @@ TEST(ModbusDrip, RtuReplyThatDripsIsATimeoutAndNeverMisframed) {
     return;
   }
   FAIL() << "no answer in " << reads << " reads after the drip ended";
+}
+
+// The framing the client reads replies by (modbus_frame.hpp), against frames written out by hand
+// from the Modbus documents: a reply's length from its first bytes, and libmodbus's checks.
+TEST(ModbusFrame, ReplyLengthsFromTheirFirstBytes) {
+  namespace mb = dr::modbus;
+  using B = std::vector<std::uint8_t>;
+  // TCP: MBAP length 7 (unit, fc 3, byte count 4, 4 data bytes) -> 6 + 7 bytes in all.
+  EXPECT_EQ(mb::reply_frame_length(mb::Framing::tcp, B{0, 1, 0, 0, 0}), 0);
+  EXPECT_EQ(mb::reply_frame_length(mb::Framing::tcp, B{0, 1, 0, 0, 0, 7}), 13);
+  EXPECT_EQ(mb::reply_frame_length(mb::Framing::tcp, B{0, 1, 0, 5, 0, 7}), -1);     // protocol id
+  EXPECT_EQ(mb::reply_frame_length(mb::Framing::tcp, B{0, 1, 0, 0, 0xFF, 0}), -1);  // > 260
+  // RTU: read -> unit, fc, count, data, CRC; write 6/16 -> 8; exception -> 5; unknown fc -> -1.
+  EXPECT_EQ(mb::reply_frame_length(mb::Framing::rtu, B{7, 3}), 0);
+  EXPECT_EQ(mb::reply_frame_length(mb::Framing::rtu, B{7, 3, 4}), 9);
+  EXPECT_EQ(mb::reply_frame_length(mb::Framing::rtu, B{7, 16}), 8);
+  EXPECT_EQ(mb::reply_frame_length(mb::Framing::rtu, B{7, 6}), 8);
+  EXPECT_EQ(mb::reply_frame_length(mb::Framing::rtu, B{7, 0x83}), 5);
+  EXPECT_EQ(mb::reply_frame_length(mb::Framing::rtu, B{7, 0x42}), -1);
+}
+
+TEST(ModbusFrame, RepliesCheckedAsLibmodbusDoes) {
+  namespace mb = dr::modbus;
+  using B = std::vector<std::uint8_t>;
+  const B read2{7, 3, 0x00, 0x64, 0x00, 0x02};  // unit 7: read 2 holding registers at 100
+  const auto tcp_req = mb::request_frame(mb::Framing::tcp, 0x1234, read2);
+  EXPECT_EQ(tcp_req, (B{0x12, 0x34, 0, 0, 0, 6, 7, 3, 0, 0x64, 0, 2}));
+  const B ok{0x12, 0x34, 0, 0, 0, 7, 7, 3, 4, 0x41, 0xC8, 0, 0};
+  EXPECT_EQ(mb::check_reply(mb::Framing::tcp, tcp_req, ok), 0);
+  B other_tid = ok;
+  other_tid[1] = 0x35;
+  EXPECT_EQ(mb::check_reply(mb::Framing::tcp, tcp_req, other_tid), EMBBADDATA);
+  const B short_count{0x12, 0x34, 0, 0, 0, 5, 7, 3, 2, 0x41, 0xC8};
+  EXPECT_EQ(mb::check_reply(mb::Framing::tcp, tcp_req, short_count), EMBBADDATA);
+  const B busy{0x12, 0x34, 0, 0, 0, 3, 7, 0x83, 6};
+  EXPECT_EQ(mb::check_reply(mb::Framing::tcp, tcp_req, busy), EMBXSBUSY);
+  const B wrong_fc_exception{0x12, 0x34, 0, 0, 0, 3, 7, 0x84, 6};
+  EXPECT_EQ(mb::check_reply(mb::Framing::tcp, tcp_req, wrong_fc_exception), EMBBADEXC);
+  // RTU: the CRC of "01 03 00 00 00 01" is 84 0A (low byte first), as every Modbus primer shows.
+  EXPECT_EQ(mb::request_frame(mb::Framing::rtu, 0, B{1, 3, 0, 0, 0, 1}),
+            (B{1, 3, 0, 0, 0, 1, 0x84, 0x0A}));
+  const auto rtu_req = mb::request_frame(mb::Framing::rtu, 0, read2);
+  auto rtu_reply = [](B body) {
+    const auto crc = mb::crc16(body);
+    body.push_back(static_cast<std::uint8_t>(crc & 0xFF));
+    body.push_back(static_cast<std::uint8_t>(crc >> 8));
+    return body;
+  };
+  EXPECT_EQ(mb::check_reply(mb::Framing::rtu, rtu_req, rtu_reply({7, 3, 4, 1, 2, 3, 4})), 0);
+  EXPECT_EQ(mb::check_reply(mb::Framing::rtu, rtu_req, rtu_reply({8, 3, 4, 1, 2, 3, 4})),
+            EMBBADSLAVE);
+  auto bad_crc = rtu_reply({7, 3, 4, 1, 2, 3, 4});
+  bad_crc.back() ^= 0xFF;
+  EXPECT_EQ(mb::check_reply(mb::Framing::rtu, rtu_req, bad_crc), EMBBADCRC);
 }
