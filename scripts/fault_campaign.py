@@ -47,6 +47,13 @@ FAULTS = ["kill9", "door", "estop", "chamber_sensor", "chamber_stall", "chamber_
 SENSOR_BREAK_CHAMBERS = {"generic_plc", "watlow_f4", "watlow_f4t", "watlow_f4t_map2", "watlow_f4p"}
 # Faults that must end in a safe hold, and how fast (time_to_safe_s).
 HOLD_FAULTS = ("door", "estop", "chamber_sensor", "table_refuse")
+# Issue 34: the chamber's air reading lies (simrig `chamber air 99999.9`, no alarm) for LIE_S,
+# longer than the safety layer's 5 ticks: one implausible_reading and its end, a safe hold and
+# its end; another master writes the setpoint (`chamber setpoint 60`, inside the limits): one
+# setpoint_foreign and its end (the station's value written again, [chamber] on_foreign_setpoint
+# = "restore").
+FAULTS += ["chamber_lie", "foreign_setpoint"]
+LIE_S = 8
 # An ACUTROL that refuses every command for 7 s (simrig `table refuse`: an ACL error on each, read
 # from its error queue or header): one outage_start naming the refusal, and a safe hold once its
 # interlock has gone unread for the safety layer's 5 blind ticks.
@@ -204,6 +211,8 @@ def inject(kind, rig, daemon, db, rng, log):
     commands = {
         "door": (["door open"], ["door close"], {"safe_hold"}),
         "estop": (["estop press"], ["estop release"], {"safe_hold"}),
+        "chamber_lie": (["chamber air 99999.9"], ["chamber air off"], {"implausible_reading"}),
+        "foreign_setpoint": (["chamber setpoint 60"], [], {"setpoint_foreign"}),
         # A broken air sensor: one sensor_fault event and a safe hold (checked in campaign()).
         "chamber_sensor": (["chamber alarm sensor on"], ["chamber alarm sensor off"],
                            {"sensor_fault"}),
@@ -224,6 +233,8 @@ def inject(kind, rig, daemon, db, rng, log):
     # A drip's late bytes keep a link down a few ticks after it ends (till its reconnect).
     time.sleep(REFUSE_S + 0.5 if kind == "table_refuse" else
                DRIP_S + 3.5 if kind in DRIP_FAULTS else 3.5)
+    if kind == "chamber_lie":
+        time.sleep(LIE_S - 3.5)  # past the 5 ticks an implausible air may last without a hold
     if commands[1]:
         rig.send(*commands[1])
     return snap, t0, commands[2]
@@ -313,6 +324,17 @@ def campaign(args, work):
             held = kind == "chamber_drip" or seen >= {"safe_hold", "safe_hold_cleared"}
             row["event_expected"] = ends and held and row["ticks_lost"] == 0
             if kind == "table_drip":
+                holds += [wall(e[1]) - t0 for e in new if e[4] == "safe_hold_changed"]
+                row["time_to_safe_s"] = round(min(holds), 3) if holds else None
+        if kind in ("chamber_lie", "foreign_setpoint"):
+            # Exactly one episode with its end; the lie also a safe hold and its end.
+            start, end = {"chamber_lie": ("implausible_reading", "implausible_reading_end"),
+                          "foreign_setpoint": ("setpoint_foreign", "setpoint_foreign_end")}[kind]
+            row["episodes"] = [sum(e[4] == k for e in new) for k in (start, end)]
+            held = kind != "chamber_lie" or (
+                bool({"safe_hold", "safe_hold_changed"} & seen) and "safe_hold_cleared" in seen)
+            row["event_expected"] = row["episodes"] == [1, 1] and held
+            if kind == "chamber_lie":
                 holds += [wall(e[1]) - t0 for e in new if e[4] == "safe_hold_changed"]
                 row["time_to_safe_s"] = round(min(holds), 3) if holds else None
         if kind in HOLD_FAULTS:

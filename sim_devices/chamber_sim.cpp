@@ -71,6 +71,16 @@ void ChamberSim::set_air_sensor_failed(bool failed) {
   sensor_failed_ = failed;
 }
 
+void ChamberSim::set_air_shown_c(std::optional<double> c) {
+  std::lock_guard lock(mutex_);
+  air_shown_c_ = c;
+}
+
+double ChamberSim::shown_air_c() const {
+  std::lock_guard lock(mutex_);
+  return air_shown_c_.value_or(air_c_);
+}
+
 void ChamberSim::set_door_open(bool open) {
   std::lock_guard lock(mutex_);
   door_open_ = open;
@@ -159,7 +169,8 @@ int ChamberSim::register_count() const {
 
 void ChamberSim::publish(modbus_mapping_t& regs) {
   std::lock_guard lock(mutex_);
-  put_point(regs, map_.at(cm::kAir), sensor_failed_ ? cfg_.broken_sensor_c : air_c_);
+  put_point(regs, map_.at(cm::kAir),
+            sensor_failed_ ? cfg_.broken_sensor_c : air_shown_c_.value_or(air_c_));
   put_point(regs, map_.at(cm::kProduct), product_c_);
   put_point(regs, map_.at(cm::kStatus), status_locked());
   put_point(regs, map_.at(cm::kAlarms), alarms_locked());

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <mutex>
+#include <optional>
 
 #include "drivers/modbus/register_map.hpp"
 #include "sim_devices/servers/modbus_server.hpp"
@@ -47,6 +48,12 @@ class ChamberSim final : public ModbusDeviceModel {
 
   /// Fault: air sensor broken (sensor-break alarm, air register shows broken_sensor_c).
   void set_air_sensor_failed(bool failed);
+  /// Fault: the air reading shows `c` deg C instead of the model's air (a lying sensor or a
+  /// corrupt reply: no alarm; an integer face saturates it, -32768 / 0x8000 at the bottom);
+  /// std::nullopt ends it.
+  void set_air_shown_c(std::optional<double> c);
+  /// What a face shows as the air reading: the injected value, else the model's air, deg C.
+  double shown_air_c() const;
   /// Fault: door switch open (alarm bit).
   void set_door_open(bool open);
   /// Fault: independent high-limit tripped (alarm bit; output disabled while set).
@@ -91,6 +98,7 @@ class ChamberSim final : public ModbusDeviceModel {
   ChamberSimConfig cfg_;
   mutable std::mutex mutex_;
   double t_s_ = 0, air_c_, product_c_, setpoint_c_, effective_sp_c_, ramp_c_per_min_ = 0;
+  std::optional<double> air_shown_c_;
   bool run_, hold_ = false, sensor_failed_ = false, door_open_ = false, high_limit_ = false;
 };
 

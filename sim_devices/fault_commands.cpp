@@ -26,19 +26,23 @@ constexpr CommandDoc kCommands[] = {
     {"chamber alarm sensor on|off",
      "air sensor break as the face shows it (generic: alarm bit, air 999.9; F4T: PV NaN)"},
     {"chamber setpoint C", "someone else writes the setpoint (front panel, another master)"},
+    {"chamber air C|off",
+     "the air reading shows C (a lying sensor or reply; an integer face saturates, -32768 at the "
+     "bottom) until off"},
+    {"table rate DPS|off", "the rate reading shows DPS (a lying encoder or reply) until off"},
     {"table fault on|off", "turntable drive fault bit (drive disabled)"},
     {"chamber|table stall SECONDS", "no reply to any request for SECONDS (0 ends it)"},
     {"chamber|table exception CODE [N|always]", "exception CODE (1..11) to the next N requests"},
     {"chamber|table refuse SECONDS",
      "every request refused for SECONDS: Modbus exception 6 (busy), an ACUTROL's ACL error "
      "(ILLEGAL CMD in its error queue / header), a P300's NA: line"},
+    {"chamber|table drip SECONDS [MS]",
+     "every reply in the next SECONDS leaves one byte every MS ms (default 300: a slow proxy), "
+     "replies behind it queued in order (0 ends it)"},
     {"chamber|table disconnect [SECONDS]", "close connections, refuse new ones for SECONDS"},
     {"chamber|table clear", "end that device's Modbus faults"},
     {"can drop|duplicate|corrupt N", "the next N counter-board frames on the bus"},
     {"can drop|duplicate|corrupt rate P", "each frame with probability P (0..1) from now on"},
-    {"chamber|table drip SECONDS [MS]",
-     "every reply in the next SECONDS leaves one byte every MS ms (default 300: a slow proxy), "
-     "replies behind it queued in order (0 ends it)"},
     {"can clear", "end the CAN faults"},
     {"board NODE reset", "board power cycle: counters and board clock restart from 0"},
     {"board NODE silent|answer", "the board stops / resumes answering SYNC"},
@@ -50,14 +54,14 @@ constexpr CommandDoc kCommands[] = {
 
 using Args = std::vector<std::string_view>;
 
-Args split(std::string_view line) {
-  Args out;
-  std::size_t i = 0;
-  while (i < line.size()) {
 // The drip of issue 34: a proxy forwarding one byte every 0.3 s, under libmodbus's 0.5 s byte
 // timeout, so only a deadline for the whole exchange ends it.
 constexpr double kDripMs = 300;
 
+Args split(std::string_view line) {
+  Args out;
+  std::size_t i = 0;
+  while (i < line.size()) {
     while (i < line.size() && std::isspace(static_cast<unsigned char>(line[i]))) ++i;
     std::size_t j = i;
     while (j < line.size() && !std::isspace(static_cast<unsigned char>(line[j]))) ++j;
@@ -111,13 +115,13 @@ std::string modbus_fault(SimServer& server, const Args& a, std::string_view dev)
     // Modbus Application Protocol v1.1b3 §7: 06 "Server Device Busy" (a line device refuses
     // in its own words: LineDevice::error_reply).
     server.refuse_for(number(a[2], "seconds", 0, 1e6), 6);
+  } else if (a[1] == "drip" && (a.size() == 3 || a.size() == 4)) {
+    const double ms = a.size() == 4 ? number(a[3], "milliseconds", 1, 60000) : kDripMs;
+    server.drip_for(number(a[2], "seconds", 0, 1e6), ms / 1000.0);
   } else if (a[1] == "disconnect" && a.size() <= 3) {
     server.disconnect_for(a.size() == 3 ? number(a[2], "seconds", 0, 1e6) : 0.0);
   } else if (a[1] == "clear" && a.size() == 2) {
     server.clear_faults();
-  } else if (a[1] == "drip" && (a.size() == 3 || a.size() == 4)) {
-    const double ms = a.size() == 4 ? number(a[3], "milliseconds", 1, 60000) : kDripMs;
-    server.drip_for(number(a[2], "seconds", 0, 1e6), ms / 1000.0);
   } else {
     usage(syntax);
   }
@@ -136,6 +140,12 @@ std::string chamber(SimWorld& w, const Args& a) {
     }
     return "ok";
   }
+  if (a.size() == 3 && a[1] == "air") {
+    // Any finite value, however absurd: the point is a reading no chamber could give.
+    w.chamber().set_air_shown_c(a[2] == "off" ? std::nullopt
+                                              : std::optional(number(a[2], "air", -1e308, 1e308)));
+    return "ok";
+  }
   if (a.size() == 3 && a[1] == "setpoint") {
     w.chamber().set_setpoint_c(number(a[2], "setpoint", -1000, 1000));
     return fmt::format("ok setpoint_c={:.1f}", w.chamber().setpoint_c());
@@ -146,6 +156,11 @@ std::string chamber(SimWorld& w, const Args& a) {
 std::string table(SimWorld& w, const Args& a) {
   if (a.size() == 3 && a[1] == "fault") {
     w.turntable().set_fault(pick(a[2], "on", "off", "table fault on|off"));
+    return "ok";
+  }
+  if (a.size() == 3 && a[1] == "rate") {
+    w.turntable().set_rate_shown_dps(
+        a[2] == "off" ? std::nullopt : std::optional(number(a[2], "rate", -1e308, 1e308)));
     return "ok";
   }
   return modbus_fault(w.turntable_server(), a, "table");

@@ -209,7 +209,9 @@ void SimWorld::clear_faults() {
   set_estop(false);
   chamber_sim_->set_high_limit_trip(false);
   chamber_sim_->set_air_sensor_failed(false);
+  chamber_sim_->set_air_shown_c(std::nullopt);
   table_sim_->set_fault(false);
+  table_sim_->set_rate_shown_dps(std::nullopt);
   chamber_.server->clear_faults();
   table_.server->clear_faults();
   can_rates_ = {};

@@ -72,6 +72,16 @@ double TurntableSim::rate_dps() const {
   return rate_dps_;
 }
 
+void TurntableSim::set_rate_shown_dps(std::optional<double> dps) {
+  std::lock_guard lock(mutex_);
+  rate_shown_dps_ = dps;
+}
+
+double TurntableSim::shown_rate_dps() const {
+  std::lock_guard lock(mutex_);
+  return rate_shown_dps_.value_or(rate_dps_);
+}
+
 void TurntableSim::set_interlock_open(bool open) {
   std::lock_guard lock(mutex_);
   interlock_open_ = open;
@@ -148,7 +158,7 @@ void TurntableSim::publish(modbus_mapping_t& regs) {
   put_point(regs, map_.at(tm::kLock), locked_ ? 1 : 0);
   put_point(regs, map_.at(tm::kStop), stopping_ ? 1 : 0);
   put_point(regs, map_.at(tm::kAngle), angle_deg_);
-  put_point(regs, map_.at(tm::kRate), rate_dps_);
+  put_point(regs, map_.at(tm::kRate), rate_shown_dps_.value_or(rate_dps_));
   put_point(regs, map_.at(tm::kStatus), status_locked());
   put_point(regs, map_.at(tm::kModeActual), mode_);
 }

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <mutex>
+#include <optional>
 
 #include "drivers/modbus/register_map.hpp"
 #include "sim_devices/servers/modbus_server.hpp"
@@ -31,6 +32,11 @@ class TurntableSim final : public ModbusDeviceModel {
   double angle_deg() const;
   /// Table rate, deg/s.
   double rate_dps() const;
+  /// Fault: the rate reading shows `dps` instead of the model's rate (a lying encoder or a
+  /// corrupt reply); std::nullopt ends it.
+  void set_rate_shown_dps(std::optional<double> dps);
+  /// What a face shows as the rate reading: the injected value, else the model's, deg/s.
+  double shown_rate_dps() const;
   /// Fault: interlock open (drive disabled: mode off, table coasts to rest at max decel).
   void set_interlock_open(bool open);
   /// Fault: drive fault bit (drive disabled like the interlock).
@@ -64,6 +70,7 @@ class TurntableSim final : public ModbusDeviceModel {
   TurntableSimConfig cfg_;
   mutable std::mutex mutex_;
   double t_s_ = 0, angle_deg_ = 0, rate_dps_ = 0, position_demand_deg_ = 0, rate_demand_dps_ = 0;
+  std::optional<double> rate_shown_dps_;
   int mode_ = 0;  // 0 off, 1 position, 2 rate
   bool locked_ = false, interlock_open_ = false, fault_ = false, stopping_ = false;
 };

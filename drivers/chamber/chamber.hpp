@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 
+#include "drivers/common/plausible.hpp"
 #include "drivers/common/result.hpp"
 
 namespace station::drivers {
@@ -75,6 +76,12 @@ class Chamber {
   /// ramp); false (Watlow F4, ESPEC P300) and the station ramps by moving the setpoint each tick
   /// (ProtocolRunner) and ignores ramp commands. No I/O.
   virtual bool controller_ramp() const { return true; }
+  /// The air temperatures this dialect can report, deg C (docs/DEVICES.md, "Plausible
+  /// readings"); by default from absolute zero up. No I/O.
+  virtual PlausibleRange air_range_c() const { return {-273.15, PlausibleRange{}.hi}; }
+  /// The step of the setpoint register in deg C (one decimal: 0.1): a read-back within it of
+  /// what was written is that value. No I/O.
+  virtual double setpoint_resolution_c() const { return 0.1; }
 };
 
 /// "off", "constant", "ramping", "hold", "profile", "manual".

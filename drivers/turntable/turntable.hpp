@@ -4,6 +4,7 @@
 #include <optional>
 #include <string>
 
+#include "drivers/common/plausible.hpp"
 #include "drivers/common/result.hpp"
 
 namespace station::drivers {
@@ -58,6 +59,9 @@ class Turntable {
   virtual Result<void> stop() = 0;
   /// Device name for logs and records.
   virtual std::string name() const = 0;
+  /// The rates this dialect can report, deg/s (docs/DEVICES.md, "Plausible readings"); by
+  /// default any finite one. No I/O.
+  virtual PlausibleRange rate_range_dps() const { return {}; }
   /// What the controller says about itself (probe); the default knows nothing.
   virtual Result<std::string> identify() { return std::string{}; }
 };

@@ -80,7 +80,7 @@ std::string AcutrolFace::motion(const AclUnit& u, std::uint32_t& error, std::str
   const bool tripped = table_.fault() || table_.interlock_open();
   if (p == ":Read:Position" || p == ":Read:Rate") {  // p. 168-169
     if (!axis_args(u, 0, 1, error, why)) return {};
-    return fmt5(p == ":Read:Position" ? table_.angle_deg() : table_.rate_dps());
+    return fmt5(p == ":Read:Position" ? table_.angle_deg() : table_.shown_rate_dps());
   }
   if (p == ":Interlock") {  // Close / Open / Fault ([ACL] p. 133's words; [py] :41)
     if (!axis_args(u, 0, 1, error, why)) return {};

@@ -75,7 +75,7 @@ std::string P300Face::answer(std::string_view c) {
   namespace p3 = sources::p300;
   const auto& cfg = chamber_.config();
   const auto mode = [&] { return chamber_.run() ? "CONSTANT" : "STANDBY"; };
-  const double pv = chamber_.air_sensor_failed() ? cfg.broken_sensor_c : chamber_.air_c();
+  const double pv = chamber_.air_sensor_failed() ? cfg.broken_sensor_c : chamber_.shown_air_c();
   if (c == p3::kTempQuery)
     return fmt::format("{:.1f},{:.1f},{:.1f},{:.1f}", pv, chamber_.setpoint_c(),
                        cfg.setpoint_high_c, cfg.setpoint_low_c);

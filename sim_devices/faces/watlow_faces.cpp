@@ -70,7 +70,7 @@ std::uint8_t F4Face::check_write(const RegisterWrite& write) const {
 
 void F4Face::publish(modbus_mapping_t& regs) {
   const bool broken = chamber_.air_sensor_failed();
-  put(regs, f4::kAir, broken ? 32767 : raw_temp(chamber_.air_c()));
+  put(regs, f4::kAir, broken ? 32767 : raw_temp(chamber_.shown_air_c()));
   put(regs, f4::kAirError, broken ? f4::kInputOverRange : 0);
   put(regs, f4::kProduct,
       panel_.humidity ? std::nearbyint(kSimHumidityRh * std::pow(10.0, panel_.decimals))
@@ -123,7 +123,7 @@ std::uint8_t F4tFace::check_write(const RegisterWrite& write) const {
 }
 
 void F4tFace::publish(modbus_mapping_t& regs) {
-  put(regs, f4t::kAir, chamber_.air_sensor_failed() ? NAN : unit(chamber_.air_c()));
+  put(regs, f4t::kAir, chamber_.air_sensor_failed() ? NAN : unit(chamber_.shown_air_c()));
   put(regs, f4t::kProduct, panel_.humidity ? kSimHumidityRh : unit(chamber_.product_c()));
   put(regs, f4t::kLoop1Kind, f4t::kAbsoluteTemperature);
   put(regs, f4t::kLoop2Kind, panel_.humidity ? f4t::kHumidity : f4t::kAbsoluteTemperature);
@@ -185,7 +185,7 @@ std::uint8_t F4pFace::check_write(const RegisterWrite& write) const {
 void F4pFace::publish(modbus_mapping_t& regs) {
   const bool broken = chamber_.air_sensor_failed();
   put(regs, f4p::kModel, f4p::kModelF4p);
-  put(regs, f4p::kAir, broken ? 32767 : raw_temp(chamber_.air_c()));
+  put(regs, f4p::kAir, broken ? 32767 : raw_temp(chamber_.shown_air_c()));
   put(regs, f4p::kAirError, broken ? f4p::kInputOverRange : 0);
   put(regs, f4p::kAlarm1, (chamber_.alarms() & 1u) != 0 ? 1 : 0);
   put(regs, f4p::kOperation, chamber_.run() ? f4p::kAuto : f4p::kManual);

@@ -85,7 +85,9 @@ void link_defaults(const TomlView& v, const Dialect& dialect, DeviceConfig& d) {
 DeviceConfig read_device(const TomlView& v, bool is_chamber) {
   v.allow_only({"endpoint", "model", "preset", "unit_id", "timeout_s", "readback_every", "point",
                 "run_event", "product_input", "humidity_event", "setpoint_low_c", "setpoint_high_c",
-                "request_gap_s", "word_order", "gateway", "framing"});
+                "request_gap_s", "word_order", "gateway", "framing", "on_foreign_setpoint"});
+  if (!is_chamber && v.table().contains("on_foreign_setpoint"))
+    throw v.error("on_foreign_setpoint", "is a [chamber] key");
   DeviceConfig d;
   d.name = is_chamber ? "chamber" : "turntable";
   if (v.opt_string("model") && v.opt_string("preset"))
@@ -131,22 +133,22 @@ DeviceConfig read_device(const TomlView& v, bool is_chamber) {
   return d;
 }
 
-SlotConfig read_slot(const TomlView& v) {
-  v.allow_only({"node", "serial", "pulse_weight_arcsec", "axis", "relay", "part"});
 /// The text rule (common/text_rule.hpp) at `key`: "FILE:LINE: key 'K': U+XXXX at ...".
 void require_identifier_at(const TomlView& v, std::string_view key, const std::string& text) {
   if (const auto problem = identifier_problem(text)) throw v.error(key, *problem);
 }
 
+SlotConfig read_slot(const TomlView& v) {
+  v.allow_only({"node", "serial", "pulse_weight_arcsec", "axis", "relay", "part"});
   SlotConfig s;
   const long long node = v.get_integer("node");
   if (node < 1 || node > 16) throw v.error("node", "CAN node must be 1..16");
   s.node = static_cast<int>(node);
   s.serial = v.get_string("serial");
   if (s.serial.empty()) throw v.error("serial", "must not be empty");
+  require_identifier_at(v, "serial", s.serial);
   s.pulse_weight_arcsec = v.opt_number("pulse_weight_arcsec").value_or(1.5);
   if (!(s.pulse_weight_arcsec > 0 && s.pulse_weight_arcsec < 100)) {
-  require_identifier_at(v, "serial", s.serial);
     throw v.error("pulse_weight_arcsec", "must be in (0, 100) arcsec");
   }
   s.axis = v.opt_string("axis").value_or("up");
@@ -154,9 +156,9 @@ void require_identifier_at(const TomlView& v, std::string_view key, const std::s
   s.relay = v.opt_string("relay").value_or("");
   if (auto part = v.opt_string("part")) {
     if (part->empty()) throw v.error("part", "must not be empty");
+    require_identifier_at(v, "part", *part);
     s.part = *part;
     s.part_line = v.line_of("part");
-    require_identifier_at(v, "part", *part);
   }
   return s;
 }
@@ -222,9 +224,9 @@ void read_station_table(const TomlView& root, const std::string& path, StationCo
   if (!st) throw root.error("station", "missing [station] table (latitude_deg is required)");
   st->allow_only({"name", "latitude_deg", "ref_temp_c", "bin_s", "max_lost_share", "parts"});
   c.name = st->opt_string("name").value_or(c.name);
+  require_identifier_at(*st, "name", c.name);
   c.latitude_deg = st->get_number("latitude_deg");
   if (c.latitude_deg < -90 || c.latitude_deg > 90)
-  require_identifier_at(*st, "name", c.name);
     throw st->error("latitude_deg", "must be -90..90");
   c.ref_temp_c =
       st->opt_number_in("ref_temp_c", compensation::kMinTempC, compensation::kMaxTempC, "C")
@@ -296,6 +298,9 @@ StationConfig parse_station_config(const std::string& text, const std::string& p
   auto chamber = root.opt_table("chamber");
   if (!chamber) throw root.error("chamber", "missing [chamber] table");
   c.chamber = read_device(*chamber, true);
+  c.on_foreign_setpoint = chamber->opt_string("on_foreign_setpoint").value_or("restore");
+  if (c.on_foreign_setpoint != "restore" && c.on_foreign_setpoint != "hold")
+    throw chamber->error("on_foreign_setpoint", "must be \"restore\" or \"hold\"");
   if (auto t = root.opt_table("turntable")) c.turntable = read_device(*t, false);
   read_can_table(root, c);
   for (const auto& s : root.table_array("slot")) c.slots.push_back(read_slot(s));

@@ -66,6 +66,10 @@ struct StationConfig {
   /// this file; empty when the key is absent.
   std::string parts_path;
   DeviceConfig chamber;
+  /// [chamber] on_foreign_setpoint: "restore" (default: the station's setpoint is written again)
+  /// or "hold" (a safe hold until the chamber reads the station's setpoint again), when the
+  /// chamber's setpoint reads other than the station commanded (station/daemon/setpoint_watch).
+  std::string on_foreign_setpoint = "restore";
   std::optional<DeviceConfig> turntable;
   std::string can_transport;  ///< socketcan:can0 | unix:PATH | fd:N
   int can_tick_timeout_ms = 200;

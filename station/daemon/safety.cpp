@@ -105,6 +105,10 @@ constexpr CauseWords kCauseWords[] = {
     {&SafetyCauses::chamber_high_limit, "chamber high-limit trip", "chamber high-limit trip reset"},
     {&SafetyCauses::chamber_sensor_break, "chamber air sensor break",
      "chamber air sensor reads again"},
+    {&SafetyCauses::chamber_air_implausible, "chamber air reading implausible",
+     "chamber air reads plausibly again"},
+    {&SafetyCauses::setpoint_foreign, "chamber setpoint written by another master",
+     "chamber setpoint reads the station's again"},
     {&SafetyCauses::estop_pressed, "e-stop pressed", "e-stop released"},
     {&SafetyCauses::chamber_door_open, "chamber door open", "chamber door closed"},
     {&SafetyCauses::door_open, "interlock open", "interlock closed"},
@@ -172,12 +176,23 @@ SafetyDecision Safety::decide(const SafetyInputs& in) {
     c.chamber_high_limit = in.chamber->alarms.high_limit_trip;
     c.chamber_sensor_break = in.chamber->alarms.sensor_break;
     c.out_of_limits = judge(in.chamber);
+    alarm_events(in.chamber->alarms, d.events);
+    // An implausible air holds once it lasts as long as an unreadable interlock may.
+    implausible_ticks_ = in.air_implausible ? implausible_ticks_ + 1 : 0;
   }
+  c.chamber_air_implausible = implausible_ticks_ >= kBlindTicks;
+  c.setpoint_foreign = in.setpoint_foreign;
   c.inputs_unreadable = blind_ticks_ >= kBlindTicks;
   if (c.chamber_sensor_break != causes_.chamber_sensor_break)
     d.events.push_back(sensor_event(c.chamber_sensor_break));
-  // A broken sensor's air is no reading to hold at (nor to resume a ramp from).
-  const auto air_c = c.chamber_sensor_break ? std::nullopt : in.air_c;
+  // No air to hold at (nor to resume a ramp from) that a hold's cause made untrustworthy: a
+  // broken sensor's, an implausible one, air beyond the limits; nor a hold setpoint written over
+  // another master's until the operator answers it.
+  const double lo = limits_.min_setpoint_c - limits_.air_margin_c;
+  const double hi = limits_.max_setpoint_c + limits_.air_margin_c;
+  const bool untrusted = c.chamber_sensor_break || in.air_implausible || c.setpoint_foreign ||
+                         (in.air_c && !(*in.air_c >= lo && *in.air_c <= hi));
+  const auto air_c = untrusted ? std::nullopt : in.air_c;
   const bool was = holding_;
   const auto change = update(std::move(c));
   finish(d, was, change, in.chamber, air_c);
@@ -192,6 +207,31 @@ SafetyEvent Safety::sensor_event(bool broken) {
             "reads again",
             data};
   return {Severity::info, EventKind::sensor_fault_cleared, "chamber air sensor reads again", data};
+}
+
+void Safety::alarm_events(const drivers::AlarmBits& now, std::vector<SafetyEvent>& events) {
+  struct Alarm {
+    bool drivers::AlarmBits::*flag;
+    const char* name;
+    Severity severity;  ///< while on: error for the ones that hold a run
+  };
+  static constexpr Alarm kAlarms[] = {
+      {&drivers::AlarmBits::high_limit_trip, "high_limit_trip", Severity::error},
+      {&drivers::AlarmBits::door_open, "door_open", Severity::error},
+      {&drivers::AlarmBits::deviation, "deviation", Severity::warn},
+      {&drivers::AlarmBits::other, "other", Severity::warn},
+  };
+  for (const auto& a : kAlarms) {
+    if (now.*a.flag == alarms_.*a.flag) continue;
+    const nlohmann::json data{{"alarm", a.name}};
+    if (now.*a.flag)
+      events.push_back({a.severity, EventKind::chamber_alarm,
+                        fmt::format("chamber alarm on: {}", a.name), data});
+    else
+      events.push_back({Severity::info, EventKind::chamber_alarm_cleared,
+                        fmt::format("chamber alarm off: {}", a.name), data});
+  }
+  alarms_ = now;
 }
 
 SafetyDecision Safety::decide_between_ticks(std::optional<bool> door_closed,

@@ -29,6 +29,11 @@ struct SafetyInputs {
   std::optional<bool> door_closed;    ///< the GPIO interlock line (closed = safe)
   std::optional<bool> estop_pressed;  ///< the GPIO e-stop line
   std::optional<double> air_c;        ///< last finite air reading (where a hold keeps the chamber)
+  /// The chamber's air read this tick was no reading (plausibility.hpp): kBlindTicks in a row
+  /// hold, as an unreadable interlock does.
+  bool air_implausible = false;
+  /// Hold for a setpoint another master wrote ([chamber] on_foreign_setpoint = "hold").
+  bool setpoint_foreign = false;
 };
 
 /// The safety inputs of one rig reading (`air_c`: the last finite air reading).
@@ -53,6 +58,8 @@ struct SafetyCauses {
   bool estop_pressed = false;              ///< the GPIO e-stop line
   bool chamber_high_limit = false;         ///< the chamber's high-limit (over-temperature) trip
   bool chamber_sensor_break = false;       ///< the chamber's air sensor broken: no air reading
+  bool chamber_air_implausible = false;    ///< the air implausible for kBlindTicks: no reading
+  bool setpoint_foreign = false;           ///< another master's setpoint, held for (config)
   bool inputs_unreadable = false;          ///< interlock / e-stop unreadable for kBlindTicks
   std::vector<std::string> out_of_limits;  ///< the chamber's readings outside the limits
   bool interlock_open() const {
@@ -60,9 +67,10 @@ struct SafetyCauses {
   }
   bool estop() const { return estop_pressed || chamber_high_limit; }
   /// A device fault someone must repair (tower lamp red): a broken sensor.
-  bool sensor_fault() const { return chamber_sensor_break; }
+  bool sensor_fault() const { return chamber_sensor_break || chamber_air_implausible; }
   bool any() const {
-    return interlock_open() || estop() || sensor_fault() || !out_of_limits.empty();
+    return interlock_open() || estop() || sensor_fault() || setpoint_foreign ||
+           !out_of_limits.empty();
   }
   /// The active causes in words ("chamber high-limit trip; GPIO e-stop pressed"), or "none".
   std::string text() const;
@@ -140,6 +148,9 @@ class Safety {
   bool blind(const SafetyInputs& in) const;
   /// The event of the chamber's air sensor breaking (`broken`) or reading again.
   static SafetyEvent sensor_event(bool broken);
+  /// One event per chamber alarm that came on or went off since the last reading (a sensor
+  /// break has its own, sensor_event).
+  void alarm_events(const drivers::AlarmBits& now, std::vector<SafetyEvent>& events);
   /// Applies a state change (or none) to `d`, and the hold's commands.
   void finish(SafetyDecision& d, bool was_holding, const std::optional<std::string>& change,
               const std::optional<drivers::ChamberState>& chamber, std::optional<double> air_c);
@@ -150,6 +161,8 @@ class Safety {
   SafetyCauses causes_;
   bool limits_fault_ = false;
   int blind_ticks_ = 0;
+  int implausible_ticks_ = 0;    ///< ticks in a row the chamber's air was implausible
+  drivers::AlarmBits alarms_{};  ///< the chamber's alarms as last read
   std::optional<double> hold_air_c_;
   bool hold_acknowledged_ = false, table_stopped_ = false;
 };

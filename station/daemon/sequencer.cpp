@@ -38,6 +38,8 @@ Sequencer::Sequencer(const StationConfig& config, const Protocol& protocol, Rig&
       clock_(clock),
       options_(std::move(options)),
       safety_(config.limits, sources_of(rig)),
+      setpoint_watch_(
+          parse_foreign_setpoint(config.on_foreign_setpoint).value_or(ForeignSetpoint::restore)),
       outputs_(rig.gpio.get(), config.slots.size()) {}
 
 void Sequencer::emit(double t_s, Severity severity, const std::string& source, EventKind kind,
@@ -76,6 +78,7 @@ void Sequencer::read_devices(double t_s, TickData& d) {
     note_link(t_s, "turntable", d.in.table.has_value(),
               d.in.table_error ? d.in.table_error->message : std::string());
   note_edges(t_s, d.in);
+  screen(t_s, d);
 }
 
 void Sequencer::note_link(double t_s, const std::string& device, std::optional<bool> answered,
@@ -195,7 +198,12 @@ void Sequencer::assemble_samples(double t_s, TickData& d) {
 }
 
 void Sequencer::apply_safety(double t_s, TickData& d) {
-  const auto decision = safety_.decide(safety_inputs(d.in, d.obs.air_c));
+  check_setpoint(t_s, d);
+  auto in = safety_inputs(d.in, d.obs.air_c);
+  in.air_implausible = d.air_implausible;
+  in.setpoint_foreign =
+      setpoint_watch_.foreign() && setpoint_watch_.action() == ForeignSetpoint::hold;
+  const auto decision = safety_.decide(in);
   act_on_safety(t_s, decision);
   if (decision.cleared) runner_->reenter(decision.hold_air_c);
 }
@@ -222,6 +230,7 @@ void Sequencer::act_on_safety(double t_s, const SafetyDecision& d) {
   if (d.chamber) {
     const auto r = rig_.chamber->command(*d.chamber);
     chamber_ok = r.ok();
+    if (chamber_ok) note_commanded(*d.chamber);
     if (!r && command_failures_++ % 60 == 0)
       emit(t_s, Severity::error, "chamber", EventKind::hold_failed, r.error().message);
   }
@@ -252,6 +261,7 @@ void Sequencer::apply_actions(double t_s, const Actions& a) {
   // Commands are retried every tick until the device accepts them.
   if (pending_chamber_) {
     if (auto r = rig_.chamber->command(*pending_chamber_); r) {
+      note_commanded(*pending_chamber_);
       pending_chamber_.reset();
       command_failures_ = 0;
     } else if (command_failures_++ % 60 == 0) {

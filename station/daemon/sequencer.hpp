@@ -17,10 +17,12 @@
 #include "station/config/protocol.hpp"
 #include "station/daemon/outages.hpp"
 #include "station/daemon/outputs.hpp"
+#include "station/daemon/plausibility.hpp"
 #include "station/daemon/protocol_runner.hpp"
 #include "station/daemon/rig.hpp"
 #include "station/daemon/rig_reading.hpp"
 #include "station/daemon/safety.hpp"
+#include "station/daemon/setpoint_watch.hpp"
 #include "station/parts/part_file.hpp"
 #include "station/store/calibration.hpp"
 #include "station/store/store.hpp"
@@ -122,6 +124,7 @@ class Sequencer {
     RigReading in;  ///< the rig, read once (rig_reading.hpp)
     std::vector<SampleRow> rows;
     Observation obs;
+    bool air_implausible = false;  ///< the chamber's air was taken out as implausible
   };
   /// The tick's summary for SequencerOptions::on_tick.
   TickReport report(double t_s, const TickData& d) const;
@@ -140,6 +143,12 @@ class Sequencer {
   void note_tick_gap(double t_s, std::int64_t skipped);
   void tick(double t_s, TickData& d);
   void read_devices(double t_s, TickData& d);
+  /// Takes implausible readings out of `d.in` (plausibility.hpp), one event per episode.
+  void screen(double t_s, TickData& d);
+  /// The chamber's setpoint against the station's (setpoint_watch.hpp): events, a restore.
+  void check_setpoint(double t_s, const TickData& d);
+  /// The chamber accepted `c`: its setpoint is the station's now.
+  void note_commanded(const drivers::ChamberCommand& c);
   void apply_safety(double t_s, TickData& d);
   /// Stores an event per GPIO edge of a reading.
   void note_edges(double t_s, const RigReading& in);
@@ -188,6 +197,8 @@ class Sequencer {
   bool replaying_ = false;
   int command_failures_ = 0;
   OutageTracker outages_;             ///< link outages per device
+  PlausibilityWatch plausibility_;    ///< implausible readings, per episode
+  SetpointWatch setpoint_watch_;      ///< the chamber's setpoint against the station's
   std::optional<double> last_air_c_;  ///< last chamber air reading
   RigOutputs outputs_;                ///< lamps and relays, written where they change
   /// Time spent per tick phase (wall seconds, summed), logged at the end of a run.

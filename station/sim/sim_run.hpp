@@ -40,6 +40,7 @@ struct SimRunOptions {
   std::string record_dir;          ///< record the session in this directory (empty: no)
   std::string parts_path;          ///< part file: every simulated gyro is judged (empty: no)
   std::string part_number;         ///< their part (empty: the file's first in sort order)
+  std::string on_foreign_setpoint;  ///< [chamber] on_foreign_setpoint (empty: the default)
   /// Faults injected into the simulated rig: at tick t_s (after the world advanced to it), the
   /// simrig control command (docs/SIMRIG.md), e.g. {3000, "door open"}. In time order.
   std::vector<std::pair<double, std::string>> faults;

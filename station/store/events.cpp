@@ -64,6 +64,21 @@ constexpr EventKindInfo kKinds[] = {
      "a device's sensor broke (chamber air: no reading, a safe hold)"},
     {K::sensor_fault_cleared, "sensor_fault_cleared", "info", "device sensor",
      "a broken sensor reads again"},
+    {K::implausible_reading, "implausible_reading", "error", "device quantity value bound",
+     "a reading no such device can give (its dialect's range, the limits widened): no value, the "
+     "sample keeps it empty; a safe hold if it lasts as long as an unreadable input may"},
+    {K::implausible_reading_end, "implausible_reading_end", "info", "device quantity ticks",
+     "an implausible reading is plausible again after `ticks` ticks"},
+    {K::setpoint_foreign, "setpoint_foreign", "warn|error", "read_c commanded_c action",
+     "the chamber's setpoint reads other than the station commanded (the panel, another master): "
+     "`action` `restore` (written again) or `hold` (a safe hold)"},
+    {K::setpoint_foreign_end, "setpoint_foreign_end", "info", "read_c commanded_c",
+     "the chamber's setpoint reads what the station commanded again"},
+    {K::chamber_alarm, "chamber_alarm", "warn|error", "alarm",
+     "a chamber alarm came on during a run (`alarm`: deviation, door_open, high_limit_trip, "
+     "other)"},
+    {K::chamber_alarm_cleared, "chamber_alarm_cleared", "info", "alarm",
+     "a chamber alarm went off"},
     {K::listen, "listen", "info", "url", "where the live page is served"},
     {K::idle_fault, "idle_fault", "warn", "fault", "serve found the idle rig faulted"},
     {K::idle_clear, "idle_clear", "info", "was", "the idle rig's faults cleared"},

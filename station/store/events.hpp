@@ -61,6 +61,12 @@ enum class EventKind {
   safe_hold_cleared,
   sensor_fault,
   sensor_fault_cleared,
+  implausible_reading,
+  implausible_reading_end,
+  setpoint_foreign,
+  setpoint_foreign_end,
+  chamber_alarm,
+  chamber_alarm_cleared,
   // The service, releases and verification
   listen,
   idle_fault,

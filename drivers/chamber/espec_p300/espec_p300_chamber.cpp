@@ -93,7 +93,8 @@ Result<ChamberState> EspecP300Chamber::read() {
   s.air_c = t->pv_c;
   s.setpoint_c = t->sp_c;
   s.ramp_c_per_min = 0;  // no constant-mode ramp on a P300
-  s.alarms.other = m->alarms > 0 || other_alarm_;
+  // MON?'s count is fresh every read; the codes (ALARM?) only on the read that asked for them.
+  s.alarms.other = m->alarms > 0 || (full && other_alarm_);
   switch (p3::parse_mode(m->mode)) {
     case p3::Mode::constant:
       s.mode = ChamberMode::constant;

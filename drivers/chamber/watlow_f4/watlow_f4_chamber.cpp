@@ -184,6 +184,16 @@ Result<ChamberState> WatlowF4Chamber::read() {
   return s;
 }
 
+PlausibleRange WatlowF4Chamber::air_range_c() const {
+  const TemperatureScale s = scale_.value_or(TemperatureScale{});
+  return PlausibleRange{s.c_from_raw(-32767), s.c_from_raw(32767)} & Chamber::air_range_c();
+}
+
+double WatlowF4Chamber::setpoint_resolution_c() const {
+  const TemperatureScale s = scale_.value_or(TemperatureScale{});
+  return s.delta_to_c(std::pow(10.0, -s.decimals));
+}
+
 // The setpoint limits: 602/603 where the map serves them, else the configured ones, else none
 // (the station's [limits] still bound every setpoint).
 Result<std::pair<double, double>> WatlowF4Chamber::setpoint_limits_c(const TemperatureScale& s) {

@@ -3,8 +3,9 @@
 // event output. The F4 has no constant-mode ramp: controller_ramp() is false and the station
 // ramps by moving the setpoint. What each input measures (608/618) is read at connect: the air
 // input must be a temperature, the product input (configured, WatlowInputs) too; on a humidity
-// chamber the humidity event output is switched off when the station starts the chamber. Data Map 2 serves fewer registers
-// (no status, limits or input units): the driver uses what the map has. Constructor does no I/O.
+// chamber the humidity event output is switched off when the station starts the chamber. Data Map 2
+// serves fewer registers (no status, limits or input units): the driver uses what the map has.
+// Constructor does no I/O.
 #pragma once
 
 #include <memory>
@@ -37,6 +38,12 @@ class WatlowF4Chamber final : public Chamber {
   std::string name() const override { return name_; }
   Result<ChamberIdentity> identify() override;
   bool controller_ramp() const override { return false; }
+  /// What a signed 16-bit register with the unit's decimals carries: -32767..32767 (x 10^-dec,
+  /// in its unit); -32768 (0x8000) is the int16's out-of-range mark, never a value
+  /// (docs/DEVICES.md, "Plausible readings"). Before the scale is read: one decimal, deg C.
+  PlausibleRange air_range_c() const override;
+  /// One count of the setpoint register (300) in deg C: 10^-decimals (606), x 5/9 in deg F.
+  double setpoint_resolution_c() const override;
 
   void set_tap(Tap* tap) { client_.set_tap(tap); }
   void set_readback_every(int reads) { readback_.set_every(reads); }

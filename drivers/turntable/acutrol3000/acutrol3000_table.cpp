@@ -65,6 +65,11 @@ Result<void> Acutrol3000Table::read_rate_limit() {
   return {};
 }
 
+PlausibleRange Acutrol3000Table::rate_range_dps() const {
+  if (!rate_limit_dps_) return {};
+  return {-2.0 * *rate_limit_dps_, 2.0 * *rate_limit_dps_};
+}
+
 Result<TurntableState> Acutrol3000Table::read() {
   const bool full = readback_.due(link_.connects());
   auto pr = link_.query(ac::kReadPositionRate, is_position_rate);

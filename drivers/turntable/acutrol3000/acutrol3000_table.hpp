@@ -34,6 +34,10 @@ class Acutrol3000Table final : public Turntable {
   /// :Mode:Off 1, the unit's controlled stop ([ACL] p. 150).
   Result<void> stop() override;
   std::string name() const override { return name_; }
+  /// Twice the rate limit the unit reports ([ACL] p. 145, `:Limit:Rate? R,1`, read at connect):
+  /// it refuses any demand beyond it, so a measured rate beyond its double is no reading (a servo
+  /// overshoots its demand by far less). Unbounded (finite) until the limit is known.
+  PlausibleRange rate_range_dps() const override;
   /// *IDN? ([ACL] p. 15), the reply framing in use and the rate limit, for probe.
   Result<std::string> identify() override;
 
