@@ -9,6 +9,8 @@
 #include <cstring>
 #include <variant>
 
+#include "drivers/common/exchange_deadline.hpp"
+
 namespace station::drivers::ascii {
 
 Error translate_line_error(int err, const std::string& what) {
@@ -118,7 +120,8 @@ Result<void> LineClient::transmit(std::string_view command, double timeout_s) {
 }
 
 Result<std::string> LineClient::query(std::string_view command) {
-  const double deadline_s = deadline_after(timeout_s_);
+  // Its own timeout, or less while the tick's budget bounds every exchange (exchange_deadline).
+  const double deadline_s = ExchangeDeadline::bound_s(deadline_after(timeout_s_));
   if (auto t = transmit(command, seconds_left(deadline_s)); !t) return t.error();
   std::string line;
   if (wire_->receive(line, framing_.reply_terminator, seconds_left(deadline_s),

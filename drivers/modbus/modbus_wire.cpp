@@ -12,6 +12,7 @@
 #include <thread>
 #include <variant>
 
+#include "drivers/common/exchange_deadline.hpp"
 #include "drivers/modbus/modbus_adu.hpp"
 
 namespace station::drivers::modbus {
@@ -164,13 +165,18 @@ int LibmodbusWire::exchange(const std::vector<std::uint8_t>& adu,
     return -1;
   }
   rest();
-  const auto deadline = SteadyClock::now() + timeout_;
+  // Its own timeout, or less while the tick's budget bounds every exchange (exchange_deadline).
+  const auto deadline = ExchangeDeadline::bound(SteadyClock::now() + timeout_);
   if (drop_late(deadline) == -1) {
     errno = ETIME;  // the last reply still drips: this one cannot begin
     return ended(-1);
   }
   // On a serial line a late reply has no id to tell it by: what came between exchanges goes.
   if (framing() == Framing::rtu) modbus_flush(ctx_.get());
+  if (SteadyClock::now() >= deadline) {  // the tick's budget is spent: nothing is sent
+    errno = ETIMEDOUT;
+    return ended(-1);
+  }
   tid_ = static_cast<std::uint16_t>(tid_ + 1);
   const auto request = request_frame(framing(), tid_, adu);
   if (send_frame(request, deadline) == -1) return ended(-1);

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <string_view>
 
+#include "drivers/common/exchange_deadline.hpp"
 #include "station/daemon/stopwatch.hpp"
 
 namespace station {
@@ -34,6 +35,12 @@ void read_counters(Rig& rig, std::uint8_t seq, RigReading& r) {
 class ReadBudget {
  public:
   explicit ReadBudget(std::optional<double> budget_s) : budget_s_(budget_s) {}
+  /// When the budget ends (none: no budget).
+  std::optional<std::chrono::steady_clock::time_point> end() const {
+    if (!budget_s_) return std::nullopt;
+    return start_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                        std::chrono::duration<double>(*budget_s_));
+  }
   /// Why `device` is not read now (its turn came after the budget was spent), or nothing.
   std::optional<dr::Error> spent(std::string_view device) const {
     const double used_s =
@@ -52,6 +59,10 @@ class ReadBudget {
 
 void read_devices(Rig& rig, const RigReadPlan& plan, RigReading& r, RigReadTimes* times) {
   const ReadBudget budget(plan.budget_s);  // from the chamber's turn: CAN has its own bound
+  // Every exchange of both ends by the budget's end: a chamber that used most of it leaves the
+  // turntable the rest, never a whole timeout past the tick.
+  std::optional<dr::ExchangeDeadline> cap;
+  if (const auto end = budget.end()) cap.emplace(*end);
   if (plan.chamber) {
     Stopwatch w(field(times, &RigReadTimes::chamber));
     if (auto c = rig.chamber->read(); c) {

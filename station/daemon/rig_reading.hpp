@@ -32,8 +32,9 @@ struct IoError {
 /// with it the tick, past the tick's second. Of the second, the counter boards' latch before
 /// them has its own bound (`[can] tick_timeout_ms`, 0.2 s by default), 0.6 s is theirs, and
 /// 0.2 s is left for what follows the reading: the samples' store commit, safety and the
-/// commands it sends. A device whose turn comes after the budget is spent is not read this
-/// tick: a timeout, never its last state passed as fresh.
+/// commands it sends. Every exchange of both ends by the budget's end at the latest
+/// (drivers/common/exchange_deadline.hpp), and a device whose turn comes after it is not read
+/// this tick: a timeout, never its last state passed as fresh.
 inline constexpr double kTickReadBudgetS = 0.6;
 
 /// What to read. A run reads everything each tick; between ticks only the GPIO inputs.

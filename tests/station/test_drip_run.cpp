@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <fstream>
 #include <memory>
 #include <string>
@@ -113,6 +114,38 @@ TEST(DripRun, AnF4tChamberThatDripsLosesNoTick) {
   expect_no_tick_lost(r);
   EXPECT_EQ(count(r, "outage_start", "chamber"), 1) << kinds(r);
   EXPECT_EQ(count(r, "outage", "chamber"), 1) << kinds(r);
+}
+
+// Both drip at once, each with the default 0.5 s timeout: without a bound the two timeouts would
+// take 1 s, the whole tick; the turntable's exchange ends with the tick's budget instead.
+TEST(DripRun, BothDevicesDrippingEndWithTheTickBudget) {
+  constexpr double kTimeoutS = 0.5;
+  static_assert(2 * kTimeoutS > station::kTickReadBudgetS);
+  sim::SimWorldConfig wc;
+  wc.gyros = 1;
+  sim::SimWorld world(wc);
+  station::Rig rig;
+  rig.chamber = std::make_unique<dr::ModbusChamber>(
+      "chamber", dr::modbus::parse_endpoint(world.chamber_endpoint()),
+      dr::chamber_map::generic_plc(), kTimeoutS);
+  rig.turntable = std::make_unique<dr::ModbusTurntable>(
+      "table", dr::modbus::parse_endpoint(world.turntable_endpoint()),
+      dr::turntable_map::generic_plc(), dr::TurntableLimits{}, kTimeoutS);
+  station::RigReadPlan plan;
+  plan.budget_s = station::kTickReadBudgetS;
+  ASSERT_TRUE(station::read_rig(rig, plan).table_interlock_open.has_value());
+  ASSERT_EQ(sim::run_fault_command(world, "chamber drip 3600"), "ok");
+  ASSERT_EQ(sim::run_fault_command(world, "table drip 3600"), "ok");
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto r = station::read_rig(rig, plan);
+  const double took_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ASSERT_TRUE(r.chamber_error && r.table_error);
+  EXPECT_EQ(r.table_error->kind, dr::ErrorKind::timeout) << r.table_error->message;
+  EXPECT_FALSE(r.table_interlock_open.has_value());
+  // Each unbounded exchange waits its whole timeout (the drips never finish a reply in it): 1 s
+  // together. Bounded, the reading ends near the budget; the bound below leaves 0.4 s for load.
+  EXPECT_LT(took_s, 2 * kTimeoutS);
 }
 
 // A chamber configured with a timeout past the tick's budget (0.9 s > kTickReadBudgetS) whose
