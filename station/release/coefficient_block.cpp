@@ -8,6 +8,7 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 
+#include "station/common/text_rule.hpp"
 #include "station/parts/deliverable_terms.hpp"
 #include "station/store/calibration.hpp"
 #include "station/store/fit_model_choice.hpp"
@@ -126,6 +127,28 @@ void seal_block(CoefficientBlock& b) {
   b.crc32 = gyro_tc_crc32(text.data(), text.size());
 }
 
+namespace {
+
+/// A released block whose serial or part number holds ';' or '%' (text the rule of issue 34
+/// refuses, so an older station stored it): it was delivered with gyro_tc/2's checksum, which
+/// the release did not store, and today's gyro_tc_canonical() escapes those characters
+/// (gyro_tc/3). No checksum verifies under both headers: refused rather than re-checksummed.
+void refuse_legacy_released_text(const CoefficientBlock& b) {
+  if (!b.release) return;
+  for (const std::string* s : {&b.serial, &b.part_number})
+    if (s->find_first_of(";%") != std::string::npos)
+      throw ReleaseRefused(fmt::format(
+          "fit {} of serial '{}' is released and its {} '{}' holds ';' or '%' (stored by a "
+          "station before the text rule): its release went out with a gyro_tc/2 checksum the "
+          "station did not keep, and gyro_tc.h now checksums such text as gyro_tc/3, so a "
+          "re-export could not verify on the firmware that holds the old header; nothing "
+          "exported (deliver the shipped block, or rename the gyro and release a new fit)",
+          b.fit_id, ascii_escaped(b.serial), s == &b.serial ? "serial" : "part number",
+          ascii_escaped(*s)));
+}
+
+}  // namespace
+
 CoefficientBlock make_block(Store& store, const FitRecord& fit,
                             const std::optional<ReleaseRow>& release) {
   if (const auto bad = undeliverable_term(fit.fit))
@@ -152,6 +175,7 @@ CoefficientBlock make_block(Store& store, const FitRecord& fit,
   b.release = release;
   b.software_version = STATION_VERSION;
   check_finite(b);
+  refuse_legacy_released_text(b);
   seal_block(b);
   return b;
 }

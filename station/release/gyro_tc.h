@@ -109,8 +109,11 @@ static inline int gyro_tc_put_number(char *buf, size_t n, size_t *len, const cha
  * when it does not fit. Numbers as %.17g: a double prints to the same text on every IEEE-754
  * machine with a correctly rounding printf (glibc, musl, newlib). Version 3 escapes ';' and '%'
  * in the serial and the part number (gyro_tc_put_field); a block whose strings hold neither has
- * nothing to escape and its text is version 2's, byte for byte, under version 2's name: every
- * checksum an earlier station wrote for such a block still verifies. */
+ * nothing to escape and its text is version 2's, byte for byte, under version 2's name, so an
+ * earlier checksum of such a block still verifies. One of a block whose serial or part holds ';'
+ * or '%' (accepted before the station's text rule) does not: version 2 covered the raw text.
+ * The station refuses to re-export such a released block rather than ship a checksum that one
+ * of the two headers rejects. */
 static inline int gyro_tc_canonical(const gyro_tc_block *b, char *buf, size_t n) {
   const double v[] = {b->t_ref_c,  b->t_min_c,  b->t_max_c,  b->grad_min_c, b->grad_max_c,
                       b->b0_dph,   b->k_dph[0], b->k_dph[1], b->k_dph[2],   b->k_dph[3],

@@ -187,6 +187,38 @@ TEST_F(ExportRoundTrip, StoredSpanIsTheSamplesSpanAndOlderFitsExportTheSame) {
   EXPECT_EQ(again.crc32, block_.crc32);
 }
 
+// Issue 34 defect 6: before the text rule a serial like "A;part=B" was accepted and released;
+// its block went out with gyro_tc/2's checksum, which the release did not store, and gyro_tc.h
+// now checksums such text as gyro_tc/3. Exporting the release again would ship a checksum the
+// firmware holding the old header refuses: the export is refused, naming the serial and why.
+// A fit of it that is not released still gets a block (verification, `export --fit`).
+TEST_F(ExportRoundTrip, AReleasedLegacySerialWithASemicolonIsRefusedNotReChecksummed) {
+  const std::string legacy = "A;part=B";
+  std::string sql = "PRAGMA foreign_keys = OFF;";
+  for (const char* table :
+       {"gyros", "run_slots", "samples", "bins", "fits", "releases", "verifications"})
+    sql += fmt::format("UPDATE {} SET serial = '{}' WHERE serial = '{}';", table, legacy, serial_);
+  sql += fmt::format("UPDATE runs SET resolved_json = replace(resolved_json, '\"{}\"', '\"{}\"');",
+                     serial_, legacy);
+  store_->db().exec(sql);
+  const auto rel = station::current_release(*store_, legacy);
+  ASSERT_TRUE(rel);
+  const auto fit = *store_->find_fit(rel->fit_id);
+  ASSERT_EQ(fit.serial, legacy);
+  try {
+    station::make_block(*store_, fit, rel);
+    ADD_FAILURE() << "a released legacy serial was exported with a new checksum";
+  } catch (const station::ReleaseRefused& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("serial 'A;part=B'"), std::string::npos) << what;
+    EXPECT_NE(what.find("gyro_tc/2"), std::string::npos) << what;
+    EXPECT_NE(what.find("nothing exported"), std::string::npos) << what;
+  }
+  const auto unreleased = station::make_block(*store_, fit, std::nullopt);
+  EXPECT_EQ(unreleased.canonical.rfind("gyro_tc/3;serial=A%3Bpart=B;", 0), 0u)
+      << unreleased.canonical;
+}
+
 TEST_F(ExportRoundTrip, CsvRowsReproduceTheStation) {
   const auto rows = csv_rows(station::blocks_csv({block_}));
   ASSERT_EQ(rows.size(), 3u);
