@@ -282,9 +282,12 @@ long long PgConnection::copy_in(std::string_view table_and_columns, std::string_
     }
     at += piece.size();
   }
+  // As above: what the server sent meanwhile (an error, a NOTICE) must be read, or the socket
+  // stays readable, poll returns at once and the loop spins until the deadline.
   for (int put; (put = PQputCopyEnd(live(sql), nullptr)) != 1;) {
     if (put < 0) lost(sql);
     wait_socket(true, deadline, sql, started);
+    if (PQconsumeInput(conn_.get()) == 0) lost(sql);
   }
   flush(deadline, sql, started);
   PGresult* raw = next_result(deadline, sql, started);
