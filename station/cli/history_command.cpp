@@ -175,7 +175,10 @@ fleet::FleetSerialHistory read_history(const HistoryOptions& o) {
     return fleet::fleet_serial_history(pg, o.serial);
   }
   Store store(o.db, OpenMode::read_only);
-  return {serial_runs(store, o.serial), serial_fits(store, o.serial), releases_of(store, o.serial)};
+  fleet::FleetSerialHistory h{serial_runs(store, o.serial), serial_fits(store, o.serial),
+                              releases_of(store, o.serial)};
+  store.db().check_unchanged();
+  return h;
 }
 
 void run_history(const HistoryOptions& o) {

@@ -103,6 +103,7 @@ void run_export(const ExportOptions& o) {
   std::vector<CoefficientBlock> blocks;
   if (o.serials.empty()) blocks.push_back(export_block(store, o, ""));
   for (const auto& s : o.serials) blocks.push_back(export_block(store, o, s));
+  store.db().check_unchanged();
   if (o.format == "csv") {
     std::cout << blocks_csv(blocks);
   } else if (o.format == "c") {

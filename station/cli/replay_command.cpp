@@ -125,6 +125,7 @@ int run_replay(const ReplayCommandOptions& o) {
                                {"max_diff_in_std_errors", worst}});
   }
   report["identical"] = identical;
+  store.db().check_unchanged();
   if (o.json) {
     std::cout << report.dump(2) << '\n';
   } else {

@@ -22,6 +22,8 @@
 
 namespace station {
 
+void (*database_lock_hooks::after_create)(const std::string& path) = nullptr;
+
 using Key = std::pair<unsigned long long, unsigned long long>;  // (st_dev, st_ino)
 
 struct HeldDatabase {
@@ -56,6 +58,7 @@ int open_database_file(const std::string& path, bool create, bool& created) {
     fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
     if (fd >= 0) {
       created = true;
+      if (database_lock_hooks::after_create) database_lock_hooks::after_create(path);
       return fd;
     }
     if (errno != EEXIST) return fd;  // another process created it just now: open that one
@@ -134,24 +137,67 @@ std::shared_ptr<HeldDatabase> new_hold(int fd, Key key, bool created, const std:
 
 }  // namespace
 
+namespace {
+
+// Descriptors of files this process could not lock, one per file (inode), reused by every later
+// attempt on it: a refusal opens no new descriptor and closes none. Closing one is not safe: the
+// lock is a flock(2), held by its open file description and untouched by closing another, but
+// SQLite's locks are POSIX fcntl(2) locks, which closing *any* descriptor of the file drops for
+// the whole process (fcntl(2), "Advisory record locking"), and this process may be reading the
+// file through SQLite.
+std::map<Key, int>& refused_descriptors() {
+  static std::map<Key, int> r;
+  return r;
+}
+
+// A descriptor of `path`: the one kept from an earlier refusal on the same file, else a new one.
+int descriptor_of(const std::string& path, bool create, bool& created) {
+  created = false;
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0) {
+    const auto it = refused_descriptors().find(
+        {static_cast<unsigned long long>(st.st_dev), static_cast<unsigned long long>(st.st_ino)});
+    if (it != refused_descriptors().end()) return it->second;
+  }
+  return open_database_file(path, create, created);
+}
+
+// True when `path` still names the file `key` (it was not removed nor replaced while locking).
+bool still_named(const std::string& path, Key key) {
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0 && Key{static_cast<unsigned long long>(st.st_dev),
+                                               static_cast<unsigned long long>(st.st_ino)} == key;
+}
+
+}  // namespace
+
 DatabaseHold DatabaseHold::writer(const std::string& path, bool create) {
   const std::lock_guard<std::mutex> guard(registry_mutex());
-  if (auto held = hold_of(path)) return DatabaseHold(held);
-  bool created = false;
-  const int fd = open_database_file(path, create, created);
-  if (fd < 0) {
-    throw InputError(fmt::format("{}: cannot open the database: {}", path, std::strerror(errno)));
+  for (int attempt = 0;; ++attempt) {
+    if (auto held = hold_of(path)) return DatabaseHold(held);
+    bool created = false;
+    const int fd = descriptor_of(path, create, created);
+    if (fd < 0) {
+      throw InputError(fmt::format("{}: cannot open the database: {}", path, std::strerror(errno)));
+    }
+    const Key key = key_of(fd, path);
+    refused_descriptors().erase(key);
+    try {
+      lock_exclusive(fd, path, key);
+    } catch (...) {
+      // Never unlinked, even when this attempt created it: whoever holds the lock now owns the
+      // file and may be writing it.
+      refused_descriptors()[key] = fd;
+      throw;
+    }
+    // A holder that removed the (empty) file as it ended, or a rename over it, leaves this lock
+    // on a file no longer at `path`: released, and the name opened again.
+    if (still_named(path, key)) return DatabaseHold(new_hold(fd, key, created, path));
+    ::flock(fd, LOCK_UN);
+    refused_descriptors()[key] = fd;
+    if (attempt == 3)
+      throw InputError(fmt::format("{}: the file was replaced while it was locked; retry", path));
   }
-  const Key key = key_of(fd, path);
-  try {
-    lock_exclusive(fd, path, key);
-  } catch (...) {
-    // The descriptor stays open: this process may read the file through SQLite, and closing a
-    // descriptor of a file drops all of the process's POSIX locks on it (SQLite's included).
-    if (created) (void)::unlink(path.c_str());
-    throw;
-  }
-  return DatabaseHold(new_hold(fd, key, created, path));
 }
 
 bool DatabaseHold::held_here(const std::string& path) {

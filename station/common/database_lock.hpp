@@ -22,7 +22,11 @@ class DatabaseHold {
  public:
   /// Exclusive, without waiting: refuses (InputError "PATH: database is in use by station run
   /// (pid N); nothing was touched ...") when another process holds it. `create`: a missing file
-  /// is created empty (0644), and removed again when the hold ends if nothing was written to it.
+  /// is created empty (0644), and removed again when the hold ends if nothing was written to it;
+  /// never when the lock is refused, even on a file this call created (another process locked it
+  /// first and owns it now). A refusal keeps one descriptor per file, reused by every later
+  /// attempt on that file (closing it would drop SQLite's POSIX locks of this process on it).
+  /// The lock taken, `path` must still name the locked file, or it is released and taken again.
   static DatabaseHold writer(const std::string& path, bool create);
   /// True when this process holds the file at `path` (it writes it). Opens no descriptor.
   static bool held_here(const std::string& path);
@@ -30,6 +34,12 @@ class DatabaseHold {
  private:
   explicit DatabaseHold(std::shared_ptr<HeldDatabase> held) : held_(std::move(held)) {}
   std::shared_ptr<HeldDatabase> held_;
+};
+
+/// For tests only: called by DatabaseHold::writer between creating a missing file and locking it
+/// (the instant another process may open and lock the new file first).
+struct database_lock_hooks {
+  static void (*after_create)(const std::string& path);
 };
 
 /// A process holding a flock(2) on a file, from /proc/locks.

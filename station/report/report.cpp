@@ -108,6 +108,7 @@ ReportFiles write_report(const ReportOptions& o) {
         o.chromium));
   Store store(o.db, OpenMode::read_only);
   const RunReport r = load_report(store, o.run_id);
+  store.db().check_unchanged();
   std::error_code ec;
   fs::create_directories(o.out_dir, ec);
   if (ec || !fs::is_directory(o.out_dir))

@@ -1,6 +1,7 @@
 // The lock and the way of reading a station database file, decided before SQLite opens it.
 #include "station/store/database_access.hpp"
 
+#include <fcntl.h>
 #include <fmt/format.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -65,7 +66,8 @@ DatabaseAccess claim_database_file(const std::string& path, OpenMode mode) {
   if (mode != OpenMode::read_only) {
     if (!exists && mode != OpenMode::create) return {};  // SQLite says it must exist
     // The lock first: a refusal because another process writes it names that process.
-    DatabaseAccess access{DatabaseHold::writer(path, mode == OpenMode::create)};
+    DatabaseAccess access{DatabaseHold::writer(path, mode == OpenMode::create),
+                          ReadWay::beside_writer, std::nullopt};
     refuse_log_of_another_name(path);
     refuse_names_not_found(path);
     refuse_unwritable(path);
@@ -83,7 +85,29 @@ DatabaseAccess claim_database_file(const std::string& path, OpenMode mode) {
   // Only a connection that can write the file and its directory removes the -wal and -shm.
   const std::string dir = fs::path(own).parent_path().string();
   const bool writable = ::access(own.c_str(), W_OK) == 0 && ::access(dir.c_str(), W_OK) == 0;
-  return {std::nullopt, writable ? ReadWay::leave_nothing : ReadWay::immutable};
+  if (writable) return {std::nullopt, ReadWay::leave_nothing, std::nullopt};
+  return {std::nullopt, ReadWay::immutable, stamp_of(path)};
+}
+
+FileStamp stamp_of(const std::string& path) {
+  FileStamp s;
+  const std::string own = sqlite_name(path);
+  s.logs = beside(own, "-wal") || beside(own, "-shm");
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return s;
+  // This process has no SQLite connection on the file (an immutable read is chosen only then),
+  // so closing this descriptor drops no lock of its.
+  struct stat st {};
+  char header[8] = {};
+  if (::fstat(fd, &st) == 0 && ::pread(fd, header, sizeof header, 24) == sizeof header) {
+    s.ino = static_cast<unsigned long long>(st.st_ino);
+    s.size_bytes = static_cast<long long>(st.st_size);
+    s.mtime_ns = st.st_mtim.tv_sec * 1000000000LL + st.st_mtim.tv_nsec;
+    s.ctime_ns = st.st_ctim.tv_sec * 1000000000LL + st.st_ctim.tv_nsec;
+    s.header.assign(header, sizeof header);
+  }
+  ::close(fd);
+  return s;
 }
 
 std::string immutable_uri(const std::string& path) {

@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "schemas/migrations.hpp"
+#include "station/common/input_error.hpp"
 #include "station/store/database_access.hpp"
 
 namespace station {
@@ -75,6 +76,7 @@ Database::Database(const std::string& path, OpenMode mode) : path_(path), mode_(
   DatabaseAccess access = claim_database_file(path, mode);
   hold_ = std::move(access.hold);
   const bool immutable = mode == OpenMode::read_only && access.read == ReadWay::immutable;
+  if (immutable) stamp_ = access.stamp;
   const bool leave_nothing = mode == OpenMode::read_only && access.read == ReadWay::leave_nothing;
   const int flags = mode == OpenMode::create     ? SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE
                     : mode == OpenMode::existing ? SQLITE_OPEN_READWRITE
@@ -107,6 +109,17 @@ Database::Database(const std::string& path, OpenMode mode) : path_(path), mode_(
   // WAL with synchronous=NORMAL: a commit survives the process being killed at any instant (only
   // an OS crash can lose the last commits; SQLite docs, "Write-Ahead Logging", PRAGMA synchronous).
   exec("PRAGMA journal_mode=WAL; PRAGMA synchronous=NORMAL; PRAGMA foreign_keys=ON;");
+}
+
+void Database::check_unchanged() const {
+  if (!stamp_) return;
+  // A -wal or -shm now, even one already there when the stamp was taken: a writer is at work.
+  const FileStamp now = stamp_of(path_);
+  if (now == *stamp_ && !now.logs) return;
+  throw InputError(
+      fmt::format("{}: the database changed while it was read (a writer began on it); nothing was "
+                  "output: retry",
+                  path_));
 }
 
 void Database::quick_check() {

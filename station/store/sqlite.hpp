@@ -13,6 +13,7 @@
 #include <string_view>
 
 #include "station/common/database_lock.hpp"
+#include "station/store/database_access.hpp"
 
 namespace station {
 
@@ -112,6 +113,10 @@ class Database {
   int schema_version();
   const std::string& path() const { return path_; }
   OpenMode mode() const { return mode_; }
+  /// A reader that opened the file with `immutable=1` (no lock: database_access.hpp) and whose
+  /// file changed since: throws InputError "PATH: the database changed while it was read: retry".
+  /// Called after a command's reads, before it writes its output. Nothing for other opens.
+  void check_unchanged() const;
   /// True inside BEGIN ... COMMIT (sqlite3_get_autocommit is 0).
   bool in_transaction() const { return sqlite3_get_autocommit(db_.get()) == 0; }
 
@@ -130,6 +135,8 @@ class Database {
   void backup_before_migrating(int have);
   /// This process's lock on the file (database_access.hpp), released after the connection closes.
   std::optional<DatabaseHold> hold_;
+  /// An immutable reader's stamp of the file before its first read (database_access.hpp).
+  std::optional<FileStamp> stamp_;
   std::unique_ptr<sqlite3, SqliteClose> db_;
   std::string path_;
   OpenMode mode_;
