@@ -77,8 +77,11 @@ class Chamber {
   /// (ProtocolRunner) and ignores ramp commands. No I/O.
   virtual bool controller_ramp() const { return true; }
   /// The air temperatures this dialect can report, deg C (docs/DEVICES.md, "Plausible
-  /// readings"); by default from absolute zero up. No I/O.
-  virtual PlausibleRange air_range_c() const { return {-273.15, PlausibleRange{}.hi}; }
+  /// readings"); by default what a chamber's air sensor can read (kSensorRangeC). No I/O.
+  virtual PlausibleRange air_range_c() const { return kSensorRangeC; }
+  /// The widest span any chamber air sensor reads, deg C: a platinum RTD's (IEC 60751: -200 ...
+  /// 850 C); a thermocouple of a test chamber reads within it too. Beyond it no sensor answers.
+  static constexpr PlausibleRange kSensorRangeC{-200.0, 850.0};
   /// The step of the setpoint register in deg C (one decimal: 0.1): a read-back within it of
   /// what was written is that value. No I/O.
   virtual double setpoint_resolution_c() const { return 0.1; }

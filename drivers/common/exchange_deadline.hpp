@@ -1,5 +1,6 @@
 // A bound on every device exchange a thread begins while it lasts, whatever the device's own
-// timeout: the tick's budget for device reads (station/daemon/rig_reading.cpp), so a chamber that
+// timeout: the tick's budget for all of its device I/O (station/daemon/sequencer.cpp,
+// kTickIoShare) and, within it, for its reads (station/daemon/rig_reading.cpp), so a chamber that
 // used most of it leaves the turntable the rest, not a whole timeout past the tick (issue 34).
 // The real links take it (LibmodbusWire, LineClient); a recorded session answers from its log.
 #pragma once

@@ -62,6 +62,9 @@ class Turntable {
   /// The rates this dialect can report, deg/s (docs/DEVICES.md, "Plausible readings"); by
   /// default any finite one. No I/O.
   virtual PlausibleRange rate_range_dps() const { return {}; }
+  /// The angles a table reports, degrees (docs/DEVICES.md, "Plausible readings"): one turn
+  /// either way (the interface's [0, 360), a signed +-180 form, a value not yet wrapped). No I/O.
+  virtual PlausibleRange angle_range_deg() const { return {-360.0, 360.0}; }
   /// What the controller says about itself (probe); the default knows nothing.
   virtual Result<std::string> identify() { return std::string{}; }
 };

@@ -10,12 +10,11 @@ namespace station {
 
 namespace dr = station::drivers;
 
-PlausibleRanges plausible_ranges(const LimitsConfig& limits, const Rig& rig) {
+PlausibleRanges plausible_ranges(const Rig& rig) {
   PlausibleRanges r;
-  const dr::PlausibleRange configured{limits.min_setpoint_c - kPlausibleAirMarginC,
-                                      limits.max_setpoint_c + kPlausibleAirMarginC};
-  r.air_c = rig.chamber ? rig.chamber->air_range_c() & configured : configured;
+  r.air_c = rig.chamber ? rig.chamber->air_range_c() : dr::Chamber::kSensorRangeC;
   if (rig.turntable) r.rate_dps = rig.turntable->rate_range_dps();
+  if (rig.turntable) r.angle_deg = rig.turntable->angle_range_deg();
   return r;
 }
 
@@ -34,12 +33,19 @@ std::vector<Implausible> screen_reading(RigReading& r, const PlausibleRanges& ra
   auto& chamber = r.chamber;
   // A NaN air with the sensor-break alarm is the chamber's report of its broken sensor.
   const bool broken = chamber && std::isnan(chamber->air_c) && sensor_break(*chamber);
-  if (chamber && !broken) {
-    if (const auto bound = dr::broken_bound(chamber->air_c, ranges.air_c)) {
-      out.push_back({"chamber", "air_c", chamber->air_c, *bound});
-      chamber->air_c = std::nan("");
+  // One rule for each value: outside its range it is taken out (NaN) and reported.
+  const auto take_out = [&out](const char* device, const char* quantity, double& v,
+                               const dr::PlausibleRange& range) {
+    if (const auto bound = dr::broken_bound(v, range)) {
+      out.push_back({device, quantity, v, *bound});
+      v = std::nan("");
     }
-  }
+  };
+  if (chamber && !broken) take_out("chamber", "air_c", chamber->air_c, ranges.air_c);
+  // A NaN setpoint read-back stays the safety layer's (out of limits); any other is screened.
+  if (chamber && !std::isnan(chamber->setpoint_c))
+    take_out("chamber", "setpoint_c", chamber->setpoint_c, ranges.air_c);
+  if (r.table) take_out("turntable", "angle_deg", r.table->angle_deg, ranges.angle_deg);
   if (r.table) {
     if (const auto bound = dr::broken_bound(r.table->rate_dps, ranges.rate_dps)) {
       out.push_back({"turntable", "rate_dps", r.table->rate_dps, *bound});

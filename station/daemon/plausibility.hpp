@@ -17,20 +17,17 @@
 
 namespace station {
 
-/// How far beyond the station's setpoint limits chamber air is still a reading, deg C: the
-/// chamber's independent high-limit trip sits a few degrees past them and cuts the output, and
-/// no chamber cools 50 C below the coldest setpoint it is given.
-inline constexpr double kPlausibleAirMarginC = 50.0;
-
 /// The ranges this rig's readings must lie in.
 struct PlausibleRanges {
-  drivers::PlausibleRange air_c;     ///< chamber air, deg C
-  drivers::PlausibleRange rate_dps;  ///< turntable rate, deg/s
+  drivers::PlausibleRange air_c;        ///< chamber air and setpoint read-back, deg C
+  drivers::PlausibleRange rate_dps;     ///< turntable rate, deg/s
+  drivers::PlausibleRange angle_deg{};  ///< turntable angle, degrees
 };
 
-/// The dialects' ranges (asked each tick: a driver learns its scale and limits at connect),
-/// chamber air narrowed to the limits widened by kPlausibleAirMarginC.
-PlausibleRanges plausible_ranges(const LimitsConfig& limits, const Rig& rig);
+/// The dialects' own ranges (asked each tick: a driver learns its scale and limits at connect).
+/// The configured limits do not narrow them: a value outside the limits but one the device can
+/// report is a real reading out of limits (Safety's immediate hold), not an implausible one.
+PlausibleRanges plausible_ranges(const Rig& rig);
 
 /// One implausible reading: the device, which reading, its value and the bound it broke.
 struct Implausible {
@@ -38,10 +35,11 @@ struct Implausible {
   double value = 0, bound = 0;
 };
 
-/// Screens `r` in place: an implausible chamber air becomes NaN (no value: the sample keeps it
-/// empty), an implausible turntable reading is dropped with its interlock (an unreadable input:
-/// the safety layer's blind ticks). Returns what it took out. A sensor break's NaN is the
-/// chamber's own alarm, not judged here.
+/// Screens `r` in place: an implausible chamber air or setpoint read-back becomes NaN (no value:
+/// the sample keeps it empty, the setpoint watch skips it), an implausible turntable rate drops
+/// the table's reading with its interlock (an unreadable input: the safety layer's blind ticks),
+/// an implausible angle becomes NaN (no position). Returns what it took out. A sensor break's NaN
+/// is the chamber's own alarm, not judged here.
 std::vector<Implausible> screen_reading(RigReading& r, const PlausibleRanges& ranges);
 
 /// Episodes of implausible readings, one tick's findings at a time. Not thread-safe.

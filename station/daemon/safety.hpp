@@ -134,6 +134,8 @@ class Safety {
 
   /// True while the rig must stay in safe hold.
   bool holding() const { return holding_; }
+  /// What holds the rig now (as of the last decision).
+  const SafetyCauses& causes() const { return causes_; }
   /// True while readings out of limits hold the rig (a fault: tower lamp red).
   bool limits_fault() const { return limits_fault_; }
   /// The command that holds the chamber where it is (setpoint = air, step), clamped.

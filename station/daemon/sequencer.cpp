@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "drivers/common/exchange_deadline.hpp"
 #include "drivers/gpio/gpio_bank.hpp"
 #include "station/common/logging.hpp"
 #include "station/daemon/sample.hpp"
@@ -174,7 +175,8 @@ void Sequencer::assemble_samples(double t_s, TickData& d) {
   const auto& chamber = d.in.chamber;
   if (table) {
     d.obs.table_in_position = table->in_position;
-    d.obs.table_angle_deg = table->angle_deg;
+    // An angle screened out (plausibility.cpp) is no position.
+    if (std::isfinite(table->angle_deg)) d.obs.table_angle_deg = table->angle_deg;
     d.obs.table_locked = table->locked;
   }
   d.obs.air_c = d.in.air_c();
@@ -185,7 +187,7 @@ void Sequencer::assemble_samples(double t_s, TickData& d) {
     r.t_s = t_s;
     r.recording = recording;
     r.air_c = d.obs.air_c;
-    if (chamber) r.setpoint_c = chamber->setpoint_c;
+    if (chamber && std::isfinite(chamber->setpoint_c)) r.setpoint_c = chamber->setpoint_c;
     r.flags = (chamber ? 0 : kChamberMissing) | (safety_.holding() ? kSafeHold : 0);
     const dr::counters::CounterReading* rd = nullptr;
     if (d.in.counters) {
@@ -222,20 +224,23 @@ void Sequencer::watch_inputs_until(double deadline_s, double t_s) {
 
 void Sequencer::act_on_safety(double t_s, const SafetyDecision& d) {
   for (const auto& e : d.events) emit(t_s, "safety", e);
-  if (d.entered) {
-    pending_chamber_.reset();  // nothing the protocol asked for goes out during the hold
+  // Nothing the protocol asked for goes out during the hold; a hold only for another master's
+  // setpoint keeps it for when the chamber reads the station's value again.
+  SafetyCauses foreign_only;
+  foreign_only.setpoint_foreign = true;
+  if (d.entered && !(safety_.causes() == foreign_only)) {
+    pending_chamber_.reset();
     pending_table_.reset();
   }
   bool chamber_ok = false, table_ok = false;
   if (d.chamber) {
-    const auto r = rig_.chamber->command(*d.chamber);
+    const auto r = command_chamber(*d.chamber);
     chamber_ok = r.ok();
-    if (chamber_ok) note_commanded(*d.chamber);
     if (!r && command_failures_++ % 60 == 0)
       emit(t_s, Severity::error, "chamber", EventKind::hold_failed, r.error().message);
   }
   if (d.stop_table && rig_.turntable) {
-    const auto r = rig_.turntable->stop();
+    const auto r = stop_table();
     table_ok = r.ok();
     if (!r && command_failures_++ % 60 == 0)
       emit(t_s, Severity::error, "table", EventKind::stop_failed, r.error().message);
@@ -258,10 +263,11 @@ void Sequencer::apply_actions(double t_s, const Actions& a) {
     for (const auto& n : notes) emit(t_s, Severity::warn, "safety", EventKind::clamp, n);
   }
   if (a.table) pending_table_ = a.table;
-  // Commands are retried every tick until the device accepts them.
+  // Commands are retried every tick until the device accepts them; none while the rig holds
+  // (one kept through a hold for a foreign setpoint waits for its end).
+  if (safety_.holding()) return;
   if (pending_chamber_) {
-    if (auto r = rig_.chamber->command(*pending_chamber_); r) {
-      note_commanded(*pending_chamber_);
+    if (auto r = command_chamber(*pending_chamber_); r) {
       pending_chamber_.reset();
       command_failures_ = 0;
     } else if (command_failures_++ % 60 == 0) {
@@ -269,7 +275,7 @@ void Sequencer::apply_actions(double t_s, const Actions& a) {
     }
   }
   if (pending_table_ && rig_.turntable) {
-    if (auto r = rig_.turntable->command(*pending_table_); r) {
+    if (auto r = command_table(*pending_table_); r) {
       pending_table_.reset();
     } else if (command_failures_++ % 60 == 0) {
       emit(t_s, Severity::warn, "table", EventKind::command_failed, r.error().message);
@@ -302,12 +308,24 @@ TickReport Sequencer::report(double t_s, const TickData& d) const {
 }
 
 void Sequencer::tick(double t_s, TickData& d) {
-  read_devices(t_s, d);
-  assemble_samples(t_s, d);
-  apply_safety(t_s, d);
-  Actions a;
-  if (!safety_.holding()) a = runner_->tick(d.obs);
-  apply_actions(t_s, a);
+  {
+    // One deadline for all of the tick's device I/O, reads and commands: every exchange ends by
+    // it (the drivers take the scope), and a command whose turn comes after it is not sent.
+    const auto io_s = std::chrono::duration<double>(kTickIoShare * options_.period_s);
+    io_end_ = std::chrono::steady_clock::now() +
+              std::chrono::duration_cast<std::chrono::steady_clock::duration>(io_s);
+    const dr::ExchangeDeadline cap(*io_end_);
+    struct EndsWithTheScope {  // between ticks (and after a throw) no tick budget holds
+      std::optional<std::chrono::steady_clock::time_point>& end;
+      ~EndsWithTheScope() { end.reset(); }
+    } window{io_end_};
+    read_devices(t_s, d);
+    assemble_samples(t_s, d);
+    apply_safety(t_s, d);
+    Actions a;
+    if (!safety_.holding()) a = runner_->tick(d.obs);
+    apply_actions(t_s, a);
+  }
   if (!replaying_) {
     Stopwatch timer(&phase_s_.store);
     store_.append_tick(run_id_, t_s, d.rows, runner_->progress());

@@ -6,6 +6,7 @@
 
 #include <array>
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -30,6 +31,13 @@
 namespace station {
 
 /// One tick's summary for progress lines, the live page and metrics.
+/// The share of the tick's period its device I/O may take, reads and commands alike (the
+/// reads' own kTickReadBudgetS within it): the rest (0.1 s of the 1 s tick) is the store's
+/// transaction and the margin to the next tick's deadline, so a device whose replies drip or
+/// never come costs no tick. A command whose turn comes after it is not sent this tick; it is
+/// retried next tick, as a failed command is.
+inline constexpr double kTickIoShare = 0.9;
+
 struct TickReport {
   double t_s = 0;
   int step_index = 0;
@@ -149,6 +157,14 @@ class Sequencer {
   void check_setpoint(double t_s, const TickData& d);
   /// The chamber accepted `c`: its setpoint is the station's now.
   void note_commanded(const drivers::ChamberCommand& c);
+  /// Why no more device I/O goes out this tick (its kTickIoShare is spent), or nothing.
+  std::optional<drivers::Error> io_spent(const char* what) const;
+  /// The device commands of a tick, each within its I/O budget (io_spent: not sent, an error
+  /// to retry next tick); the chamber's setpoint told to the setpoint watch as tried,
+  /// accepted, or failed with its outcome known or not.
+  drivers::Result<void> command_chamber(const drivers::ChamberCommand& c);
+  drivers::Result<void> command_table(const drivers::TurntableCommand& c);
+  drivers::Result<void> stop_table();
   void apply_safety(double t_s, TickData& d);
   /// Stores an event per GPIO edge of a reading.
   void note_edges(double t_s, const RigReading& in);
@@ -196,6 +212,9 @@ class Sequencer {
   std::uint8_t latch_seq_ = 0;
   bool replaying_ = false;
   int command_failures_ = 0;
+  /// When this tick's device I/O must end (kTickIoShare of the period from its start), on the
+  /// steady clock the exchanges run on; none between ticks.
+  std::optional<std::chrono::steady_clock::time_point> io_end_;
   OutageTracker outages_;             ///< link outages per device
   PlausibilityWatch plausibility_;    ///< implausible readings, per episode
   SetpointWatch setpoint_watch_;      ///< the chamber's setpoint against the station's

@@ -27,9 +27,13 @@ SetpointNews SetpointWatch::observe(const std::optional<drivers::ChamberState>& 
   // Before the station has commanded one (a new daemon resuming a hold step commands none), the
   // setpoint it finds is the reference: what the chamber holds when the station takes over.
   if (!commanded_c_) commanded_c_ = chamber->setpoint_c;
-  const double read_c = chamber->setpoint_c, commanded_c = *commanded_c_;
+  const double read_c = chamber->setpoint_c;
   // Within one register step (plus rounding of the scaling) the read-back is what was written.
-  const bool differs = std::abs(read_c - commanded_c) > resolution_c + 1e-6;
+  const auto within = [&](double c) { return std::abs(read_c - c) <= resolution_c + 1e-6; };
+  // A write whose reply was lost reached the chamber after all: the station's own value.
+  if (tried_c_ && within(*tried_c_)) commanded_c_ = *tried_c_, tried_c_.reset();
+  const double commanded_c = *commanded_c_;
+  const bool differs = !within(commanded_c);
   if (differs && !foreign_) {
     foreign_ = true;
     const bool hold = action_ == ForeignSetpoint::hold;

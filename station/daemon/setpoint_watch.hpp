@@ -30,8 +30,20 @@ struct SetpointNews {
 class SetpointWatch {
  public:
   explicit SetpointWatch(ForeignSetpoint action = ForeignSetpoint::restore) : action_(action) {}
+  /// The station is about to write `setpoint_c`, deg C: until the write is acknowledged or
+  /// refused, a read-back of this value is the station's too (its reply may be lost).
+  void trying(double setpoint_c) { tried_c_ = setpoint_c; }
   /// The chamber accepted `setpoint_c` (a protocol step, a hold, a restore), deg C.
-  void commanded(double setpoint_c) { commanded_c_ = setpoint_c; }
+  void commanded(double setpoint_c) {
+    commanded_c_ = setpoint_c;
+    tried_c_.reset();
+  }
+  /// The write tried failed; `outcome_unknown` when it may have reached the chamber (a timeout, a
+  /// reply cut off or garbled, a link lost mid-exchange): a read-back of the value tried is then
+  /// taken as commanded, with no event. A refusal (or a write never sent) forgets it.
+  void failed(bool outcome_unknown) {
+    if (!outcome_unknown) tried_c_.reset();
+  }
   /// One reading (none: no news; the first, before any command, is the reference);
   /// `resolution_c` the register's step
   /// (Chamber::setpoint_resolution_c): a read-back within it is the commanded value.
@@ -43,6 +55,7 @@ class SetpointWatch {
  private:
   ForeignSetpoint action_;
   std::optional<double> commanded_c_;
+  std::optional<double> tried_c_;  ///< written, its outcome not known yet
   bool foreign_ = false;
 };
 

@@ -54,6 +54,11 @@ std::string sim_config_text(sim::SimWorld& world, const SimRunOptions& o,
     if (at != std::string::npos)
       t.insert(at + 10, fmt::format("on_foreign_setpoint = \"{}\"\n", o.on_foreign_setpoint));
   }
+  if (o.turntable_timeout_s > 0) {
+    const auto at = t.find("[turntable]\n");
+    if (at != std::string::npos)
+      t.insert(at + 12, fmt::format("timeout_s = {}\n", o.turntable_timeout_s));
+  }
   return t;
 }
 

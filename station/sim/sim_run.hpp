@@ -28,19 +28,20 @@ struct SimRunOptions {
   std::string chamber_model = "generic_plc";    ///< dialect the simulated chamber speaks
   std::string turntable_model = "generic_plc";  ///< dialect the simulated table speaks
   std::string acutrol_framing = "bare";  ///< a simulated ACUTROL's replies: "bare" or "header"
-  std::string gyro_preset = "station";          ///< sim::GyroPreset by name: "station" or "paper"
+  std::string gyro_preset = "station";   ///< sim::GyroPreset by name: "station" or "paper"
   double latitude_deg = 39.9;
-  std::string protocol = "paper";  ///< shipped name or file
-  std::string db_path;             ///< empty: station-sim.db in the current directory
-  bool fresh = false;              ///< ignore an unfinished run in the database
-  bool progress = true;            ///< progress lines on stderr
-  bool wall_clock = false;         ///< run at 1 Hz on CLOCK_MONOTONIC instead of simulated time
-  double speed = 0;                ///< simulated s per wall s (0: as fast as possible)
-  std::string record_can_path;     ///< write every CAN frame in candump format here (empty: no)
-  std::string record_dir;          ///< record the session in this directory (empty: no)
-  std::string parts_path;          ///< part file: every simulated gyro is judged (empty: no)
-  std::string part_number;         ///< their part (empty: the file's first in sort order)
+  std::string protocol = "paper";   ///< shipped name or file
+  std::string db_path;              ///< empty: station-sim.db in the current directory
+  bool fresh = false;               ///< ignore an unfinished run in the database
+  bool progress = true;             ///< progress lines on stderr
+  bool wall_clock = false;          ///< run at 1 Hz on CLOCK_MONOTONIC instead of simulated time
+  double speed = 0;                 ///< simulated s per wall s (0: as fast as possible)
+  std::string record_can_path;      ///< write every CAN frame in candump format here (empty: no)
+  std::string record_dir;           ///< record the session in this directory (empty: no)
+  std::string parts_path;           ///< part file: every simulated gyro is judged (empty: no)
+  std::string part_number;          ///< their part (empty: the file's first in sort order)
   std::string on_foreign_setpoint;  ///< [chamber] on_foreign_setpoint (empty: the default)
+  double turntable_timeout_s = 0;   ///< [turntable] timeout_s (0: the dialect's)
   /// Faults injected into the simulated rig: at tick t_s (after the world advanced to it), the
   /// simrig control command (docs/SIMRIG.md), e.g. {3000, "door open"}. In time order.
   std::vector<std::pair<double, std::string>> faults;

@@ -16,6 +16,7 @@
 #include "sim_devices/chamber_sim.hpp"
 #include "sim_devices/fault_commands.hpp"
 #include "sim_devices/sim_world.hpp"
+#include "station/daemon/setpoint_watch.hpp"
 #include "station/sim/sim_run.hpp"
 #include "station/store/store.hpp"
 #include "tests/station/sim_options.hpp"
@@ -134,6 +135,37 @@ TEST(ForeignSetpoint, HoldModeHoldsUntilTheChamberReadsTheStationsSetpointAgain)
     // A sample carries the hold as it stood when it was read: from the tick after the event.
     if (s.t_s > kForeign_s) EXPECT_TRUE(s.flags & station::kSafeHold) << s.t_s;
   }
+}
+
+// The watch alone: a write whose reply was lost (a timeout: its outcome unknown) that reached the
+// chamber reads back as the value tried, the station's own -- no event, no restore; a write the
+// chamber refused (an exception reply) leaves the value tried forgotten, so that value read back
+// is another master's.
+TEST(ForeignSetpoint, AWriteWhoseReplyWasLostReadsBackAsTheStationsOwn) {
+  const auto reading = [](double setpoint_c) {
+    station::drivers::ChamberState c;
+    c.setpoint_c = setpoint_c;
+    return std::optional<station::drivers::ChamberState>(c);
+  };
+  station::SetpointWatch lost(station::ForeignSetpoint::hold);
+  lost.commanded(23.0);
+  EXPECT_TRUE(lost.observe(reading(23.0), kStepC).events.empty());
+  lost.trying(40.0);
+  lost.failed(true);  // timeout: it may have landed
+  const auto news = lost.observe(reading(40.0), kStepC);
+  EXPECT_TRUE(news.events.empty());
+  EXPECT_FALSE(news.restore_c);
+  EXPECT_FALSE(lost.foreign());
+  EXPECT_TRUE(lost.observe(reading(40.0), kStepC).events.empty());  // and it stays the station's
+
+  station::SetpointWatch refused;
+  refused.commanded(23.0);
+  refused.trying(40.0);
+  refused.failed(false);  // refused: it never landed
+  const auto other = refused.observe(reading(40.0), kStepC);
+  ASSERT_EQ(other.events.size(), 1u);
+  EXPECT_EQ(other.events[0].kind, station::EventKind::setpoint_foreign);
+  EXPECT_EQ(other.restore_c, std::optional<double>(23.0));
 }
 
 }  // namespace

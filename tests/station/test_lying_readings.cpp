@@ -14,6 +14,7 @@
 
 #include "sim_devices/fault_commands.hpp"
 #include "sim_devices/sim_world.hpp"
+#include "station/daemon/plausibility.hpp"
 #include "station/daemon/safety.hpp"
 #include "station/sim/sim_run.hpp"
 #include "station/store/store.hpp"
@@ -122,5 +123,52 @@ INSTANTIATE_TEST_SUITE_P(ChamberDialects, LyingAirRun,
                                            Lie{"generic_plc", "1e308"}, Lie{"watlow_f4", "-1e308"},
                                            Lie{"watlow_f4t", "1e30"}),
                          [](const auto& info) { return std::string(info.param.model); });
+
+// Issue 34 review point 10: air beyond the configured limits that the chamber's sensor can read
+// (150 C against max_setpoint_c 85) is a real reading out of limits -- the immediate safe hold --
+// never an "implausible" one waiting kBlindTicks with the gyros powered.
+TEST(OutOfLimitsAir, IsARealReadingHeldAtOnceNotAnImplausibleOne) {
+  const auto db = station::testing_support::fresh_db("out_of_limits_air");
+  auto o = station::testing_support::short_cycle_run(db, 1);
+  o.on_world_tick = [](double t_s, station::sim::SimWorld& w) {
+    if (t_s == kLie_s) EXPECT_EQ(station::sim::run_fault_command(w, "chamber air 150"), "ok");
+    if (t_s == kTruth_s) EXPECT_EQ(station::sim::run_fault_command(w, "chamber air off"), "ok");
+  };
+  const auto r = station::run_simulated(o);
+  ASSERT_EQ(r["state"], "completed") << r.dump();
+  station::Store store(db);
+  const auto run = r["run_id"].get<std::int64_t>();
+  const auto rows = store.event_rows(run);
+  const auto all = ::testing::PrintToString(store.events(run));
+  EXPECT_TRUE(of_kind(rows, "implausible_reading").empty()) << all;
+  const auto holds = of_kind(rows, "safe_hold");
+  ASSERT_EQ(holds.size(), 1u) << all;
+  EXPECT_EQ(holds[0].t_s, kLie_s) << all;
+  EXPECT_NE(holds[0].message.find("beyond limits"), std::string::npos) << holds[0].message;
+}
+
+// The chamber's setpoint read-back and the table's angle pass the same rule as the air: 1e308 or
+// a float32 subnormal is taken out (NaN: stored NULL, no position, not the setpoint watch's).
+TEST(ScreenReading, SetpointReadBackAndTableAngleAreScreenedByTheSameRule) {
+  for (const double lie : {1e308, -4.6e-41}) {
+    station::RigReading in;
+    in.chamber = station::drivers::ChamberState{};
+    in.chamber->air_c = 150.0;  // out of limits, yet a reading
+    in.chamber->setpoint_c = lie;
+    in.table = station::drivers::TurntableState{};
+    in.table->angle_deg = lie;
+    in.has_table = true;
+    auto ranges = station::plausible_ranges(station::Rig{});  // a chamber's default range
+    ranges.angle_deg = {-360.0, 360.0};  // a table's default (Turntable::angle_range_deg)
+    const auto found = station::screen_reading(in, ranges);
+    std::vector<std::string> what;
+    for (const auto& f : found) what.push_back(f.device + " " + f.quantity);
+    EXPECT_EQ(what, (std::vector<std::string>{"chamber setpoint_c", "turntable angle_deg"})) << lie;
+    EXPECT_TRUE(std::isnan(in.chamber->setpoint_c)) << lie;
+    ASSERT_TRUE(in.table) << lie;  // the rest of the table's reading stands
+    EXPECT_TRUE(std::isnan(in.table->angle_deg)) << lie;
+    EXPECT_EQ(in.chamber->air_c, 150.0);
+  }
+}
 
 }  // namespace

@@ -11,6 +11,10 @@ namespace station::drivers {
 namespace ac = acutrol3000;
 namespace {
 
+// The largest position the unit's reply may carry and still be an angle, degrees: far more turns
+// than a table makes in a run (a week at its top rate); beyond it the wrap would invent an angle.
+constexpr double kMaxPositionDeg = 1e9;
+
 // What each query's reply must be (acutrol_wire.hpp); anything else is no reading.
 bool is_number(std::string_view s) {
   return ac::parse_number(s).has_value();
@@ -85,7 +89,10 @@ Result<TurntableState> Acutrol3000Table::read() {
   const auto i = il.value();
   if (full) position_demand_deg_ = pd.value(), rate_demand_dps_ = rd.value();
   TurntableState s;
-  s.angle_deg = ac::wrap_deg(p->first);
+  // A position no unit reports (1e308) is no angle: left NaN for the station's screen, never
+  // wrapped into [0, 360) as if it were one.
+  const bool angle_read = std::isfinite(p->first) && std::fabs(p->first) <= kMaxPositionDeg;
+  s.angle_deg = angle_read ? ac::wrap_deg(p->first) : std::nan("");
   s.rate_dps = p->second;
   s.mode = m == ac::Mode::position ? TurntableMode::position
            : m == ac::Mode::rate   ? TurntableMode::rate
