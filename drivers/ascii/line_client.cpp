@@ -54,7 +54,11 @@ LineClient::LineClient(std::string device, LineEndpoint endpoint, LineFraming fr
 
 Result<void> LineClient::connect() {
   disconnect();
-  if (wire_->open(timeout_s_) == -1) {
+  // While the tick's budget bounds every exchange (exchange_deadline), the connect waits at most
+  // what is left of it; none is attempted once it is spent.
+  const double connect_s = seconds_left(ExchangeDeadline::bound_s(deadline_after(timeout_s_)));
+  if (connect_s <= 0) errno = ETIMEDOUT;
+  if (connect_s <= 0 || wire_->open(connect_s) == -1) {
     const int err = errno;
     auto e = translate_line_error(err, device_ + " connect " + to_string(endpoint_));
     if (e.kind != ErrorKind::timeout) e.kind = ErrorKind::disconnected;
@@ -135,7 +139,8 @@ Result<std::string> LineClient::query(std::string_view command) {
 }
 
 Result<void> LineClient::send(std::string_view command) {
-  if (auto t = transmit(command, timeout_s_); !t) return t;
+  const double deadline_s = ExchangeDeadline::bound_s(deadline_after(timeout_s_));
+  if (auto t = transmit(command, seconds_left(deadline_s)); !t) return t;
   link_.answered();
   return {};
 }

@@ -7,6 +7,7 @@
 #include <cstdint>
 
 #include "drivers/ascii/line_client.hpp"
+#include "drivers/common/exchange_deadline.hpp"
 
 namespace station::drivers::ascii {
 namespace {
@@ -77,13 +78,13 @@ Result<Reply> LineClient::finish_line(std::string_view command, std::string raw,
 }
 
 Result<Reply> LineClient::query_frame(std::string_view command, const FrameLayout& layout) {
-  const double deadline_s = deadline_after(timeout_s_);
+  const double deadline_s = ExchangeDeadline::bound_s(deadline_after(timeout_s_));
   if (auto t = transmit(command, seconds_left(deadline_s)); !t) return t.error();
   return finish_frame(command, layout, {}, deadline_s);
 }
 
 Result<Reply> LineClient::query_detect(std::string_view command, const FrameLayout& layout) {
-  const double deadline_s = deadline_after(timeout_s_);
+  const double deadline_s = ExchangeDeadline::bound_s(deadline_after(timeout_s_));
   if (auto t = transmit(command, seconds_left(deadline_s)); !t) return t.error();
   // Byte by byte until a NUL (a frame's header), the line's end, or a header's worth of text.
   std::string raw;

@@ -72,18 +72,40 @@ int still_needed(Framing f, const std::vector<std::uint8_t>& frame) {
   return f == Framing::tcp ? 6 - static_cast<int>(frame.size()) : 1;  // until its length shows
 }
 
+// Sets libmodbus's timeouts, which bound only its connect here, to `s` seconds (it refuses 0 s and
+// more than 999999 µs: split whole microseconds, at least one).
+void set_connect_timeout(modbus_t* ctx, double s) {
+  const long long us = std::max(1LL, std::llround(s * 1e6));
+  const auto sec = static_cast<std::uint32_t>(us / 1000000);
+  const auto usec = static_cast<std::uint32_t>(us % 1000000);
+  modbus_set_response_timeout(ctx, sec, usec);
+  modbus_set_byte_timeout(ctx, sec, usec);
+}
+
 }  // namespace
+
+double LibmodbusWire::quiet_interval_s(const RtuEndpoint& ep, double timeout_s) {
+  const int bits = 1 + ep.data_bits + (ep.parity == 'N' ? 0 : 1) + ep.stop_bits;
+  const double t35_s = ep.baud > 19200 ? 1.75e-3 : 3.5 * bits / ep.baud;
+  return std::max(t35_s, timeout_s / 4);
+}
 
 int LibmodbusWire::open(double timeout_s) {
   close();
   ctx_ = make_context(endpoint_);
-  const double whole = std::floor(timeout_s);
-  const auto sec = static_cast<std::uint32_t>(whole);
-  const auto usec = static_cast<std::uint32_t>(std::lround((timeout_s - whole) * 1e6));
-  // libmodbus waits only in the connect now (its response timeout bounds a TCP connect); the
-  // exchanges are bounded here, as a whole, by the same timeout.
-  modbus_set_response_timeout(ctx_.get(), sec, usec);
-  modbus_set_byte_timeout(ctx_.get(), sec, usec);
+  // libmodbus's response timeout bounds its TCP connect (modbus-tcp.c `_connect`: a select() on
+  // the non-blocking socket, per address); while an ExchangeDeadline is on, what is left of it.
+  const auto now = SteadyClock::now();
+  const double connect_s = std::min(
+      timeout_s,
+      std::chrono::duration<double>(ExchangeDeadline::bound(now + to_steady(timeout_s)) - now)
+          .count());
+  if (connect_s <= 0) {  // the budget is spent: no connect is attempted
+    ctx_.reset();
+    errno = ETIMEDOUT;
+    return -1;
+  }
+  set_connect_timeout(ctx_.get(), connect_s);
   if (modbus_connect(ctx_.get()) == -1) {
     const int err = errno;
     ctx_.reset();
@@ -91,6 +113,8 @@ int LibmodbusWire::open(double timeout_s) {
     return -1;
   }
   timeout_ = to_steady(timeout_s);
+  if (const auto* rtu = std::get_if<RtuEndpoint>(&endpoint_))
+    quiet_ = to_steady(quiet_interval_s(*rtu, timeout_s));
   return 0;
 }
 
@@ -105,8 +129,32 @@ Framing LibmodbusWire::framing() const {
   return std::holds_alternative<TcpEndpoint>(endpoint_) ? Framing::tcp : Framing::rtu;
 }
 
-void LibmodbusWire::rest() {
-  if (gap_ > SteadyClock::duration::zero()) std::this_thread::sleep_until(last_end_ + gap_);
+bool LibmodbusWire::rest(SteadyClock::time_point deadline) {
+  if (gap_ <= SteadyClock::duration::zero()) return true;
+  if (last_end_ + gap_ >= deadline) return false;
+  std::this_thread::sleep_until(last_end_ + gap_);
+  return true;
+}
+
+int LibmodbusWire::wait_quiet(SteadyClock::time_point deadline) {
+  if (!in_flight_) return 0;
+  const int fd = modbus_get_socket(ctx_.get());
+  for (;;) {
+    if (quiet_since_ + quiet_ > deadline) {
+      errno = ETIMEDOUT;
+      return -1;
+    }
+    if (wait_for(fd, POLLIN, quiet_since_ + quiet_) == -1) {
+      if (errno != ETIMEDOUT) return -1;
+      in_flight_ = false;  // quiet for the interval: whatever was on its way has come
+      return 0;
+    }
+    std::uint8_t buf[256];
+    const ssize_t got = ::read(fd, buf, sizeof buf);
+    if (got == 0) errno = ECONNRESET;
+    if (got <= 0 && errno != EINTR && errno != EAGAIN) return -1;
+    quiet_since_ = SteadyClock::now();
+  }
 }
 
 int LibmodbusWire::ended(int rc) {
@@ -126,11 +174,12 @@ int LibmodbusWire::send_frame(const std::vector<std::uint8_t>& frame,
     if (n < 0 && errno == ENOTSOCK) n = ::write(fd, frame.data() + done, left);
     if (n > 0) {
       done += static_cast<std::size_t>(n);
-    } else if (n < 0 && errno != EINTR && errno != EAGAIN) {
-      return -1;
-    } else if (n < 0 && errno == EAGAIN && wait_for(fd, POLLOUT, deadline) == -1) {
-      return -1;
+      continue;
     }
+    if (n == 0) errno = EAGAIN;  // nothing taken: wait for room, by the deadline
+    if (errno == EINTR) continue;
+    if (errno != EAGAIN && errno != EWOULDBLOCK) return -1;
+    if (wait_for(fd, POLLOUT, deadline) == -1) return -1;
   }
   return 0;
 }
@@ -155,6 +204,7 @@ int LibmodbusWire::drop_late(SteadyClock::time_point deadline) {
   if (rc == -1 && errno == ETIMEDOUT) return -1;  // still dripping: this exchange waited for it
   if (rc == -1) modbus_flush(ctx_.get());         // it frames nothing: drop what is there
   late_.clear();
+  quiet_since_ = SteadyClock::now();  // RTU: the quiet wait counts from its last byte
   return 0;
 }
 
@@ -164,13 +214,19 @@ int LibmodbusWire::exchange(const std::vector<std::uint8_t>& adu,
     errno = ENOTCONN;
     return -1;
   }
-  rest();
-  // Its own timeout, or less while the tick's budget bounds every exchange (exchange_deadline).
-  const auto deadline = ExchangeDeadline::bound(SteadyClock::now() + timeout_);
+  // Its own timeout from the request gap's end, or less while the tick's budget bounds every
+  // exchange (exchange_deadline): the gap, a late reply's rest and the quiet wait count in it.
+  const auto start = std::max(SteadyClock::now(), last_end_ + gap_);
+  const auto deadline = ExchangeDeadline::bound(start + timeout_);
+  if (!rest(deadline)) {  // no time to keep the gap: not attempted, the gap still due next time
+    errno = ETIMEDOUT;
+    return -1;
+  }
   if (drop_late(deadline) == -1) {
     errno = ETIME;  // the last reply still drips: this one cannot begin
     return ended(-1);
   }
+  if (framing() == Framing::rtu && wait_quiet(deadline) == -1) return -1;  // nothing was sent
   // On a serial line a late reply has no id to tell it by: what came between exchanges goes.
   if (framing() == Framing::rtu) modbus_flush(ctx_.get());
   if (SteadyClock::now() >= deadline) {  // the tick's budget is spent: nothing is sent
@@ -183,6 +239,11 @@ int LibmodbusWire::exchange(const std::vector<std::uint8_t>& adu,
   for (;;) {
     reply.clear();
     if (receive_frame(reply, deadline) == -1) {
+      // RTU: its reply (or the rest of it) may still come; the next request waits for quiet.
+      if (errno == ETIMEDOUT && framing() == Framing::rtu) {
+        in_flight_ = true;
+        quiet_since_ = SteadyClock::now();
+      }
       if (errno == ETIMEDOUT && reply.empty() && framing() == Framing::tcp) {
         if (late_ids_.size() == kLateIdsKept) late_ids_.erase(late_ids_.begin());
         late_ids_.push_back(tid_);

@@ -39,12 +39,20 @@ class ModbusWire {
 };
 
 /// The real link: libmodbus opens it (TCP connect, RTU serial setup); the exchanges are this
-/// class's own, each bounded as a whole: from the request sent to the last byte of its reply,
-/// one deadline of `timeout_s` (open()), however the reply's bytes are spaced (modbus_frame.hpp
-/// says why libmodbus cannot bound it so). No reply by the deadline is ETIMEDOUT, a reply begun
-/// but not finished by it (or one still arriving when the next request is due) ETIME; its late
-/// bytes are framed and dropped as they come, never read as the next reply. The constructor does
-/// no I/O.
+/// class's own, each bounded as a whole by one deadline of `timeout_s` (open()) from its start (the
+/// request gap kept), however the reply's bytes are spaced (modbus_frame.hpp says why libmodbus
+/// cannot bound it so), and by an active ExchangeDeadline (exchange_deadline.hpp): the request gap,
+/// the dropping of a late reply, the quiet wait (below), the send and the reply all end by it, and
+/// a connect waits at most what is left of it (a TCP host name that resolves to several addresses:
+/// that much per address; the name lookup itself is not bounded). No reply by the deadline is
+/// ETIMEDOUT, a reply begun but not finished by it (or one still arriving when the next request is
+/// due) ETIME. What holds for late bytes: on TCP a late reply is told by its transaction id and
+/// dropped, never read as the next reply. On RTU a frame has no id: the rest of a reply begun is
+/// framed and dropped as it comes; after a timeout the next request is sent only once the line has
+/// been quiet for quiet_interval_s() (bytes that come meanwhile are dropped), so a late reply that
+/// begins within that interval of the timeout, or of the last byte seen, is never read as the next
+/// reply; one a device sends later still (outside the protocol: Serial Line v1.02 §2.4.1 sets the
+/// response timeout longer than any answer takes) can be. The constructor does no I/O.
 class LibmodbusWire final : public ModbusWire {
  public:
   explicit LibmodbusWire(Endpoint endpoint) : endpoint_(std::move(endpoint)) {}
@@ -54,14 +62,23 @@ class LibmodbusWire final : public ModbusWire {
   int write(int unit, std::uint16_t addr, std::span<const std::uint16_t> words) override;
   void flush() override;
   void set_request_gap_s(double gap_s) override { gap_ = to_steady(gap_s); }
+  /// RTU: the silence the line must keep after a timeout before the next request (s): a quarter
+  /// of the timeout, and at least the 3.5 character times that end a frame (Serial Line v1.02
+  /// §2.5.1.1: at the endpoint's baud, start, data, parity and stop bits; 1.75 ms above 19200
+  /// baud).
+  static double quiet_interval_s(const RtuEndpoint& ep, double timeout_s);
 
  private:
   using SteadyClock = std::chrono::steady_clock;
   static SteadyClock::duration to_steady(double s) {
     return std::chrono::duration_cast<SteadyClock::duration>(std::chrono::duration<double>(s));
   }
-  /// Sleeps out what is left of the gap since the last exchange ended.
-  void rest();
+  /// Sleeps out what is left of the gap since the last exchange ended, if it ends before the
+  /// deadline; false (no wait) when it does not.
+  bool rest(SteadyClock::time_point deadline);
+  /// RTU after a timeout: drops what comes until the line has been quiet for quiet_; 0, or -1
+  /// with errno (ETIMEDOUT: not quiet by the deadline, so nothing may be sent).
+  int wait_quiet(SteadyClock::time_point deadline);
   /// Marks the end of an exchange; returns `rc`.
   int ended(int rc);
   /// Sends the request `adu` (unit id and PDU) and reads its reply into `reply` by one deadline;
@@ -79,6 +96,9 @@ class LibmodbusWire final : public ModbusWire {
   ModbusHandle ctx_;
   SteadyClock::duration timeout_{0};
   SteadyClock::duration gap_{0};
+  SteadyClock::duration quiet_{0};         ///< quiet_interval_s() (RTU)
+  bool in_flight_ = false;                 ///< RTU: a timed-out reply may still be on its way
+  SteadyClock::time_point quiet_since_{};  ///< RTU: the timeout, or the last byte dropped since
   SteadyClock::time_point last_end_{};
   std::uint16_t tid_ = 0;                ///< the last request's transaction id (TCP)
   std::vector<std::uint8_t> late_;       ///< the bytes read of a reply abandoned at its deadline
