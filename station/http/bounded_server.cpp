@@ -11,6 +11,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <condition_variable>
 #include <nlohmann/json.hpp>
 #include <thread>
@@ -21,29 +22,40 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-/// Set on a connection's thread when no thread could be had for it: answer 503 and close.
+/// Set on a connection's thread when no thread may be had for it: answer 503 and close.
 thread_local bool over_capacity = false;
+/// Set by exempt_from_response_deadline() for the response being written on this thread.
+thread_local bool endless_response = false;
 
 /// A thread per connection (a slow client holds only its own; the caps are BoundedServer's, a
-/// connection beyond them gets a thread that only answers). shutdown() waits for every thread.
+/// connection beyond them gets a thread that only answers) while fewer than `max_threads` run;
+/// beyond, or when no thread can be had, the connection is answered on the accept thread
+/// without waiting (over_capacity). shutdown() waits for every thread.
 class ConnectionQueue final : public httplib::TaskQueue {
  public:
+  explicit ConnectionQueue(int max_threads) : max_threads_(max_threads) {}
   void enqueue(std::function<void()> fn) override {
     std::unique_lock lock(state_->mu);
-    ++state_->running;
+    const bool room = state_->running < max_threads_;
+    if (room) ++state_->running;
     lock.unlock();
-    auto run = [st = state_](const std::function<void()>& f) {
-      f();
-      std::lock_guard done(st->mu);
-      if (--st->running == 0) st->idle.notify_all();
-    };
-    try {
-      std::thread(run, std::move(fn)).detach();
-    } catch (const std::system_error&) {  // no thread to be had: refuse on the accept thread
-      over_capacity = true;
-      run(fn);
-      over_capacity = false;
+    if (room) {
+      try {
+        std::thread(
+            [st = state_](const std::function<void()>& f) {
+              f();
+              st->done();
+            },
+            std::move(fn))
+            .detach();
+        return;
+      } catch (const std::system_error&) {  // no thread to be had
+        state_->done();
+      }
     }
+    over_capacity = true;
+    fn();
+    over_capacity = false;
   }
   void shutdown() override {
     std::unique_lock lock(state_->mu);
@@ -55,7 +67,12 @@ class ConnectionQueue final : public httplib::TaskQueue {
     std::mutex mu;
     std::condition_variable idle;
     int running = 0;
+    void done() {
+      std::lock_guard lock(mu);
+      if (--running == 0) idle.notify_all();
+    }
   };
+  int max_threads_;
   std::shared_ptr<State> state_ = std::make_shared<State>();
 };
 
@@ -82,17 +99,28 @@ bool wait_for(socket_t sock, short events, Clock::time_point until) {
 }
 
 /// The socket as httplib reads it: the bytes already read first, then reads until the request's
-/// deadline (a body trickled past it ends the request); writes time out per write.
+/// deadline (a body trickled past it ends the request). Writes never block (MSG_DONTWAIT: a
+/// blocking send of a large piece would wait for the reader however slow) and end at the
+/// response's deadline: kSendAllowance after the later of the request's deadline and the first
+/// write, plus a second per kMinSendBytesPerS bytes sent so far. A reader slower than that
+/// throughput falls behind its deadline and is cut off, whatever it reads each few seconds; one
+/// at least that fast is served to the end. An endless response (exempt_from_response_deadline:
+/// the event stream, capped by its handler) keeps a per-write timeout instead.
 class DeadlineStream final : public httplib::Stream {
  public:
+  /// Time for an answer's first bytes to leave (the per-write timeout this replaced).
+  static constexpr auto kSendAllowance = std::chrono::seconds(5);
+  /// The slowest reader served to the end: 8 KiB/s (64 kbit/s, a poor mobile link) sends the
+  /// largest answer, dygraphs' 430 kB, in under a minute; a reader below it holds a place for
+  /// little more than kSendAllowance past the request's deadline.
+  static constexpr double kMinSendBytesPerS = 8 * 1024;
+
   DeadlineStream(socket_t sock, std::string read, Clock::time_point deadline)
       : sock_(sock), read_(std::move(read)), deadline_(deadline) {}
   bool is_readable() const override {
     return at_ < read_.size() || wait_for(sock_, POLLIN, deadline_);
   }
-  bool is_writable() const override {
-    return wait_for(sock_, POLLOUT, Clock::now() + kWriteTimeout);
-  }
+  bool is_writable() const override { return wait_for(sock_, POLLOUT, send_deadline()); }
   ssize_t read(char* ptr, size_t size) override {
     if (at_ < read_.size()) {
       const std::size_t n = std::min(size, read_.size() - at_);
@@ -103,7 +131,12 @@ class DeadlineStream final : public httplib::Stream {
     return wait_for(sock_, POLLIN, deadline_) ? ::recv(sock_, ptr, size, 0) : -1;
   }
   ssize_t write(const char* ptr, size_t size) override {
-    return is_writable() ? ::send(sock_, ptr, size, MSG_NOSIGNAL) : -1;
+    if (!first_write_) first_write_ = Clock::now();
+    if (!is_writable()) return -1;
+    const ssize_t n = ::send(sock_, ptr, size, MSG_NOSIGNAL | MSG_DONTWAIT);
+    if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) return 0;  // httplib writes again
+    if (n > 0) sent_bytes_ += static_cast<std::size_t>(n);
+    return n;
   }
   void get_remote_ip_and_port(std::string& ip, int& port) const override {
     name_of(::getpeername, ip, port);
@@ -114,7 +147,14 @@ class DeadlineStream final : public httplib::Stream {
   socket_t socket() const override { return sock_; }
 
  private:
-  static constexpr auto kWriteTimeout = std::chrono::seconds(5);
+  Clock::time_point send_deadline() const {
+    const auto now = Clock::now();
+    if (endless_response) return now + kSendAllowance;
+    const auto start = first_write_.value_or(now);
+    const auto allowance = std::chrono::duration_cast<Clock::duration>(
+        std::chrono::duration<double>(static_cast<double>(sent_bytes_) / kMinSendBytesPerS));
+    return std::max(deadline_, start + kSendAllowance) + allowance;
+  }
   template <class F>
   void name_of(F get, std::string& ip, int& port) const {
     sockaddr_storage sa{};
@@ -127,6 +167,8 @@ class DeadlineStream final : public httplib::Stream {
   std::string read_;
   std::size_t at_ = 0;
   Clock::time_point deadline_;
+  std::optional<Clock::time_point> first_write_;
+  std::size_t sent_bytes_ = 0;
 };
 
 const char* reason_phrase(int status) {
@@ -157,10 +199,16 @@ std::string client_of(std::string_view address) {
   return a;
 }
 
+void exempt_from_response_deadline() {
+  endless_response = true;
+}
+
 BoundedServer::BoundedServer(ConnectionLimits limits, std::function<void(int)> refused,
                              std::function<bool(std::string_view)> token_holder)
     : limits_(limits), refused_(std::move(refused)), token_holder_(std::move(token_holder)) {
-  new_task_queue = [] { return new ConnectionQueue(); };
+  new_task_queue = [max = kThreadsPerPlace * limits_.max_connections] {
+    return new ConnectionQueue(max);
+  };
 }
 
 void BoundedServer::set_backlog(int connections) {
@@ -276,7 +324,8 @@ void BoundedServer::refuse(socket_t sock, const HeadVerdict& v) const {
       "Connection: close\r\n{}\r\n{}",
       v.status, reason_phrase(v.status), body.size(), v.status == 503 ? "Retry-After: 1\r\n" : "",
       body);
-  if (wait_for(sock, POLLOUT, Clock::now() + std::chrono::seconds(1)))
+  // On the accept thread (over_capacity) nothing waits: a new socket's buffer takes the reply.
+  if (over_capacity || wait_for(sock, POLLOUT, Clock::now() + std::chrono::seconds(1)))
     (void)::send(sock, reply.data(), reply.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
   if (refused_) refused_(v.status);
 }
@@ -293,7 +342,9 @@ void BoundedServer::serve(SlotRef slot, Clock::time_point deadline, std::string 
   if (v.status == 0) {
     DeadlineStream stream(slot->sock, std::move(buffer), deadline);
     bool closed = false;
+    endless_response = false;
     process_request(stream, true, closed, nullptr);
+    endless_response = false;
   } else if (v.status > 0) {
     refuse(slot->sock, v);
   }
@@ -311,7 +362,7 @@ bool BoundedServer::process_and_close_socket(socket_t sock) {
   const std::atomic<bool> never{false};
   const HeadVerdict first =
       over_capacity
-          ? HeadVerdict{503, "no thread for another connection"}
+          ? HeadVerdict{503, "too many connections are being answered"}
           : read_head(sock, std::min(deadline, Clock::now() + kFirstBytes), never, buffer);
   const bool whole = first.status == 0;
   if (first.status != 0 && first.status != 408) {

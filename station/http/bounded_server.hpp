@@ -6,8 +6,10 @@
 // slow client; of the same client when its cap is the one reached, else of the client holding
 // the most), or is answered 503 at once when every slot is serving a request. Once its head is
 // read, a request without the API token is served only while the token holder's share is free.
-// Everything above the limits is answered at once (503, 408, 414, 431, 400) and closed. The
-// routes, handlers and responses stay httplib's.
+// Everything above the limits is answered at once (503, 408, 414, 431, 400) and closed. A
+// response has a deadline of its own, scaled to what it sends (a reader slower than
+// DeadlineStream's minimum throughput is cut off), and threads are capped before a connection
+// gets one (kThreadsPerPlace). The routes, handlers and responses stay httplib's.
 #pragma once
 
 #include <atomic>
@@ -44,6 +46,11 @@ struct ConnectionLimits {
 /// bind any of them), any other address itself (an IPv4-mapped one as its IPv4 form).
 std::string client_of(std::string_view address);
 
+/// Called by a handler whose response has no end (the event stream, capped by its handler): its
+/// writes each have a few seconds instead of the response deadline a response otherwise has
+/// (DeadlineStream, bounded_server.cpp).
+void exempt_from_response_deadline();
+
 class BoundedServer : public httplib::Server {
  public:
   /// How long a new connection's head is read before it is counted: a client sends its head
@@ -51,6 +58,12 @@ class BoundedServer : public httplib::Server {
   /// whole is judged at once and can never lose its place to a newer connection; a head not
   /// whole by then is read on as a counted connection, whose place a newer one may take.
   static constexpr std::chrono::milliseconds kFirstBytes{50};
+  /// Threads at most per place of `max_connections`: a connection's thread lives on after its
+  /// place is given up (a shed one answering 503, a refused one, one reading its first
+  /// kFirstBytes), so each place may have one such beside its current holder. Beyond, a new
+  /// connection is answered 503 on the accept thread without a wait and closed: the thread
+  /// count does not grow with the connection rate.
+  static constexpr int kThreadsPerPlace = 2;
 
   /// `refused(status)` is called for every connection answered here (metrics);
   /// `token_holder(authorization)` says whether an Authorization header value carries the API

@@ -10,8 +10,11 @@
 #include "station/http/route_params.hpp"
 #include "station/store/sqlite.hpp"
 
-// Last: httplib.h pulls in <resolv.h>, whose `_res` macro breaks Eigen headers included after it.
+// Last: httplib.h (also through bounded_server.hpp) pulls in <resolv.h>, whose `_res` macro
+// breaks Eigen headers included after it.
 #include <httplib.h>
+
+#include "station/http/bounded_server.hpp"
 
 namespace station::http {
 
@@ -115,6 +118,7 @@ void HttpServer::event_stream(const httplib::Request& req, httplib::Response& re
     start = std::min<std::uint64_t>(static_cast<std::uint64_t>(*n), start);
   }
   hub_.metrics().stream_clients(streams_.load());
+  exempt_from_response_deadline();  // endless by design; max_streams bounds how many
   auto after = std::make_shared<std::uint64_t>(start);
   res.set_chunked_content_provider(
       "text/event-stream",

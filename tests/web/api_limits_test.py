@@ -19,11 +19,14 @@ raw sockets against `station run --sim --speed 50 --http 127.0.0.1:0`:
   token holder's, while the attackers' connections keep taking each other's places;
 - Host: only an IP literal of the loopback or `localhost` reads without the token
   (127.evil.com, 127.0.0.1.nip.io:8080, 0x7f.1, 127.1 need it);
-- a FIFO as --token-file: exit 2 within 5 s naming it (before: the start blocked for ever).
+- a FIFO as --token-file: exit 2 within 5 s naming it (before: the start blocked for ever);
+- a connect flood (3 processes for 5 s) holds the daemon's threads to 2 per place of the 64 and
+  a few (before: 307).
 
 The bounds are availability bounds with room for a loaded 2-core machine, not speed figures.
 Usage: api_limits_test.py STATION_BINARY     exit 0 pass, 1 fail
 """
+import multiprocessing
 import os
 import select
 import socket
@@ -253,6 +256,49 @@ def check_loopback_slowloris(port, token):
             f"{shed} attacker connections shed")
 
 
+def threads_of(pid):
+    with open(f"/proc/{pid}/status") as f:
+        for line in f:
+            if line.startswith("Threads:"):
+                return int(line.split()[1])
+    return 0
+
+
+def connect_flood(port, seconds):
+    """Opens connections as fast as it can for `seconds`, keeping the newest 200 open."""
+    held, end = [], time.time() + seconds
+    while time.time() < end:
+        try:
+            held.append(socket.create_connection((HOST, port), timeout=2))
+        except OSError:
+            continue
+        if len(held) > 200:
+            held.pop(0).close()
+    for s in held:
+        s.close()
+
+
+def check_connect_flood(st, port):
+    """Issue 34 defect 7: threads are capped before a connection gets one (2 per place of the 64:
+    bounded_server.hpp kThreadsPerPlace); 3 processes connecting as fast as they can for 5 s
+    (before: a thread per accepted connection, 307 threads at once on a 2-core machine)."""
+    idle = threads_of(st.proc.pid)
+    floods = [multiprocessing.Process(target=connect_flood, args=(port, 5)) for _ in range(3)]
+    for p in floods:
+        p.start()
+    most = idle
+    while any(p.is_alive() for p in floods):
+        most = max(most, threads_of(st.proc.pid))
+        time.sleep(0.002)
+    for p in floods:
+        p.join()
+    cap = idle + 2 * 64 + 4
+    base.check(most <= cap, f"a connect flood holds the daemon's threads to at most {cap}",
+               f"{idle} threads before, {most} at most during the flood")
+    base.still_up(port, "the connect flood")
+    base.ok(f"connect flood: threads {idle} before, {most} at most")
+
+
 def check_host_forms(port):
     for host in ("127.evil.com", "127.0.0.1.nip.io:8080", "0x7f.1", "127.1", "localhost.evil.com",
                  "[::1].evil.com", "127.0.0.1:80x", ""):
@@ -295,6 +341,7 @@ def main():
         check_loopback_slowloris(port, open(os.path.join(tmp, "a.db.token")).read().strip())
         check_header_flood(st, port)
         check_slow_clients(port)
+        check_connect_flood(st, port)
         base.still_up(port, "every attack")
         check_fifo_token(binary, tmp)
     except base.Fatal:
