@@ -208,16 +208,7 @@ int LibmodbusWire::drop_late(SteadyClock::time_point deadline) {
   return 0;
 }
 
-int LibmodbusWire::exchange(const std::vector<std::uint8_t>& adu,
-                            std::vector<std::uint8_t>& reply) {
-  if (!ctx_) {
-    errno = ENOTCONN;
-    return -1;
-  }
-  // Its own timeout from the request gap's end, or less while the tick's budget bounds every
-  // exchange (exchange_deadline): the gap, a late reply's rest and the quiet wait count in it.
-  const auto start = std::max(SteadyClock::now(), last_end_ + gap_);
-  const auto deadline = ExchangeDeadline::bound(start + timeout_);
+int LibmodbusWire::begin(SteadyClock::time_point deadline) {
   if (!rest(deadline)) {  // no time to keep the gap: not attempted, the gap still due next time
     errno = ETIMEDOUT;
     return -1;
@@ -233,6 +224,20 @@ int LibmodbusWire::exchange(const std::vector<std::uint8_t>& adu,
     errno = ETIMEDOUT;
     return ended(-1);
   }
+  return 0;
+}
+
+int LibmodbusWire::exchange(const std::vector<std::uint8_t>& adu,
+                            std::vector<std::uint8_t>& reply) {
+  if (!ctx_) {
+    errno = ENOTCONN;
+    return -1;
+  }
+  // Its own timeout from the request gap's end, or less while the tick's budget bounds every
+  // exchange (exchange_deadline): the gap, a late reply's rest and the quiet wait count in it.
+  const auto start = std::max(SteadyClock::now(), last_end_ + gap_);
+  const auto deadline = ExchangeDeadline::bound(start + timeout_);
+  if (begin(deadline) == -1) return -1;
   tid_ = static_cast<std::uint16_t>(tid_ + 1);
   const auto request = request_frame(framing(), tid_, adu);
   if (send_frame(request, deadline) == -1) return ended(-1);

@@ -81,6 +81,9 @@ class LibmodbusWire final : public ModbusWire {
   int wait_quiet(SteadyClock::time_point deadline);
   /// Marks the end of an exchange; returns `rc`.
   int ended(int rc);
+  /// Before a request: the gap, a late reply's rest, the quiet wait (RTU), all by the deadline;
+  /// 0, or -1 with errno (nothing may be sent).
+  int begin(SteadyClock::time_point deadline);
   /// Sends the request `adu` (unit id and PDU) and reads its reply into `reply` by one deadline;
   /// 0, or -1 with errno set.
   int exchange(const std::vector<std::uint8_t>& adu, std::vector<std::uint8_t>& reply);
