@@ -310,11 +310,16 @@ TickReport Sequencer::report(double t_s, const TickData& d) const {
 void Sequencer::tick(double t_s, TickData& d) {
   {
     // One deadline for all of the tick's device I/O, reads and commands: every exchange ends by
-    // it (the drivers take the scope), and a command whose turn comes after it is not sent.
-    const auto io_s = std::chrono::duration<double>(kTickIoShare * options_.period_s);
-    io_end_ = std::chrono::steady_clock::now() +
-              std::chrono::duration_cast<std::chrono::steady_clock::duration>(io_s);
-    const dr::ExchangeDeadline cap(*io_end_);
+    // it (the drivers take the scope), and a command whose turn comes after it is not sent. Only
+    // on the wall clock: a simulated tick (SimClock: lockstep, replay) loses nothing to the wall
+    // time its I/O takes, and a budget there would make the run depend on the machine's load.
+    std::optional<dr::ExchangeDeadline> cap;
+    if (dynamic_cast<const dr::MonotonicClock*>(&clock_) != nullptr) {
+      const auto io_s = std::chrono::duration<double>(kTickIoShare * options_.period_s);
+      io_end_ = std::chrono::steady_clock::now() +
+                std::chrono::duration_cast<std::chrono::steady_clock::duration>(io_s);
+      cap.emplace(*io_end_);
+    }
     struct EndsWithTheScope {  // between ticks (and after a throw) no tick budget holds
       std::optional<std::chrono::steady_clock::time_point>& end;
       ~EndsWithTheScope() { end.reset(); }
