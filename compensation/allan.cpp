@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <tuple>
@@ -12,73 +13,57 @@
 #include "compensation/limits.hpp"
 #include "compensation/noise_edf.hpp"
 #include "compensation/noise_id.hpp"
+#include "compensation/vector_sums.hpp"
 
 namespace station::compensation {
 namespace {
 
-// Sum over k < n_terms of (theta[k+2m] - 2 theta[k+m] + theta[k])^2. Four independent
-// accumulators break the add dependency chain so the loop pipelines without -ffast-math.
-double second_difference_sum(const double* theta, std::size_t m, std::size_t n_terms) {
-  const double* a = theta;
-  const double* b = theta + m;
-  const double* c = theta + 2 * m;
-  double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
-  std::size_t k = 0;
-  for (; k + 4 <= n_terms; k += 4) {
-    const double d0 = c[k] - 2.0 * b[k] + a[k];
-    const double d1 = c[k + 1] - 2.0 * b[k + 1] + a[k + 1];
-    const double d2 = c[k + 2] - 2.0 * b[k + 2] + a[k + 2];
-    const double d3 = c[k + 3] - 2.0 * b[k + 3] + a[k + 3];
-    s0 += d0 * d0;
-    s1 += d1 * d1;
-    s2 += d2 * d2;
-    s3 += d3 * d3;
-  }
-  for (; k < n_terms; ++k) {
-    const double d = c[k] - 2.0 * b[k] + a[k];
-    s0 += d * d;
-  }
-  return (s0 + s1) + (s2 + s3);
-}
-
-// Sum over k < n_terms of (theta[k+3m] - 3 theta[k+2m] + 3 theta[k+m] - theta[k])^2: the
-// Hadamard variance's third difference (NIST SP 1065 §5.2.8, eq. 23 with x = tau0 theta).
-double third_difference_sum(const double* theta, std::size_t m, std::size_t n_terms) {
-  double s = 0;
-  for (std::size_t k = 0; k < n_terms; ++k) {
-    const double d = theta[k + 3 * m] - 3.0 * theta[k + 2 * m] + 3.0 * theta[k + m] - theta[k];
-    s += d * d;
-  }
-  return s;
-}
-
-void check_adev_inputs(std::span<const double> rate, double rate_hz, double confidence) {
+void check_adev_arguments(double rate_hz, double confidence) {
   if (!(rate_hz > 0.0) || !std::isfinite(rate_hz) || !(confidence > 0.0 && confidence < 1.0)) {
     throw DataError("overlapping_adev: need rate_hz > 0 and 0 < confidence < 1, got " +
                     std::to_string(rate_hz) + ", " + std::to_string(confidence));
   }
+}
+
+// The mean rate in one sequential sum: the order whose rounding the angle has always had (the
+// curve's values depend on the angle's last bits at small tau). With `check`, each sample is
+// checked finite on the way, in the shadow of the chain of adds rather than in a pass of its own.
+double rate_mean(std::span<const double> rate, bool check) {
+  double sum = 0;
   for (std::size_t i = 0; i < rate.size(); ++i) {
-    if (!std::isfinite(rate[i]))
+    if (check && !std::isfinite(rate[i]))
       throw DataError("overlapping_adev: sample " + std::to_string(i) + ": " +
                       finite_problem(rate[i]));
+    sum += rate[i];
+  }
+  return sum / static_cast<double>(rate.size());
+}
+
+// theta_0 = 0, theta_{k+1} = theta_k + (y_k - mean) into out[0 .. n]: a chain of adds, the running
+// value kept in a register (not read back from memory; push_back instead was twice as slow).
+void fill_angle(std::span<const double> rate, double mean, double* out) {
+  double t = 0.0;
+  out[0] = t;
+  for (std::size_t i = 0; i < rate.size(); ++i) {
+    t += rate[i] - mean;
+    out[i + 1] = t;
   }
 }
 
-// One point of the curve, its interval still to come. NIST SP 1065 §5.2.4, overlapping AVAR from
-// phase data: AVAR(m tau0) = 1 / (2 tau^2 (N - 2m)) sum_k (x_{k+2m} - 2 x_{k+m} + x_k)^2, and
-// §5.2.8, overlapping HVAR: 1 / (6 tau^2 (N - 3m)) sum_k (third difference)^2, with
-// x = tau0 * theta and tau = m tau0, so tau0^2 cancels.
-AdevPoint deviation_point(const std::vector<double>& theta, std::size_t m, double tau0_s,
-                          bool hadamard) {
-  const std::size_t n_terms = theta.size() - (hadamard ? 3 : 2) * m;
-  const double sum = hadamard ? third_difference_sum(theta.data(), m, n_terms)
-                              : second_difference_sum(theta.data(), m, n_terms);
+// One point of the curve, its interval still to come, from the sum of its squared differences
+// (difference_sums.hpp). NIST SP 1065 §5.2.4, overlapping AVAR from phase data:
+// AVAR(m tau0) = 1 / (2 tau^2 (N - 2m)) sum_k (x_{k+2m} - 2 x_{k+m} + x_k)^2, and §5.2.8,
+// overlapping HVAR: 1 / (6 tau^2 (N - 3m)) sum_k (third difference)^2, with x = tau0 * theta and
+// tau = m tau0, so tau0^2 cancels.
+AdevPoint deviation_point(double sum, std::size_t n_theta, std::size_t m, double tau0_s,
+                          int order) {
+  const std::size_t n_terms = n_theta - static_cast<std::size_t>(order) * m;
   const double md = static_cast<double>(m);
   AdevPoint p;
   p.m = m;
   p.tau_s = md * tau0_s;
   p.n = n_terms;
-  p.adev = std::sqrt(sum / ((hadamard ? 6.0 : 2.0) * md * md * static_cast<double>(n_terms)));
+  p.adev = std::sqrt(sum / ((order == 3 ? 6.0 : 2.0) * md * md * static_cast<double>(n_terms)));
   if (!std::isfinite(p.adev)) {
     throw DataError("overlapping_adev: the Allan deviation at m = " + std::to_string(m) +
                     " overflows: the values are too large");
@@ -87,15 +72,23 @@ AdevPoint deviation_point(const std::vector<double>& theta, std::size_t m, doubl
 }
 
 // The noise at this tau decides the interval (Greenhall & Riley 2003). Identified as Stable32
-// does (NIST SP 1065 §5.6; noise_id.hpp): by the lag-1 autocorrelation where 30 averages remain,
-// by the B1 ratio down to 8; below that carried from the largest tau where it was identified,
-// and white FM (the gyro's angle random walk) when the series is too short to identify anything.
-void assign_noise(AdevPoint& p, std::span<const double> rate, int order,
+// does (NIST SP 1065 §5.6; noise_id.hpp) in the tau-averaged series: by the lag-1
+// autocorrelation where 30 averages remain, by the B1 ratio down to 8; below that carried from the
+// largest tau where it was identified, and white FM (the gyro's angle random walk) when the series
+// is too short to identify anything.
+void assign_noise(AdevPoint& p, BlockAverages& averages, std::span<const double> theta, int order,
                   std::optional<int>& last_alpha) {
-  if (const auto id = identify_noise(rate, p.m, order)) {
+  const std::size_t n_averages = (theta.size() - 1) / p.m;
+  if (n_averages < kMinB1Averages) {
+    p.alpha = last_alpha.value_or(0);
+    p.noise_id = NoiseIdMethod::none;
+    return;
+  }
+  const std::span<const double> a = averages.at(p.m);
+  if (const auto id = identify_noise_in_averages(a, order)) {
     p.alpha = id->alpha;
     p.noise_id = NoiseIdMethod::lag1;
-  } else if (const auto b1 = identify_noise_b1(rate, p.m)) {
+  } else if (const auto b1 = identify_noise_b1_in_averages(a, theta, p.m)) {
     p.alpha = b1->alpha;
     p.noise_id = NoiseIdMethod::b1;
   } else {
@@ -192,31 +185,34 @@ std::pair<double, double> chi_squared_interval(double dev, double edf, double co
 // difference annihilates), and it keeps the cumulative sum a zero-mean random walk, small enough
 // for 1e7 samples not to lose precision.
 std::vector<double> integrated_angle(std::span<const double> rate) {
-  double mean = 0;
-  for (double y : rate) mean += y;
-  mean /= static_cast<double>(rate.size());
   std::vector<double> theta(rate.size() + 1);
-  theta[0] = 0.0;
-  for (std::size_t i = 0; i < rate.size(); ++i) theta[i + 1] = theta[i] + (rate[i] - mean);
+  fill_angle(rate, rate_mean(rate, false), theta.data());
   return theta;
 }
 
 std::vector<AdevPoint> overlapping_adev(std::span<const double> rate, double rate_hz,
                                         std::span<const std::size_t> m_list, double confidence,
                                         DeviationKind kind) {
-  check_adev_inputs(rate, rate_hz, confidence);
+  check_adev_arguments(rate_hz, confidence);
   std::vector<AdevPoint> out;
   if (rate.empty()) return out;
-  const std::vector<double> theta = integrated_angle(rate);
-  const bool hadamard = kind == DeviationKind::hdev;
-  const int order = hadamard ? 3 : 2;  // the difference the variance takes of the angle
-  std::optional<int> last_alpha;
+  // The angle written once, not zeroed first (a pass of its own over N values).
+  const auto angle = std::make_unique_for_overwrite<double[]>(rate.size() + 1);
+  fill_angle(rate, rate_mean(rate, true), angle.get());
+  const std::span<const double> theta(angle.get(), rate.size() + 1);
+  const int order = kind == DeviationKind::hdev ? 3 : 2;  // the difference taken of the angle
+  std::vector<std::size_t> ms;                            // the factors with at least one term
   for (std::size_t m : m_list) {
-    if (m == 0 || static_cast<std::size_t>(order) * m >= theta.size()) continue;  // no term
-    AdevPoint p = deviation_point(theta, m, 1.0 / rate_hz, hadamard);
-    assign_noise(p, rate, order, last_alpha);
-    p.edf = greenhall_edf(p.alpha, order, static_cast<double>(m), static_cast<double>(theta.size()),
-                          true);
+    if (m != 0 && static_cast<std::size_t>(order) * m < theta.size()) ms.push_back(m);
+  }
+  const std::vector<double> sums = difference_sums(theta, ms, order);
+  BlockAverages averages(rate);
+  std::optional<int> last_alpha;
+  for (std::size_t i = 0; i < ms.size(); ++i) {
+    AdevPoint p = deviation_point(sums[i], theta.size(), ms[i], 1.0 / rate_hz, order);
+    assign_noise(p, averages, theta, order, last_alpha);
+    p.edf = greenhall_edf(p.alpha, order, static_cast<double>(ms[i]),
+                          static_cast<double>(theta.size()), true);
     std::tie(p.ci_low, p.ci_high) = chi_squared_interval(p.adev, p.edf, confidence);
     out.push_back(p);
   }

@@ -52,9 +52,11 @@ enum class DeviationKind { adev, hdev };
 std::vector<double> integrated_angle(std::span<const double> rate);
 
 /// Overlapping ADEV (or HDEV) of `rate` (any rate unit, sampled at rate_hz) at each factor in
-/// `m_list` (increasing), computed from the integrated angle in O(N) per tau; interval at
-/// `confidence` (two-sided) from the chi-squared distribution with the equivalent degrees of
-/// freedom of Greenhall & Riley for the noise identified at that tau (noise_id.hpp). Factors
+/// `m_list` (increasing), computed from the integrated angle in one tiled sweep for all taus
+/// (vector_sums.hpp: O(N) work per tau, the angle read from memory a few times in all); interval
+/// at `confidence` (two-sided) from the chi-squared distribution with the equivalent degrees of
+/// freedom of Greenhall & Riley for the noise identified at that tau in its tau-averaged series
+/// (noise_id.hpp, BlockAverages: each formed from the previous tau's, one pass in all). Factors
 /// with fewer than 1 term are skipped. Throws DataError unless rate_hz > 0 is finite,
 /// 0 < confidence < 1 and every sample is finite, or when the result overflows. Pure.
 std::vector<AdevPoint> overlapping_adev(std::span<const double> rate, double rate_hz,

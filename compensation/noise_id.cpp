@@ -6,41 +6,69 @@
 #include <vector>
 
 #include "compensation/allan.hpp"
+#include "compensation/vector_sums.hpp"
 
 namespace station::compensation {
 namespace {
 
-/// The means of the N = floor(n / m) whole non-overlapping blocks of m samples.
-std::vector<double> block_averages(std::span<const double> rate, std::size_t m) {
-  std::vector<double> a(rate.size() / m);
-  for (std::size_t b = 0; b < a.size(); ++b) {
-    double s = 0;
-    for (std::size_t i = 0; i < m; ++i) s += rate[b * m + i];
-    a[b] = s / static_cast<double>(m);
+/// The mean of the q values at p: four partial sums, so a long block does not wait on one add.
+double block_mean(const double* p, std::size_t q) {
+  double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+  std::size_t i = 0;
+  for (; i + 4 <= q; i += 4) {
+    s0 += p[i];
+    s1 += p[i + 1];
+    s2 += p[i + 2];
+    s3 += p[i + 3];
   }
-  return a;
+  for (; i < q; ++i) s0 += p[i];
+  return ((s0 + s1) + (s2 + s3)) / static_cast<double>(q);
+}
+
+/// The least-squares line a + b t of y against t = 0 .. n-1.
+struct Line {
+  double icpt = 0, slope = 0;
+};
+
+/// Sum t and sum t^2 over t = 0 .. n-1 in closed form (n (n-1) / 2, (n-1) n (2n-1) / 6), sum y
+/// and sum t y by vector_sums.hpp.
+Line least_squares_line(std::span<const double> y) {
+  const double n = static_cast<double>(y.size());
+  const LineSums sums = line_sums(y);
+  const double st = n * (n - 1) / 2, stt = (n - 1) * n * (2 * n - 1) / 6;
+  const double den = n * stt - st * st;
+  Line line;
+  line.slope = den != 0 ? (n * sums.ty - st * sums.y) / den : 0.0;
+  line.icpt = (sums.y - line.slope * st) / n;
+  return line;
 }
 
 /// y minus its least-squares line.
-std::vector<double> detrended(std::vector<double> y) {
-  const double n = static_cast<double>(y.size());
-  double st = 0, sy = 0, stt = 0, sty = 0;
-  for (std::size_t i = 0; i < y.size(); ++i) {
-    const double t = static_cast<double>(i);
-    st += t;
-    sy += y[i];
-    stt += t * t;
-    sty += t * y[i];
-  }
-  const double den = n * stt - st * st;
-  const double slope = den != 0 ? (n * sty - st * sy) / den : 0.0;
-  const double icpt = (sy - slope * st) / n;
-  for (std::size_t i = 0; i < y.size(); ++i) y[i] -= icpt + slope * static_cast<double>(i);
-  return y;
+std::vector<double> detrended(std::span<const double> y, const Line& line) {
+  std::vector<double> x(y.size());
+  for (std::size_t i = 0; i < y.size(); ++i)
+    x[i] = y[i] - (line.icpt + line.slope * static_cast<double>(i));
+  return x;
+}
+
+/// The lag-1 autocorrelation (Riley & Greenhall 2004, eq. 2) of x = y minus its line, in one pass
+/// over y (vector_sums.hpp): sums of x, x^2 and x_t x_{t+1}, the mean taken out afterwards by
+/// sum (x - mu)^2 = sum x^2 - mu sum x and
+/// sum (x_t - mu)(x_{t+1} - mu) = sum x_t x_{t+1} - mu (2 sum x - x_0 - x_{n-1}) + (n - 1) mu^2.
+/// The mean of a least-squares residual is 0 but for rounding, so neither correction cancels.
+double lag1_about_line(std::span<const double> y, const Line& line) {
+  const std::size_t n = y.size();
+  const LagSums s = residual_lag_sums(y, line.icpt, line.slope);
+  const double x0 = y[0] - line.icpt;
+  const double x_last = y[n - 1] - (line.icpt + line.slope * static_cast<double>(n - 1));
+  const double mu = s.x / static_cast<double>(n);
+  const double den = s.xx - mu * s.x;
+  const double num = s.x_next - mu * (2 * s.x - x0 - x_last) + static_cast<double>(n - 1) * mu * mu;
+  return den > 0 ? num / den : 0.0;
 }
 
 /// Lag-1 autocorrelation about the mean (Riley & Greenhall 2004, eq. 2).
-double lag1(const std::vector<double>& x) {
+double lag1(std::span<const double> x) {
   double mean = 0;
   for (const double v : x) mean += v;
   mean /= static_cast<double>(x.size());
@@ -53,7 +81,7 @@ double lag1(const std::vector<double>& x) {
 }
 
 /// The standard (N-sample) variance, N - 1 in the denominator (NIST SP 1065 §5.2.1).
-double standard_variance(const std::vector<double>& a) {
+double standard_variance(std::span<const double> a) {
   double mean = 0;
   for (const double v : a) mean += v;
   mean /= static_cast<double>(a.size());
@@ -68,7 +96,7 @@ double standard_variance(const std::vector<double>& a) {
 /// N averages as the standard variance, it is correlated with it, and at 10 averages of white FM
 /// the ratio finds white FM in 52.2 % of series where the overlapping AVAR's finds 44.2 %
 /// (100,000 seeded series of 1,000 samples, m = 100).
-double allan_variance_of_averages(const std::vector<double>& a) {
+double allan_variance_of_averages(std::span<const double> a) {
   double ss = 0;
   for (std::size_t j = 0; j + 1 < a.size(); ++j) ss += (a[j + 1] - a[j]) * (a[j + 1] - a[j]);
   return ss / (2.0 * static_cast<double>(a.size() - 1));
@@ -78,8 +106,7 @@ double allan_variance_of_averages(const std::vector<double>& a) {
 /// 1 / (2 m^2 tau^2 (N - 3m + 1)) sum_j (sum_{i=j}^{j+m-1} x_{i+2m} - 2 x_{i+m} + x_i)^2 over the
 /// N = n + 1 phase points x = tau0 theta, theta the integrated rate (tau0^2 cancels with tau).
 /// Needs n >= 3m.
-double modified_allan_variance(std::span<const double> rate, std::size_t m) {
-  const std::vector<double> theta = integrated_angle(rate);
+double modified_allan_variance(std::span<const double> theta, std::size_t m) {
   const auto d2 = [&](std::size_t i) { return theta[i + 2 * m] - 2 * theta[i + m] + theta[i]; };
   const std::size_t terms = theta.size() - 3 * m + 1;
   double inner = 0;
@@ -136,11 +163,33 @@ std::string_view noise_id_method_name(NoiseIdMethod method) {
   return "none";
 }
 
-std::optional<NoiseId> identify_noise(std::span<const double> rate, std::size_t m, int d_max) {
-  if (m == 0 || rate.size() / m < kMinNoiseIdPoints) return std::nullopt;
-  std::vector<double> x = detrended(block_averages(rate, m));
+std::span<const double> BlockAverages::at(std::size_t m) {
+  if (m <= 1) return rate_;
+  if (m == m_) return {last_.get(), size_};
+  const bool from_last = m_ > 1 && m % m_ == 0;
+  const std::span<const double> src =
+      from_last ? std::span<const double>(last_.get(), size_) : rate_;
+  const std::size_t q = from_last ? m / m_ : m;
+  const std::size_t blocks = src.size() / q;
+  if (!from_last) last_ = std::make_unique_for_overwrite<double[]>(blocks);
+  // In place when formed from last_: block b reads q >= 2 values from index b q >= b on.
+  double* out = last_.get();
+  if (q == 2) {  // octave taus: the same bits as block_mean, in a loop that vectorises
+    for (std::size_t b = 0; b < blocks; ++b) out[b] = (src[2 * b] + src[2 * b + 1]) / 2.0;
+  } else {
+    for (std::size_t b = 0; b < blocks; ++b) out[b] = block_mean(src.data() + b * q, q);
+  }
+  size_ = blocks;
+  m_ = m;
+  return {last_.get(), size_};
+}
+
+std::optional<NoiseId> identify_noise_in_averages(std::span<const double> averages, int d_max) {
+  if (averages.size() < kMinNoiseIdPoints) return std::nullopt;
+  const Line line = least_squares_line(averages);
+  double r1 = lag1_about_line(averages, line);
+  std::vector<double> x;  // the differenced series, formed only when a difference is taken
   for (int d = 0;; ++d) {
-    const double r1 = lag1(x);
     const double delta = r1 / (1 + r1);
     if (delta < 0.25 || d >= d_max) {
       NoiseId id;
@@ -151,9 +200,17 @@ std::optional<NoiseId> identify_noise(std::span<const double> rate, std::size_t 
       id.alpha = std::clamp(id.alpha, 2 - 2 * d_max, 2);
       return id;
     }
+    if (d == 0) x = detrended(averages, line);
     for (std::size_t i = 0; i + 1 < x.size(); ++i) x[i] = x[i + 1] - x[i];
     x.pop_back();
+    r1 = lag1(x);
   }
+}
+
+std::optional<NoiseId> identify_noise(std::span<const double> rate, std::size_t m, int d_max) {
+  if (m == 0 || rate.size() / m < kMinNoiseIdPoints) return std::nullopt;
+  BlockAverages averages(rate);
+  return identify_noise_in_averages(averages.at(m), d_max);
 }
 
 double b1_expected(double n_averages, int mu) {
@@ -182,9 +239,9 @@ double rn_expected(int alpha, double m) {
   return 1.5 * std::log(256.0 / 27.0) / (1.038 + 3.0 * std::log(std::numbers::pi * m));
 }
 
-std::optional<B1Id> identify_noise_b1(std::span<const double> rate, std::size_t m) {
-  if (m == 0 || rate.size() / m < kMinB1Averages) return std::nullopt;
-  const std::vector<double> a = block_averages(rate, m);
+std::optional<B1Id> identify_noise_b1_in_averages(std::span<const double> a,
+                                                  std::span<const double> theta, std::size_t m) {
+  if (m == 0 || a.size() < kMinB1Averages) return std::nullopt;
   const double avar = allan_variance_of_averages(a);
   if (!(avar > 0.0)) return std::nullopt;
   B1Id id;
@@ -193,9 +250,15 @@ std::optional<B1Id> identify_noise_b1(std::span<const double> rate, std::size_t 
   const int mu = mu_from_b1(id.b1, static_cast<double>(a.size()));
   id.alpha = -mu - 1;  // the FM noises: AVAR ~ tau^mu with mu = -alpha - 1 (SP 1065 §5.6)
   if (mu > -2) return id;
-  id.rn = modified_allan_variance(rate, m) / avar;
+  id.rn = modified_allan_variance(theta, m) / avar;
   id.alpha = pm_by_rn(*id.rn, static_cast<double>(m));
   return id;
+}
+
+std::optional<B1Id> identify_noise_b1(std::span<const double> rate, std::size_t m) {
+  if (m == 0 || rate.size() / m < kMinB1Averages) return std::nullopt;
+  BlockAverages averages(rate);
+  return identify_noise_b1_in_averages(averages.at(m), integrated_angle(rate), m);
 }
 
 }  // namespace station::compensation

@@ -23,9 +23,11 @@
 #pragma once
 
 #include <cstddef>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string_view>
+#include <vector>
 
 namespace station::compensation {
 
@@ -52,6 +54,27 @@ struct NoiseId {
   int differences = 0;   ///< d
 };
 
+/// The means of the floor(n / m) whole non-overlapping blocks of m rate samples (the tau-averaged
+/// series the noise is identified in), for factors asked in increasing order. A factor's
+/// averages are formed from those of the previous factor when it divides m (octave taus: pairs
+/// of the previous averages, all of them one pass over the rate and n values of memory), else
+/// from the rate (m = 1: the rate itself). Holds a view of `rate`.
+class BlockAverages {
+ public:
+  explicit BlockAverages(std::span<const double> rate) : rate_(rate) {}
+  /// The averages at factor m (>= 1, not below the previous call's); valid until the next call.
+  std::span<const double> at(std::size_t m);
+
+ private:
+  std::span<const double> rate_;
+  std::size_t m_ = 1;               // the factor of last_; 1: the rate itself
+  std::unique_ptr<double[]> last_;  // its averages, written once (not zeroed first)
+  std::size_t size_ = 0;            // how many
+};
+
+/// identify_noise on the averages a BlockAverages formed; empty below kMinNoiseIdPoints of them.
+std::optional<NoiseId> identify_noise_in_averages(std::span<const double> averages, int d_max);
+
 /// Identifies the dominant power-law noise of `rate` at averaging factor m by the lag-1 method;
 /// empty when fewer than kMinNoiseIdPoints averages remain. `d_max` is 2 for ADEV, 3 for HDEV.
 /// The result is clamped to the range the variance converges for (-2 .. +2 for ADEV). Pure.
@@ -77,5 +100,10 @@ struct B1Id {
 /// says PM, R(n): white PM, flicker PM, or white FM that B1 mistook for PM. Empty when fewer than
 /// kMinB1Averages averages remain or the Allan variance is 0. Pure.
 std::optional<B1Id> identify_noise_b1(std::span<const double> rate, std::size_t m);
+
+/// identify_noise_b1 on the averages at factor m that a BlockAverages formed, with `theta` the
+/// integrated angle of the rate (allan.hpp, integrated_angle) for R(n).
+std::optional<B1Id> identify_noise_b1_in_averages(std::span<const double> averages,
+                                                  std::span<const double> theta, std::size_t m);
 
 }  // namespace station::compensation

@@ -1,0 +1,244 @@
+// The ADEV curve's long sums with vector arithmetic: squared differences of the angle for every
+// tau in one tiled sweep, and the lag-1 noise identification's sums of a tau-averaged series.
+#include "compensation/vector_sums.hpp"
+
+#include <algorithm>
+
+namespace station::compensation {
+namespace {
+
+// Doubles as one value (GCC's vector extension), the machine's native width in each kernel:
+// 8 with AVX-512, 4 with AVX2, 2 with SSE2 (a wider type than the machine's is kept in memory by
+// GCC: three times slower). The arithmetic is the same IEEE operations lane by lane.
+using V2 = double __attribute__((vector_size(16)));
+using V4 = double __attribute__((vector_size(32)));
+using V8 = double __attribute__((vector_size(64)));
+template <class V>
+constexpr std::size_t kWidth = sizeof(V) / sizeof(double);
+
+constexpr std::size_t kLanes = 32;        // partial sums of a difference sum (vector_sums.hpp)
+constexpr std::size_t kSeriesLanes = 16;  // partial sums of a series' sum
+// Terms per tile (a multiple of kLanes): 3 x 16 KiB per factor, every factor's share of the
+// angle taken while the tile's neighbourhood is still in the core's cache.
+constexpr std::size_t kTile = 2048;
+
+// The kernels are templates on the vector type, always inlined into one entry point per
+// instruction set (target attribute), picked once by what the CPU has. The file is compiled with
+// -ffp-contract=off (CMakeLists.txt): the AVX-512 kernel fuses no product into a sum (AVX-512F
+// has FMA), and every machine gets the same bits.
+#define STATION_INLINE inline __attribute__((always_inline))
+#pragma GCC diagnostic ignored "-Wpsabi"  // vectors passed by value only inside inlined code
+
+// The partial sums added pairwise: ((p0 + p1) + (p2 + p3)) + ...
+STATION_INLINE double pairwise_total(double* p, std::size_t n) {
+  for (; n > 1; n /= 2) {
+    for (std::size_t i = 0; i < n / 2; ++i) p[i] = p[2 * i] + p[2 * i + 1];
+  }
+  return p[0];
+}
+
+template <class V>
+STATION_INLINE V load(const double* p) {
+  V v;
+  __builtin_memcpy(&v, p, sizeof v);
+  return v;
+}
+template <class V>
+STATION_INLINE void store(double* p, const V& v) {
+  __builtin_memcpy(p, &v, sizeof v);
+}
+
+// Allan: (theta[k+2m] - 2 theta[k+m] + theta[k])^2 (SP 1065 eq. 11, x = tau0 theta).
+struct Second {
+  template <class V>
+  STATION_INLINE static V diff(const double* t, std::size_t m) {
+    return load<V>(t + 2 * m) - 2.0 * load<V>(t + m) + load<V>(t);
+  }
+};
+// Hadamard: (theta[k+3m] - 3 theta[k+2m] + 3 theta[k+m] - theta[k])^2 (SP 1065 eq. 23).
+struct Third {
+  template <class V>
+  STATION_INLINE static V diff(const double* t, std::size_t m) {
+    return load<V>(t + 3 * m) - 3.0 * load<V>(t + 2 * m) + 3.0 * load<V>(t + m) - load<V>(t);
+  }
+};
+// The same with one lane: the last terms of a sum.
+template <class Diff>
+STATION_INLINE double diff1(const double* t, std::size_t m) {
+  using V1 = double __attribute__((vector_size(8)));
+  return Diff::template diff<V1>(t, m)[0];
+}
+
+// Adds the terms k0 <= k < k1 (k0 a multiple of kLanes) at lag m to the kLanes partial sums.
+template <class V, class Diff>
+STATION_INLINE void add_terms(const double* theta, std::size_t m, std::size_t k0, std::size_t k1,
+                              double* partial) {
+  constexpr std::size_t w = kWidth<V>, nv = kLanes / w;
+  V s[nv];
+  for (std::size_t v = 0; v < nv; ++v) s[v] = load<V>(partial + w * v);
+  std::size_t k = k0;
+  for (; k + kLanes <= k1; k += kLanes) {
+    for (std::size_t v = 0; v < nv; ++v) {
+      const V d = Diff::template diff<V>(theta + k + w * v, m);
+      s[v] += d * d;
+    }
+  }
+  for (std::size_t v = 0; v < nv; ++v) store(partial + w * v, s[v]);
+  for (; k < k1; ++k) {  // the last terms of the sum, each into its own partial
+    const double d = diff1<Diff>(theta + k, m);
+    partial[k % kLanes] += d * d;
+  }
+}
+
+// t0, t0 + 1, ... as doubles (exact below 2^53).
+template <class V>
+STATION_INLINE V ramp(double t0) {
+  V r;
+  for (std::size_t i = 0; i < kWidth<V>; ++i) r[i] = t0 + static_cast<double>(i);
+  return r;
+}
+// x_t = y_t - (icpt + slope t) for the lanes' t from t0.
+template <class V>
+STATION_INLINE V residual(const double* y, double t0, double icpt, double slope) {
+  return load<V>(y) - (icpt + slope * ramp<V>(t0));
+}
+
+// Sum y_t, sum t y_t into sums[0], sums[1]: kSeriesLanes partials each, the tail in its lanes.
+template <class V>
+STATION_INLINE void line_sums_into(const double* y, std::size_t n, double* sums) {
+  constexpr std::size_t w = kWidth<V>, nv = kSeriesLanes / w;
+  V sy[nv] = {}, sty[nv] = {};
+  std::size_t k = 0;
+  for (; k + kSeriesLanes <= n; k += kSeriesLanes) {
+    for (std::size_t v = 0; v < nv; ++v) {
+      const V yv = load<V>(y + k + w * v);
+      sy[v] += yv;
+      sty[v] += ramp<V>(static_cast<double>(k + w * v)) * yv;
+    }
+  }
+  double py[kSeriesLanes], pty[kSeriesLanes];
+  for (std::size_t v = 0; v < nv; ++v) {
+    store(py + w * v, sy[v]);
+    store(pty + w * v, sty[v]);
+  }
+  for (; k < n; ++k) {
+    py[k % kSeriesLanes] += y[k];
+    pty[k % kSeriesLanes] += static_cast<double>(k) * y[k];
+  }
+  sums[0] = pairwise_total(py, kSeriesLanes);
+  sums[1] = pairwise_total(pty, kSeriesLanes);
+}
+
+// Sum x_t, sum x_t^2 (t < n) and sum x_t x_{t+1} (t < n - 1) into sums[0..2].
+template <class V>
+STATION_INLINE void lag_sums_into(const double* y, std::size_t n, double icpt, double slope,
+                                  double* sums) {
+  constexpr std::size_t w = kWidth<V>, nv = kSeriesLanes / w;
+  V sx[nv] = {}, sxx[nv] = {}, sxn[nv] = {};
+  std::size_t k = 0;
+  for (; k + kSeriesLanes + 1 <= n; k += kSeriesLanes) {
+    for (std::size_t v = 0; v < nv; ++v) {
+      const double t = static_cast<double>(k + w * v);
+      const V x = residual<V>(y + k + w * v, t, icpt, slope);
+      const V next = residual<V>(y + k + w * v + 1, t + 1, icpt, slope);
+      sx[v] += x;
+      sxx[v] += x * x;
+      sxn[v] += x * next;
+    }
+  }
+  double p[3][kSeriesLanes];
+  for (std::size_t v = 0; v < nv; ++v) {
+    store(p[0] + w * v, sx[v]);
+    store(p[1] + w * v, sxx[v]);
+    store(p[2] + w * v, sxn[v]);
+  }
+  const auto x_at = [&](std::size_t t) { return y[t] - (icpt + slope * static_cast<double>(t)); };
+  for (; k < n; ++k) {
+    const double x = x_at(k);
+    p[0][k % kSeriesLanes] += x;
+    p[1][k % kSeriesLanes] += x * x;
+    if (k + 1 < n) p[2][k % kSeriesLanes] += x * x_at(k + 1);
+  }
+  for (std::size_t j = 0; j < 3; ++j) sums[j] = pairwise_total(p[j], kSeriesLanes);
+}
+
+// One entry point per instruction set for each kernel, and the one the CPU runs.
+struct Kernels {
+  void (*second)(const double*, std::size_t, std::size_t, std::size_t, double*);
+  void (*third)(const double*, std::size_t, std::size_t, std::size_t, double*);
+  void (*line)(const double*, std::size_t, double*);
+  void (*lag)(const double*, std::size_t, double, double, double*);
+};
+
+#define STATION_KERNELS(name, V, attr)                                                   \
+  attr void name##_second(const double* t, std::size_t m, std::size_t a, std::size_t b,  \
+                          double* p) {                                                   \
+    add_terms<V, Second>(t, m, a, b, p);                                                 \
+  }                                                                                      \
+  attr void name##_third(const double* t, std::size_t m, std::size_t a, std::size_t b,   \
+                         double* p) {                                                    \
+    add_terms<V, Third>(t, m, a, b, p);                                                  \
+  }                                                                                      \
+  attr void name##_line(const double* y, std::size_t n, double* s) {                     \
+    line_sums_into<V>(y, n, s);                                                          \
+  }                                                                                      \
+  attr void name##_lag(const double* y, std::size_t n, double i, double sl, double* s) { \
+    lag_sums_into<V>(y, n, i, sl, s);                                                    \
+  }                                                                                      \
+  constexpr Kernels name{name##_second, name##_third, name##_line, name##_lag};
+
+STATION_KERNELS(kBaseline, V2, )  // SSE2 on x86-64; what the compiler makes of it elsewhere
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+STATION_KERNELS(kAvx2, V4, __attribute__((target("avx2"))))
+STATION_KERNELS(kAvx512, V8, __attribute__((target("avx512f"))))
+#endif
+
+const Kernels& kernels() {
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+  static const Kernels& chosen = []() -> const Kernels& {
+    __builtin_cpu_init();
+    if (__builtin_cpu_supports("avx512f")) return kAvx512;
+    if (__builtin_cpu_supports("avx2")) return kAvx2;
+    return kBaseline;
+  }();
+  return chosen;
+#else
+  return kBaseline;
+#endif
+}
+
+}  // namespace
+
+LineSums line_sums(std::span<const double> y) {
+  double s[2];
+  kernels().line(y.data(), y.size(), s);
+  return {s[0], s[1]};
+}
+
+LagSums residual_lag_sums(std::span<const double> y, double icpt, double slope) {
+  double s[3];
+  kernels().lag(y.data(), y.size(), icpt, slope, s);
+  return {s[0], s[1], s[2]};
+}
+
+std::vector<double> difference_sums(std::span<const double> theta,
+                                    std::span<const std::size_t> m_list, int order) {
+  const auto add = order == 3 ? kernels().third : kernels().second;
+  std::vector<std::size_t> terms(m_list.size());
+  for (std::size_t i = 0; i < m_list.size(); ++i)
+    terms[i] = theta.size() - static_cast<std::size_t>(order) * m_list[i];
+  const std::size_t most = terms.empty() ? 0 : *std::max_element(terms.begin(), terms.end());
+  std::vector<double> partial(m_list.size() * kLanes, 0.0);
+  for (std::size_t k0 = 0; k0 < most; k0 += kTile) {
+    for (std::size_t i = 0; i < m_list.size(); ++i) {
+      if (k0 >= terms[i]) continue;
+      add(theta.data(), m_list[i], k0, std::min(k0 + kTile, terms[i]), &partial[i * kLanes]);
+    }
+  }
+  std::vector<double> sums(m_list.size());
+  for (std::size_t i = 0; i < m_list.size(); ++i)
+    sums[i] = pairwise_total(&partial[i * kLanes], kLanes);
+  return sums;
+}
+
+}  // namespace station::compensation

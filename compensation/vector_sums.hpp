@@ -1,0 +1,40 @@
+// The long sums of an ADEV curve, vectorised: the sums of squared differences of the integrated
+// angle that the overlapping Allan and Hadamard variances are made of (NIST SP 1065, Riley 2008,
+// §5.2.4 eq. 11 and §5.2.8 eq. 23, with phase x = tau0 theta), for all averaging factors of a
+// curve in one sweep over the angle, and the sums the lag-1 noise identification takes of each
+// tau-averaged series (noise_id.hpp). Each sum is kept in 32 partial sums (16 for the series'
+// sums; term k into partial k mod 32, in increasing k) added pairwise at the end: the same bits on
+// every machine, whichever vector width (AVX-512, AVX2 or SSE2, picked by what the CPU has)
+// computes them.
+#pragma once
+
+#include <cstddef>
+#include <span>
+#include <vector>
+
+namespace station::compensation {
+
+/// For each factor m of `m_list` (increasing, order * m < theta.size()), the sum over
+/// k < theta.size() - order * m of the squared order-th difference of theta at lag m:
+/// (theta[k+2m] - 2 theta[k+m] + theta[k])^2 for order 2 (Allan),
+/// (theta[k+3m] - 3 theta[k+2m] + 3 theta[k+m] - theta[k])^2 for order 3 (Hadamard).
+/// The angle is swept once in tiles, every factor's terms of a tile taken while the tile is in
+/// cache (the taus' streams at lags m and 2m share it up to the cache's size). Pure.
+std::vector<double> difference_sums(std::span<const double> theta,
+                                    std::span<const std::size_t> m_list, int order);
+
+/// Sum y_t and sum t y_t over t = 0 .. n-1: what the least-squares line of y needs besides the
+/// closed forms of sum t and sum t^2. Pure.
+struct LineSums {
+  double y = 0, ty = 0;
+};
+LineSums line_sums(std::span<const double> y);
+
+/// With x_t = y_t - (icpt + slope t): sum x_t, sum x_t^2 (t < n) and sum x_t x_{t+1} (t < n-1),
+/// the lag-1 autocorrelation's sums (Riley & Greenhall 2004, eq. 2). Pure.
+struct LagSums {
+  double x = 0, xx = 0, x_next = 0;
+};
+LagSums residual_lag_sums(std::span<const double> y, double icpt, double slope);
+
+}  // namespace station::compensation
