@@ -51,6 +51,7 @@ struct RunOptions {
   std::string parts, part;          ///< --parts FILE, --part PN (--sim)
   std::vector<std::string> faults;  ///< --sim: "T:COMMAND"
   int gyros = 4;
+  std::vector<std::string> slots;   ///< --slot N=SERIAL[,PART]: the run's gyros
   std::uint64_t seed = 1;
   std::string gyro_preset = "station";
   std::string chamber_model = "generic_plc";
@@ -133,26 +134,29 @@ SequencerOptions real_hooks(const RunOptions& o, std::map<std::string, PartLimit
 // The real rig on the wall clock: the start check, the one start rule, the one host's run.
 int run_real(const RunOptions& o) {
   const StationConfig config = load_station_config(o.config);
-  if (!o.part.empty()) throw InputError("--part is for --sim; a rig's slots name their part");
-  auto part_limits = slot_part_limits(config, o.parts);  // a bad part file stops here
+  if (!o.part.empty()) throw InputError("--part is for --sim; give a rig's parts with --slot");
+  slot_part_limits(config, o.parts);  // a bad part file stops here
+  StartRequest request{load_protocol(o.protocol), o.fresh, std::nullopt, {}};
+  for (const auto& text : o.slots) request.gyros.push_back(parse_slot_gyro(text, "--slot"));
   const auto locks = lock_db_and_devices(o.db, &config);
   DeferredTap tap;
+  // The gyros are checked before the rig is touched; the rig is built naming them.
+  const StationConfig named = refuse_bad_gyros(o.db, config, request, o.parts);
   Recording rec;  // before the rig: closing the rig's GPIO still writes through the tap
   RigOptions ro;
   ro.tap = &tap;
-  Rig rig = build_rig(config, ro);
+  Rig rig = build_rig(named, ro);
   // The start check: every device read once before anything moves or the database is touched.
-  const StartRequest request{load_protocol(o.protocol), o.fresh, std::nullopt,
-                             unreachable_devices(config, rig)};
+  request.rig_problems = unreachable_devices(named, rig);
   refuse_broken_rig(o.db, request);
   Store store(o.db);
   drivers::MonotonicClock clock;
   Host host(config, rig, store, clock);
-  const StartPlan plan = host.start(request);
-  rec.start(o, tap, config, plan.protocol);
+  const StartPlan plan = host.start(request);  // the run's gyros: plan.config
+  rec.start(o, tap, plan.config, plan.protocol);
   OneRunControl control(g_stop, g_abort);
   LiveService live(live_options(o, o.db, config.name, false), control);
-  SequencerOptions so = real_hooks(o, std::move(part_limits), rec, live);
+  SequencerOptions so = real_hooks(o, slot_part_limits(plan.config, o.parts), rec, live);
   // Progress: a redrawn line on a terminal, a line every 5 minutes of run time in a log, and
   // systemd's status line under a service.
   ProgressDisplay progress(stderr, ::isatty(STDERR_FILENO) != 0, 300.0, config.bin_s,
@@ -301,6 +305,11 @@ void add_record_and_fault_options(CLI::App* cmd, RunOptions& o) {
                   "--sim: the simulated gyros' part number (default: the part file's first, in "
                   "sort order)");
 }
+  cmd->add_option("--slot", o.slots,
+                  "--config: the gyro on slot N (from 1, the order of the configuration's "
+                  "[[slot]] tables) for this run, N=SERIAL or N=SERIAL,PART; repeatable. A slot "
+                  "not given takes the configuration's serial (and part); a resume keeps the "
+                  "run's own and refuses others");
 
 }  // namespace
 
@@ -342,6 +351,8 @@ void add_run_command(CLI::App& app, CommandStatus& status) {
     on_stop_signals(on_stop_signal);
     if (!o->sim && o->speed > 0) throw InputError("--speed is for --sim (a rig runs at 1 Hz)");
     if (!o->sim && (o->config.empty() || o->db.empty())) {
+    if (o->sim && !o->slots.empty())
+      throw InputError("--slot is for --config (the simulated gyros are SIM-0001, ...)");
       throw InputError("run: give --config FILE and --db PATH, or --sim");
     }
     status.exit_code = o->sim ? run_sim(*o) : run_real(*o);

@@ -75,7 +75,7 @@ struct Service {
   Store& store;
   LiveService& live;
   ServeControl& control;
-  std::map<std::string, PartLimits> part_limits;
+  std::string parts_path;  ///< --parts (empty: the configuration's [station] parts)
   bool watchdog = false;
   std::optional<UnclosedRun> unclosed;  ///< a failed run still 'running' in the store
 };
@@ -120,7 +120,6 @@ SequencerOptions serve_hooks(Service& s, const std::string& operator_name,
   so.stop = &g_run_stop;
   so.abort = &g_run_abort;
   so.detach = &g_detach;
-  so.part_limits = s.part_limits;
   if (s.watchdog) so.watchdog = [] { sd_notify(0, "WATCHDOG=1"); };
   so.on_run_start = [&s, &run_id](std::int64_t id, const Protocol&, const std::vector<RunSlot>&) {
     run_id = id;
@@ -146,7 +145,9 @@ void run_one(Service& s, const StartPlan& plan, const std::string& operator_name
   g_run_abort.store(false);
   if (plan.resume) run_id = plan.resume->id;
   try {
-    const RunOutcome out = s.host.run(plan, serve_hooks(s, operator_name, run_id, progress));
+    SequencerOptions so = serve_hooks(s, operator_name, run_id, progress);
+    so.part_limits = slot_part_limits(plan.config, s.parts_path);  // the run's gyros' parts
+    const RunOutcome out = s.host.run(plan, std::move(so));
     s.live.hub().run_ended(out.run_id, std::string(to_string(out.state)));
     notify_status(fmt::format("idle; run {} {}", out.run_id, to_string(out.state)));
     log("serve")->info("run {} {} at t = {:.0f} s after {} ticks", out.run_id, to_string(out.state),
@@ -187,7 +188,9 @@ void idle_until_stopped(Service& s) {
     // An API start never touches another run: one left unfinished (a failed close) is refused.
     std::optional<StartPlan> plan;
     try {
-      plan = s.host.start(StartRequest{req->protocol, false, std::nullopt, {}});
+      StartRequest ask{req->protocol, false, std::nullopt, {}};
+      ask.gyros = req->gyros;
+      plan = s.host.start(ask);
       if (plan->resume)
         throw InputError(
             fmt::format("run {} is unfinished: it must be closed first", plan->resume->id));
@@ -207,6 +210,11 @@ LiveServiceOptions live_options(const ServeOptions& o, const StationConfig& conf
   lo.db_path = o.db;
   lo.info.station = config.name;
   lo.info.bin_s = config.bin_s;
+  for (std::size_t i = 0; i < config.slots.size(); ++i)  // the live page's start form
+    lo.info.rig_slots.push_back({{"slot", i + 1},
+                                 {"node", config.slots[i].node},
+                                 {"serial", config.slots[i].serial},
+                                 {"part", config.slots[i].part}});
   return lo;
 }
 
@@ -239,7 +247,7 @@ std::unique_ptr<fleet::ForwarderThread> start_forwarder(const ServeOptions& o,
 // The real rig on the wall clock, runs started over the API; the run is the one host's.
 int serve(const ServeOptions& o) {
   const StationConfig config = load_station_config(o.config);
-  auto part_limits = slot_part_limits(config, o.parts);  // a bad part file stops here
+  slot_part_limits(config, o.parts);  // a bad part file stops here
   const auto locks = lock_db_and_devices(o.db, &config);
   Rig rig = build_rig(config, {});
   if (rig.gpio) {
@@ -247,18 +255,18 @@ int serve(const ServeOptions& o) {
   }
   Store store(o.db);
   drivers::MonotonicClock clock;
-  ServeControl control(config.http.protocol_dir, g_run_stop, g_run_abort);
+  // The API's gyros are checked on its thread, before the request reaches the loop.
+  const std::string parts_path = o.parts.empty() ? config.parts_path : o.parts;
+  ServeControl control(config.http.protocol_dir, g_run_stop, g_run_abort,
+                       [&config, parts_path](const std::vector<SlotGyro>& gyros) {
+                         return gyro_problems(config, gyros, parts_path, true);
+                       });
   LiveService live(live_options(o, config), control);
   Host host(config, rig, store, clock, [&live](const RunEvent& e) { live.hub().event(e); });
   std::uint64_t watchdog_usec = 0;
-  Service s{config,
-            host,
-            store,
-            live,
-            control,
-            std::move(part_limits),
-            sd_watchdog_enabled(0, &watchdog_usec) > 0,
-            std::nullopt};
+  Service s{
+      config,      host, store, live, control, o.parts, sd_watchdog_enabled(0, &watchdog_usec) > 0,
+      std::nullopt};
   auto forwarder = start_forwarder(o, config, live);
   sd_notify(0, "READY=1");
   // A run a killed daemon left unfinished goes on first, by the one start rule; one that no

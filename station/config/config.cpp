@@ -144,9 +144,11 @@ SlotConfig read_slot(const TomlView& v) {
   const long long node = v.get_integer("node");
   if (node < 1 || node > 16) throw v.error("node", "CAN node must be 1..16");
   s.node = static_cast<int>(node);
-  s.serial = v.get_string("serial");
-  if (s.serial.empty()) throw v.error("serial", "must not be empty");
-  require_identifier_at(v, "serial", s.serial);
+  if (auto serial = v.opt_string("serial")) {  // a default: a run may give its own
+    if (serial->empty()) throw v.error("serial", "must not be empty");
+    require_identifier_at(v, "serial", *serial);
+    s.serial = *serial;
+  }
   s.pulse_weight_arcsec = v.opt_number("pulse_weight_arcsec").value_or(1.5);
   if (!(s.pulse_weight_arcsec > 0 && s.pulse_weight_arcsec < 100)) {
     throw v.error("pulse_weight_arcsec", "must be in (0, 100) arcsec");
@@ -213,7 +215,7 @@ void check_slots_unique(const TomlView& root, const std::vector<SlotConfig>& slo
   for (std::size_t i = 0; i < slots.size(); ++i) {
     const auto key = fmt::format("slot[{}]", i);
     if (!nodes.insert(slots[i].node).second) throw root.error("slot", key + ": node used twice");
-    if (!serials.insert(slots[i].serial).second)
+    if (!slots[i].serial.empty() && !serials.insert(slots[i].serial).second)
       throw root.error("slot", key + ": serial used twice");
   }
 }

@@ -25,14 +25,17 @@ using DeviceConfig = drivers::DeviceSpec;
 
 /// One gyro position on the rig.
 struct SlotConfig {
-  int node = 1;                      ///< CAN node id of its counter board, 1..16
-  std::string serial;                ///< gyro serial number
+  int node = 1;  ///< CAN node id of its counter board, 1..16
+  /// The gyro's serial number: a default for runs that give none for this slot (empty: each
+  /// run must give one, daemon/run_gyros.hpp).
+  std::string serial;
   double pulse_weight_arcsec = 1.5;  ///< angle per net pulse, arcsec
   std::string axis = "up";    ///< input axis: up, down, north, south, east, west, heading:DEG
   compensation::EnuAxis enu;  ///< the axis as a unit vector
   std::string relay;          ///< GPIO line powering this gyro (optional)
-  std::string part;           ///< part number, a key of the part file (empty: no verdict)
+  std::string part;           ///< part number, a key of the part file (empty: none); a default
   std::size_t part_line = 0;  ///< line of the `part` key, for messages naming it
+  bool gyro_given = false;    ///< serial (and part) given with the run, not the file's default
 };
 
 /// The station's hard limits, enforced by the safety layer whatever a protocol asks.

@@ -13,7 +13,7 @@ Host::Host(const StationConfig& config, Rig& rig, Store& store, drivers::Clock& 
 
 RunOutcome Host::run(const StartPlan& plan, SequencerOptions options) {
   options.replay_until_t_s = plan.replay_until_t_s;
-  Sequencer seq(config_, plan.protocol, rig_, store_, clock_, std::move(options));
+  Sequencer seq(plan.config, plan.protocol, rig_, store_, clock_, std::move(options));
   try {
     const RunOutcome out = seq.run(plan.resume);
     idle_.run_ended();  // the run drove the lamps: the next idle look writes them again

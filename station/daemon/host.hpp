@@ -27,8 +27,9 @@ class Host {
 
   /// Rules 1-5 of run_start.hpp on this host's store.
   StartPlan start(const StartRequest& request) { return start_run(store_, config_, request); }
-  /// Running: the plan's run (new or resumed) to its end. The plan decides where a resumed
-  /// simulation replays to; `options` carries the caller's hooks.
+  /// Running: the plan's run (new or resumed) to its end, on the plan's configuration (the
+  /// run's gyros). The plan decides where a resumed simulation replays to; `options` carries
+  /// the caller's hooks (`plan` must outlive the call).
   RunOutcome run(const StartPlan& plan, SequencerOptions options);
   /// Idle: one look at the rig (idle_watch.hpp).
   IdleReading look() { return idle_.look(); }

@@ -14,7 +14,8 @@ std::vector<RunSlot> run_slots_of(const StationConfig& c) {
   for (std::size_t i = 0; i < c.slots.size(); ++i) {
     const auto& s = c.slots[i];
     out.push_back({static_cast<int>(i), s.node, s.serial, s.axis, s.pulse_weight_arcsec,
-                   compensation::earth_rate_along_axis_dph(c.latitude_deg, s.enu)});
+                   compensation::earth_rate_along_axis_dph(c.latitude_deg, s.enu),
+                   s.gyro_given ? "start" : "config"});
   }
   return out;
 }

@@ -119,15 +119,15 @@ void Sequencer::note_counters(double t_s, const TickData& d, const std::string& 
         emit(t_s, Severity::warn, device, EventKind::board_reset,
              fmt::format("{}: counters restarted (reset flag, or counts or board clock went "
                          "backwards): re-baselined, no rate for this latch",
-                         r->serial),
-             {{"serial", r->serial}});
+                         config_.slots[i].serial),
+             {{"serial", config_.slots[i].serial}});
         break;
       case dr::counters::LatchChain::unproven:
         emit(t_s, Severity::warn, device, EventKind::counts_rebaselined,
              fmt::format("{}: board clock disagrees with the time since its last good latch: "
                          "continuity unproven, re-baselined, no rate for this latch",
-                         r->serial),
-             {{"serial", r->serial}});
+                         config_.slots[i].serial),
+             {{"serial", config_.slots[i].serial}});
         break;
       case dr::counters::LatchChain::first:
       case dr::counters::LatchChain::continuous:
@@ -181,18 +181,18 @@ void Sequencer::assemble_samples(double t_s, TickData& d) {
   }
   d.obs.air_c = d.in.air_c();
   if (d.obs.air_c) last_air_c_ = d.obs.air_c;
-  for (const auto& slot : config_.slots) {
+  for (std::size_t i = 0; i < config_.slots.size(); ++i) {
     SampleRow r;
-    r.serial = slot.serial;
+    r.serial = config_.slots[i].serial;
     r.t_s = t_s;
     r.recording = recording;
     r.air_c = d.obs.air_c;
     if (chamber && std::isfinite(chamber->setpoint_c)) r.setpoint_c = chamber->setpoint_c;
     r.flags = (chamber ? 0 : kChamberMissing) | (safety_.holding() ? kSafeHold : 0);
     const dr::counters::CounterReading* rd = nullptr;
-    if (d.in.counters) {
-      for (const auto& x : d.in.counters->readings) rd = x.serial == slot.serial ? &x : rd;
-    }
+    // The board of slot i (its node): the gyro on it is the run's (run_gyros.hpp), whatever
+    // serial the rig was built with.
+    if (d.in.counters && i < d.in.counters->readings.size()) rd = &d.in.counters->readings[i];
     apply_reading(rd, r);
     if (r.temp_c) d.obs.gyro_temps_c.push_back(*r.temp_c);
     d.rows.push_back(std::move(r));

@@ -6,6 +6,7 @@
 #include "station/common/logging.hpp"
 #include "station/common/text_rule.hpp"
 #include "station/http/api_runs.hpp"
+#include "station/http/api_slots.hpp"
 #include "station/http/http_server.hpp"
 #include "station/http/json_reply.hpp"
 #include "station/http/route_params.hpp"
@@ -46,7 +47,7 @@ bool HttpServer::dispatch_bodyless_post(const httplib::Request& req, httplib::Re
   return false;
 }
 
-// POST /api/runs {"protocol", "operator"}.
+// POST /api/runs {"protocol", "operator", "slots"}.
 void HttpServer::start_run(const httplib::Request& req, httplib::Response& res) {
   if (!may_write(req, res)) return;
   const auto body = nlohmann::json::parse(req.body, nullptr, false);
@@ -56,17 +57,18 @@ void HttpServer::start_run(const httplib::Request& req, httplib::Response& res) 
     return;
   }
   std::string error;
-  if (!known_keys_only(body, {"protocol", "operator"}, error)) {
+  if (!known_keys_only(body, {"protocol", "operator", "slots"}, error)) {
     send_json(res, 400, {{"error", error}});
     return;
   }
   const auto protocol = string_field(body, "protocol", 4096, error);
   const auto op = string_field(body, "operator", kMaxPersonBytes, error);
+  const auto gyros = error.empty() ? slots_field(body, error) : std::vector<SlotGyro>{};
   if (!error.empty() || !protocol || protocol->empty()) {
     send_json(res, 400, {{"error", error.empty() ? "field 'protocol' is required" : error}});
     return;
   }
-  const ControlReply r = control_.start(*protocol, op.value_or(""));
+  const ControlReply r = control_.start(*protocol, op.value_or(""), gyros);
   nlohmann::json reply = control_json(r);
   if (r.run_id > 0) reply["run_id"] = r.run_id;
   send_json(res, r.status, reply);

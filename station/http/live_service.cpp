@@ -13,7 +13,8 @@
 
 namespace station {
 
-http::ControlReply OneRunControl::start(const std::string&, const std::string&) {
+http::ControlReply OneRunControl::start(const std::string&, const std::string&,
+                                        const std::vector<SlotGyro>&) {
   return {409,
           "this daemon is `station run`: it runs one protocol; start runs with `station serve`"};
 }

@@ -24,7 +24,8 @@ struct LiveServiceOptions {
 class OneRunControl final : public http::RunControl {
  public:
   OneRunControl(std::atomic<bool>& stop, std::atomic<bool>& abort) : stop_(stop), abort_(abort) {}
-  http::ControlReply start(const std::string&, const std::string&) override;
+  http::ControlReply start(const std::string&, const std::string&,
+                           const std::vector<SlotGyro>&) override;
   http::ControlReply stop(std::int64_t run_id, bool abort) override;
 
  private:

@@ -4,6 +4,9 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
+
+#include "station/daemon/run_gyros.hpp"
 
 namespace station::http {
 
@@ -18,7 +21,9 @@ struct ControlReply {
 class RunControl {
  public:
   virtual ~RunControl() = default;
-  virtual ControlReply start(const std::string& protocol, const std::string& operator_name) = 0;
+  /// Starts `protocol` with the gyros given (slots not given: the configuration's defaults).
+  virtual ControlReply start(const std::string& protocol, const std::string& operator_name,
+                             const std::vector<SlotGyro>& gyros) = 0;
   /// Ends the running run `run_id` (the caller checked it is the running one).
   virtual ControlReply stop(std::int64_t run_id, bool abort) = 0;
 };

@@ -43,10 +43,13 @@ Protocol ServeControl::find_protocol(const std::string& name) const {
 }
 
 http::ControlReply ServeControl::start(const std::string& protocol,
-                                       const std::string& operator_name) {
+                                       const std::string& operator_name,
+                                       const std::vector<SlotGyro>& gyros) {
   Protocol p;
   try {
     p = find_protocol(protocol);
+    const auto problems = check_gyros_ ? check_gyros_(gyros) : std::vector<std::string>{};
+    if (!problems.empty()) throw InputError::lines(problems);
   } catch (const InputError& e) {
     return {400, e.what()};
   }
@@ -57,7 +60,7 @@ http::ControlReply ServeControl::start(const std::string& protocol,
   if (!fault_.empty() && storage_fault_)
     return {503, fmt::format("the station cannot record a run now: {}", fault_)};
   if (!fault_.empty()) return {409, fmt::format("the rig is not ready: {}", fault_)};
-  pending_ = ApiStart{std::move(p), operator_name};
+  pending_ = ApiStart{std::move(p), operator_name, gyros};
   const std::uint64_t mine = ++requests_;
   cv_.notify_all();
   // Answer with the run's id once the serve loop created it (it does so before any device I/O),

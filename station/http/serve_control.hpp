@@ -1,11 +1,13 @@
 // `station serve`'s run control: the API's start/stop requests handed to the serve loop. A run
 // is started by protocol name only (a shipped one, or NAME.toml in [http] protocol_dir): a
-// request never names a path.
+// request never names a path. Its gyros (the body's "slots") are checked here, before the
+// request reaches the loop: each problem is a line of the 400's error.
 #pragma once
 
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <functional>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -19,13 +21,22 @@ namespace station {
 struct ApiStart {
   Protocol protocol;
   std::string operator_name;
+  std::vector<SlotGyro> gyros;  ///< the body's slots (none: the configuration's defaults)
 };
+
+/// What is wrong with a start's gyros, one line each (run_gyros.hpp gyro_problems).
+using GyroCheck = std::function<std::vector<std::string>(const std::vector<SlotGyro>&)>;
 
 class ServeControl final : public http::RunControl {
  public:
-  ServeControl(std::string protocol_dir, std::atomic<bool>& run_stop, std::atomic<bool>& run_abort)
-      : protocol_dir_(std::move(protocol_dir)), run_stop_(run_stop), run_abort_(run_abort) {}
-  http::ControlReply start(const std::string& protocol, const std::string& operator_name) override;
+  ServeControl(std::string protocol_dir, std::atomic<bool>& run_stop, std::atomic<bool>& run_abort,
+               GyroCheck check_gyros = {})
+      : protocol_dir_(std::move(protocol_dir)),
+        run_stop_(run_stop),
+        run_abort_(run_abort),
+        check_gyros_(std::move(check_gyros)) {}
+  http::ControlReply start(const std::string& protocol, const std::string& operator_name,
+                           const std::vector<SlotGyro>& gyros) override;
   http::ControlReply stop(std::int64_t run_id, bool abort) override;
 
   /// The serve loop: the next start request, waiting up to `timeout` (or until woken).
@@ -49,6 +60,7 @@ class ServeControl final : public http::RunControl {
   const std::string protocol_dir_;
   std::atomic<bool>& run_stop_;
   std::atomic<bool>& run_abort_;
+  const GyroCheck check_gyros_;
   std::mutex mu_;
   std::condition_variable cv_;
   std::optional<ApiStart> pending_;

@@ -261,6 +261,7 @@ nlohmann::json LiveHub::status_locked() const {
       {"speed", num(info_.speed)},
       {"http", http_url_},
       {"run", run},
+      {"rig_slots", info_.rig_slots},
       {"chamber", chamber_json(live    ? last_->chamber
                                : idle_ ? idle_->in.chamber
                                        : std::nullopt)},

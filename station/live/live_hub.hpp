@@ -30,6 +30,9 @@ struct StationInfo {
   bool sim = false;
   std::optional<double> speed;  ///< simulated seconds per wall second (--speed)
   double bin_s = compensation::kPaperBinS;
+  /// The rig's slots for a start form: [{"slot", "node", "serial", "part"}], serial and part the
+  /// configuration's defaults ("" for none; run_gyros.hpp). Empty: this daemon starts no runs.
+  nlohmann::json rig_slots = nlohmann::json::array();
 };
 
 /// One event-stream message, formatted for the wire ("id: …\nevent: …\ndata: …\n\n").

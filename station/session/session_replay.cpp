@@ -15,6 +15,7 @@
 #include "station/config/config.hpp"
 #include "station/config/protocol.hpp"
 #include "station/session/replay_daemons.hpp"
+#include "station/daemon/run_gyros.hpp"
 #include "station/session/session_digest.hpp"
 #include "station/session/session_files.hpp"
 #include "station/session/session_log.hpp"
@@ -57,7 +58,22 @@ void check_version(const std::string& path, const toml::table& t) {
 }
 
 RecordedSession read_session(const std::string& path, const toml::table& t) {
-  return {parse_station_config(required_text(t, path, "config"), path + "[config]"),
+  const auto config = parse_station_config(required_text(t, path, "config"), path + "[config]");
+  return {with_gyros(config, recorded_gyros(t, config)),
+/// The recorded run's gyros: each [[slot]] serial the configuration's default does not name
+/// (given at start: daemon/run_gyros.hpp).
+std::vector<SlotGyro> recorded_gyros(const toml::table& t, const StationConfig& config) {
+  std::vector<SlotGyro> out;
+  const auto* list = t["slot"].as_array();
+  for (std::size_t i = 0; list != nullptr && i < list->size() && i < config.slots.size(); ++i) {
+    const auto* slot = (*list)[i].as_table();
+    const auto serial = slot ? (*slot)["serial"].value<std::string>() : std::nullopt;
+    if (serial && *serial != config.slots[i].serial)
+      out.push_back({static_cast<int>(i + 1), *serial, ""});
+  }
+  return out;
+}
+
           parse_protocol(required_text(t, path, "protocol"), path + "[protocol]"),
           t["sim_seed"].value<std::int64_t>(), read_session_end(path)};
 }

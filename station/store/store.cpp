@@ -55,13 +55,17 @@ std::int64_t Store::create_run(const RunInfo& info, const std::vector<RunSlot>& 
   auto gyro = db_.prepare("INSERT OR IGNORE INTO gyros (serial, first_seen_utc) VALUES (?, ?)");
   auto slot = db_.prepare(
       "INSERT INTO run_slots (run_id, slot, node, serial, pulse_weight_arcsec, axis, "
-      "earth_rate_dph) VALUES (?,?,?,?,?,?,?)");
+      "earth_rate_dph, gyro_source) VALUES (?,?,?,?,?,?,?,?)");
   for (const auto& s : slots) {
     gyro.bind(1, s.serial).bind(2, utc_now_iso());
     gyro.step();
     gyro.reset();
     slot.bind(1, id).bind(2, s.slot).bind(3, s.node).bind(4, s.serial);
     slot.bind(5, s.pulse_weight_arcsec).bind(6, s.axis).bind(7, s.earth_rate_dph);
+    if (s.gyro_source.empty())
+      slot.bind_null(8);
+    else
+      slot.bind(8, s.gyro_source);
     slot.step();
     slot.reset();
   }

@@ -67,6 +67,9 @@ struct RunSlot {
   int slot = 0, node = 0;
   std::string serial, axis;
   double pulse_weight_arcsec = 0, earth_rate_dph = 0;
+  /// Where the serial came from: "start" (given with the run), "config" (the configuration's
+  /// default); empty: not known (stored before migration 11, or not read back).
+  std::string gyro_source;
 };
 
 /// Flag bits stored with every sample (column samples.flags).

@@ -615,13 +615,11 @@
     return S.status && S.status.run ? S.status.run.id : null;
   }
 
+  // The start form (start_form.js): a field per slot for the run's gyros.
   function start() {
-    var protocol = window.prompt("Protocol (a name under the station's protocols):", "paper");
-    if (protocol === null || !protocol.trim()) return;
-    var op = window.prompt("Operator:", sessionStorage.getItem("station.operator") || "");
-    if (op === null) return;
-    sessionStorage.setItem("station.operator", op.trim());
-    post("/api/runs", {protocol: protocol.trim(), operator: op.trim()}, "start " + protocol.trim());
+    window.StartForm.open(S.status || {}, function (body) {
+      post("/api/runs", body, "start " + body.protocol);
+    });
   }
 
   function stop() {

@@ -51,16 +51,27 @@ TEST(Resume, SameSlotsContinueWithTheStoredProtocol) {
   EXPECT_FALSE(d.replay_until_t_s.has_value()) << "a rig continues at the elapsed time";
 }
 
-TEST(Resume, OtherSlotsAreRefusedNamingTheDifference) {
+TEST(Resume, ItKeepsItsOwnSerialsWhateverTheConfigurationNowSays) {
+  // Issue 35: the gyros belong to the run; the configuration's serials are defaults of new runs.
+  station::Store s(fresh_db("resume-own-serials"));
+  const auto id = start_run(s);
+  const auto d = station::start_run(s, config_with("C"), ask());
+  ASSERT_TRUE(d.resume.has_value());
+  EXPECT_EQ(d.resume->id, id);
+  EXPECT_EQ(d.config.slots[1].serial, "B");
+}
+
+TEST(Resume, OtherSerialsGivenAreRefusedNamingTheDifference) {
   station::Store s(fresh_db("resume-other"));
   start_run(s);
+  auto other = ask();
+  other.gyros = {{2, "C", ""}};
   try {
-    station::start_run(s, config_with("C"), ask());
+    station::start_run(s, config_with("B"), other);
     FAIL() << "expected InputError";
   } catch (const station::InputError& e) {
-    EXPECT_NE(
-        std::string(e.what()).find("started with slots A@1 B@2 but the configuration has A@1 C@2"),
-        std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("was started with other gyros: slot 2 serial 'B' -> 'C'"),
+              std::string::npos)
         << e.what();
     EXPECT_NE(std::string(e.what()).find("--new"), std::string::npos);
   }
