@@ -9,20 +9,28 @@
 // the term shows in the bins as much as that k2 term does: the part of it the fitted model cannot
 // absorb (its residual after least squares on B0, dT and gradT) has the same norm.
 //
-// Where no test can reach 80 % the bound is what one could: the power of the oracle test that
-// knows the noise's true covariance (generalized least squares of the extended model, the
-// candidate's z against the same Bonferroni bound: with a known covariance the most powerful
-// unbiased test of one coefficient), computed here from the sample covariance of many
-// realizations of the noise alone. Strong flicker hides a k2 = 1e-5 term from any test: the
-// oracle names it in 38 % of flicker B 0.006 realizations.
+// Where no test can reach 80 % the bound is what one could: the oracle that knows the noise's
+// true covariance (generalized least squares, computed here from the sample covariance of many
+// realizations of the noise alone). Its power, the candidate's z beyond the same Bonferroni
+// bound (with a known covariance the most powerful unbiased test of one coefficient), bounds how
+// often the fit can find the term: strong flicker hides a k2 = 1e-5 term from any test (the
+// oracle finds it in 39 % of flicker B 0.006 realizations). It does not bound naming, which must
+// also tell the term from the other candidates: a noise wander shaped like one candidate makes
+// another fit better even under the true covariance. So the oracle also names, on the same
+// realizations, the candidate of largest |z| beyond the bound (each z in the model extended by it
+// alone); under Gauss-Markov noise it finds dT3 in 0.92 and names it in 0.71. Each cell asserts
+// two shares: the fit finds the term (its own ratio beyond the bound) in at least min(0.80, the
+// oracle's power), and names it in at least min(0.80, the oracle's naming share).
 // GYRO_LACK_OF_FIT_REALIZATIONS overrides the count per cell (docs/UNCERTAINTY.md's table: 200).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "compensation/fit_diagnostics.hpp"
 #include "compensation/model_choice.hpp"
@@ -96,6 +104,36 @@ Eigen::MatrixXd noise_precision(const compensation::ModelData& design, const Lev
   return (kDraws - static_cast<double>(n) - 2) / kDraws * s.inverse();
 }
 
+/// The oracle's GLS z of each candidate in the model extended by it alone, under `precision`.
+std::vector<double> oracle_z(const compensation::ModelData& d, const Eigen::MatrixXd& precision) {
+  using compensation::Term;
+  std::vector<double> z;
+  const Eigen::Map<const Eigen::VectorXd> y(d.bias_dph.data(),
+                                            static_cast<Eigen::Index>(d.bias_dph.size()));
+  for (const Term t : {Term::dT2, Term::dT3, Term::dTdt, Term::gradTdT}) {
+    compensation::ModelSpec spec;
+    spec.terms.push_back(t);
+    const Eigen::MatrixXd x = compensation::design_matrix(d.view(), spec);
+    const Eigen::MatrixXd cov = (x.transpose() * precision * x).inverse();
+    const Eigen::VectorXd b = cov * (x.transpose() * (precision * y));
+    const Eigen::Index k = x.cols() - 1;
+    z.push_back(b(k) / std::sqrt(cov(k, k)));
+  }
+  return z;
+}
+
+/// The option the oracle names: the candidate of largest |z| beyond z_crit ("" for none).
+std::string oracle_named(const compensation::ModelData& d, const Eigen::MatrixXd& precision,
+                         double z_crit) {
+  const std::vector<double> z = oracle_z(d, precision);
+  const char* const options[] = {"dT2", "dT3", "dTdt", "gradTdT"};
+  std::string best;
+  double largest = z_crit;
+  for (std::size_t k = 0; k < z.size(); ++k)
+    if (std::abs(z[k]) > largest) largest = std::abs(z[k]), best = options[k];
+  return best;
+}
+
 /// Power of the oracle test: the candidate's GLS z, N(delta, 1), beyond +-z_crit.
 double oracle_power(const compensation::ModelData& design, const Eigen::MatrixXd& precision,
                     const Case& c, double z_crit) {
@@ -108,6 +146,13 @@ double oracle_power(const compensation::ModelData& design, const Eigen::MatrixXd
                 std::erfc((z_crit + delta) / std::sqrt(2.0)));
 }
 
+/// Whether the fit finds candidate `option` significant (its ratio beyond the bound).
+bool significant(const compensation::FitResult& fit, const std::string& option) {
+  for (const auto& c : fit.candidates)
+    if (c.option == option) return c.significant;
+  return false;
+}
+
 /// The option a fit's lack-of-fit warning names ("" when it warns of none).
 std::string named(const compensation::FitResult& fit) {
   for (const auto& w : fit.warnings) {
@@ -118,21 +163,32 @@ std::string named(const compensation::FitResult& fit) {
   return "";
 }
 
-/// Share of realizations whose fit names `c.missing` (or, for the null case, names anything).
-double share_named(const compensation::ModelData& design, const Case& c, const Levels& lv,
-                   std::uint64_t seed) {
+/// Shares of realizations whose fit, and the oracle, name `c.missing` (or, for the null case,
+/// name anything); and whose fit finds c.missing significant, named or not.
+struct Shares {
+  double station = 0, oracle = 0, significant = 0;
+};
+
+Shares shares_named(const compensation::ModelData& design, const Case& c, const Levels& lv,
+                    const Eigen::MatrixXd& precision, double z_crit, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
-  int hits = 0;
+  int hits = 0, oracle_hits = 0, found = 0;
   const int n = realizations(*c.missing == 0);
+  const auto hit = [&c](const std::string& said) {
+    return std::string(c.missing).empty() ? !said.empty() : said == c.missing;
+  };
   for (int r = 0; r < n; ++r) {
     compensation::ModelData d = design;
     for (std::size_t i = 0; i < d.bias_dph.size(); ++i)
       d.bias_dph[i] = kB0 + kK1 * (d.temp_c[i] - 25) + kK0 * d.grad_c[i] + c.extra(design, i);
     add_noise(d, lv, rng);
-    const std::string said = named(compensation::fit_model(d.view(), {}));
-    hits += std::string(c.missing).empty() ? !said.empty() : said == c.missing;
+    const compensation::FitResult fit = compensation::fit_model(d.view(), {});
+    hits += hit(named(fit));
+    found += significant(fit, c.missing);
+    oracle_hits += hit(oracle_named(d, precision, z_crit));
   }
-  return static_cast<double>(hits) / n;
+  return {static_cast<double>(hits) / n, static_cast<double>(oracle_hits) / n,
+          static_cast<double>(found) / n};
 }
 
 TEST(LackOfFit, NamesAMissingTermUnderEveryNoiseAndRarelyWarnsWithoutOne) {
@@ -143,20 +199,27 @@ TEST(LackOfFit, NamesAMissingTermUnderEveryNoiseAndRarelyWarnsWithoutOne) {
     const Eigen::MatrixXd precision = noise_precision(design, row.levels);
     std::string line = std::string("| ") + row.name;
     for (const Case& c : cases(design)) {
-      const double s = share_named(design, c, row.levels, seed++);
+      const Shares got = shares_named(design, c, row.levels, precision, kZCrit, seed++);
+      const double s = got.station;
       const int n = realizations(*c.missing == 0);
       SCOPED_TRACE(std::string(row.name) + ", missing " + (*c.missing ? c.missing : "nothing"));
       // One-sided binomial slack at 1 %: 2.33 sd of a share of n at the bound.
       const auto slack = [n](double p) { return 2.33 * std::sqrt(p * (1 - p) / n); };
       char cell[48];
       if (*c.missing == 0) {
-        std::snprintf(cell, sizeof cell, " | %.2f", s);
+        std::snprintf(cell, sizeof cell, " | %.2f (%.2f)", s, got.oracle);
         EXPECT_LE(s, 0.10 + slack(0.10)) << "false alarms";
       } else {
-        const double oracle = oracle_power(design, precision, c, kZCrit);
-        const double goal = std::min(0.80, oracle);
-        std::snprintf(cell, sizeof cell, " | %.2f (%.2f)", s, oracle);
-        EXPECT_GE(s, goal - slack(goal)) << "named too rarely; the oracle: " << oracle;
+        // Named: 80 %, or what the oracle names on the same realizations where that is less.
+        // Found significant: 80 %, or the oracle's power where that is less.
+        const double power = oracle_power(design, precision, c, kZCrit);
+        const double goal = std::min(0.80, got.oracle), found_goal = std::min(0.80, power);
+        std::snprintf(cell, sizeof cell, " | %.2f [%.2f] (%.2f; %.2f)", s, got.significant, power,
+                      got.oracle);
+        EXPECT_GE(got.significant, found_goal - slack(found_goal))
+            << "found too rarely; the oracle's power " << power;
+        EXPECT_GE(s, goal - slack(goal)) << "named too rarely; the oracle names it in "
+                                         << got.oracle << " (power " << power << ")";
       }
       line += cell;
     }
