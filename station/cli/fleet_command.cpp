@@ -1,6 +1,8 @@
-// `station fleet --pg URL [--part PN] [--since DATE] [--out DIR] [--json]`: control charts of
-// the calibrations every station forwarded (station/fleet/fleet_charts.hpp), as JSON and as a
-// self-contained page DIR/fleet.html; the points beyond a limit are listed. Read-only.
+// `station fleet --pg URL [--part PN] [--since DATE] [--out DIR] [--json] [--propose-noise]`:
+// control charts of the calibrations every station forwarded (station/fleet/fleet_charts.hpp), as
+// JSON and as a self-contained page DIR/fleet.html; the points beyond a limit are listed. With
+// --propose-noise, each part's noise from its runs (station/fleet/noise_proposal.hpp) as a
+// ready-to-paste [part."PN".noise] block, in the JSON ("noise") and on the page. Read-only.
 #include <fmt/format.h>
 
 #include <filesystem>
@@ -13,6 +15,7 @@
 #include "station/common/input_error.hpp"
 #include "station/config/fleet_config.hpp"
 #include "station/fleet/fleet_charts.hpp"
+#include "station/fleet/fleet_noise.hpp"
 #include "station/fleet/fleet_page.hpp"
 
 namespace station {
@@ -21,6 +24,7 @@ namespace {
 struct FleetOptions {
   std::string pg, part, since, out;
   bool json = false;
+  bool propose_noise = false;
 };
 
 std::string filter_text(const FleetOptions& o) {
@@ -56,7 +60,13 @@ void run_fleet(const FleetOptions& o) {
   const report::Assets assets =
       o.out.empty() ? report::Assets{} : report::read_dygraphs(std::string(report::kDygraphsDir));
   fleet::PgConnection pg({o.pg, {}});
-  const auto charts = fleet::fleet_charts_json(fleet::fleet_points(pg, f));
+  auto charts = fleet::fleet_charts_json(fleet::fleet_points(pg, f));
+  std::vector<fleet::NoiseProposal> noise;
+  if (o.propose_noise) {
+    noise = fleet::propose_noise(fleet::fleet_run_noise(pg, f));
+    charts["noise"] = nlohmann::json::array();
+    for (const auto& p : noise) charts["noise"].push_back(fleet::noise_proposal_json(p));
+  }
   if (!o.out.empty()) {
     std::filesystem::create_directories(o.out);
     const auto path = std::filesystem::path(o.out) / "fleet.html";
@@ -68,6 +78,9 @@ void run_fleet(const FleetOptions& o) {
     return;
   }
   print_outside(charts);
+  for (const auto& p : noise) fmt::print("\n{}", fleet::noise_toml(p));
+  if (o.propose_noise && noise.empty())
+    fmt::print("\nno part's noise to propose: no fit with a part number used a run\n");
 }
 
 }  // namespace
@@ -82,6 +95,11 @@ void add_fleet_command(CLI::App& app, CommandStatus& status) {
   cmd->add_option("--since", o->since, "only calibrations created at or after (ISO-8601)");
   cmd->add_option("--out", o->out, "write DIR/fleet.html");
   cmd->add_flag("--json", o->json, "print the charts as JSON");
+  cmd->add_flag("--propose-noise", o->propose_noise,
+                "propose each part's noise from its runs: the IEEE 952 terms (N, B, K) of each "
+                "run's compensated 1 Hz record (its samples must have been forwarded), their "
+                "median over at least 3 runs and a trust factor from their spread, as a "
+                "[part.\"PN\".noise] block for the part file");
   cmd->callback([o, &status] {
     run_fleet(*o);
     status.exit_code = 0;

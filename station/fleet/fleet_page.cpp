@@ -97,6 +97,29 @@ std::string outside_table(const json& part) {
   return t + "</table>\n";
 }
 
+/// `station fleet --propose-noise`: one row per part, its block to paste (noise_proposal.hpp).
+std::string noise_section(const json& noise) {
+  std::string t =
+      "<section class=\"noise\">\n<h2>The parts' noise proposed from their runs</h2>\n"
+      "<p>IEEE 952 terms fitted to each run's compensated 1 Hz record; per part the median over "
+      "its usable runs and a trust factor from their spread (README, <em>The part's "
+      "noise</em>).</p>\n<table class=\"noise\">\n" +
+      cells(
+          {"part", "runs (usable / all)", "stations (count)", "serials (count)", "N (deg/sqrt(h))",
+           "B (deg/h)", "K (deg/h/sqrt(h))", "trust factor (x/)", "part-file block"},
+          "th");
+  for (const auto& p : noise) {
+    std::vector<std::string> v;
+    for (const auto& term : p["terms"]) v.push_back(num(term["value"]));
+    t += cells({html_escape(p["part"].get<std::string>()),
+                fmt::format("{} / {}", p["usable_runs"].get<int>(), p["runs"].get<int>()),
+                std::to_string(p["stations"].get<int>()), std::to_string(p["serials"].get<int>()),
+                v[0], v[1], v[2], num(p["trust_factor"]),
+                "<pre>" + html_escape(p["toml"].get<std::string>()) + "</pre>"});
+  }
+  return t + "</table>\n</section>\n";
+}
+
 }  // namespace
 
 std::string fleet_html(const json& charts, const std::string& filter_text,
@@ -130,6 +153,7 @@ std::string fleet_html(const json& charts, const std::string& filter_text,
     ++i;
   }
   if (charts["parts"].empty()) body += "<p class=\"empty\">No calibration matches.</p>\n";
+  if (charts.contains("noise")) body += noise_section(charts["noise"]);
   return report::page_html("Fleet control charts", body, figures, assets);
 }
 
