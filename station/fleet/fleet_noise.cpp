@@ -4,8 +4,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "compensation/binning.hpp"
 #include "station/report/report_allan.hpp"
+#include "station/store/calibration.hpp"
 
 namespace station::fleet {
 namespace {
@@ -25,12 +25,11 @@ sc::FitResult stored_model(const std::string& terms, double ref_temp_c,
   return fit;
 }
 
-/// The run's bin width as it recorded it (resolved_json "bin_s"; store/calibration's rule).
+/// The run's bin width: the store's rule (store/calibration.hpp) on the central resolved_json.
 double bin_s_of(const std::optional<std::string>& resolved_json) {
-  const auto j = json::parse(resolved_json.value_or("{}"), nullptr, false);
-  if (j.is_object() && j.contains("bin_s") && j["bin_s"].is_number() && j["bin_s"] > 0)
-    return j["bin_s"].get<double>();
-  return sc::kPaperBinS;
+  RunRecord run;
+  run.resolved_json = resolved_json.value_or("{}");
+  return run_bin_s(run);
 }
 
 std::vector<SampleRow> samples_of(PgConnection& pg, const std::string& run_uuid,
