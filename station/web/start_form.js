@@ -105,6 +105,7 @@
     $("start-go").addEventListener("click", go);
     $("start-cancel").addEventListener("click", close);
     $("start-form").addEventListener("keydown", onKey);
+    $("start-form").addEventListener("input", function () { $("start-error").textContent = ""; });
   }
 
   window.StartForm = {open: open};
