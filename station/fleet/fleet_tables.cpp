@@ -33,10 +33,11 @@ const std::vector<FleetTable> kTables = {
      Merge::upsert},
     {"run_slots", Item::run,
      "run_uuid,slot,node,serial,pulse_weight_arcsec,axis,earth_rate_dph,part_number,"
-     "part_limits_json",
+     "part_limits_json,gyro_source",
      "run_uuid,slot",
      "SELECT r.uuid, s.slot, s.node, s.serial, s.pulse_weight_arcsec, s.axis, s.earth_rate_dph, "
-     "s.part_number, s.part_limits_json FROM run_slots AS s JOIN runs AS r ON r.id = s.run_id "
+     "s.part_number, s.part_limits_json, s.gyro_source FROM run_slots AS s JOIN runs AS r ON r.id "
+     "= s.run_id "
      "WHERE s.run_id = :id",
      Merge::replace_set},
     {"bins", Item::run,
