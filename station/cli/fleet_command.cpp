@@ -34,8 +34,8 @@ std::string filter_text(const FleetOptions& o) {
 
 void print_outside(const nlohmann::json& charts) {
   for (const auto& part : charts["parts"]) {
-    fmt::print("part {}: {} calibrations at {} stations, {} points beyond a limit\n",
-               part["part"].get<std::string>(), part["calibrations"].get<int>(),
+    fmt::print("{}: {} calibrations at {} stations, {} points beyond a limit\n",
+               fleet::chart_set_title(part), part["calibrations"].get<int>(),
                part["stations"].size(), part["outside"].size());
     for (const auto& o : part["outside"])
       fmt::print("  {} {} {} fit {} ({}): {:.4g} beyond the {} {}\n",

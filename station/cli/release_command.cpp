@@ -38,6 +38,7 @@ struct VerifyOptions {
   std::int64_t run_id = 0;
   std::optional<std::int64_t> fit_id;
   bool json = false;
+  bool redo = false;  ///< verify again and store a new verification beside the stored one
 };
 
 void run_release(const ReleaseOptions& o) {
@@ -162,12 +163,24 @@ int run_verify(const VerifyOptions& o) {
         fmt::format("verify: --parts {}: run {}'s slot of '{}' names no part: give "
                     "--part PN",
                     o.parts, o.run_id, o.serial));
-  VerificationResult v = verify_fit(store, *fit, o.run_id, limits);
-  save_verification(store, v);
-  if (o.json)
-    std::cout << verification_json(v).dump(2) << '\n';
-  else
+  // The same fit on the same run against the same part gives the same figures: the stored
+  // verification is reported, not stored again, unless --redo asks for a new one.
+  auto stored = o.redo ? std::nullopt : stored_verification(store, fit->id, o.run_id, limits);
+  const bool reused = stored.has_value();
+  VerificationResult v = reused ? std::move(*stored) : verify_fit(store, *fit, o.run_id, limits);
+  if (!reused) save_verification(store, v);
+  if (o.json) {
+    auto j = verification_json(v);
+    j["verification_id"] = v.id;
+    j["created_utc"] = v.created_utc;
+    j["stored_before"] = reused;
+    std::cout << j.dump(2) << '\n';
+  } else {
     print_verification(v);
+    if (reused)
+      fmt::print("  (stored {}: the same fit on the same run; --redo verifies it again)\n",
+                 v.created_utc);
+  }
   return v.verdict && !v.verdict->pass ? 1 : 0;
 }
 
@@ -226,6 +239,9 @@ void add_verify(CLI::App& app, CommandStatus& status) {
   c->add_option("--parts", o->parts, "part file (default: the limits stored with the run)");
   c->add_option("--part", o->part, "part number (default: the one the run's slot named)");
   c->add_flag("--json", o->json, "print JSON");
+  c->add_flag("--redo", o->redo,
+              "verify again and store a new verification (default: report the stored one of "
+              "this fit on this run and part)");
   c->callback([o, &status] { status.exit_code = run_verify(*o); });
 }
 

@@ -1,5 +1,7 @@
 #include "station/fleet/fleet_charts.hpp"
 
+#include <fmt/format.h>
+
 #include <map>
 #include <tuple>
 
@@ -154,6 +156,11 @@ std::vector<FleetPoint> fleet_points(PgConnection& pg, const ChartFilter& f) {
   std::vector<FleetPoint> out;
   for (int i = 0; i < r.rows(); ++i) out.push_back(point_of(r, i));
   return out;
+}
+
+std::string chart_set_title(const json& part) {
+  return fmt::format("part {}, model {}, T_ref {:g} C", part["part"].get<std::string>(),
+                     part["terms"].get<std::string>(), part["ref_temp_c"].get<double>());
 }
 
 json fleet_charts_json(const std::vector<FleetPoint>& points) {

@@ -39,6 +39,10 @@ std::vector<FleetPoint> fleet_points(PgConnection& pg, const ChartFilter& filter
 /// ranges within each station (compensation::individuals_chart with groups).
 nlohmann::json fleet_charts_json(const std::vector<FleetPoint>& points);
 
+/// What tells one chart set of `fleet_charts_json` from another, as its text says it: "part
+/// GX-200, model B0+dT+gradT, T_ref 25 C" (two sets of one part differ in model or T_ref).
+std::string chart_set_title(const nlohmann::json& part);
+
 /// The part label of a calibration without a part number.
 inline constexpr const char* kNoPart = "(no part)";
 

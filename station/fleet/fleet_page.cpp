@@ -54,7 +54,7 @@ report::Figure metric_figure(const json& chart, std::size_t part_index) {
       f.series.push_back(std::move(line));
     }
   }
-  if (x < 2) f.note = "fewer than two calibrations: no control limits";
+  if (x == 1) f.note = "one calibration: no control limits (they need two, ISO 7870-2)";
   return f;
 }
 
@@ -142,11 +142,20 @@ std::string fleet_html(const json& charts, const std::string& filter_text,
         num(part["ref_temp_c"]), part["calibrations"].get<int>(), part["stations"].size());
     body += station_table(part);
     for (const auto& c : part["charts"]) {
+      if (c["points"].empty()) {  // a coefficient this model does not have: no empty chart
+        body += fmt::format(
+            "<p class=\"no-chart\" data-metric=\"{0}\">{0}: not a term of "
+            "model {1}, no chart.</p>\n",
+            html_escape(c["metric"].get<std::string>()),
+            html_escape(part["terms"].get<std::string>()));
+        continue;
+      }
       const auto f = metric_figure(c, i);
       body += report::figure_html(f);
       auto j = report::figure_json(f);
-      // The first and last calibrations off the corners, where the x and y labels meet.
-      j["options"]["xRangePad"] = 24;
+      // Calibrations 1..n with half a place either side: the first and last off the corners,
+      // and one calibration in the middle, not on the axis.
+      j["options"]["dateWindow"] = {0.5, static_cast<double>(c["points"].size()) + 0.5};
       figures.push_back(std::move(j));
     }
     body += "<h3>Points beyond a limit</h3>\n" + outside_table(part) + "</section>\n";

@@ -47,6 +47,14 @@ void fit_drift(const sc::ModelData& bins, const std::vector<double>& after, doub
   }
 }
 
+/// The verdict of `limits` on v's figures (fewer than kMinVerifyBins bins: cannot be shown, so
+/// every limit fails, verdict.hpp's rule).
+std::optional<Verdict> judge(const PartLimits& limits, const VerificationResult& v) {
+  VerificationFigures fig{v.eval.std_after_dph, v.eval.std_ratio};
+  if (v.bins < kMinVerifyBins) fig = {NAN, std::nullopt};
+  return judge_verification(limits, fig);
+}
+
 }  // namespace
 
 VerificationResult verify_fit(Store& store, const FitRecord& fit, std::int64_t run_id,
@@ -92,9 +100,7 @@ VerificationResult verify_fit(Store& store, const FitRecord& fit, std::int64_t r
                     v.bins, kMinVerifyBins));
   if (limits) {
     v.part_number = limits->number;
-    VerificationFigures fig{v.eval.std_after_dph, v.eval.std_ratio};
-    if (!enough) fig = {NAN, std::nullopt};  // cannot be shown: fails (verdict.hpp's rule)
-    v.verdict = judge_verification(*limits, fig);
+    v.verdict = judge(*limits, v);
     if (!v.verdict)
       v.warnings.push_back(
           fmt::format("part {} sets no verification limit (max_verify_std_dph, "
@@ -177,6 +183,23 @@ std::vector<VerificationResult> verifications_of_run(Store& store, std::int64_t 
     out.push_back(std::move(v));
   }
   return out;
+}
+
+std::optional<VerificationResult> stored_verification(Store& store, std::int64_t fit_id,
+                                                      std::int64_t run_id,
+                                                      const std::optional<PartLimits>& limits) {
+  const std::optional<std::string> part =
+      limits ? std::optional<std::string>(limits->number) : std::nullopt;
+  auto all = verifications_of_run(store, run_id);
+  for (auto it = all.rbegin(); it != all.rend(); ++it) {
+    if (it->fit_id != fit_id || it->part_number != part) continue;
+    const auto now = limits ? judge(*limits, *it) : std::nullopt;
+    const auto as_json = [](const std::optional<Verdict>& v) {
+      return v ? verdict_json(*v) : json(nullptr);
+    };
+    if (as_json(now) == as_json(it->verdict)) return std::move(*it);
+  }
+  return std::nullopt;
 }
 
 }  // namespace station

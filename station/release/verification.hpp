@@ -50,6 +50,15 @@ VerificationResult verify_fit(Store& store, const FitRecord& fit, std::int64_t r
 /// Stores a verification (and an event 'verification' on its run); returns its id.
 std::int64_t save_verification(Store& store, VerificationResult& v);
 
+/// The stored verification that verifying fit `fit_id` on run `run_id` against `limits` again
+/// would repeat: the newest of that fit on that run with the same part number (none: no part)
+/// whose stored verdict is the one `limits` give its stored figures today (a part file edited
+/// since gives another, so it is not the same verification). Empty when there is none. The
+/// figures are a function of the stored fit and the run's stored bins, which do not change.
+std::optional<VerificationResult> stored_verification(Store& store, std::int64_t fit_id,
+                                                      std::int64_t run_id,
+                                                      const std::optional<PartLimits>& limits);
+
 /// The stored verifications of a run, oldest first (figures without the per-bin series: the
 /// report recomputes them with verify_fit from the stored fit).
 std::vector<VerificationResult> verifications_of_run(Store& store, std::int64_t run_id);

@@ -15,6 +15,7 @@
 #include "station/common/input_error.hpp"
 #include "station/report/report_html.hpp"
 #include "station/report/report_load.hpp"
+#include "station/report/report_page.hpp"
 #include "station/store/store.hpp"
 
 extern char** environ;
@@ -118,14 +119,12 @@ ReportFiles write_report(const ReportOptions& o) {
   ReportFiles files;
   std::vector<std::string> names;
   for (const auto& s : r.serials) {
-    names.push_back(!s.fit ? ""
-                           : fmt::format("run-{}-slot{}-{}.html", r.run.id, s.slot.slot,
-                                         file_safe(s.slot.serial)));
+    names.push_back(!s.fit ? "" : serial_page_name(r.run.id, s.slot.slot, s.slot.serial));
     if (names.back().empty()) continue;
     write_file(dir / names.back(), serial_html(r, s, assets));
     files.pages.push_back((dir / names.back()).string());
   }
-  files.index = (dir / fmt::format("run-{}.html", r.run.id)).string();
+  files.index = (dir / index_page_name(r.run.id)).string();
   write_file(files.index, index_html(r, assets, names));
   if (o.pdf) {
     std::vector<std::string> all{files.index};

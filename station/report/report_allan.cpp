@@ -16,8 +16,8 @@ bool has_coefficient(const sc::FitResult& fit, const char* name) {
   return std::find(fit.names.begin(), fit.names.end(), name) != fit.names.end();
 }
 
-/// dT/dt of each sample: the least-squares slope of the 600 s bin it falls in (what the fit saw
-/// as its kr regressor), 0 outside a bin.
+/// dT/dt of each sample: the least-squares slope of the bin (bin_s wide) it falls in (what the fit
+/// saw as its kr regressor), 0 outside a bin.
 std::vector<double> per_sample_dtdt(const std::vector<double>& t_s,
                                     const std::vector<double>& temp_c, double bin_s) {
   std::vector<double> rate(t_s.size(), 0.0), out(t_s.size(), 0.0);

@@ -79,9 +79,10 @@ std::vector<RunBin> whole_run_bins(const std::vector<SampleRow>& rows, double bi
   return out;
 }
 
-Figure figure_2a(const std::vector<RunBin>& bins) {
-  Figure f = make_figure("2a", "Bias (600 s bins) and temperatures against time", "time (h)",
-                         "bias (\u00b0/h)", "temperature (\u00b0C)");
+Figure figure_2a(const std::vector<RunBin>& bins, double bin_s) {
+  Figure f =
+      make_figure("2a", fmt::format("Bias ({:g} s bins) and temperatures against time", bin_s),
+                  "time (h)", "bias (\u00b0/h)", "temperature (\u00b0C)");
   Series bias = points("bias", {}, {}), gyro = points("gyro temperature", {}, {}),
          air = points("chamber air", {}, {});
   for (const auto& b : bins) {

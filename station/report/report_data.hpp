@@ -35,7 +35,7 @@ struct Figure {
 Figure make_figure(std::string id, std::string title, std::string x_label, std::string y_label,
                    std::string y2_label = {});
 
-/// A 600 s bin of the whole run (record window or not), for Figs. 2a/2b.
+/// A bin of the whole run (record window or not) at the run's bin width, for Figs. 2a/2b.
 struct RunBin {
   double t_mid_s = 0;       ///< bin centre, s since the run started
   double bias_dph = 0;      ///< bin mean rate minus Earth rate, deg/h
@@ -50,8 +50,9 @@ struct RunBin {
 std::vector<RunBin> whole_run_bins(const std::vector<SampleRow>& rows, double bin_s,
                                    double earth_rate_dph);
 
-/// Fig. 2a: bias and the chamber / gyro temperatures (right axis) against time in hours.
-Figure figure_2a(const std::vector<RunBin>& bins);
+/// Fig. 2a: bias and the chamber / gyro temperatures (right axis) against time in hours; the
+/// title names `bin_s`, the run's bin width (store/calibration.hpp run_bin_s).
+Figure figure_2a(const std::vector<RunBin>& bins, double bin_s);
 
 /// Temperature slope beyond which a bin counts as heating or cooling, deg C/h.
 inline constexpr double kBranchSlopeCPerH = 1.0;

@@ -60,6 +60,7 @@ json figure_options(const Figure& f, bool bars) {
          {"sigFigs", 4}};
   // Ticks and label widths: the page's script (report_script.cpp) sets them for each axis.
   o["axes"] = json::object();
+  // The value ranges: padded around the data by the page's script (StationTicks.padded).
   if (!f.y2_label.empty()) o["y2label"] = f.y2_label;
   if (f.log_axes) {
     o["logscale"] = true;
@@ -136,8 +137,11 @@ json figure_json(const Figure& f) {
         it->second.push_back(s.x[i]);
         for (std::size_t n = 0; n < f.series.size(); ++n) it->second.push_back(nullptr);
       }
-      it->second[k + 1] =
-          bars && !s.y_low.empty() ? json::array({s.y_low[i], s.y[i], s.y_high[i]}) : json(s.y[i]);
+      // With bars on, dygraphs reads every value as [low, y, high]: a series without an
+      // interval (Fig. 5b's fitted curves) is its value thrice, else it is not drawn.
+      it->second[k + 1] = !bars              ? json(s.y[i])
+                          : !s.y_low.empty() ? json::array({s.y_low[i], s.y[i], s.y_high[i]})
+                                             : json::array({s.y[i], s.y[i], s.y[i]});
     }
   }
   json data = json::array();

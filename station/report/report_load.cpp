@@ -11,6 +11,7 @@
 #include "station/common/input_error.hpp"
 #include "station/store/calibration.hpp"
 #include "station/store/fit_verdicts.hpp"
+#include "station/store/run_fits.hpp"
 
 namespace station::report {
 
@@ -34,11 +35,36 @@ std::vector<RampRun> ramp_runs(Store& store, const std::string& serial) {
   return out;
 }
 
+/// The serial's verifications on the run, oldest first; a verification identical to an earlier
+/// one (the same fit, part, figures and verdict: `verify` called again before it reported the
+/// stored one) folded into the newest copy, which names when the first was stored.
+std::vector<VerificationResult> distinct_verifications(Store& store, std::int64_t run_id,
+                                                       const std::string& serial) {
+  std::vector<VerificationResult> out;
+  std::vector<std::string> keys;  // verification_json of each as stored (part and verdict in it)
+  for (auto& v : verifications_of_run(store, run_id)) {
+    if (v.serial != serial) continue;
+    std::string key = verification_json(v).dump();
+    const auto same = std::find(keys.begin(), keys.end(), key);
+    if (same != keys.end()) {
+      const auto& first = out[static_cast<std::size_t>(same - keys.begin())];
+      v.warnings.push_back(
+          fmt::format("the same verification was stored before, on {} "
+                      "(verification {}): shown once",
+                      first.created_utc, first.id));
+      out.erase(out.begin() + (same - keys.begin()));
+      keys.erase(same);
+    }
+    out.push_back(std::move(v));
+    keys.push_back(std::move(key));
+  }
+  return out;
+}
+
 /// The verifications stored on run `run_id` for the serial, each recomputed for its series (the
 /// stored figures and verdict are kept: they are what was reported when it ran).
 void load_verifications(Store& store, std::int64_t run_id, SerialReport& s) {
-  for (auto& stored : verifications_of_run(store, run_id)) {
-    if (stored.serial != s.slot.serial) continue;
+  for (auto& stored : distinct_verifications(store, run_id, s.slot.serial)) {
     if (const auto fit = store.find_fit(stored.fit_id)) {
       const VerificationResult again = verify_fit(store, *fit, run_id, std::nullopt);
       stored.t_s = again.t_s;
@@ -61,7 +87,13 @@ SerialReport load_serial(Store& store, const RunReport& rr, const RunSlot& slot)
   s.slot = slot;
   s.current_release = current_release(store, slot.serial);
   load_verifications(store, rr.run.id, s);
-  s.fit = store.latest_fit_of_run(slot.serial, rr.run.id);
+  auto fits = fits_of_run(store, slot.serial, rr.run.id);
+  const auto own = own_fit_index(fits, rr.run.id);
+  for (std::size_t i = 0; i < fits.size(); ++i)
+    if (i != own) s.other_fits.push_back({fits[i], release_of_fit(store, fits[i].id)});
+  if (own) s.fit = std::move(fits[*own]);
+  if (s.current_release && (!s.fit || s.current_release->fit_id != s.fit->id))
+    s.current_release_fit = store.find_fit(s.current_release->fit_id);
   if (!s.fit) return s;
   s.extras = fit_extras(store, *s.fit);
   s.fit_release = release_of_fit(store, s.fit->id);
@@ -69,7 +101,7 @@ SerialReport load_serial(Store& store, const RunReport& rr, const RunSlot& slot)
   const auto bins = whole_run_bins(samples, rr.bin_s, slot.earth_rate_dph);
   const auto data = store.model_data(slot.serial, s.fit->runs);
   s.allan = allan_curves(one_hz_record(samples, slot.earth_rate_dph, s.fit->fit, rr.bin_s));
-  s.figures = {figure_2a(bins),
+  s.figures = {figure_2a(bins, rr.bin_s),
                figure_2b(bins),
                figure_3(ramp_runs(store, slot.serial)),
                figure_4(s.fit->fit, data),

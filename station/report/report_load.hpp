@@ -13,6 +13,7 @@
 #include "station/release/verification.hpp"
 #include "station/report/report_allan.hpp"
 #include "station/report/report_data.hpp"
+#include "station/report/report_model.hpp"
 #include "station/store/store.hpp"
 
 namespace station::report {
@@ -31,12 +32,17 @@ FitExtras fit_extras(Store& store, const FitRecord& rec);
 /// One serial of the run.
 struct SerialReport {
   RunSlot slot;
-  std::optional<FitRecord> fit;  ///< the newest fit that used this run; empty: none stored
+  /// The run's own fit (store/run_fits.hpp: the first fitted on this run alone); empty: none.
+  /// A later fit or release never changes it: those are `other_fits` and dated notes.
+  std::optional<FitRecord> fit;
   FitExtras extras;
-  AllanCurves allan;                          ///< for the noise terms
-  std::vector<Figure> figures;                ///< 2a, 2b, 3, 4, 5a, 5b (empty without a fit)
-  std::optional<ReleaseRow> fit_release;      ///< the newest release of this run's fit
-  std::optional<ReleaseRow> current_release;  ///< the serial's released calibration (any fit)
+  AllanCurves allan;                             ///< for the noise terms
+  std::vector<Figure> figures;                   ///< 2a, 2b, 3, 4, 5a, 5b (empty without a fit)
+  std::optional<ReleaseRow> fit_release;         ///< the newest release of this run's fit
+  std::optional<ReleaseRow> current_release;     ///< the serial's released calibration (any fit)
+  std::optional<FitRecord> current_release_fit;  ///< its fit (for its model), when not `fit`
+  std::vector<OtherFit>
+      other_fits;  ///< every other fit that used this run (later ones), oldest first
   /// Verifications stored on this run for this serial, with their per-bin series, and Fig. 6
   /// of each (same order).
   std::vector<VerificationResult> verifications;

@@ -4,9 +4,11 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <optional>
 
 #include "compensation/fit.hpp"
+#include "station/report/report_model.hpp"
 #include "station/store/fit_json.hpp"
 
 namespace station::report {
@@ -109,15 +111,37 @@ std::string evaluation_table(const FitRecord& rec) {
   return t + "</table>\n";
 }
 
+/// Above this \u03c7\u00b2/dof the curve's scatter is not what its points' own variance allows:
+/// 3 is beyond the 99.9 % point of \u03c7\u00b2/dof for 10 or more degrees of freedom (2.96 at 10;
+/// NIST/SEMATECH e-Handbook of Statistical Methods, 1.3.6.7.4).
+constexpr double kChi2FarAboveOne = 3.0;
+
+/// What a \u03c7\u00b2/dof far above 1 means for the terms in its column (compensation/allan.hpp
+/// fit_noise_terms: the standard errors are scaled by sqrt(\u03c7\u00b2/dof) when above 1).
+std::string chi2_note(const std::optional<double>& chi2, const char* column) {
+  if (!chi2 || !(*chi2 > kChi2FarAboveOne)) return "";
+  return fmt::format(
+      "<p class=\"note chi2\" data-column=\"{0}\">{0}: \u03c7\u00b2/dof {1:.3g} is far above 1: "
+      "the "
+      "four IEEE 952 terms do not describe this Allan curve (its points lie {2:.3g} times "
+      "further from the fitted curve than their own uncertainty allows: a noise or drift that "
+      "is not one of the four shapes it). The terms are the best fit of a model that does not "
+      "hold; their "
+      "&plusmn; uncertainties are already widened by \u221a(\u03c7\u00b2/dof) = {2:.3g}, which "
+      "does not make the values right.</p>\n",
+      column, *chi2, std::sqrt(*chi2));
+}
+
 std::string noise_table(const AllanCurves& a) {
   std::string t =
-      "<table class=\"noise\">\n<tr><th>noise term (IEEE 952 Table C.2), fitted over the whole "
+      "<div class=\"noise-terms\">\n<table class=\"noise\">\n<tr><th>noise term (IEEE 952 Table "
+      "C.2), fitted over the whole "
       "Allan variance (unit)</th><th>before (term's unit)</th><th>after (term's unit)</th></tr>\n";
   const auto& b = a.noise_before;
   const auto& c = a.noise_after;
   // value ± standard error of the weighted fit over the whole curve (compensation/allan.hpp).
   const auto pm = [](const std::optional<double>& v, const std::optional<double>& se) {
-    return v ? num(v) + (se ? " &plusmn; " + num(se, "{:.2g}") : std::string()) : "0 (not in fit)";
+    return v ? num(v) + (se ? " &plusmn; " + num(se, "{:.2g}") : std::string()) : "not in fit";
   };
   t += kv("quantization Q (arcsec)", {pm(b.quantization_arcsec, b.quantization_se),
                                       pm(c.quantization_arcsec, c.quantization_se)});
@@ -132,10 +156,9 @@ std::string noise_table(const AllanCurves& a) {
            pm(c.rate_random_walk_dph_rth, c.rate_random_walk_se)});
   t += kv("fit \u03c7\u00b2/dof (ratio)",
           {num(b.fit_chi2_per_dof, "{:.2f}"), num(c.fit_chi2_per_dof, "{:.2f}")});
-  return t + "</table>\n";
+  return t + "</table>\n" + chi2_note(b.fit_chi2_per_dof, "before") +
+         chi2_note(c.fit_chi2_per_dof, "after") + "</div>\n";
 }
-
-std::string release_cell(const SerialReport& s);
 
 /// Coefficient names of every serial's fit, in order of first appearance: the index's columns.
 std::vector<std::string> coefficient_columns(const RunReport& r) {
@@ -176,40 +199,6 @@ std::string serial_summary_row(const RunReport& r, std::size_t i, const std::str
   return t;
 }
 
-std::string release_line(const ReleaseRow& r) {
-  std::string t = fmt::format("fit {} released {} by {}", r.fit_id, html_escape(r.released_utc),
-                              html_escape(r.released_by));
-  if (!r.note.empty()) t += " (" + html_escape(r.note) + ")";
-  if (r.override_reason)
-    t += " <span class=\"fail\">over its verdict: " + html_escape(*r.override_reason) + "</span>";
-  return t;
-}
-
-/// Whether this run's fit is the gyro's calibration, was superseded, or was never released.
-std::string release_html(const SerialReport& s) {
-  std::string t = "<p class=\"release\">";
-  const bool current = s.fit && s.current_release && s.current_release->fit_id == s.fit->id;
-  if (current)
-    t += "<span class=\"pass\">RELEASED</span>: " + release_line(*s.current_release) +
-         ". This fit is the gyro's calibration (`station export`).";
-  else if (s.fit_release)
-    t += "Superseded: " + release_line(*s.fit_release) + "; the released calibration is now " +
-         (s.current_release ? release_line(*s.current_release) : std::string("none")) + ".";
-  else if (s.current_release)
-    t += "This run's fit is not released; the gyro's calibration is " +
-         release_line(*s.current_release) + ".";
-  else
-    t += "Not released: no fit of this gyro is released (`station release --fit ID --by NAME`).";
-  return t + "</p>\n";
-}
-
-std::string release_cell(const SerialReport& s) {
-  if (s.fit && s.current_release && s.current_release->fit_id == s.fit->id)
-    return fmt::format("<span class=\"pass\">released</span> (fit {})", s.fit->id);
-  if (s.current_release) return fmt::format("fit {} is released", s.current_release->fit_id);
-  return "not released";
-}
-
 std::string verification_rows(const VerificationResult& v) {
   std::string t;
   t += kv("calibration applied", {fmt::format("fit {} (fitted on other runs; the navigation "
@@ -227,6 +216,7 @@ std::string verification_rows(const VerificationResult& v) {
         "residual drift against T (\u00b0/h/\u00b0C)",
         {num(*v.drift_dph_per_c, "{:.3e}") + " &plusmn; " + num(v.drift_se_dph_per_c, "{:.1e}")});
   t += kv("ADEV floor, compensated 1 Hz (\u00b0/h)", {num(v.adev_floor_dph)});
+  for (const auto& w : v.warnings) t += kv("note", {html_escape(w)});
   const std::string cls = !v.verdict ? "" : (v.verdict->pass ? "pass" : "fail");
   t += kv("verdict", {fmt::format("<span class=\"verdict {}\">{}</span>", cls,
                                   html_escape(station::verdict_text(v.verdict)))});
@@ -334,15 +324,18 @@ std::string serial_html(const RunReport& r, const SerialReport& s, const Assets&
   const std::string title =
       fmt::format("Serial {}, run {}: calibration report", s.slot.serial, r.run.id);
   std::string body = "<h1>" + html_escape(title) + "</h1>\n<p>Verdict: " + verdict_html(s.extras) +
-                     "</p>\n" + release_html(s);
+                     "</p>\n" + release_html(s) + other_fits_html(s);
   json figures = json::array();
   if (s.fit) {
-    body +=
-        "<h2>Coefficients</h2>\n<p>Model B = B0 + k1&middot;&Delta;T + k0&middot;&nabla;T "
-        "(Zhou et al. 2013, eq. (4)), &Delta;T = T &minus; " +
-        num(s.fit->fit.spec.ref_temp_c) + " &deg;C.</p>\n" + coefficient_table(*s.fit, s.extras) +
-        evaluation_table(*s.fit) + "<h2>Noise terms of the 1 Hz record</h2>\n" +
-        noise_table(s.allan) + "<h2>Figures</h2>\n<div class=\"figures\">\n";
+    body += fmt::format(
+                "<h2>Coefficients</h2>\n<p class=\"model\">Fit {} ({}, runs {}), model {} "
+                "(Zhou et al. 2013, eq. (4), with this fit's terms), &Delta;T = T &minus; {} "
+                "&deg;C.</p>\n",
+                s.fit->id, html_escape(s.fit->created_utc), fmt::join(s.fit->runs, ","),
+                html_escape(model_formula(s.fit->fit)), num(s.fit->fit.spec.ref_temp_c)) +
+            coefficient_table(*s.fit, s.extras) + evaluation_table(*s.fit) +
+            "<h2>Noise terms of the 1 Hz record</h2>\n" + noise_table(s.allan) +
+            "<h2>Figures</h2>\n<div class=\"figures\">\n";
     for (const auto& f : s.figures) {
       body += figure_box(f);
       figures.push_back(figure_json(f));

@@ -30,6 +30,17 @@ std::string verdict_text(const FitExtras& e);
 /// state, start and end.
 std::string run_record_html(const RunReport& r);
 
+/// Whether the run's own fit is the gyro's calibration, was superseded, or was never released;
+/// a released fit other than the run's named with its model (report_release.cpp).
+std::string release_html(const SerialReport& s);
+
+/// The index's release cell of a serial.
+std::string release_cell(const SerialReport& s);
+
+/// <section> with every other fit that used the run (later refits, other models), dated, each
+/// with its model and release; empty when there is none.
+std::string other_fits_html(const SerialReport& s);
+
 /// <section> with the run's events in order.
 std::string events_html(const RunReport& r);
 

@@ -34,6 +34,7 @@ const std::string_view kRenderJs = R"js(
     opts.drawCallback = function (g) {
       if (settled) return;
       settled = true;
+      box.dygraph = g;  // for a test to read what was drawn
       setTimeout(function () {
         var more = tries < 3 ? T.room(g, box) : null;
         if (!more) { box.setAttribute("data-drawn", "true"); return; }
@@ -42,6 +43,35 @@ const std::string_view kRenderJs = R"js(
       }, 0);
     };
     new Dygraph(box.querySelector(".chart"), rows, opts);
+  }
+  // Per axis (x, y, y2) the [lo, hi] of the figure's values, intervals included; on a log
+  // axis only positive ones.
+  function extents(f, logX, logY) {
+    var o = f.options, ex = {x: [Infinity, -Infinity], y: [Infinity, -Infinity],
+                             y2: [Infinity, -Infinity]};
+    function add(a, v, log) {
+      if (v === null || !isFinite(v) || (log && v <= 0)) return;
+      ex[a][0] = Math.min(ex[a][0], v);
+      ex[a][1] = Math.max(ex[a][1], v);
+    }
+    f.rows.forEach(function (r) {
+      add("x", r[0], logX);
+      for (var k = 1; k < r.length; k++) {
+        var s = (o.series || {})[o.labels[k]] || {}, a = s.axis === "y2" ? "y2" : "y";
+        (Array.isArray(r[k]) ? r[k] : [r[k]]).forEach(function (v) { add(a, v, logY); });
+      }
+    });
+    return ex;
+  }
+  // The ranges padded around the data (StationTicks.padded) unless the figure sets its own.
+  function pad(f, opts) {
+    var logX = !!(opts.axes.x && opts.axes.x.logscale), logY = !!opts.logscale;
+    var ex = extents(f, logX, logY);
+    if (!opts.dateWindow && ex.x[0] <= ex.x[1]) opts.dateWindow = T.padded(ex.x[0], ex.x[1], logX);
+    ["y", "y2"].forEach(function (a) {
+      if (!opts.axes[a].valueRange && ex[a][0] <= ex[a][1])
+        opts.axes[a].valueRange = T.padded(ex[a][0], ex[a][1], logY);
+    });
   }
   var figures = JSON.parse(document.getElementById("report-figures").textContent);
   figures.forEach(function (f) {
@@ -55,6 +85,7 @@ const std::string_view kRenderJs = R"js(
       opts.axes[a].ticker = T.numeric(a === "x");
     });
     opts.axes.y2.independentTicks = true;  // its own round values, not y's positions
+    pad(f, opts);
     draw(box, f.rows, opts, 0);
   });
 })();

@@ -12,6 +12,7 @@
 //    label plus, for y and y2, the rotated axis title's strip, which dygraphs does not reserve),
 //    or null; widen(opts, more) the options with those widths. A chart that needs more room is
 //    drawn anew with them (dygraphs' updateOptions keeps the old plot outside the new plot area).
+//  - padded(lo, hi, log): a data range with room around it, for dateWindow / valueRange.
 (function () {
   "use strict";
   var FONT_PX = 14;  // dygraphs' axisLabelFontSize
@@ -140,5 +141,21 @@
     o.axes = axes;
     return o;
   }
-  window.StationTicks = {numeric: numeric, hours: hours, room: room, widen: widen, hm: hm};
+  // [lo, hi] of the data widened by PAD of its span on each side (of its decades on a log
+  // axis), so no point sits on an axis line or is cut at the plot's edge (dygraphs ends the x
+  // range at the outermost points); a single value gets +-10 % of itself (+-1 at 0).
+  var PAD = 0.05;
+  function padded(lo, hi, log) {
+    if (log && lo > 0) {
+      var a = Math.log10(lo), b = Math.log10(hi), s = b - a || 1;
+      return [Math.pow(10, a - PAD * s), Math.pow(10, b + PAD * s)];
+    }
+    if (!(hi > lo)) {
+      var d = Math.abs(lo) / 10 || 1;
+      return [lo - d, hi + d];
+    }
+    return [lo - PAD * (hi - lo), hi + PAD * (hi - lo)];
+  }
+  window.StationTicks = {numeric: numeric, hours: hours, room: room, widen: widen, hm: hm,
+                         padded: padded};
 })();

@@ -87,11 +87,22 @@ def main():
         check({f["station"] for f in h["fits"]} == {"rig-a", "rig-b"},
               "history --pg names both stations: %s" % {f["station"] for f in h["fits"]})
         check({r["station"] for r in h["runs"]} == {"rig-a", "rig-b"}, "runs of both stations")
+        # One calibration of another model (dT: no k0) at rig-a: a chart set of its own with
+        # one point per chart and no k0 chart.
+        run(station, "fit", "--db", "a.db", "--serial", serial, "--terms", "dT", cwd=work)
+        run(station, "sync", "--db", "a.db", "--pg", pg.url(), cwd=work)
 
         out = os.path.join(work, "fleet")
         charts = json.loads(run(station, "fleet", "--pg", pg.url(), "--out", out, "--json"))
         check(len(charts["parts"]) >= 1, "a part charted: %s" % charts)
+        single = [p for p in charts["parts"] if p["terms"] == "dT"]
+        check(len(single) == 1 and single[0]["calibrations"] == 1 and
+              not single[0]["charts"][1]["points"],
+              "one calibration of model dT (no gradT), no k0: %s" % [(p["terms"], p["calibrations"])
+                                                           for p in charts["parts"]])
         for part in charts["parts"]:
+            if part in single:
+                continue
             metrics = [c["metric"] for c in part["charts"]]
             check(metrics == ["k1", "k0", "B0", "std_ratio"], "the four charts: %s" % metrics)
             k1 = part["charts"][0]
@@ -111,13 +122,25 @@ def main():
             WebDriverWait(driver, 20).until(lambda d: d.execute_script(
                 "return document.querySelectorAll('[data-figure]').length > 0 && "
                 "document.querySelectorAll('[data-figure]:not([data-drawn])').length === 0"))
-            ids = ["%s-%d" % (m, i + 1) for i in range(len(charts["parts"]))
-                   for m in ("k1", "k0", "B0", "std_ratio")]
+            ids = ["%s-%d" % (c["metric"], i + 1) for i, p in enumerate(charts["parts"])
+                   for c in p["charts"] if c["points"]]
             try:
                 report_browser.check_ticks(driver, "fleet.html", ids)
                 report_browser.check_units(driver, "fleet.html")
+                # Every point inside its plot area: one calibration in the middle, not on the axis.
+                report_browser.check_drawn(driver, "fleet.html", fitted_curves=False)
             except SystemExit:  # report_browser.fail printed what failed
-                check(False, "fleet.html: the report's tick or unit checks")
+                check(False, "fleet.html: the report's tick, unit or drawn-point checks")
+            one = charts["parts"].index(single[0]) + 1 if single else 0
+            check(not driver.find_elements("css selector", '[data-figure="k0-%d"]' % one),
+                  "no empty k0 chart for model dT")
+            sec = [e for e in driver.find_elements("css selector", "section.part")
+                   if e.find_elements("css selector", '.no-chart[data-metric="k0"]')]
+            check(len(sec) == 1 and "one calibration" in sec[0].text,
+                  "the dT set says 'one calibration' and why k0 has no chart")
+            if sec:
+                os.makedirs(artifacts, exist_ok=True)
+                sec[0].screenshot(os.path.join(artifacts, "fleet-one-calibration.png"))
             severe = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
             check(not severe, "no console error: %s" % severe)
             os.makedirs(artifacts, exist_ok=True)

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <set>
+#include <string>
 
 #include "compensation/control_chart.hpp"
 #include "station/fleet/fleet_charts.hpp"
@@ -91,6 +93,25 @@ TEST(FleetCharts, ModelsAndReferenceTemperaturesAreChartedApart) {
   ASSERT_EQ(j["parts"].size(), 2u);
   EXPECT_EQ(j["parts"][0]["calibrations"].get<int>() + j["parts"][1]["calibrations"].get<int>(),
             40);
+}
+
+// Issue 35: `station fleet` printed "part (no part): ..." twice, the model that separates the two
+// chart sets unnamed. Each set's title names part, model and T_ref, and no two are alike.
+TEST(FleetCharts, EachChartSetIsNamedByPartModelAndReference) {
+  auto pts = line_of_two_stations(0);
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    pts[i].part = station::fleet::kNoPart;
+    pts[i].terms = i % 2 == 0 ? "B0+dT+gradT" : "B0+dT";
+    pts[i].ref_temp_c = i < 4 ? 20 : 25;
+  }
+  const auto j = station::fleet::fleet_charts_json(pts);
+  ASSERT_EQ(j["parts"].size(), 4u);
+  std::set<std::string> titles;
+  for (const auto& part : j["parts"]) titles.insert(station::fleet::chart_set_title(part));
+  EXPECT_EQ(titles, (std::set<std::string>{"part (no part), model B0+dT, T_ref 20 C",
+                                           "part (no part), model B0+dT, T_ref 25 C",
+                                           "part (no part), model B0+dT+gradT, T_ref 20 C",
+                                           "part (no part), model B0+dT+gradT, T_ref 25 C"}));
 }
 
 }  // namespace

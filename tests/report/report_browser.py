@@ -263,6 +263,70 @@ def check_ticks(drv, path, expect):
         fail(f"{path}: tick labels:\n  " + "\n  ".join(problems))
 
 
+# What dygraphs drew (the page keeps each Dygraph on its figure element): per series the points
+# the figure's data gives it, the points drawn with a finite value, and the drawn points closer
+# than MARGIN_PX to an edge of the plot area (on an axis line, or cut at the edge).
+MARGIN_PX = 2
+DRAWN_JS = """
+var figs = JSON.parse(document.getElementById('report-figures').textContent), out = [];
+document.querySelectorAll('[data-figure][data-drawn="true"]').forEach(function (box) {
+  var id = box.getAttribute('data-figure'), g = box.dygraph;
+  if (!g) { out.push({id: id, missing: true}); return; }
+  var f = figs.filter(function (x) { return x.id === id; })[0], a = g.getArea(), m = arguments[0];
+  var series = [];
+  g.layout_.setNames.forEach(function (name, i) {
+    var col = f.options.labels.indexOf(name), given = 0, drawn = 0, edge = [];
+    f.rows.forEach(function (r) { if (r[col] !== null) given++; });
+    g.layout_.points[i].forEach(function (p) {
+      if (typeof p.yval !== 'number' || !isFinite(p.yval)) return;
+      drawn++;
+      if (p.canvasx < a.x + m || p.canvasx > a.x + a.w - m || p.canvasy < a.y + m ||
+          p.canvasy > a.y + a.h - m) edge.push([p.xval, p.yval]);
+    });
+    series.push({name: name, given: given, drawn: drawn, edge: edge.slice(0, 3)});
+  });
+  out.push({id: id, series: series});
+});
+return out;
+""".replace("arguments[0]", str(MARGIN_PX))
+
+
+def check_drawn(drv, path, fitted_curves=True):
+    """Every point the data gives is drawn (Fig. 5b's fitted IEEE 952 curves included, which
+    dygraphs' error bars once left undrawn) and none on an axis or cut at the plot's edge."""
+    problems = []
+    figs = drv.execute_script(DRAWN_JS)
+    for f in figs:
+        if f.get("missing"):
+            problems.append(f"fig {f['id']}: no dygraph kept on its element")
+            continue
+        for s in f["series"]:
+            if s["drawn"] != s["given"]:
+                problems.append(f"fig {f['id']} '{s['name']}': {s['drawn']} of {s['given']} "
+                                "points drawn")
+            if s["edge"]:
+                problems.append(f"fig {f['id']} '{s['name']}': points within {MARGIN_PX} px of "
+                                f"the plot's edge: {s['edge']}")
+    if fitted_curves:
+        fig5b = [f for f in figs if f["id"] == "5b"]
+        names = [s["name"] for f in fig5b for s in f.get("series", []) if s["drawn"] > 1]
+        for want in ("fitted terms (before)", "fitted terms (after)"):
+            if want not in names:
+                problems.append(f"fig 5b: no curve '{want}' drawn (drawn: {names})")
+    if problems:
+        fail(f"{path}: drawn data:\n  " + "\n  ".join(problems))
+    print(f"{path}: {len(figs)} figures, every point drawn inside the plot area")
+
+
+def shoot_figures(drv, artifacts, name):
+    """A screenshot of each figure and of the noise-term table, for docs/ (README says which)."""
+    from selenium.webdriver.common.by import By
+    for el in drv.find_elements(By.CSS_SELECTOR, "[data-figure]"):
+        el.screenshot(os.path.join(artifacts, f"{name}-fig-{el.get_attribute('data-figure')}.png"))
+    for el in drv.find_elements(By.CSS_SELECTOR, "div.noise-terms"):
+        el.screenshot(os.path.join(artifacts, f"{name}-noise.png"))
+
+
 # A number in a table cell ("1.5", "-2.3e-04", "1.2e-03 ± 2e-05"): its column or row heading
 # must name its unit in parentheses; ids and counts that have none are listed here.
 CELL_NUMBER = re.compile(r"^-?\d+(\.\d+)?(e[-+]?\d+)?( ± .*)?$")
@@ -361,6 +425,8 @@ def main():
         drv.find_element(By.CSS_SELECTOR, ".figures").screenshot(figures)
         print(f"screenshots {shot} {figures}")
         check_ticks(drv, pages[0], [f for f in FIGURES if a.ramps or f != "3"])
+        check_drawn(drv, pages[0])
+        shoot_figures(drv, a.artifacts, name)
         if a.verify:
             fig6 = check_verification(drv, index, pages[0], report)
             verification = os.path.join(a.artifacts, name + "-verification.png")
@@ -368,6 +434,7 @@ def main():
             print(f"screenshot {verification}")
             check_units(drv, pages[0])
             check_ticks(drv, pages[0], ["6"])
+            check_drawn(drv, pages[0])
             # The calibration run's page: its fit is the released one.
             cal_dir = out_dir + "-calibration"
             shutil.rmtree(cal_dir, ignore_errors=True)

@@ -74,7 +74,7 @@ TEST(ReportData, WholeRunBinsCoverTheRunNotOnlyTheRecordWindowAndRemoveEarthRate
     EXPECT_NEAR(b.air_c, b.temp_c + 1.0, 1e-3);  // air over all samples, temp over the usable
     EXPECT_NEAR(b.dtdt_c_per_h, 10.0, 1e-9);
   }
-  const auto f = rp::figure_2a(bins);
+  const auto f = rp::figure_2a(bins, 600.0);
   EXPECT_EQ(f.id, "2a");
   EXPECT_EQ(f.points(), 3 * bins.size());
   EXPECT_NEAR(f.series[0].x[0], bins[0].t_mid_s / 3600.0, 1e-12);
