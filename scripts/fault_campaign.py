@@ -104,7 +104,8 @@ class Rig:
         text = open(out.name).read()
         # Short bins so a run of minutes gives a fit (the campaign is about the daemon, not the
         # paper's 600 s pulse-quantization argument).
-        text = text.replace("bin_s = 600", "bin_s = 10")
+        # (simrig prints no bin_s unless given --bin-s: the station's default is the paper's.)
+        text = text.replace("ref_temp_c = 25.0\n", "ref_temp_c = 25.0\nbin_s = 10\n", 1)
         open(self.config, "w").write(text)
 
     def send(self, *commands):

@@ -44,7 +44,8 @@ struct Options {
   std::string acutrol_framing = "bare";         // an ACUTROL's reply framing: bare or header
   std::string can_socket = "/tmp/simrig-can.sock";
   double latitude_deg = 39.9;
-  std::string control;            // fault-injection control socket, "" = none
+  int bin_s = 0;        // the printed configuration's [station] bin_s (0: none, the paper's)
+  std::string control;  // fault-injection control socket, "" = none
   std::vector<std::string> send;  // client mode: commands for a running simrig's control socket
   bool chamber_humidity = false;  // a Watlow temperature/humidity chamber (input/loop 2 %RH)
   bool chamber_cascade = false;   // an F4T with cascade control
@@ -97,13 +98,14 @@ void print_config(const sim::SimWorld& world, const Options& o) {
       "# simrig: simulated rig, seed {}, {} gyros, wall clock\n"
       "# chamber    {}\n# turntable  {}\n# can        {}\n"
       "# GPIO lines are simulated inside simrig only: this config has no [gpio].\n"
-      "[station]\nname = \"simrig\"\nlatitude_deg = {}\nref_temp_c = 25.0\nbin_s = 600\n\n"
+      "[station]\nname = \"simrig\"\nlatitude_deg = {}\nref_temp_c = 25.0\n{}\n"
       "[limits]\nmin_setpoint_c = -45.0\nmax_setpoint_c = 85.0\nmax_ramp_c_per_min = 3.0\n\n"
       "{}\n"
       "[can]\ntransport = \"{}\"\ntick_timeout_ms = 200\n",
       o.seed, o.gyros, o.chamber_model + " " + world.chamber_endpoint(),
       o.turntable_model + " " + world.turntable_endpoint(), world.can_transport(), o.latitude_deg,
-      world.devices_toml(), world.can_transport());
+      o.bin_s > 0 ? fmt::format("bin_s = {}\n", o.bin_s) : std::string(), world.devices_toml(),
+      world.can_transport());
   if (!o.control.empty())
     fmt::print("# fault commands: simrig --control {} --send 'help'\n", o.control);
   for (const auto& g : world.gyros()) {
@@ -190,6 +192,11 @@ void add_options(CLI::App& app, Options& o) {
   app.add_option("--latitude", o.latitude_deg, "site latitude, deg (Earth rate in the gyros)")
       ->capture_default_str()
       ->check(CLI::Range(-90.0, 90.0));
+  app.add_option("--bin-s", o.bin_s,
+                 "[station] bin_s of the printed configuration: the bin width, s (60 for the "
+                 "`demo` protocol, whose record lasts minutes; default: none printed, so the "
+                 "station bins as the paper does; the station checks the value)")
+      ->check(CLI::PositiveNumber);
   app.add_flag("--chamber-humidity", o.chamber_humidity,
                "Watlow: a temperature/humidity chamber (input / loop 2 reads %RH, humidity on "
                "event 2, left on at the panel)");

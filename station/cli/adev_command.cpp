@@ -130,10 +130,13 @@ void print_table(const AdevOptions& o, std::size_t n, const std::vector<sc::Adev
       "0 white FM = ARW, -1 flicker FM = bias instability, -2 random-walk FM = RRW; unmarked: "
       "lag-1 autocorrelation, b: B1 ratio (8-29 averages), *: carried from a shorter tau)\n\n",
       o.file, o.col, n, o.rate_hz, h ? "Hadamard deviation" : "Allan deviation");
-  fmt::print("  {:>12} {:>9} {:>13} {:>13} {:>13} {:>9} {:>6} {:>8}\n", "tau_s", "m",
-             h ? "hdev" : "adev", "ci_low", "ci_high", "n", "alpha", "edf");
+  // Units in the headings: tau in s, the deviation and its interval in the column's unit
+  // (deg/h, as the noise terms below assume).
+  fmt::print("  {:>12} {:>9} {:>15} {:>15} {:>15} {:>9} {:>6} {:>8}\n", "tau (s)", "m",
+             h ? "hdev (deg/h)" : "adev (deg/h)", "ci_low (deg/h)", "ci_high (deg/h)", "n", "alpha",
+             "edf");
   for (const auto& p : pts) {
-    fmt::print("  {:>12g} {:>9} {:>13.5e} {:>13.5e} {:>13.5e} {:>9} {:>5}{} {:>8.1f}\n", p.tau_s,
+    fmt::print("  {:>12g} {:>9} {:>15.5e} {:>15.5e} {:>15.5e} {:>9} {:>5}{} {:>8.1f}\n", p.tau_s,
                p.m, p.adev, p.ci_low, p.ci_high, p.n, p.alpha, method_mark(p.noise_id), p.edf);
   }
   auto line = [](const char* what, const std::optional<double>& v, const std::optional<double>& se,
@@ -141,7 +144,7 @@ void print_table(const AdevOptions& o, std::size_t n, const std::vector<sc::Adev
     if (v)
       fmt::print("  {:<26} {:.4e} +- {:.1e} {}\n", what, *v, se.value_or(NAN), unit);
     else
-      fmt::print("  {:<26} (not in the fit: zero)\n", what);
+      fmt::print("  {:<26} not in fit\n", what);
   };
   fmt::print(
       "\nnoise terms, weighted fit of the whole Allan-variance curve (IEEE 952 Table C.2; units "

@@ -6,6 +6,8 @@
 
 #include <cmath>
 
+#include "station/daemon/time_left.hpp"
+
 namespace station {
 
 ProgressDisplay::ProgressDisplay(std::FILE* out, bool terminal, double log_interval_s, double bin_s,
@@ -19,6 +21,7 @@ ProgressDisplay::ProgressDisplay(std::FILE* out, bool terminal, double log_inter
 std::string ProgressDisplay::text(const TickReport& r, long bins, double bin_s) {
   std::string s = fmt::format("run {}  {:.2f} h  step {}/{}", r.run_id, r.t_s / 3600.0,
                               r.step_index + 1, r.steps);
+  if (r.time_left_s) s += ", " + time_left_text(*r.time_left_s) + (r.step_label.empty() ? "" : ":");
   if (!r.step_label.empty()) s += " " + r.step_label;
   if (r.air_c && std::isfinite(*r.air_c)) s += fmt::format("  air {:.1f} C", *r.air_c);
   if (r.chamber) s += fmt::format("  setpoint {:.1f} C", r.chamber->setpoint_c);
@@ -30,8 +33,17 @@ std::string ProgressDisplay::text(const TickReport& r, long bins, double bin_s) 
 void ProgressDisplay::tick(const TickReport& r) {
   if (r.replaying) return;
   if (r.recording) ++recorded_ticks_;
-  const std::string line =
-      text(r, static_cast<long>(static_cast<double>(recorded_ticks_) / bin_s_), bin_s_);
+  const long bins = static_cast<long>(static_cast<double>(recorded_ticks_) / bin_s_);
+  // A safe hold extends the run: the time left stands still while it lasts.
+  if (!r.safe_hold) left_before_hold_s_ = r.time_left_s;
+  std::string line;
+  if (r.safe_hold && left_before_hold_s_ != r.time_left_s) {
+    TickReport held = r;
+    held.time_left_s = left_before_hold_s_;
+    line = text(held, bins, bin_s_);
+  } else {
+    line = text(r, bins, bin_s_);
+  }
   if (status_) status_(line);
   if (out_ == nullptr) return;
   if (terminal_) {

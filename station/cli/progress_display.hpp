@@ -4,6 +4,7 @@
 
 #include <cstdio>
 #include <functional>
+#include <optional>
 #include <string>
 
 #include "compensation/binning.hpp"
@@ -23,7 +24,8 @@ class ProgressDisplay {
   /// Ends a redrawn line (before other output or at the end of the run).
   void finish();
 
-  /// The progress text of a tick: step, its label, run time, air and setpoint, bins so far.
+  /// The progress text of a tick: step, the time left (daemon/time_left.hpp), the step's
+  /// label, run time, air and setpoint, bins so far.
   static std::string text(const TickReport& r, long bins, double bin_s = compensation::kPaperBinS);
 
  private:
@@ -32,6 +34,7 @@ class ProgressDisplay {
   double log_interval_s_, bin_s_, next_log_s_ = 0;
   std::function<void(const std::string&)> status_;
   long recorded_ticks_ = 0;
+  std::optional<double> left_before_hold_s_;  ///< the time left when a safe hold began
   bool line_open_ = false;
 };
 

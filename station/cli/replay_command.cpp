@@ -36,6 +36,7 @@ struct ReplayCommandOptions {
 // `station replay DIR`: a whole session through the daemon (station/session/session_replay.*).
 int run_session_replay(const ReplayCommandOptions& o) {
   station::ReplayOptions ro{o.log, o.db, o.rtol, o.atol};
+  ro.narrate = true;
   const ReplayReport r = replay_session(ro);
   if (o.json) {
     std::cout << r.json().dump(2) << '\n';

@@ -22,6 +22,7 @@
 #include "station/cli/exit_status.hpp"
 #include "station/cli/number_options.hpp"
 #include "station/cli/progress_display.hpp"
+#include "station/cli/run_summary.hpp"
 #include "station/cli/text_options.hpp"
 #include "station/common/logging.hpp"
 #include "station/common/process_lock.hpp"
@@ -50,8 +51,8 @@ struct RunOptions {
   std::string config, protocol = "paper", db, operator_name, log_file, record_can, record;
   std::string parts, part;          ///< --parts FILE, --part PN (--sim)
   std::vector<std::string> faults;  ///< --sim: "T:COMMAND"
-  int gyros = 4;
   std::vector<std::string> slots;   ///< --slot N=SERIAL[,PART]: the run's gyros
+  int gyros = 4;
   std::uint64_t seed = 1;
   std::string gyro_preset = "station";
   std::string chamber_model = "generic_plc";
@@ -139,9 +140,9 @@ int run_real(const RunOptions& o) {
   StartRequest request{load_protocol(o.protocol), o.fresh, std::nullopt, {}};
   for (const auto& text : o.slots) request.gyros.push_back(parse_slot_gyro(text, "--slot"));
   const auto locks = lock_db_and_devices(o.db, &config);
-  DeferredTap tap;
   // The gyros are checked before the rig is touched; the rig is built naming them.
   const StationConfig named = refuse_bad_gyros(o.db, config, request, o.parts);
+  DeferredTap tap;
   Recording rec;  // before the rig: closing the rig's GPIO still writes through the tap
   RigOptions ro;
   ro.tap = &tap;
@@ -169,9 +170,8 @@ int run_real(const RunOptions& o) {
   live.shutdown();
   if (rec.session) rec.session->finish(store, out.run_id);
   sd_notify(0, "STOPPING=1");
-  fmt::print("run {} {} at t = {:.0f} s after {} ticks\n", out.run_id, to_string(out.state),
-             out.t_s, out.ticks);
-  print_verdicts(store, out.run_id);
+  std::cout << run_summary_text(
+      rig_run_summary(store, out.run_id, to_string(out.state), out.t_s, out.ticks, o.db));
   live.exit_if_abandoned(0);
   return 0;
 }
@@ -188,8 +188,7 @@ std::vector<std::pair<double, std::string>> parse_faults(const std::vector<std::
     const auto parsed = std::from_chars(tick.data(), tick.data() + tick.size(), at_s);
     const bool digits = !tick.empty() && tick.size() <= 12 &&
                         tick.find_first_not_of("0123456789") == std::string::npos;
-    if (colon == std::string::npos || !digits || parsed.ec != std::errc() ||
-        colon + 1 >= f.size())
+    if (colon == std::string::npos || !digits || parsed.ec != std::errc() || colon + 1 >= f.size())
       throw InputError(fmt::format(
           "--fault '{}': expected TICK:COMMAND, TICK the run's second in digits (at most 12), "
           "e.g. 3000:door open",
@@ -243,7 +242,8 @@ int run_sim(const RunOptions& o) {
   if (o.json) {
     std::cout << report.dump(2) << '\n';
   } else {
-    print_sim_report(report);
+    report["report"] = report_command(db, report["run_id"].get<std::int64_t>());
+    std::cout << run_summary_text(report);
   }
   std::cout.flush();
   live.exit_if_abandoned(0);
@@ -304,12 +304,12 @@ void add_record_and_fault_options(CLI::App* cmd, RunOptions& o) {
   cmd->add_option("--part", o.part,
                   "--sim: the simulated gyros' part number (default: the part file's first, in "
                   "sort order)");
-}
   cmd->add_option("--slot", o.slots,
                   "--config: the gyro on slot N (from 1, the order of the configuration's "
                   "[[slot]] tables) for this run, N=SERIAL or N=SERIAL,PART; repeatable. A slot "
                   "not given takes the configuration's serial (and part); a resume keeps the "
                   "run's own and refuses others");
+}
 
 }  // namespace
 
@@ -350,9 +350,9 @@ void add_run_command(CLI::App& app, CommandStatus& status) {
     setup_daemon_logging(o->sim ? spdlog::level::warn : spdlog::level::info, o->log_file);
     on_stop_signals(on_stop_signal);
     if (!o->sim && o->speed > 0) throw InputError("--speed is for --sim (a rig runs at 1 Hz)");
-    if (!o->sim && (o->config.empty() || o->db.empty())) {
     if (o->sim && !o->slots.empty())
       throw InputError("--slot is for --config (the simulated gyros are SIM-0001, ...)");
+    if (!o->sim && (o->config.empty() || o->db.empty())) {
       throw InputError("run: give --config FILE and --db PATH, or --sim");
     }
     status.exit_code = o->sim ? run_sim(*o) : run_real(*o);

@@ -59,8 +59,9 @@ ProcessLock ProcessLock::acquire(const std::string& lock_path, const std::string
     const std::string holder = read_holder(fd);
     ::close(fd);
     if (err == EWOULDBLOCK) {
-      throw InputError(fmt::format("{}: {} is in use by another station process (pid {})",
-                                   lock_path, what, holder));
+      throw LockHeld(fmt::format("{}: {} is in use by another station process (pid {})", lock_path,
+                                 what, holder),
+                     holder);
     }
     throw InputError(fmt::format("{}: cannot lock {}: {}", lock_path, what, std::strerror(err)));
   }

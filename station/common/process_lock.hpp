@@ -7,14 +7,28 @@
 #include <string>
 
 #include "station/common/database_lock.hpp"
+#include "station/common/input_error.hpp"
 
 namespace station {
+
+/// The refusal of ProcessLock::acquire when another process holds the lock (its PID named).
+class LockHeld : public InputError {
+ public:
+  LockHeld(const std::string& what, std::string holder_pid)
+      : InputError(what), holder_pid_(std::move(holder_pid)) {}
+  /// The holder's pid as its lock file says it ("" when unreadable).
+  const std::string& holder_pid() const { return holder_pid_; }
+
+ private:
+  std::string holder_pid_;
+};
 
 /// A held exclusive lock on a file. Move-only; released (not deleted) in the destructor.
 class ProcessLock {
  public:
-  /// Takes the lock on `lock_path` (created 0644 when missing) without waiting; throws InputError
-  /// "PATH: held by pid N (WHAT)" when another process holds it, or naming the OS error.
+  /// Takes the lock on `lock_path` (created 0644 when missing) without waiting; throws LockHeld
+  /// "PATH: WHAT is in use by another station process (pid N)" when another process holds it,
+  /// InputError naming the OS error otherwise.
   static ProcessLock acquire(const std::string& lock_path, const std::string& what);
   /// Takes the writer's lock on the database file itself (DatabaseHold::writer: its inode, so
   /// every name of it — a hard link, a symlink, `./`, `..` — is the same lock), before anything

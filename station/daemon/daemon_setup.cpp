@@ -8,7 +8,6 @@
 
 #include "station/common/logging.hpp"
 #include "station/daemon/device_identity.hpp"
-#include "station/parts/judged_fit.hpp"
 
 namespace station {
 
@@ -37,8 +36,14 @@ std::vector<ProcessLock> lock_db_and_devices(const std::string& db, const Statio
   std::vector<ProcessLock> locks;
   locks.push_back(ProcessLock::acquire_database(db));
   if (config == nullptr) return locks;
-  std::vector<std::string> endpoints{config->chamber.endpoint, config->can_transport};
-  if (config->turntable) endpoints.push_back(config->turntable->endpoint);
+  for (auto& l : lock_devices(*config)) locks.push_back(std::move(l));
+  return locks;
+}
+
+std::vector<ProcessLock> lock_devices(const StationConfig& config) {
+  std::vector<ProcessLock> locks;
+  std::vector<std::string> endpoints{config.chamber.endpoint, config.can_transport};
+  if (config.turntable) endpoints.push_back(config.turntable->endpoint);
   // Keyed on what each endpoint reaches, not on its spelling (device_identity.hpp).
   for (const auto& e : endpoints) {
     for (const auto& id : device_identities(e)) {
@@ -48,19 +53,6 @@ std::vector<ProcessLock> lock_db_and_devices(const std::string& db, const Statio
     }
   }
   return locks;
-}
-
-/// Each slot's fit and verdict of run `run_id`, one line per slot.
-void print_verdicts(Store& store, std::int64_t run_id) {
-  for (const auto& slot : store.run_slots(run_id)) {
-    const auto fit = store.latest_fit(slot.serial);
-    if (!fit || fit->runs != std::vector<std::int64_t>{run_id}) {
-      fmt::print("  {}: no fit\n", slot.serial);
-      continue;
-    }
-    fmt::print("  {}: fit {}: {}\n", slot.serial, fit->id,
-               verdict_text(stored_verdict(store, fit->id)));
-  }
 }
 
 }  // namespace station

@@ -1,5 +1,5 @@
 // What the daemon commands (run, serve) share before and after a run: process locks, the peek
-// for an unfinished run, the verdict lines.
+// for an unfinished run.
 #pragma once
 
 #include <spdlog/common.h>
@@ -23,7 +23,8 @@ void on_stop_signals(void (*handler)(int));
 void setup_daemon_logging(spdlog::level::level_enum console_level, const std::string& log_file);
 /// One daemon per database (and, on a real rig, per device): held until the process ends.
 std::vector<ProcessLock> lock_db_and_devices(const std::string& db, const StationConfig* config);
-/// Each slot's fit and verdict of run `run_id`, one line per slot on stdout.
-void print_verdicts(Store& store, std::int64_t run_id);
+/// The device locks alone (lock_db_and_devices without the database), as `probe` takes them
+/// while it reads the devices; throws InputError naming the holder when one is held.
+std::vector<ProcessLock> lock_devices(const StationConfig& config);
 
 }  // namespace station

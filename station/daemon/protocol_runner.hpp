@@ -61,6 +61,8 @@ class ProtocolRunner {
   const RunProgress& progress() const { return progress_; }
   /// The chamber setpoint the protocol has asked for (deg C), if any yet.
   std::optional<double> setpoint_c() const { return setpoint_c_; }
+  /// The setpoint the current ramp last commanded (empty: none yet, or no ramp).
+  std::optional<double> ramp_point_c() const { return ramp_sent_c_; }
 
  private:
   void enter(const Step& s, const Observation& obs, Actions& a);

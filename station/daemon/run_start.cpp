@@ -7,6 +7,7 @@
 
 #include "station/common/logging.hpp"
 #include "station/daemon/resume.hpp"
+#include "station/parts/part_coverage.hpp"
 
 namespace station {
 
@@ -73,7 +74,10 @@ StationConfig refuse_bad_gyros(const std::string& db, const StationConfig& confi
   const auto problems = gyro_problems(config, request.gyros,
                                       parts_path.empty() ? config.parts_path : parts_path, new_run);
   if (!problems.empty()) throw InputError::lines(problems);
-  return new_run ? with_gyros(config, request.gyros) : config;
+  if (!new_run) return config;
+  StationConfig named = with_gyros(config, request.gyros);
+  warn_slots_without_part(named, parts_path);  // before any device: judged against nothing
+  return named;
 }
 
 StartPlan start_run(Store& store, const StationConfig& rig_config, const StartRequest& request) {

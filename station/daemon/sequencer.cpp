@@ -12,6 +12,7 @@
 #include "station/common/logging.hpp"
 #include "station/daemon/sample.hpp"
 #include "station/daemon/stopwatch.hpp"
+#include "station/daemon/time_left.hpp"
 
 namespace station {
 
@@ -293,6 +294,9 @@ TickReport Sequencer::report(double t_s, const TickData& d) const {
   r.recording = runner_->progress().recording;
   r.target_c = runner_->setpoint_c();
   r.start_temp_c = runner_->progress().start_temp_c;
+  r.time_left_s =
+      station::time_left_s(protocol_, {r.step_index, t_s - runner_->progress().step_started_s,
+                                       r.start_temp_c, runner_->ramp_point_c(), r.target_c});
   r.safe_hold = safety_.holding();
   r.air_c = d.obs.air_c;
   r.run_id = run_id_;

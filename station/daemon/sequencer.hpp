@@ -49,6 +49,7 @@ struct TickReport {
   std::string step_label;
   std::optional<double> target_c;      ///< the protocol's target in force (a ramp's end), deg C
   std::optional<double> start_temp_c;  ///< the run's start temperature (to_start steps), deg C
+  std::optional<double> time_left_s;   ///< by the protocol's steps (daemon/time_left.hpp)
   std::optional<drivers::ChamberState> chamber;  ///< empty: not read this tick
   std::optional<drivers::TurntableState> table;
   std::optional<bool> door_closed, estop_pressed, table_interlock_open;  ///< safety inputs

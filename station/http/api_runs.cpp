@@ -1,9 +1,13 @@
 // Run queries for the API: plain SQL on a read-only connection (WAL: never blocks the writer).
 #include "station/http/api_runs.hpp"
 
+#include "station/parts/judged_fit.hpp"
+#include "station/parts/run_results.hpp"
 #include "station/release/releases.hpp"
 #include "station/release/verification.hpp"
+#include "station/report/report_page.hpp"
 #include "station/store/fit_json.hpp"
+#include "station/store/run_fits.hpp"
 
 namespace station::http {
 
@@ -58,6 +62,7 @@ std::optional<nlohmann::json> run_json(Store& store, std::int64_t run_id) {
   if (!st.step()) return std::nullopt;
   nlohmann::json j = run_row(st);
   nlohmann::json slots = nlohmann::json::array();
+  bool any_fit = false;
   for (const auto& s : store.run_slots(run_id)) {
     nlohmann::json slot{{"slot", s.slot},
                         {"node", s.node},
@@ -65,7 +70,7 @@ std::optional<nlohmann::json> run_json(Store& store, std::int64_t run_id) {
                         {"axis", s.axis},
                         {"earth_rate_dph", s.earth_rate_dph},
                         {"fit", nullptr}};
-    if (const auto f = store.latest_fit_of_run(s.serial, run_id)) {
+    if (const auto f = own_fit_of_run(store, s.serial, run_id)) {  // store/run_fits.hpp
       slot["fit"] = {{"id", f->id},
                      {"terms", f->terms},
                      {"coefficients", coefficients_json(f->fit)},
@@ -74,6 +79,11 @@ std::optional<nlohmann::json> run_json(Store& store, std::int64_t run_id) {
                      {"std_before_dph", f->eval.std_before_dph},
                      {"std_after_dph", f->eval.std_after_dph},
                      {"std_ratio", std_ratio_json(f->eval)}};
+      const auto verdict = stored_verdict(store, f->id);  // null: judged against no part
+      slot["fit"]["part_number"] = verdict ? nlohmann::json(verdict->part_number) : nullptr;
+      slot["fit"]["verdict"] = verdict ? verdict_json(*verdict) : nullptr;
+      slot["fit"]["verdict_text"] = slot_verdict_text(verdict, s.slot);
+      any_fit = true;
     }
     // The serial's released calibration (it may come from another run) and its release.
     slot["released"] = nullptr;
@@ -81,6 +91,8 @@ std::optional<nlohmann::json> run_json(Store& store, std::int64_t run_id) {
     slots.push_back(std::move(slot));
   }
   j["slots"] = std::move(slots);
+  // Its report, served from the store (GET /reports/NAME): a run without a fit has none.
+  j["report"] = any_fit ? nlohmann::json("/reports/" + report::index_page_name(run_id)) : nullptr;
   nlohmann::json verifications = nlohmann::json::array();
   for (const auto& v : verifications_of_run(store, run_id))
     verifications.push_back(verification_json(v));

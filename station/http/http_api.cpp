@@ -4,10 +4,12 @@
 
 #include <algorithm>
 
+#include "station/common/input_error.hpp"
 #include "station/http/api_runs.hpp"
 #include "station/http/http_server.hpp"
 #include "station/http/json_reply.hpp"
 #include "station/http/route_params.hpp"
+#include "station/report/report_page.hpp"
 #include "station/store/sqlite.hpp"
 
 // Last: httplib.h (also through bounded_server.hpp) pulls in <resolv.h>, whose `_res` macro
@@ -72,6 +74,32 @@ void HttpServer::get_run(const httplib::Request& req, httplib::Response& res) {
   const auto id = path_id(req, res, "run id");
   if (!id) return;
   db_read(req, res, [&](Store& st) { send_run_json(res, *id, run_json(st, *id)); });
+}
+
+// A finished run's report, each page rendered from the store as `station report` writes it
+// (report/report_page.hpp). The pages are self-contained with inline scripts and styles: their
+// own policy allows those and nothing from anywhere (their data is JSON the script escapes).
+void HttpServer::get_report(const httplib::Request& req, httplib::Response& res) {
+  const std::string name = req.matches[1].str();
+  db_read(req, res, [&](Store& st) {
+    try {
+      const auto page = report::report_page(st, name, options_.dygraphs_dir);
+      if (!page) {
+        send_json(res, 404,
+                  {{"error", fmt::format("no report page '{}': run-ID.html or "
+                                         "run-ID-slotN-SERIAL.html of a run in this database",
+                                         name.substr(0, 120))}});
+        return;
+      }
+      res.headers.erase("Content-Security-Policy");
+      res.set_header("Content-Security-Policy",
+                     "default-src 'none'; script-src 'unsafe-inline'; style-src 'unsafe-inline'; "
+                     "img-src data:; frame-ancestors 'none'");
+      res.set_content(*page, "text/html; charset=utf-8");
+    } catch (const InputError& e) {  // e.g. libjs-dygraphs missing: the station's fault
+      send_json(res, 500, {{"error", fmt::format("cannot render the report: {}", e.what())}});
+    }
+  });
 }
 
 void HttpServer::get_bins(const httplib::Request& req, httplib::Response& res) {

@@ -25,6 +25,7 @@ std::span<const HttpServer::Route> HttpServer::route_table() {
       {"GET", "/api/runs/{id}", R"(/api/runs/([^/]+))", &S::get_run},
       {"GET", "/api/runs/{id}/bins", R"(/api/runs/([^/]+)/bins)", &S::get_bins},
       {"GET", "/api/runs/{id}/events", R"(/api/runs/([^/]+)/events)", &S::get_events},
+      {"GET", "/reports/NAME", R"(/reports/([^/]+))", &S::get_report},
       {"GET", "/api/events/stream", "/api/events/stream", &S::event_stream},
       {"POST", "/api/runs", "/api/runs", &S::start_run},
       {"POST", "/api/runs/{id}/stop", R"(/api/runs/([^/]+)/stop)", &S::stop_run},

@@ -2,6 +2,7 @@
 #include "station/live/live_hub.hpp"
 
 #include <fmt/format.h>
+#include <unistd.h>
 
 #include <cmath>
 
@@ -247,21 +248,23 @@ nlohmann::json LiveHub::status_locked() const {
            {"target_c", num(last_ ? last_->target_c : std::nullopt)},
            {"steps", steps_json(protocol_, last_ ? last_->start_temp_c : std::nullopt)}};
   }
+  const bool live = run_id_ && last_;
   nlohmann::json slots = nlohmann::json::array();
-  for (const auto& s : last_rows_) {
+  for (const auto& s : live ? last_rows_ : std::vector<SampleRow>{}) {
     auto j = slot_json(s);
     j["rate_dph"] = num(s.rate_dph);
     slots.push_back(std::move(j));
   }
-  const bool live = run_id_ && last_;
   nlohmann::json j{
       {"state", state_locked()},
       {"station", info_.station},
+      {"pid", static_cast<long>(::getpid())},  // who answers: `probe` checks it holds the rig
       {"sim", info_.sim},
       {"speed", num(info_.speed)},
+      {"bin_s", info_.bin_s},
       {"http", http_url_},
-      {"run", run},
       {"rig_slots", info_.rig_slots},
+      {"run", run},
       {"chamber", chamber_json(live    ? last_->chamber
                                : idle_ ? idle_->in.chamber
                                        : std::nullopt)},

@@ -166,11 +166,12 @@ std::vector<SessionResume> replayable_resumes(const std::string& dir,
 class DaemonReplay {
  public:
   DaemonReplay(const std::string& dir, const RecordedSession& session, Store& store,
-               ReplayReport& report)
+               ReplayReport& report, std::function<void(double)> on_tick)
       : dir_(dir),
         session_(session),
         store_(store),
         report_(report),
+        on_tick_(std::move(on_tick)),
         resumes_(replayable_resumes(dir, session)),
         logs_(dir) {}
 
@@ -235,8 +236,11 @@ class DaemonReplay {
     so.abort = &abort;
     so.on_tick = [&](const TickReport& r) { after_tick(r.t_s, k, devices, stop, abort); };
     // A daemon killed before it sent its first SYNC ends before its first tick here too.
-    if (killed && resumes_[k].after_tick_s < 0 && !sent_a_sync(k))
-      so.before_tick = [](double) { throw KilledHere{}; };
+    const bool killed_first = killed && resumes_[k].after_tick_s < 0 && !sent_a_sync(k);
+    so.before_tick = [this, killed_first](double t_s) {
+      if (killed_first) throw KilledHere{};
+      if (on_tick_) on_tick_(t_s);
+    };
     try {
       const auto out = host.run(plan, std::move(so));
       if (!killed) return out.run_id;
@@ -297,6 +301,7 @@ class DaemonReplay {
   const RecordedSession& session_;
   Store& store_;
   ReplayReport& report_;
+  const std::function<void(double)> on_tick_;
   const std::vector<SessionResume> resumes_;
   SessionLogs logs_;
   // The part of the recording a segment's daemon asks first: a resumed simulation recomputes
@@ -310,8 +315,8 @@ class DaemonReplay {
 }  // namespace
 
 std::int64_t replay_daemons(const std::string& dir, const RecordedSession& session, Store& store,
-                            ReplayReport& report) {
-  return DaemonReplay(dir, session, store, report).run();
+                            ReplayReport& report, const std::function<void(double t_s)>& on_tick) {
+  return DaemonReplay(dir, session, store, report, on_tick).run();
 }
 
 }  // namespace station

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -21,13 +22,16 @@ struct RecordedSession {
   Protocol protocol;
   std::optional<std::int64_t> sim_seed;
   SessionEnd end;
+  std::string started_utc;  ///< when the run started ("2026-11-23T06:00:00Z")
 };
 
 /// Replays the session in `dir` into `store`; returns the run's id, or 0 when a divergence ended
 /// it (then `report` says where: same = false, first_difference, notes, ticks). Throws
 /// InputError when the recording cannot be replayed (a resume without its keys, a recording
 /// that starts mid-run, a run that ended before its recorded kill).
+/// `on_tick` (optional) is told each tick's t_s before it is replayed.
 std::int64_t replay_daemons(const std::string& dir, const RecordedSession& session, Store& store,
-                            ReplayReport& report);
+                            ReplayReport& report,
+                            const std::function<void(double t_s)>& on_tick = {});
 
 }  // namespace station

@@ -10,12 +10,14 @@
 #include <filesystem>
 #include <fstream>
 #include <future>
+#include <optional>
 
 #include "station/common/input_error.hpp"
 #include "station/config/config.hpp"
 #include "station/config/protocol.hpp"
-#include "station/session/replay_daemons.hpp"
 #include "station/daemon/run_gyros.hpp"
+#include "station/session/replay_daemons.hpp"
+#include "station/session/replay_narration.hpp"
 #include "station/session/session_digest.hpp"
 #include "station/session/session_files.hpp"
 #include "station/session/session_log.hpp"
@@ -57,9 +59,6 @@ void check_version(const std::string& path, const toml::table& t) {
                   path, version ? std::to_string(*version) : "missing", kSessionFormatVersion));
 }
 
-RecordedSession read_session(const std::string& path, const toml::table& t) {
-  const auto config = parse_station_config(required_text(t, path, "config"), path + "[config]");
-  return {with_gyros(config, recorded_gyros(t, config)),
 /// The recorded run's gyros: each [[slot]] serial the configuration's default does not name
 /// (given at start: daemon/run_gyros.hpp).
 std::vector<SlotGyro> recorded_gyros(const toml::table& t, const StationConfig& config) {
@@ -74,8 +73,12 @@ std::vector<SlotGyro> recorded_gyros(const toml::table& t, const StationConfig& 
   return out;
 }
 
+RecordedSession read_session(const std::string& path, const toml::table& t) {
+  const auto config = parse_station_config(required_text(t, path, "config"), path + "[config]");
+  return {with_gyros(config, recorded_gyros(t, config)),
           parse_protocol(required_text(t, path, "protocol"), path + "[protocol]"),
-          t["sim_seed"].value<std::int64_t>(), read_session_end(path)};
+          t["sim_seed"].value<std::int64_t>(), read_session_end(path),
+          t["started_utc"].value<std::string>().value_or("")};
 }
 
 std::string fresh_db_path(const ReplayOptions& o) {
@@ -123,7 +126,11 @@ ReplayReport replay_and_compare(const ReplayOptions& o, const RecordedSession& s
   {
     Store store(db);
     store.set_ticks_per_commit(600);  // nothing to lose: the recording is the record
-    const std::int64_t run_id = replay_daemons(o.dir, session, store, report);
+    std::optional<ReplayNarration> narration;
+    if (o.narrate) narration.emplace(session.started_utc, session.end.last_tick_s);
+    const std::int64_t run_id = replay_daemons(o.dir, session, store, report, [&](double t_s) {
+      if (narration) narration->at(t_s);
+    });
     if (run_id != 0) {
       store.flush();
       report = compare_with_store(recorded.get(), result_path, store, run_id, o.rtol, o.atol);

@@ -22,6 +22,10 @@ struct ReplayOptions {
   /// Check the files against digest.txt first (a mismatch: differs, naming the file and line).
   /// Off only in tests that change a recording on purpose to see what the daemon makes of it.
   bool verify = true;
+  /// Say it is a replay on stderr: the replayed daemon's log lines stamped "replayed, recorded
+  /// TIME" (the recording's time, not now) and a progress line at each tenth of the run
+  /// (replay_narration.hpp). `station replay` sets it; the comparison never sees it.
+  bool narrate = false;
 };
 
 /// What a replay found.

@@ -19,10 +19,10 @@
 #include "station/daemon/host.hpp"
 #include "station/daemon/rig.hpp"
 #include "station/parts/judged_fit.hpp"
+#include "station/parts/run_results.hpp"
 #include "station/session/session_recording.hpp"
 #include "station/sim/paced_clock.hpp"
 #include "station/store/calibration.hpp"
-#include "station/store/fit_json.hpp"
 
 namespace station {
 namespace {
@@ -62,25 +62,14 @@ std::string sim_config_text(sim::SimWorld& world, const SimRunOptions& o,
   return t;
 }
 
-nlohmann::json gyro_report(Store& store, std::int64_t run_id, const sim::SimGyro& g) {
-  nlohmann::json j{{"serial", g.serial},
-                   {"true", {{"B0", g.truth.B0_dph}, {"k1", g.truth.k1}, {"k0", g.truth.k0}}}};
-  const auto fit = store.latest_fit(g.serial);
-  if (!fit || fit->runs != std::vector<std::int64_t>{run_id}) {
-    j["error"] = "no fit for this run";
-    return j;
-  }
-  j["fitted"] = coefficients_json(fit->fit);
-  j["units"] = units_json(fit->fit);
-  j["std_errors"] = std_errors_json(fit->fit);
-  j["std_errors_ols"] = std_errors_ols_json(fit->fit);
-  j["bins"] = fit->fit.n_points;
-  j["std_before_dph"] = fit->eval.std_before_dph;
-  j["std_after_dph"] = fit->eval.std_after_dph;
-  j["std_ratio"] = std_ratio_json(fit->eval);  // null when undefined
-  const auto verdict = stored_verdict(store, fit->id);
-  j["part_number"] = verdict ? nlohmann::json(verdict->part_number) : nlohmann::json(nullptr);
-  j["verdict"] = verdict ? verdict_json(*verdict) : nlohmann::json(nullptr);
+/// A simulated gyro's result: the run's result of its slot (parts/run_results; `slot` the stored
+/// index, from 0) and its truth.
+nlohmann::json gyro_report(Store& store, std::int64_t run_id, int slot, const sim::SimGyro& g) {
+  RunSlot s;
+  s.slot = slot;
+  s.serial = g.serial;
+  nlohmann::json j = slot_result_json(store, run_id, s);
+  j["true"] = {{"B0", g.truth.B0_dph}, {"k1", g.truth.k1}, {"k0", g.truth.k0}};
   return j;
 }
 
@@ -290,7 +279,9 @@ nlohmann::json sim_report(Store& store, const RunOutcome& out, const sim::SimWor
       {"wall_s",
        std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count()},
       {"gyros", nlohmann::json::array()}};
-  for (const auto& g : world.gyros()) report["gyros"].push_back(gyro_report(store, out.run_id, g));
+  for (std::size_t i = 0; i < world.gyros().size(); ++i)
+    report["gyros"].push_back(
+        gyro_report(store, out.run_id, static_cast<int>(i), world.gyros()[i]));
   return report;
 }
 
@@ -336,76 +327,6 @@ nlohmann::json run_simulated(const SimRunOptions& o) {
   report_faults_not_run(o, out.t_s);
   if (rec.session) rec.session->finish(store, out.run_id);
   return sim_report(store, out, world, wall_start);
-}
-
-namespace {
-
-void print_verifications(const nlohmann::json& r) {
-  if (!r.contains("verifications")) return;
-  fmt::print("\ncalibration run {}; released:", r["calibration_run"]["run_id"].get<long>());
-  for (const auto& x : r["releases"])
-    fmt::print(" {} (fit {}{})", x["serial"].get<std::string>(), x["fit_id"].get<long>(),
-               x["released"].get<bool>() ? "" : ", NOT released: verdict failed");
-  fmt::print("\nverification on run {} (the calibration applied to a run it was not fitted on):\n",
-             r["run_id"].get<long>());
-  fmt::print("{:<10} {:>5} {:>13} {:>13} {:>6} {:>14}  verdict\n", "serial", "fit", "std bef deg/h",
-             "std aft deg/h", "ratio", "mean res deg/h");
-  for (const auto& v : r["verifications"]) {
-    if (v.contains("error")) {
-      fmt::print("{:<10} {:>5} {}\n", v["serial"].get<std::string>(), v["fit_id"].get<long>(),
-                 v["error"].get<std::string>());
-      continue;
-    }
-    const auto& ratio = v["ratio"];
-    const auto& verdict = v["verdict"];
-    fmt::print(
-        "{:<10} {:>5} {:>13.5f} {:>13.5f} {:>6} {:>+14.5f}  {}\n", v["serial"].get<std::string>(),
-        v["fit_id"].get<long>(), v["std_before_dph"].get<double>(),
-        v["std_after_dph"].get<double>(),
-        ratio.is_number() ? fmt::format("{:.3f}", ratio.get<double>()) : "undef",
-        v["mean_residual_dph"].get<double>(),
-        verdict_text(verdict.is_null() ? std::nullopt : std::optional(verdict_from_json(verdict))));
-  }
-}
-
-}  // namespace
-
-void print_sim_report(const nlohmann::json& r) {
-  fmt::print("run {} ({}): {:.1f} h simulated in {:.1f} s of wall time\n\n",
-             r["run_id"].get<long>(), r["state"].get<std::string>(),
-             r["sim_s"].get<double>() / 3600.0, r["wall_s"].get<double>());
-  fmt::print("{:<10} {:>4} {:>11} {:>11} {:>9} {:>9}  {:>9} {:>9} {:>6}\n", "serial", "",
-             "B0 deg/h", "k1 deg/h/C", "k0 deg/h/C", "", "std deg/h", "after", "ratio");
-  for (const auto& g : r["gyros"]) {
-    const auto& t = g["true"];
-    fmt::print("{:<10} {:>4} {:>11.4e} {:>11.4e} {:>9.4e}\n", g["serial"].get<std::string>(),
-               "true", t["B0"].get<double>(), t["k1"].get<double>(), t["k0"].get<double>());
-    if (!g.contains("fitted")) {
-      fmt::print("{:<10} {}\n", "", g.value("error", "no fit"));
-      continue;
-    }
-    const auto& f = g["fitted"];
-    const auto& ratio = g["std_ratio"];
-    // A part's model may lack k1 or k0: "-" where the fit has no such coefficient.
-    const auto cell = [](const nlohmann::json& j, const char* name, const char* format) {
-      return j.contains(name) && j[name].is_number()
-                 ? fmt::format(fmt::runtime(format), j[name].get<double>())
-                 : std::string("-");
-    };
-    fmt::print("{:<10} {:>4} {:>11} {:>11} {:>9} {:>9}  {:>9.5f} {:>9.5f} {:>6}\n", "", "fit",
-               cell(f, "B0", "{:.4e}"), cell(f, "k1", "{:.4e}"), cell(f, "k0", "{:.4e}"), "",
-               g["std_before_dph"].get<double>(), g["std_after_dph"].get<double>(),
-               ratio.is_number() ? fmt::format("{:.3f}", ratio.get<double>()) : "undef");
-    for (const auto& [label, key] : {std::pair{"+-", "std_errors"}, {"OLS", "std_errors_ols"}}) {
-      const auto& e = g[key];
-      fmt::print("{:<10} {:>4} {:>11} {:>11} {:>9}\n", "", label, cell(e, "B0", "{:.1e}"),
-                 cell(e, "k1", "{:.1e}"), cell(e, "k0", "{:.1e}"));
-    }
-    const auto v = g.value("verdict", nlohmann::json());
-    fmt::print("{:<10} {}\n", "",
-               verdict_text(v.is_null() ? std::nullopt : std::optional(verdict_from_json(v))));
-  }
-  print_verifications(r);
 }
 
 }  // namespace station

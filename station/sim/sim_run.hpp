@@ -67,7 +67,4 @@ nlohmann::json run_simulated(const SimRunOptions& options);
 /// "verifications".
 nlohmann::json run_simulated_with_verification(const SimRunOptions& options);
 
-/// Prints the report as a readable table.
-void print_sim_report(const nlohmann::json& report);
-
 }  // namespace station

@@ -64,6 +64,8 @@ struct RunRecord {
 
 /// One gyro on a run.
 struct RunSlot {
+  /// slot: the index of the configuration's [[slot]] table, from 0 (as stored since version 1);
+  /// people count slots from 1 (`--slot N`, the start form): slot N is index N - 1.
   int slot = 0, node = 0;
   std::string serial, axis;
   double pulse_weight_arcsec = 0, earth_rate_dph = 0;

@@ -206,6 +206,15 @@
     $("btn-abort").disabled = S.busy || !active;
   }
 
+  // The bias charts' captions name the width the daemon bins at (status.bin_s), never a
+  // width written into the page.
+  function renderBinWidth() {
+    var w = S.status && typeof S.status.bin_s === "number" ? S.status.bin_s + " s " : "";
+    document.querySelectorAll(".bin-s").forEach(function (el) {
+      if (el.textContent !== w) el.textContent = w;
+    });
+  }
+
   // ---- data: /api/live and the stream ------------------------------------------------------
 
   function applyLive(live) {
@@ -226,6 +235,8 @@
     S.seq = live.seq || 0;
     renderStatus();
     renderEvents();
+    renderBinWidth();
+    document.dispatchEvent(new CustomEvent("station:status", {detail: S.status}));  // results.js
     S.dirty.temp = S.dirty.bins = true;
     scheduleDraw();
   }

@@ -64,7 +64,7 @@ std::string write_protocol(const std::string& dir) {
 /// a short run must not make it 'incomplete' (the configured share, [station] max_lost_share).
 void allow_down_time(const std::string& config_path) {
   std::string text = ts::slurp(config_path);
-  const auto at = text.find("bin_s = ");
+  const auto at = text.find("ref_temp_c = ");
   ASSERT_NE(at, std::string::npos) << text;
   text.insert(text.find('\n', at) + 1, "max_lost_share = 0.5\n");
   std::ofstream(config_path) << text;

@@ -34,7 +34,7 @@ struct GyroRig {
     while (std::getline(in, line)) {
       if (line.rfind("serial = ", 0) == 0) continue;
       text += line + "\n";
-      if (line.rfind("bin_s = ", 0) == 0) text += "max_lost_share = 0.9\n";
+      if (line.rfind("ref_temp_c = ", 0) == 0) text += "max_lost_share = 0.9\n";
     }
     if (!http_dir.empty()) text += "\n[http]\nprotocol_dir = \"" + dir + "\"\n";
     std::ofstream(sim.config_path) << text;

@@ -293,6 +293,18 @@ def run_checks(drv, st, url, token, artifacts):
              90, 0.5)
     print(f"bias charts filling after {time.time() - t_start:.1f} s:"
           f" {points(drv, 'chart-bias-time')} / {points(drv, 'chart-bias-temp')} points")
+    # The bias charts' captions name the width the daemon bins at (/api/status bin_s), not a
+    # width written into the page.
+    bin_s = get_json(url + "api/status").get("bin_s")
+    captions = drv.execute_script(
+        "return Array.prototype.map.call(document.querySelectorAll('figcaption'),"
+        " function (c) { return c.textContent; }).filter(function (t) {"
+        " return t.indexOf('Bias') === 0; });")
+    want = f"in {bin_s:g} s bins"
+    if not isinstance(bin_s, (int, float)) or len(captions) != 2 or \
+            any(want not in c for c in captions):
+        fail(f"bias captions {captions} do not say '{want}' (/api/status bin_s {bin_s!r})")
+    print(f"captions name the bin width: {captions}")
     wait_for(f"#step-label changing from {step0!r}", lambda: text(drv, "step-label") != step0, 10)
     label, cur = text(drv, "step-label"), current_step(drv)
     if not cur or cur == "MANY" or label not in cur:
