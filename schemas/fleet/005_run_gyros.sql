@@ -2,4 +2,4 @@
 -- slot came from. 'start': given with the run (`run --slot`, the API's "slots", the live page's
 -- start form); 'config': the configuration's default serial for that slot; NULL: forwarded by a
 -- station before its version 11, when every serial came from the configuration.
-ALTER TABLE run_slots ADD COLUMN gyro_source text CHECK (gyro_source IN ('start', 'config'));
+ALTER TABLE run_slots ADD COLUMN IF NOT EXISTS gyro_source text CHECK (gyro_source IN ('start', 'config'));

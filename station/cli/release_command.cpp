@@ -138,25 +138,44 @@ void print_verification(const VerificationResult& v) {
   fmt::print("  verdict: {} (verification {})\n", verdict_text(v.verdict), v.id);
 }
 
-int run_verify(const VerifyOptions& o) {
-  std::optional<PartFile> parts;
-  if (!o.parts.empty()) parts = load_part_file(o.parts);
-  Store store(o.db, OpenMode::existing);
-  std::optional<FitRecord> fit;
+// The fit to verify: --fit ID (of this serial), else the serial's released calibration.
+FitRecord fit_to_verify(Store& store, const VerifyOptions& o) {
   if (o.fit_id) {
-    fit = store.find_fit(*o.fit_id);
+    auto fit = store.find_fit(*o.fit_id);
     if (!fit) throw InputError(fmt::format("{}: no fit {}", o.db, *o.fit_id));
     if (fit->serial != o.serial)
       throw InputError(fmt::format("{}: fit {} is of serial '{}', not '{}'", o.db, *o.fit_id,
                                    fit->serial, o.serial));
-  } else {
-    const auto rel = current_release(store, o.serial);
-    if (!rel)
-      throw InputError(fmt::format(
-          "{}: serial '{}' has no released calibration (give --fit ID to verify another fit)", o.db,
-          o.serial));
-    fit = store.find_fit(rel->fit_id);
+    return std::move(*fit);
   }
+  const auto rel = current_release(store, o.serial);
+  if (!rel)
+    throw InputError(fmt::format(
+        "{}: serial '{}' has no released calibration (give --fit ID to verify another fit)", o.db,
+        o.serial));
+  return *store.find_fit(rel->fit_id);
+}
+
+void print_verify(const VerifyOptions& o, const VerificationResult& v, bool reused) {
+  if (o.json) {
+    auto j = verification_json(v);
+    j["verification_id"] = v.id;
+    j["created_utc"] = v.created_utc;
+    j["stored_before"] = reused;
+    std::cout << j.dump(2) << '\n';
+    return;
+  }
+  print_verification(v);
+  if (reused)
+    fmt::print("  (stored {}: the same fit on the same run; --redo verifies it again)\n",
+               v.created_utc);
+}
+
+int run_verify(const VerifyOptions& o) {
+  std::optional<PartFile> parts;
+  if (!o.parts.empty()) parts = load_part_file(o.parts);
+  Store store(o.db, OpenMode::existing);
+  const FitRecord fit = fit_to_verify(store, o);
   const auto limits = limits_for(store, o.serial, {o.run_id}, {parts ? &*parts : nullptr, o.part});
   if (parts && !limits)
     throw InputError(
@@ -165,22 +184,11 @@ int run_verify(const VerifyOptions& o) {
                     o.parts, o.run_id, o.serial));
   // The same fit on the same run against the same part gives the same figures: the stored
   // verification is reported, not stored again, unless --redo asks for a new one.
-  auto stored = o.redo ? std::nullopt : stored_verification(store, fit->id, o.run_id, limits);
+  auto stored = o.redo ? std::nullopt : stored_verification(store, fit.id, o.run_id, limits);
   const bool reused = stored.has_value();
-  VerificationResult v = reused ? std::move(*stored) : verify_fit(store, *fit, o.run_id, limits);
+  VerificationResult v = reused ? std::move(*stored) : verify_fit(store, fit, o.run_id, limits);
   if (!reused) save_verification(store, v);
-  if (o.json) {
-    auto j = verification_json(v);
-    j["verification_id"] = v.id;
-    j["created_utc"] = v.created_utc;
-    j["stored_before"] = reused;
-    std::cout << j.dump(2) << '\n';
-  } else {
-    print_verification(v);
-    if (reused)
-      fmt::print("  (stored {}: the same fit on the same run; --redo verifies it again)\n",
-                 v.created_utc);
-  }
+  print_verify(o, v, reused);
   return v.verdict && !v.verdict->pass ? 1 : 0;
 }
 

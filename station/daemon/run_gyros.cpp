@@ -101,19 +101,22 @@ void check_parts(const StationConfig& config, const std::vector<SlotGyro>& given
 
 }  // namespace
 
+std::optional<int> slot_number(const std::string& text) {
+  const bool digits = !text.empty() && text.size() <= 3 && text[0] != '0' &&
+                      text.find_first_not_of("0123456789") == std::string::npos;
+  return digits ? std::optional<int>(std::stoi(text)) : std::nullopt;
+}
+
 SlotGyro parse_slot_gyro(const std::string& text, const std::string& where) {
   const auto eq = text.find('=');
-  const std::string number = text.substr(0, eq);
-  int slot = 0;
-  const auto parsed = std::from_chars(number.data(), number.data() + number.size(), slot);
-  const bool digits = !number.empty() && number.size() <= 3 &&
-                      number.find_first_not_of("0123456789") == std::string::npos;
-  if (eq == std::string::npos || !digits || parsed.ec != std::errc() || slot < 1)
+  const auto slot = eq == std::string::npos ? std::nullopt : slot_number(text.substr(0, eq));
+  if (!slot)
     throw InputError(fmt::format("{} '{}': expected N=SERIAL or N=SERIAL,PART (N the slot, from 1)",
                                  where, ascii_escaped(text)));
   const std::string rest = text.substr(eq + 1);
   const auto comma = rest.find(',');
-  SlotGyro g{slot, rest.substr(0, comma), comma == std::string::npos ? "" : rest.substr(comma + 1)};
+  SlotGyro g{*slot, rest.substr(0, comma),
+             comma == std::string::npos ? "" : rest.substr(comma + 1)};
   if (const auto p = identifier_problem(g.serial))
     throw InputError(fmt::format("{} '{}': serial: {}", where, ascii_escaped(text), *p));
   if (comma != std::string::npos)

@@ -5,6 +5,7 @@
 // in the order of the configuration's [[slot]] tables (as the relays are).
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,10 @@ struct SlotGyro {
   std::string part;    ///< its part number (a key of the part file); empty: the slot's default
   bool operator==(const SlotGyro&) const = default;
 };
+
+/// A slot's number as people give it (--slot N=..., the API's "slots" keys): 1..999 in plain
+/// digits, no sign, no leading zero; nullopt otherwise. The one rule for both.
+std::optional<int> slot_number(const std::string& text);
 
 /// `N=SERIAL[,PART]` (the --slot option, `where` names it in errors); throws InputError.
 SlotGyro parse_slot_gyro(const std::string& text, const std::string& where);

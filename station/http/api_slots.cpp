@@ -48,12 +48,12 @@ std::vector<SlotGyro> slots_field(const nlohmann::json& body, std::string& error
     return {};
   }
   for (const auto& [key, v] : slots.items()) {
-    const auto n = positive_int(key);
-    if (!n || *n > 999) {
+    const auto n = slot_number(key);  // daemon/run_gyros.hpp: as --slot reads N
+    if (!n) {
       error = fmt::format("field 'slots/{}': a slot is a number from 1", key.substr(0, 80));
       return {};
     }
-    SlotGyro g{static_cast<int>(*n), "", ""};
+    SlotGyro g{*n, "", ""};
     if (!read_gyro(key, v, g, error)) return {};
     out.push_back(std::move(g));
   }

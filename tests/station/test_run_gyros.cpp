@@ -54,7 +54,8 @@ std::string joined(const std::vector<std::string>& lines) {
 TEST(RunGyros, TheSlotOptionIsNumberSerialAndPart) {
   EXPECT_EQ(station::parse_slot_gyro("1=SN-7,GX-100", "--slot"), (SlotGyro{1, "SN-7", "GX-100"}));
   EXPECT_EQ(station::parse_slot_gyro("12=SN-7", "--slot"), (SlotGyro{12, "SN-7", ""}));
-  for (const std::string bad : {"SN-7", "0=SN", "x=SN", "-1=SN", "1=", "1=SN X", "1=SN,", "=SN"}) {
+  for (const std::string bad : {"SN-7", "0=SN", "x=SN", "-1=SN", "1=", "1=SN X", "1=SN,", "=SN",
+                                "01=SN", "+1=SN", "1000=SN"}) {
     try {
       station::parse_slot_gyro(bad, "--slot");
       ADD_FAILURE() << bad << " was taken";
