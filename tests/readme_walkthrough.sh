@@ -3,8 +3,9 @@
 # The commands between its <!-- walkthrough --> and <!-- /walkthrough --> lines are run as one
 # bash script, with only where things go changed: build/ is BUILD_DIR, /tmp/ a scratch directory
 # (simrig's CAN socket there too, so a parallel test's simrig is not disturbed). Then what the
-# README says they give: probe answers, the demo run completes and fits every gyro, the report
-# exists. About 9 minutes of wall time (the demo protocol on simrig's wall clock).
+# README says they give: probe answers, the demo run of the scanned serials completes and fits
+# every gyro, the report exists, the release is exported. About 9 minutes of wall time (the
+# demo protocol on simrig's wall clock).
 # usage: readme_walkthrough.sh SOURCE_DIR BUILD_DIR
 set -u
 src=${1:?usage: readme_walkthrough.sh SOURCE_DIR BUILD_DIR}
@@ -31,9 +32,12 @@ check() {  # check CONDITION WHAT
 check '[[ $rc -eq 0 ]]' "the walk-through's commands exit 0 (exit $rc)"
 check 'grep -q "^all devices answered" "$tmp/out.log"' "probe: all devices answered"
 check 'grep -q "^run 1 (completed)" "$tmp/out.log"' "run 1 (completed)"
-for serial in SIM-0001 SIM-0002; do
+check 'grep -q "run 1 (completed)" "$tmp/out.log" && grep -q "^GX-0102 " "$tmp/out.log"' \
+  "the summary names the scanned serials"
+for serial in GX-0101 GX-0102; do
   check '"$build/station/station" history --db "$tmp/demo.db" --serial $serial --json |
     grep -q "\"fit_id\""' "a fit of $serial stored"
 done
 check 'ls "$tmp"/demo-report/*.html >/dev/null 2>&1' "the report written"
+check 'grep -q "gyro_tc" "$tmp/out.log"' "the released calibration exported as C"
 exit $failed
