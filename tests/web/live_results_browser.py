@@ -24,7 +24,9 @@ import time
 import urllib.error
 import urllib.request
 
-SKIP = 77
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "report"))
+import report_browser  # noqa: E402  (the shared headless Chromium)
+
 PARTS = '[part."WIDE"]\nB0_dph = { min = -1000.0, max = 1000.0 }\n'
 
 
@@ -38,24 +40,11 @@ def check(cond, what):
 
 
 def browser():
-    try:
-        from selenium import webdriver
-        from selenium.webdriver.chrome.service import Service
-    except ImportError:
-        print("SKIP: python3-selenium is not importable (Debian: python3-selenium)")
-        sys.exit(SKIP)
-    chromium = shutil.which("chromium") or shutil.which("chromium-browser")
-    driver = shutil.which("chromedriver")
-    if not chromium or not driver:
-        print("SKIP: chromium and chromedriver are needed (Debian: chromium chromium-driver)")
-        sys.exit(SKIP)
-    opts = webdriver.ChromeOptions()
-    opts.binary_location = chromium
-    for a in ["--headless=new", "--no-sandbox", "--disable-gpu", "--window-size=1400,1100",
-              "--disable-dev-shm-usage"]:
-        opts.add_argument(a)
-    opts.set_capability("goog:loggingPrefs", {"browser": "ALL"})
-    return webdriver.Chrome(service=Service(executable_path=driver), options=opts)
+    """The report tests' headless Chromium (tests/report/report_browser.py: it skips with 77 when
+    selenium or chromium is missing), in a window the size of docs/live_after_run.png."""
+    drv = report_browser.browser()
+    drv.set_window_size(1400, 1100)
+    return drv
 
 
 def get(base, path):
