@@ -4,6 +4,7 @@
 
 #include <map>
 
+#include "station/fleet/fleet_charts.hpp"
 #include "station/report/report_pages.hpp"
 
 namespace station::fleet {
@@ -135,11 +136,10 @@ std::string fleet_html(const json& charts, const std::string& filter_text,
   json figures = json::array();
   std::size_t i = 0;
   for (const auto& part : charts["parts"]) {
-    body += fmt::format(
-        "<section class=\"part\" data-part=\"{0}\">\n<h2>Part {0} (model {1}, T_ref {2} "
-        "\u00b0C): {3} calibrations at {4} stations</h2>\n",
-        html_escape(part["part"].get<std::string>()), html_escape(part["terms"].get<std::string>()),
-        num(part["ref_temp_c"]), part["calibrations"].get<int>(), part["stations"].size());
+    body += fmt::format(  // the set's title as the text output names it (chart_set_title)
+        "<section class=\"part\" data-part=\"{}\">\n<h2>{}: {} calibrations at {} stations</h2>\n",
+        html_escape(part["part"].get<std::string>()), html_escape(chart_set_title(part)),
+        part["calibrations"].get<int>(), part["stations"].size());
     body += station_table(part);
     for (const auto& c : part["charts"]) {
       if (c["points"].empty()) {  // a coefficient this model does not have: no empty chart
