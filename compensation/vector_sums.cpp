@@ -3,6 +3,7 @@
 #include "compensation/vector_sums.hpp"
 
 #include <algorithm>
+#include <utility>
 
 namespace station::compensation {
 namespace {
@@ -78,6 +79,7 @@ STATION_INLINE void add_terms(const double* theta, std::size_t m, std::size_t k0
   for (std::size_t v = 0; v < nv; ++v) s[v] = load<V>(partial + w * v);
   std::size_t k = k0;
   for (; k + kLanes <= k1; k += kLanes) {
+#pragma GCC unroll 16  // the partial sums in registers, not reloaded from the stack each step
     for (std::size_t v = 0; v < nv; ++v) {
       const V d = Diff::template diff<V>(theta + k + w * v, m);
       s[v] += d * d;
@@ -90,12 +92,18 @@ STATION_INLINE void add_terms(const double* theta, std::size_t m, std::size_t k0
   }
 }
 
+// 0, 1, ..., w - 1: a constant, so a ramp is one add (built lane by lane through memory it cost
+// a store-forwarding stall per vector: half the noise identification's time, issue 37).
+template <class V, std::size_t... I>
+constexpr V iota(std::index_sequence<I...>) {
+  return V{static_cast<double>(I)...};
+}
+template <class V>
+constexpr V kIota = iota<V>(std::make_index_sequence<kWidth<V>>());
 // t0, t0 + 1, ... as doubles (exact below 2^53).
 template <class V>
 STATION_INLINE V ramp(double t0) {
-  V r;
-  for (std::size_t i = 0; i < kWidth<V>; ++i) r[i] = t0 + static_cast<double>(i);
-  return r;
+  return t0 + kIota<V>;
 }
 // x_t = y_t - (icpt + slope t) for the lanes' t from t0.
 template <class V>
@@ -110,6 +118,7 @@ STATION_INLINE void line_sums_into(const double* y, std::size_t n, double* sums)
   V sy[nv] = {}, sty[nv] = {};
   std::size_t k = 0;
   for (; k + kSeriesLanes <= n; k += kSeriesLanes) {
+#pragma GCC unroll 16
     for (std::size_t v = 0; v < nv; ++v) {
       const V yv = load<V>(y + k + w * v);
       sy[v] += yv;
@@ -137,6 +146,7 @@ STATION_INLINE void lag_sums_into(const double* y, std::size_t n, double icpt, d
   V sx[nv] = {}, sxx[nv] = {}, sxn[nv] = {};
   std::size_t k = 0;
   for (; k + kSeriesLanes + 1 <= n; k += kSeriesLanes) {
+#pragma GCC unroll 16
     for (std::size_t v = 0; v < nv; ++v) {
       const double t = static_cast<double>(k + w * v);
       const V x = residual<V>(y + k + w * v, t, icpt, slope);
