@@ -50,6 +50,22 @@ void fill_angle(std::span<const double> rate, double mean, double* out) {
   }
 }
 
+// The working memory of a curve, kept by the thread for its next one: the angle (N + 1 values)
+// and the tau-averaged series (N / 2). First touching fresh pages cost more than the curve: on the
+// project's VM a 10^7-sample curve spent ~420 of its ~520 ms faulting in 120 MB that blocks above
+// the heap's 32 MiB keep limit (station/common/allocator.hpp) bring fresh on every call, ~100 ms
+// computing (docs/BENCHMARKS.md). 12 bytes a sample of the longest series the thread has taken.
+std::span<double> curve_scratch(std::size_t n_values) {
+  thread_local std::unique_ptr<double[]> memory;
+  thread_local std::size_t size = 0;
+  if (n_values > size) {
+    memory.reset();  // the smaller block given back before the larger one is taken
+    memory = std::make_unique_for_overwrite<double[]>(n_values);
+    size = n_values;
+  }
+  return {memory.get(), n_values};
+}
+
 // One point of the curve, its interval still to come, from the sum of its squared differences
 // (difference_sums.hpp). NIST SP 1065 §5.2.4, overlapping AVAR from phase data:
 // AVAR(m tau0) = 1 / (2 tau^2 (N - 2m)) sum_k (x_{k+2m} - 2 x_{k+m} + x_k)^2, and §5.2.8,
@@ -197,16 +213,16 @@ std::vector<AdevPoint> overlapping_adev(std::span<const double> rate, double rat
   std::vector<AdevPoint> out;
   if (rate.empty()) return out;
   // The angle written once, not zeroed first (a pass of its own over N values).
-  const auto angle = std::make_unique_for_overwrite<double[]>(rate.size() + 1);
-  fill_angle(rate, rate_mean(rate, true), angle.get());
-  const std::span<const double> theta(angle.get(), rate.size() + 1);
+  const std::span<double> scratch = curve_scratch(rate.size() + 1 + rate.size() / 2);
+  fill_angle(rate, rate_mean(rate, true), scratch.data());
+  const std::span<const double> theta = scratch.first(rate.size() + 1);
   const int order = kind == DeviationKind::hdev ? 3 : 2;  // the difference taken of the angle
   std::vector<std::size_t> ms;                            // the factors with at least one term
   for (std::size_t m : m_list) {
     if (m != 0 && static_cast<std::size_t>(order) * m < theta.size()) ms.push_back(m);
   }
   const std::vector<double> sums = difference_sums(theta, ms, order);
-  BlockAverages averages(rate);
+  BlockAverages averages(rate, scratch.subspan(rate.size() + 1));
   std::optional<int> last_alpha;
   for (std::size_t i = 0; i < ms.size(); ++i) {
     AdevPoint p = deviation_point(sums[i], theta.size(), ms[i], 1.0 / rate_hz, order);

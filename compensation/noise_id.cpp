@@ -165,15 +165,19 @@ std::string_view noise_id_method_name(NoiseIdMethod method) {
 
 std::span<const double> BlockAverages::at(std::size_t m) {
   if (m <= 1) return rate_;
-  if (m == m_) return {last_.get(), size_};
+  if (m == m_) return {last_, size_};
   const bool from_last = m_ > 1 && m % m_ == 0;
-  const std::span<const double> src =
-      from_last ? std::span<const double>(last_.get(), size_) : rate_;
+  const std::span<const double> src = from_last ? std::span<const double>(last_, size_) : rate_;
   const std::size_t q = from_last ? m / m_ : m;
   const std::size_t blocks = src.size() / q;
-  if (!from_last) last_ = std::make_unique_for_overwrite<double[]>(blocks);
+  if (!from_last && blocks <= scratch_.size()) {
+    last_ = scratch_.data();
+  } else if (!from_last) {
+    own_ = std::make_unique_for_overwrite<double[]>(blocks);
+    last_ = own_.get();
+  }
   // In place when formed from last_: block b reads q >= 2 values from index b q >= b on.
-  double* out = last_.get();
+  double* out = last_;
   if (q == 2) {  // octave taus: the same bits as block_mean, in a loop that vectorises
     for (std::size_t b = 0; b < blocks; ++b) out[b] = (src[2 * b] + src[2 * b + 1]) / 2.0;
   } else {
@@ -181,7 +185,7 @@ std::span<const double> BlockAverages::at(std::size_t m) {
   }
   size_ = blocks;
   m_ = m;
-  return {last_.get(), size_};
+  return {last_, size_};
 }
 
 std::optional<NoiseId> identify_noise_in_averages(std::span<const double> averages, int d_max) {

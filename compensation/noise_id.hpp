@@ -62,14 +62,20 @@ struct NoiseId {
 class BlockAverages {
  public:
   explicit BlockAverages(std::span<const double> rate) : rate_(rate) {}
+  /// The same, the averages written into `scratch` (rate.size() / 2 values or more: what any
+  /// m >= 2 needs) rather than into memory of its own; holds a view of both.
+  BlockAverages(std::span<const double> rate, std::span<double> scratch)
+      : rate_(rate), scratch_(scratch) {}
   /// The averages at factor m (>= 1, not below the previous call's); valid until the next call.
   std::span<const double> at(std::size_t m);
 
  private:
   std::span<const double> rate_;
-  std::size_t m_ = 1;               // the factor of last_; 1: the rate itself
-  std::unique_ptr<double[]> last_;  // its averages, written once (not zeroed first)
-  std::size_t size_ = 0;            // how many
+  std::span<double> scratch_;      // the caller's memory for the averages, if it gave any
+  std::unique_ptr<double[]> own_;  // else memory of its own, written once (not zeroed first)
+  double* last_ = nullptr;         // the averages of factor m_, in one of the two
+  std::size_t m_ = 1;              // 1: the rate itself
+  std::size_t size_ = 0;           // how many
 };
 
 /// identify_noise on the averages a BlockAverages formed; empty below kMinNoiseIdPoints of them.

@@ -148,6 +148,22 @@ TEST(BlockAverages, FormedFromThePreviousFactorEqualThePlainMeans) {
   }
 }
 
+// The caller's scratch (what overlapping_adev lends) holds the same averages, bit for bit, as
+// memory of the averages' own, for every spacing, and is what they are written into.
+TEST(BlockAverages, InTheCallersScratchTheSameBits) {
+  const std::vector<double> y = walk_plus_white(10'007, 12);
+  for (const TauSpacing spacing : {TauSpacing::octave, TauSpacing::decade, TauSpacing::all}) {
+    std::vector<double> scratch(y.size() / 2);
+    BlockAverages own(y), lent(y, scratch);
+    for (const std::size_t m : tau_factors(y.size(), spacing)) {
+      const std::span<const double> a = own.at(m), b = lent.at(m);
+      ASSERT_EQ(a.size(), b.size()) << m;
+      if (m > 1) EXPECT_EQ(b.data(), scratch.data()) << m;
+      for (std::size_t i = 0; i < a.size(); ++i) ASSERT_EQ(a[i], b[i]) << "m " << m << " i " << i;
+    }
+  }
+}
+
 // The curve identifies the noise at every tau as identify_noise and identify_noise_b1 do
 // straight from the rate (lag-1 where 30 averages remain, B1 down to 8, carried below): the
 // averages formed tau by tau and the one-pass lag-1 sums change nothing but rounding, and no
