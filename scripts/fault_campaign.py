@@ -5,8 +5,8 @@ Two rigs run the same short protocol side by side: a reference left alone, and a
 gets, at seeded random instants, SIGKILL + restart of the daemon, Modbus stalls, disconnects and
 replies that drip (one byte every 0.3 s) of chamber and turntable, door open, e-stop, a broken
 chamber air sensor, an ACUTROL refusing every command for a while, dropped and corrupted CAN
-frames. A second phase restarts the
-simulator itself under a running daemon. Checked:
+frames. A second phase, beside the first on its own rig, restarts the simulator itself under a
+running daemon. Checked:
 
   * zero committed samples lost or changed (a snapshot of the database after every kill, and
     before every simulator restart, is compared with the final file);
@@ -35,6 +35,7 @@ import sqlite3
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from datetime import datetime, timezone
 
@@ -189,13 +190,19 @@ def wall(utc):
         tzinfo=timezone.utc).timestamp()
 
 
-def write_protocol(work, duration_s):
-    path = os.path.join(work, "campaign.toml")
+# The campaign's protocol heats 25 -> 31 C at 3 C/min: the step lasts until the air is there.
+RAMP_S = 120
+
+
+def write_protocol(work, name, duration_s):
+    """A protocol of about duration_s: the ramp (RAMP_S), then a hold for the rest. (The campaign
+    asks for 30 s more than its faults' window: injections run late by the faults' own waits.)"""
+    path = os.path.join(work, name + ".protocol.toml")
     open(path, "w").write(
         "# Fault campaign: record while the chamber heats 25 -> 31 C at 3 C/min, then hold.\n"
         'name = "campaign"\n\n[[step]]\ntype = "record_start"\n\n[[step]]\n'
         'type = "set_temperature"\nsetpoint_c = 31.0\nramp_c_per_h = 180.0\nwait = false\n\n'
-        '[[step]]\ntype = "hold"\nduration_s = %d\n' % duration_s)
+        '[[step]]\ntype = "hold"\nduration_s = %d\n' % max(10, duration_s - RAMP_S))
     return path
 
 
@@ -264,7 +271,7 @@ def compare_fits(victim, reference):
 
 def campaign(args, work):
     rng = random.Random(args.seed)
-    protocol = write_protocol(work, args.duration_s)
+    protocol = write_protocol(work, "campaign", args.duration_s + 30)
     ref_rig, rig = Rig(args.build, work, "reference", 7), Rig(args.build, work, "victim", 7)
     ref_rig.start()
     rig.start()
@@ -358,7 +365,7 @@ def campaign(args, work):
 
 def simulator_restart(args, work):
     """Phase 2: the simulator restarted under a running daemon: the links must come back."""
-    protocol = write_protocol(work, 45)
+    protocol = write_protocol(work, "restart", RAMP_S + 30)
     rig = Rig(args.build, work, "restart", 9)
     rig.start()
     db = os.path.join(work, "restart.db")
@@ -425,8 +432,21 @@ def main():
         return 2
     work = args.keep or tempfile.mkdtemp(prefix="fault-campaign-")
     os.makedirs(work, exist_ok=True)
+    # The simulator-restart phase has its own rig, daemon and files: it runs beside the campaign.
+    restart = {}
+
+    def phase2_run():
+        try:
+            restart.update(simulator_restart(args, work))
+        except Exception as e:  # reported as the phase's problem, not a lost thread
+            restart.update({"daemon_exit": "error: %r" % e, "samples_lost": 0,
+                            "samples_changed": 0, "chamber_back": False, "can_back": False})
+
+    phase2 = threading.Thread(target=phase2_run)
+    phase2.start()
     result = campaign(args, work)
-    result["simulator_restart"] = simulator_restart(args, work)
+    phase2.join()
+    result["simulator_restart"] = restart
     problems = verdict(result, result["simulator_restart"])
     result["problems"] = problems
     for r in result["faults"]:
