@@ -1,0 +1,263 @@
+// Rate-ladder scale factor, bias, nonlinearity, asymmetry and temperature coefficient:
+// exact ladders give exact figures; simulated ladders give figures within their stated errors.
+// The generator is this file's own (no sim_devices code), seeded, so every run is the same.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "compensation/scale_factor.hpp"
+
+namespace sc = station::compensation;
+
+namespace {
+
+// A gyro: y = K+ x (x > 0) or K- x (x <= 0), plus K B, plus a cubic nonlinearity, x in arcsec/s.
+struct TrueGyro {
+  double sf_pulse_per_arcsec = 0.95;
+  double asymmetry = 0;  ///< (K+ - K-) / K, a fraction
+  double bias_dph = 0.8;
+  double cubic_per_arcsec2 = 0;  ///< y += K c x^3: an odd nonlinearity
+  double output_pps(double x) const {
+    const double k = sf_pulse_per_arcsec * (1 + (x > 0 ? 0.5 : -0.5) * asymmetry);
+    return k * x + sf_pulse_per_arcsec * (bias_dph + cubic_per_arcsec2 * x * x * x);
+  }
+};
+
+// The ladder of issue 36: +-1 ... +-300 deg/s, the Earth rate along a vertical axis at 45 deg.
+const std::vector<double> kRatesDps = {1, 3, 10, 30, 100, 300, -1, -3, -10, -30, -100, -300};
+constexpr double kEarthAlongAxisDph = 15.041067 * 0.70710678;
+
+// Dwell-mean noise: 0.05 pulse/s of quantization and random walk, plus 0.2 ppm of the rate
+// (the table's rate jitter over a dwell): heteroscedastic, so the weighting matters.
+double dwell_se_pps(double y_pps) {
+  return std::hypot(0.05, 2e-7 * y_pps);
+}
+
+std::vector<sc::LadderPoint> ladder(const TrueGyro& g, std::mt19937_64* rng) {
+  std::normal_distribution<double> unit(0.0, 1.0);
+  std::vector<sc::LadderPoint> pts;
+  for (double r : kRatesDps) {
+    sc::LadderPoint p;
+    p.table_rate_dps = r;
+    p.earth_rate_dph = kEarthAlongAxisDph;
+    const double y = g.output_pps(sc::ladder_input_arcsec_per_s(p));
+    p.output_se_pps = dwell_se_pps(y);
+    p.output_pps = y + (rng ? p.output_se_pps * unit(*rng) : 0.0);
+    pts.push_back(p);
+  }
+  return pts;
+}
+
+// Fractions of |estimate - truth| within 1 and 2 standard errors.
+struct Coverage {
+  int n = 0, in1 = 0, in2 = 0;
+  void add(double estimate, double truth, double se) {
+    ++n;
+    in1 += std::abs(estimate - truth) <= se;
+    in2 += std::abs(estimate - truth) <= 2 * se;
+  }
+  double one() const { return in1 / double(n); }
+  double two() const { return in2 / double(n); }
+};
+
+// The acceptance bounds: +-1 SE in 0.60..0.78, +-2 SE at least 0.92. Nominal 68.3 % and 95.4 %;
+// the chi2/dof rule (acceptance.hpp) only inflates, so a few % more: with dof = 1 (three
+// plateaus) P(|z| < max(1, |w|)) for independent normal z, w is 0.683^2 + 0.267 = 0.733. The
+// binomial sd of a fraction near 0.7 over 1000 realizations is 1.4 %. The temperature fit
+// takes each plateau's SE after that plateau's own rule (inflated when its chi2/dof > 1), so
+// its coverage sits a little above 0.733 again.
+constexpr int kRealizations = 1000;
+void expect_coverage(const Coverage& c, const char* what) {
+  EXPECT_GE(c.one(), 0.60) << what;
+  EXPECT_LE(c.one(), 0.78) << what;
+  EXPECT_GE(c.two(), 0.92) << what;
+  std::printf("[coverage] %-28s +-1 SE %.3f  +-2 SE %.3f  (%d realizations)\n", what, c.one(),
+              c.two(), c.n);
+}
+
+}  // namespace
+
+TEST(ScaleFactor, ExactLadderGivesExactFigures) {
+  TrueGyro g;
+  const auto pts = ladder(g, nullptr);
+  const auto r = sc::analyze_rate_ladder(pts);
+  ASSERT_TRUE(r.ok()) << r.error();
+  // Exact to 1e-12 relative. The outputs reach 1e6 pulse/s, so the bias (a / K) and the
+  // residuals are exact to 1e-12 of full scale (1.08e6 arcsec/s), not of themselves.
+  EXPECT_NEAR(r->sf_pulse_per_arcsec, g.sf_pulse_per_arcsec, 1e-12 * g.sf_pulse_per_arcsec);
+  EXPECT_NEAR(r->bias_dph, g.bias_dph, 1e-12 * 300 * 3600);
+  EXPECT_LT(r->nonlinearity_max_ppm_fs, 1e-12 * 1e6);
+  EXPECT_LT(r->nonlinearity_rms_ppm_fs, 1e-12 * 1e6);
+  ASSERT_TRUE(r->asymmetry.has_value()) << r->asymmetry_note;
+  EXPECT_NEAR(r->asymmetry->asymmetry_ppm, 0.0, 1e-12 * 1e6);
+  EXPECT_EQ(r->points_used, 12u);
+  EXPECT_EQ(r->points_excluded, 0u);
+  EXPECT_EQ(r->dof, 10u);
+  EXPECT_DOUBLE_EQ(r->se_scale, 1.0);  // chi2 = 0: never shrinks the errors
+  EXPECT_NEAR(r->full_scale_dps, 300 + kEarthAlongAxisDph / 3600, 1e-9);
+  EXPECT_EQ(r->residuals.size(), 12u);
+}
+
+TEST(ScaleFactor, ExactAsymmetryIsRecovered) {
+  TrueGyro g;
+  g.asymmetry = 50e-6;
+  const auto r = sc::analyze_rate_ladder(ladder(g, nullptr));
+  ASSERT_TRUE(r.ok()) << r.error();
+  ASSERT_TRUE(r->asymmetry.has_value()) << r->asymmetry_note;
+  EXPECT_NEAR(r->asymmetry->asymmetry_ppm, 50.0, 1e-12 * 1e6);
+  EXPECT_NEAR(r->asymmetry->sf_positive_pulse_per_arcsec, 0.95 * (1 + 25e-6), 1e-12);
+  EXPECT_NEAR(r->asymmetry->sf_negative_pulse_per_arcsec, 0.95 * (1 - 25e-6), 1e-12);
+}
+
+TEST(ScaleFactor, NonlinearityIsTheLargestDeviationFromTheLeastSquaresLine) {
+  // Equal weights: the line by the textbook closed form (slope Sxy/Sxx), independent of QR.
+  TrueGyro g;
+  g.cubic_per_arcsec2 = 1e-17;  // 1e-17 * (1.08e6)^3 = 12.6 arcsec/s at full scale
+  auto pts = ladder(g, nullptr);
+  for (auto& p : pts) p.output_se_pps = 1.0;
+  const auto r = sc::analyze_rate_ladder(pts);
+  ASSERT_TRUE(r.ok()) << r.error();
+  double mx = 0, my = 0, sxx = 0, sxy = 0, fs = 0;
+  for (const auto& p : pts) mx += sc::ladder_input_arcsec_per_s(p) / 12, my += p.output_pps / 12;
+  for (const auto& p : pts) {
+    const double x = sc::ladder_input_arcsec_per_s(p);
+    sxx += (x - mx) * (x - mx), sxy += (x - mx) * (p.output_pps - my),
+        fs = std::max(fs, std::abs(x));
+  }
+  const double k = sxy / sxx, a = my - k * mx;
+  double worst = 0, ss = 0;
+  for (const auto& p : pts) {
+    const double x = sc::ladder_input_arcsec_per_s(p);
+    const double ppm = (p.output_pps - a - k * x) / (k * fs) * 1e6;
+    worst = std::max(worst, std::abs(ppm)), ss += ppm * ppm;
+  }
+  EXPECT_NEAR(r->sf_pulse_per_arcsec, k, 1e-12 * k);
+  EXPECT_NEAR(r->nonlinearity_max_ppm_fs, worst, 1e-6 * worst);
+  EXPECT_NEAR(r->nonlinearity_rms_ppm_fs, std::sqrt(ss / 12), 1e-6 * worst);
+  EXPECT_GT(worst, 1.0);  // a visible nonlinearity, ppm of full scale
+}
+
+TEST(ScaleFactor, ExcludedPointIsCountedAndNotRead) {
+  TrueGyro g;
+  auto pts = ladder(g, nullptr);
+  pts[3].rate_in_tolerance = false;
+  pts[3].output_pps = std::numeric_limits<double>::quiet_NaN();  // a table fault: no reading
+  pts[3].table_rate_dps = std::numeric_limits<double>::infinity();
+  const auto r = sc::analyze_rate_ladder(pts);
+  ASSERT_TRUE(r.ok()) << r.error();
+  EXPECT_EQ(r->points_used, 11u);
+  EXPECT_EQ(r->points_excluded, 1u);
+  EXPECT_NEAR(r->sf_pulse_per_arcsec, g.sf_pulse_per_arcsec, 1e-12);
+}
+
+TEST(ScaleFactor, TooFewPointsIsAnErrorResult) {
+  TrueGyro g;
+  auto pts = ladder(g, nullptr);
+  for (std::size_t i = 2; i < pts.size(); ++i) pts[i].rate_in_tolerance = false;
+  const auto r = sc::analyze_rate_ladder(pts);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().find("2 ladder points in tolerance (10 excluded)"), std::string::npos)
+      << r.error();
+  EXPECT_THROW((void)r.value(), std::logic_error);
+  EXPECT_FALSE(sc::analyze_rate_ladder({}).ok());
+  // Three points at one rate: no line through them.
+  std::vector<sc::LadderPoint> same(3, pts[0]);
+  const auto s = sc::analyze_rate_ladder(same);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.error().find("linearly dependent"), std::string::npos) << s.error();
+}
+
+TEST(ScaleFactor, NonFiniteInputIsRejectedWithAMessage) {
+  TrueGyro g;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  auto pts = ladder(g, nullptr);
+  pts[4].output_pps = nan;
+  auto r = sc::analyze_rate_ladder(pts);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.error(), "ladder point 4: output_pps nan is not a finite number");
+  pts = ladder(g, nullptr);
+  pts[1].table_rate_dps = inf;
+  r = sc::analyze_rate_ladder(pts);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().find("ladder point 1: table"), std::string::npos) << r.error();
+  pts = ladder(g, nullptr);
+  pts[0].output_se_pps = 0;
+  r = sc::analyze_rate_ladder(pts);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().find("output_se_pps 0 is not a positive number"), std::string::npos);
+  const std::vector<sc::PlateauScaleFactor> plateaus = {{25, 0.95, 1e-8}, {nan, 0.95, 1e-8}};
+  const auto t = sc::fit_scale_factor_vs_temperature(plateaus, 25);
+  ASSERT_FALSE(t.ok());
+  EXPECT_NE(t.error().find("plateau 1: nan is not a finite number"), std::string::npos)
+      << t.error();
+}
+
+TEST(ScaleFactor, ExactTemperatureCoefficient) {
+  const double k0 = 0.95, tc = 5e-6;
+  std::vector<sc::PlateauScaleFactor> p;
+  for (double t : {-40.0, 25.0, 70.0}) p.push_back({t, k0 * (1 + tc * (t - 25)), 1e-8});
+  const auto r = sc::fit_scale_factor_vs_temperature(p, 25.0);
+  ASSERT_TRUE(r.ok()) << r.error();
+  EXPECT_NEAR(r->tc_ppm_per_c, 5.0, 1e-12 * 1e6 / 65);
+  EXPECT_NEAR(r->sf_ref_pulse_per_arcsec, k0, 1e-12);
+  EXPECT_EQ(r->dof, 1u);
+  // One plateau, or two at the same temperature: an error result.
+  EXPECT_FALSE(sc::fit_scale_factor_vs_temperature(std::span(p).first(1), 25.0).ok());
+  p[1].temp_c = p[0].temp_c;
+  p.pop_back();
+  EXPECT_FALSE(sc::fit_scale_factor_vs_temperature(p, 25.0).ok());
+}
+
+TEST(ScaleFactor, MonteCarloScaleFactorAndBiasWithinTheirErrors) {
+  std::mt19937_64 rng(20240536);
+  TrueGyro g;
+  Coverage sf, bias;
+  for (int i = 0; i < kRealizations; ++i) {
+    const auto r = sc::analyze_rate_ladder(ladder(g, &rng));
+    ASSERT_TRUE(r.ok()) << r.error();
+    sf.add(r->sf_pulse_per_arcsec, g.sf_pulse_per_arcsec, r->sf_se_pulse_per_arcsec);
+    bias.add(r->bias_dph, g.bias_dph, r->bias_se_dph);
+  }
+  expect_coverage(sf, "scale factor");
+  expect_coverage(bias, "bias (ladder intercept)");
+}
+
+TEST(ScaleFactor, MonteCarloAsymmetryWithinItsError) {
+  std::mt19937_64 rng(77);
+  TrueGyro g;
+  g.asymmetry = 20e-6;
+  Coverage asym;
+  for (int i = 0; i < kRealizations; ++i) {
+    const auto r = sc::analyze_rate_ladder(ladder(g, &rng));
+    ASSERT_TRUE(r.ok() && r->asymmetry) << r.error();
+    asym.add(r->asymmetry->asymmetry_ppm, 20.0, r->asymmetry->asymmetry_se_ppm);
+  }
+  expect_coverage(asym, "asymmetry");
+}
+
+TEST(ScaleFactor, MonteCarloTemperatureCoefficientWithinItsError) {
+  // Three plateaus (cold, room, hot) as the acceptance protocol runs them, a ladder at each.
+  std::mt19937_64 rng(4242);
+  const double k0 = 0.95, tc = 5e-6;
+  Coverage tcc, k_ref;
+  for (int i = 0; i < kRealizations; ++i) {
+    std::vector<sc::PlateauScaleFactor> plateaus;
+    for (double t : {-40.0, 25.0, 70.0}) {
+      TrueGyro g;
+      g.sf_pulse_per_arcsec = k0 * (1 + tc * (t - 25));
+      const auto r = sc::analyze_rate_ladder(ladder(g, &rng));
+      ASSERT_TRUE(r.ok()) << r.error();
+      plateaus.push_back({t, r->sf_pulse_per_arcsec, r->sf_se_pulse_per_arcsec});
+    }
+    const auto f = sc::fit_scale_factor_vs_temperature(plateaus, 25.0);
+    ASSERT_TRUE(f.ok()) << f.error();
+    tcc.add(f->tc_ppm_per_c, tc * 1e6, f->tc_se_ppm_per_c);
+    k_ref.add(f->sf_ref_pulse_per_arcsec, k0, f->sf_ref_se_pulse_per_arcsec);
+  }
+  expect_coverage(tcc, "temperature coefficient");
+  expect_coverage(k_ref, "scale factor at T_ref");
+}
