@@ -27,7 +27,7 @@ void check_adev_arguments(double rate_hz, double confidence) {
 
 // The mean rate in one sequential sum: the order whose rounding the angle has always had (the
 // curve's values depend on the angle's last bits at small tau). With `check`, each sample is
-// checked finite on the way, in the shadow of the chain of adds rather than in a pass of its own.
+// checked finite.
 double rate_mean(std::span<const double> rate, bool check) {
   double sum = 0;
   for (std::size_t i = 0; i < rate.size(); ++i) {
@@ -39,6 +39,16 @@ double rate_mean(std::span<const double> rate, bool check) {
   return sum / static_cast<double>(rate.size());
 }
 
+// The same sequential sum, the rate's line sums for the lag-1 identification at m = 1 taken in
+// its shadow (vector_sums.hpp): one pass over the rate for both. A sample that is not finite
+// makes the sum not finite; only then are the samples checked one by one, to name it.
+double rate_mean_and_line_sums(std::span<const double> rate, LineSums& line) {
+  const SequentialAndLineSums sums = sequential_and_line_sums(rate);
+  line = sums.line;
+  if (!std::isfinite(sums.sequential)) return rate_mean(rate, true);
+  return sums.sequential / static_cast<double>(rate.size());
+}
+
 // theta_0 = 0, theta_{k+1} = theta_k + (y_k - mean) into out[0 .. n]: a chain of adds, the running
 // value kept in a register (not read back from memory; push_back instead was twice as slow).
 void fill_angle(std::span<const double> rate, double mean, double* out) {
@@ -48,6 +58,23 @@ void fill_angle(std::span<const double> rate, double mean, double* out) {
     t += rate[i] - mean;
     out[i + 1] = t;
   }
+}
+
+// fill_angle, and into pairs[b] the mean of samples 2b and 2b + 1 (BlockAverages at factor 2, the
+// same operations) in the shadow of the angle's chain of adds: one pass over the rate for both.
+void fill_angle_and_pairs(std::span<const double> rate, double mean, double* out, double* pairs) {
+  double t = 0.0;
+  out[0] = t;
+  std::size_t i = 0;
+  for (; i + 2 <= rate.size(); i += 2) {
+    const double y0 = rate[i], y1 = rate[i + 1];
+    t += y0 - mean;
+    out[i + 1] = t;
+    t += y1 - mean;
+    out[i + 2] = t;
+    pairs[i / 2] = (y0 + y1) / 2.0;
+  }
+  if (i < rate.size()) out[i + 1] = t + (rate[i] - mean);
 }
 
 // The working memory of a curve, kept by the thread for its next one: the angle (N + 1 values)
@@ -91,9 +118,9 @@ AdevPoint deviation_point(double sum, std::size_t n_theta, std::size_t m, double
 // does (NIST SP 1065 §5.6; noise_id.hpp) in the tau-averaged series: by the lag-1
 // autocorrelation where 30 averages remain, by the B1 ratio down to 8; below that carried from the
 // largest tau where it was identified, and white FM (the gyro's angle random walk) when the series
-// is too short to identify anything.
+// is too short to identify anything. `rate_line`: the rate's line sums, the averages at m = 1.
 void assign_noise(AdevPoint& p, BlockAverages& averages, std::span<const double> theta, int order,
-                  std::optional<int>& last_alpha) {
+                  const LineSums& rate_line, std::optional<int>& last_alpha) {
   const std::size_t n_averages = (theta.size() - 1) / p.m;
   if (n_averages < kMinB1Averages) {
     p.alpha = last_alpha.value_or(0);
@@ -101,7 +128,9 @@ void assign_noise(AdevPoint& p, BlockAverages& averages, std::span<const double>
     return;
   }
   const std::span<const double> a = averages.at(p.m);
-  if (const auto id = identify_noise_in_averages(a, order)) {
+  const auto id = p.m == 1 ? identify_noise_in_averages(a, order, rate_line)
+                           : identify_noise_in_averages(a, order);
+  if (id) {
     p.alpha = id->alpha;
     p.noise_id = NoiseIdMethod::lag1;
   } else if (const auto b1 = identify_noise_b1_in_averages(a, theta, p.m)) {
@@ -212,9 +241,11 @@ std::vector<AdevPoint> overlapping_adev(std::span<const double> rate, double rat
   check_adev_arguments(rate_hz, confidence);
   std::vector<AdevPoint> out;
   if (rate.empty()) return out;
-  // The angle written once, not zeroed first (a pass of its own over N values).
+  // The angle written once, not zeroed first, the pairs' means beside it.
   const std::span<double> scratch = curve_scratch(rate.size() + 1 + rate.size() / 2);
-  fill_angle(rate, rate_mean(rate, true), scratch.data());
+  LineSums rate_line;
+  const double mean = rate_mean_and_line_sums(rate, rate_line);
+  fill_angle_and_pairs(rate, mean, scratch.data(), scratch.data() + rate.size() + 1);
   const std::span<const double> theta = scratch.first(rate.size() + 1);
   const int order = kind == DeviationKind::hdev ? 3 : 2;  // the difference taken of the angle
   std::vector<std::size_t> ms;                            // the factors with at least one term
@@ -223,10 +254,11 @@ std::vector<AdevPoint> overlapping_adev(std::span<const double> rate, double rat
   }
   const std::vector<double> sums = difference_sums(theta, ms, order);
   BlockAverages averages(rate, scratch.subspan(rate.size() + 1));
+  averages.pairs_formed();
   std::optional<int> last_alpha;
   for (std::size_t i = 0; i < ms.size(); ++i) {
     AdevPoint p = deviation_point(sums[i], theta.size(), ms[i], 1.0 / rate_hz, order);
-    assign_noise(p, averages, theta, order, last_alpha);
+    assign_noise(p, averages, theta, order, rate_line, last_alpha);
     p.edf = greenhall_edf(p.alpha, order, static_cast<double>(ms[i]),
                           static_cast<double>(theta.size()), true);
     std::tie(p.ci_low, p.ci_high) = chi_squared_interval(p.adev, p.edf, confidence);

@@ -32,9 +32,8 @@ struct Line {
 
 /// Sum t and sum t^2 over t = 0 .. n-1 in closed form (n (n-1) / 2, (n-1) n (2n-1) / 6), sum y
 /// and sum t y by vector_sums.hpp.
-Line least_squares_line(std::span<const double> y) {
-  const double n = static_cast<double>(y.size());
-  const LineSums sums = line_sums(y);
+Line least_squares_line(std::size_t n_values, const LineSums& sums) {
+  const double n = static_cast<double>(n_values);
   const double st = n * (n - 1) / 2, stt = (n - 1) * n * (2 * n - 1) / 6;
   const double den = n * stt - st * st;
   Line line;
@@ -163,6 +162,12 @@ std::string_view noise_id_method_name(NoiseIdMethod method) {
   return "none";
 }
 
+void BlockAverages::pairs_formed() {
+  last_ = scratch_.data();
+  size_ = rate_.size() / 2;
+  m_ = 2;
+}
+
 std::span<const double> BlockAverages::at(std::size_t m) {
   if (m <= 1) return rate_;
   if (m == m_) return {last_, size_};
@@ -190,7 +195,13 @@ std::span<const double> BlockAverages::at(std::size_t m) {
 
 std::optional<NoiseId> identify_noise_in_averages(std::span<const double> averages, int d_max) {
   if (averages.size() < kMinNoiseIdPoints) return std::nullopt;
-  const Line line = least_squares_line(averages);
+  return identify_noise_in_averages(averages, d_max, line_sums(averages));
+}
+
+std::optional<NoiseId> identify_noise_in_averages(std::span<const double> averages, int d_max,
+                                                  const LineSums& sums) {
+  if (averages.size() < kMinNoiseIdPoints) return std::nullopt;
+  const Line line = least_squares_line(averages.size(), sums);
   double r1 = lag1_about_line(averages, line);
   std::vector<double> x;  // the differenced series, formed only when a difference is taken
   for (int d = 0;; ++d) {

@@ -29,6 +29,8 @@
 #include <string_view>
 #include <vector>
 
+#include "compensation/vector_sums.hpp"
+
 namespace station::compensation {
 
 /// Averages the lag-1 method needs (Riley & Greenhall 2004: about 30).
@@ -66,6 +68,9 @@ class BlockAverages {
   /// m >= 2 needs) rather than into memory of its own; holds a view of both.
   BlockAverages(std::span<const double> rate, std::span<double> scratch)
       : rate_(rate), scratch_(scratch) {}
+  /// Says that the scratch already holds the averages at factor 2, formed as at(2) would form
+  /// them ((y_2b + y_2b+1) / 2, b < rate.size() / 2): a caller's pass over the rate wrote them.
+  void pairs_formed();
   /// The averages at factor m (>= 1, not below the previous call's); valid until the next call.
   std::span<const double> at(std::size_t m);
 
@@ -80,6 +85,9 @@ class BlockAverages {
 
 /// identify_noise on the averages a BlockAverages formed; empty below kMinNoiseIdPoints of them.
 std::optional<NoiseId> identify_noise_in_averages(std::span<const double> averages, int d_max);
+/// The same with the averages' line sums (vector_sums.hpp, line_sums) already taken.
+std::optional<NoiseId> identify_noise_in_averages(std::span<const double> averages, int d_max,
+                                                  const LineSums& sums);
 
 /// Identifies the dominant power-law noise of `rate` at averaging factor m by the lag-1 method;
 /// empty when fewer than kMinNoiseIdPoints averages remain. `d_max` is 2 for ADEV, 3 for HDEV.

@@ -138,6 +138,38 @@ STATION_INLINE void line_sums_into(const double* y, std::size_t n, double* sums)
   sums[1] = pairwise_total(pty, kSeriesLanes);
 }
 
+// The same line sums with the sequential sum of y into sums[2]: the chain's adds one at a time.
+template <class V>
+STATION_INLINE void sequential_line_sums_into(const double* y, std::size_t n, double* sums) {
+  constexpr std::size_t w = kWidth<V>, nv = kSeriesLanes / w;
+  V sy[nv] = {}, sty[nv] = {};
+  double chain = 0;
+  std::size_t k = 0;
+  for (; k + kSeriesLanes <= n; k += kSeriesLanes) {
+#pragma GCC unroll 16
+    for (std::size_t v = 0; v < nv; ++v) {
+      const V yv = load<V>(y + k + w * v);
+      sy[v] += yv;
+      sty[v] += ramp<V>(static_cast<double>(k + w * v)) * yv;
+    }
+#pragma GCC unroll 16
+    for (std::size_t i = 0; i < kSeriesLanes; ++i) chain += y[k + i];
+  }
+  double py[kSeriesLanes], pty[kSeriesLanes];
+  for (std::size_t v = 0; v < nv; ++v) {
+    store(py + w * v, sy[v]);
+    store(pty + w * v, sty[v]);
+  }
+  for (; k < n; ++k) {
+    py[k % kSeriesLanes] += y[k];
+    pty[k % kSeriesLanes] += static_cast<double>(k) * y[k];
+    chain += y[k];
+  }
+  sums[0] = pairwise_total(py, kSeriesLanes);
+  sums[1] = pairwise_total(pty, kSeriesLanes);
+  sums[2] = chain;
+}
+
 // Sum x_t, sum x_t^2 (t < n) and sum x_t x_{t+1} (t < n - 1) into sums[0..2].
 template <class V>
 STATION_INLINE void lag_sums_into(const double* y, std::size_t n, double icpt, double slope,
@@ -177,25 +209,30 @@ struct Kernels {
   void (*second)(const double*, std::size_t, std::size_t, std::size_t, double*);
   void (*third)(const double*, std::size_t, std::size_t, std::size_t, double*);
   void (*line)(const double*, std::size_t, double*);
+  void (*sequential_line)(const double*, std::size_t, double*);
   void (*lag)(const double*, std::size_t, double, double, double*);
 };
 
-#define STATION_KERNELS(name, V, attr)                                                   \
-  attr void name##_second(const double* t, std::size_t m, std::size_t a, std::size_t b,  \
-                          double* p) {                                                   \
-    add_terms<V, Second>(t, m, a, b, p);                                                 \
-  }                                                                                      \
-  attr void name##_third(const double* t, std::size_t m, std::size_t a, std::size_t b,   \
-                         double* p) {                                                    \
-    add_terms<V, Third>(t, m, a, b, p);                                                  \
-  }                                                                                      \
-  attr void name##_line(const double* y, std::size_t n, double* s) {                     \
-    line_sums_into<V>(y, n, s);                                                          \
-  }                                                                                      \
-  attr void name##_lag(const double* y, std::size_t n, double i, double sl, double* s) { \
-    lag_sums_into<V>(y, n, i, sl, s);                                                    \
-  }                                                                                      \
-  constexpr Kernels name{name##_second, name##_third, name##_line, name##_lag};
+#define STATION_KERNELS(name, V, attr)                                                     \
+  attr void name##_second(const double* t, std::size_t m, std::size_t a, std::size_t b,    \
+                          double* p) {                                                     \
+    add_terms<V, Second>(t, m, a, b, p);                                                   \
+  }                                                                                        \
+  attr void name##_third(const double* t, std::size_t m, std::size_t a, std::size_t b,     \
+                         double* p) {                                                      \
+    add_terms<V, Third>(t, m, a, b, p);                                                    \
+  }                                                                                        \
+  attr void name##_line(const double* y, std::size_t n, double* s) {                       \
+    line_sums_into<V>(y, n, s);                                                            \
+  }                                                                                        \
+  attr void name##_sequential_line(const double* y, std::size_t n, double* s) {            \
+    sequential_line_sums_into<V>(y, n, s);                                                 \
+  }                                                                                        \
+  attr void name##_lag(const double* y, std::size_t n, double i, double sl, double* s) {   \
+    lag_sums_into<V>(y, n, i, sl, s);                                                      \
+  }                                                                                        \
+  constexpr Kernels name{name##_second, name##_third, name##_line, name##_sequential_line, \
+                         name##_lag};
 
 STATION_KERNELS(kBaseline, V2, )  // SSE2 on x86-64; what the compiler makes of it elsewhere
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
@@ -223,6 +260,12 @@ LineSums line_sums(std::span<const double> y) {
   double s[2];
   kernels().line(y.data(), y.size(), s);
   return {s[0], s[1]};
+}
+
+SequentialAndLineSums sequential_and_line_sums(std::span<const double> y) {
+  double s[3];
+  kernels().sequential_line(y.data(), y.size(), s);
+  return {s[2], {s[0], s[1]}};
 }
 
 LagSums residual_lag_sums(std::span<const double> y, double icpt, double slope) {

@@ -30,6 +30,15 @@ struct LineSums {
 };
 LineSums line_sums(std::span<const double> y);
 
+/// line_sums of y and, in the same pass, the plain sum y_0 + y_1 + ... + y_{n-1} added one value
+/// at a time in increasing t (the rounding of a sequential sum, which the angle's mean keeps; its
+/// chain of adds hides the line sums' work and their read of y). Pure.
+struct SequentialAndLineSums {
+  double sequential = 0;
+  LineSums line;
+};
+SequentialAndLineSums sequential_and_line_sums(std::span<const double> y);
+
 /// With x_t = y_t - (icpt + slope t): sum x_t, sum x_t^2 (t < n) and sum x_t x_{t+1} (t < n-1),
 /// the lag-1 autocorrelation's sums (Riley & Greenhall 2004, eq. 2). Pure.
 struct LagSums {

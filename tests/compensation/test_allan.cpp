@@ -3,11 +3,14 @@
 
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "compensation/allan.hpp"
 #include "compensation/chi_squared.hpp"
+#include "compensation/limits.hpp"
 
 namespace station::compensation {
 namespace {
@@ -247,6 +250,31 @@ TEST(OverlappingAdev, RejectsBadArguments) {
   EXPECT_THROW(overlapping_adev(y, 0.0, ms), std::invalid_argument);
   EXPECT_THROW(overlapping_adev(y, 1.0, ms, 1.0), std::invalid_argument);
   EXPECT_TRUE(overlapping_adev(std::vector<double>{}, 1.0, ms).empty());
+}
+
+// A sample that is not finite is named by its index (the check rides on the mean's sum: only a
+// sum that is not finite looks at the samples one by one); finite samples whose sum overflows
+// are no sample's fault, and the curve says it overflows.
+TEST(OverlappingAdev, NamesTheSampleThatIsNotFinite) {
+  const std::vector<std::size_t> ms = {1, 2, 4};
+  for (const double bad :
+       {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+    std::vector<double> y = white_noise(100, 1.0, 3);
+    y[57] = bad;
+    try {
+      overlapping_adev(y, 1.0, ms);
+      ADD_FAILURE() << "no DataError for " << bad;
+    } catch (const DataError& e) {
+      EXPECT_NE(std::string(e.what()).find("sample 57"), std::string::npos) << e.what();
+    }
+  }
+  const std::vector<double> huge(100, 1e308);
+  try {
+    overlapping_adev(huge, 1.0, ms);
+    ADD_FAILURE() << "no DataError for an overflowing sum";
+  } catch (const DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("overflows"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -125,6 +125,21 @@ TEST(VectorSums, LineAndLagSumsAgreeWithPlainLoops) {
   EXPECT_NEAR(lag.x_next, sxn, bound * axn);
 }
 
+// The sequential sum taken beside the line sums is the plain loop's, and the line sums are
+// line_sums', bit for bit, for every length's tail.
+TEST(VectorSums, SequentialSumBesideTheLineSumsBitForBit) {
+  for (const std::size_t n : {0u, 1u, 15u, 16u, 17u, 1000u, 10'007u}) {
+    const std::vector<double> y = walk_plus_white(n, 13);
+    double plain = 0;
+    for (const double v : y) plain += v;
+    const SequentialAndLineSums both = sequential_and_line_sums(y);
+    const LineSums line = line_sums(y);
+    EXPECT_EQ(both.sequential, plain) << n;
+    EXPECT_EQ(both.line.y, line.y) << n;
+    EXPECT_EQ(both.line.ty, line.ty) << n;
+  }
+}
+
 // Averages formed from the previous factor's (octave: pairs; decade's 20 from 10) or from the rate
 // (decade's 10 after 4) against the plain mean of each block: a sum of q values in any order is
 // within (q - 1) u of the exact sum of magnitudes, so two orders within 2 (q - 1) u.
@@ -158,7 +173,9 @@ TEST(BlockAverages, InTheCallersScratchTheSameBits) {
     for (const std::size_t m : tau_factors(y.size(), spacing)) {
       const std::span<const double> a = own.at(m), b = lent.at(m);
       ASSERT_EQ(a.size(), b.size()) << m;
-      if (m > 1) EXPECT_EQ(b.data(), scratch.data()) << m;
+      if (m > 1) {
+        EXPECT_EQ(b.data(), scratch.data()) << m;
+      }
       for (std::size_t i = 0; i < a.size(); ++i) ASSERT_EQ(a[i], b[i]) << "m " << m << " i " << i;
     }
   }
