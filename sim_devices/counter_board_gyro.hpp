@@ -1,8 +1,13 @@
-// Simulated ring laser gyro behind a counter board: thermal bias model, noise, pulse quantisation.
+// Simulated ring laser gyro behind a counter board: thermal bias model, noise, pulse quantisation,
+// and (issue 36) the table it sits on, its scale factor, power, turn-on bias and warm-up.
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <random>
+#include <vector>
+
+#include "sim_devices/gyro_acceptance.hpp"
 
 namespace station::sim {
 
@@ -30,12 +35,21 @@ struct NoiseParams {
   double rrw_dph_psh = 1.0e-4;          ///< rate random walk K, deg/h/sqrt(h)
 };
 
+/// The table's unwrapped angle at a simulated time, deg, right-handed about up
+/// (TurntableSim::cumulative_angle_at_deg); called only for times the gyro steps through.
+using TableAngleFn = std::function<double(double sim_time_s)>;
+
 /// Everything one simulated gyro needs.
 struct GyroConfig {
   TrueCoefficients coefficients;
   ThermalParams thermal;
   NoiseParams noise;
-  double earth_rate_dph = 0.0;         ///< Earth rate along the input axis, deg/h (from caller)
+  AcceptanceTruth acceptance;  ///< scale factor, turn-on, warm-up, mounting (default: none)
+  /// Earth rate's vertical component (W sin(lat)), deg/h, from the caller: for the default
+  /// mounting (input axis up, no misalignment) the Earth rate along the input axis.
+  double earth_rate_dph = 0.0;
+  double earth_rate_north_dph = 0.0;   ///< its north component (W cos(lat)), deg/h
+  TableAngleFn table_angle_deg;        ///< the table the gyro is mounted on; empty: at rest
   double pulse_weight_arcsec = 1.5;    ///< angle per net pulse, arcsec
   double dither_pulses_per_s = 2.0e4;  ///< pulses each counter counts from dither, per s
   double step_s = 1.0;                 ///< internal integration step, s
@@ -61,7 +75,16 @@ class RlgGyroModel {
   double grad_t_c() const { return temp_b_c_ - temp_a_c_; }
   /// Deterministic thermal bias at the current temperatures, deg/h (no noise, no Earth rate).
   double thermal_bias_dph() const;
-  /// True integrated angle since time 0 (Earth rate + bias + noise), arcsec.
+  /// Switches the gyro's power at time_s(). Off: no pulses at all, dither included (the
+  /// temperatures and the noise processes go on). Off to on: a new turn-on bias drawn from
+  /// N(0, turn_on_sigma_dph) and the warm-up transient restarts. Powered from time 0, which
+  /// counts as a power-up.
+  void set_powered(bool on);
+  bool powered() const { return powered_; }
+  /// Every power-up so far, the first at time 0.
+  const std::vector<PowerUp>& power_ups() const { return power_ups_; }
+  /// True integrated angle since time 0 as the gyro sensed it while powered (table through the
+  /// scale factor, Earth rate, bias, noise), arcsec.
   double true_angle_arcsec() const { return angle_arcsec_; }
   /// Net pulses emitted since time 0: floor(true angle / pulse weight), remainder carried.
   std::int64_t net_pulses() const { return net_pulses_; }
@@ -76,6 +99,10 @@ class RlgGyroModel {
  private:
   void advance(double dt_s, double air_c);
   double noise_rate_dph(double dt_s);
+  double power_bias_dph(double from_s, double dt_s) const;
+  double table_input_arcsec(double from_deg, double to_deg, double dt_s) const;
+  void power_up();
+  void count_pulses(double dangle_arcsec, double dt_s);
 
   GyroConfig config_;
   std::mt19937_64 rng_;
@@ -86,6 +113,10 @@ class RlgGyroModel {
   double angle_arcsec_ = 0, residual_pulses_ = 0, dither_residual_ = 0;
   std::int64_t net_pulses_ = 0;
   std::uint64_t dither_pulses_ = 0, up_pulses_ = 0, down_pulses_ = 0;
+  // Power: its own random stream, so the noise is the same whatever the power does.
+  std::mt19937_64 power_rng_;
+  bool powered_ = true;
+  std::vector<PowerUp> power_ups_;
 };
 
 }  // namespace station::sim

@@ -70,6 +70,9 @@ std::vector<can_frame> CounterBoardSim::build_frames(std::uint8_t latch_seq) {
                      static_cast<std::uint32_t>(std::llround((gyro_.time_s() - reset_at_s_) * 1e6));
   if (failed_temp >= 0) st.flags |= wire::kFlagTempSensorFault;
   if (std::exchange(reset_pending_, false)) st.flags |= wire::kFlagCounterReset;
+  // An unpowered gyro: no laser discharge and no dither drive (can_frames.md, STATUS bits 0, 3).
+  const bool powered = gyro_.powered();
+  if (!powered) st.flags |= wire::kFlagLaserFault | wire::kFlagDitherFault;
   if (config_.temp_channels > 0) st.follows |= wire::kFollowsTemps;
   if (config_.send_discharge) st.follows |= wire::kFollowsDischarge;
   std::vector<can_frame> out{wire::encode(st),
@@ -83,7 +86,8 @@ std::vector<can_frame> CounterBoardSim::build_frames(std::uint8_t latch_seq) {
     out.push_back(wire::encode(t));
   }
   if (config_.send_discharge)
-    out.push_back(wire::encode(wire::DischargeFrame{node, config_.discharge_ua}));
+    out.push_back(wire::encode(wire::DischargeFrame{
+        node, powered ? config_.discharge_ua : std::array<std::uint32_t, 2>{}}));
   return out;
 }
 
@@ -166,6 +170,22 @@ void CounterBoardBus::reset_board(std::uint8_t node) {
   const std::lock_guard lock(mutex_);
   for (auto& b : boards_) {
     if (b->node() == node) return b->reset();
+  }
+  throw std::out_of_range("counter board bus: no board with that node");
+}
+
+void CounterBoardBus::set_powered(std::uint8_t node, bool on) {
+  const std::lock_guard lock(mutex_);
+  for (auto& b : boards_) {
+    if (b->node() == node) return b->set_powered(on);
+  }
+  throw std::out_of_range("counter board bus: no board with that node");
+}
+
+std::vector<PowerUp> CounterBoardBus::power_ups(std::uint8_t node) {
+  const std::lock_guard lock(mutex_);
+  for (auto& b : boards_) {
+    if (b->node() == node) return b->gyro().power_ups();
   }
   throw std::out_of_range("counter board bus: no board with that node");
 }

@@ -88,6 +88,12 @@ class CounterBoardSim {
   void set_extra_flags(std::uint8_t flags) { extra_flags_ = flags; }
   /// Stops (false) or resumes (true) answering SYNCs.
   void set_answering(bool answering) { answering_ = answering; }
+  /// The gyro's power relay (RlgGyroModel::set_powered); the board has its own supply. While the
+  /// gyro is off the board answers every SYNC as usual: STATUS with flags kFlagLaserFault |
+  /// kFlagDitherFault (no discharge, no dither), COUNTS unchanged since the power went off,
+  /// TEMPS (the sensors are the board's), DISCHARGE 0/0 uA. Not thread-safe: while a bus serves
+  /// the board, call CounterBoardBus::set_powered.
+  void set_powered(bool on) { gyro_.set_powered(on); }
   /// Board reset (a power cycle): up/down counters and the board clock restart from 0, and the
   /// first STATUS after it flags kFlagCounterReset. Not thread-safe: while a bus serves the
   /// board, call CounterBoardBus::reset_board instead.
@@ -129,6 +135,11 @@ class CounterBoardBus {
   void step_to(double sim_time_s, double chamber_air_c);
   /// Waits up to timeout for frames, answers every pending SYNC; returns SYNCs handled.
   int service(std::chrono::milliseconds timeout);
+  /// Switches the power of the gyro on board `node` (CounterBoardSim::set_powered) under the bus
+  /// lock; throws std::out_of_range if none.
+  void set_powered(std::uint8_t node, bool on);
+  /// The power-ups of the gyro on board `node` so far (a copy, under the bus lock).
+  std::vector<PowerUp> power_ups(std::uint8_t node);
   /// Bus-level faults on the next `n` frames any board sends (thread-safe).
   void drop_frames(int n);
   void duplicate_frames(int n);

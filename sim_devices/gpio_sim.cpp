@@ -89,6 +89,12 @@ std::optional<std::string> GpioSimChips::consumer(std::string_view line) const {
   return p->consumer;
 }
 
+bool GpioSimChips::claimed_as_output(std::string_view line) const {
+  std::lock_guard lock(mu_);
+  const Pin* p = lookup(line);
+  return p != nullptr && p->ever_output;
+}
+
 Result<GpioPinId> GpioSimChips::request(const GpioLineConfig& cfg, const std::string& consumer,
                                         bool initial_high, EdgeSink sink) {
   std::lock_guard lock(mu_);
@@ -119,6 +125,7 @@ Result<GpioPinId> GpioSimChips::request(const GpioLineConfig& cfg, const std::st
         fmt::format("{}: request: Device or resource busy (held by '{}')", what, p.consumer));
   p.consumer = consumer.empty() ? "?" : consumer;
   p.output = cfg.direction == GpioDirection::output;
+  p.ever_output = p.ever_output || p.output;
   if (p.output) p.high = initial_high;
   p.sink = std::move(sink);
   return GpioPinId{ci, off};

@@ -46,6 +46,9 @@ class GpioSimChips {
   std::optional<bool> pin_level(std::string_view line) const;
   /// Test API: consumer label holding the pin, "" when free; nullopt for an unknown line.
   std::optional<std::string> consumer(std::string_view line) const;
+  /// Whether a bank has ever requested the pin as an output (a wired relay, say); false for an
+  /// unknown line. A released output keeps its level, and this stays true.
+  bool claimed_as_output(std::string_view line) const;
 
   /// Bank side: requests a pin as the kernel would (errors: no chip, no line, busy).
   drivers::Result<GpioPinId> request(const drivers::gpio::GpioLineConfig& cfg,
@@ -62,7 +65,8 @@ class GpioSimChips {
     std::string name;
     bool high = false;
     bool output = false;
-    std::string consumer;  // "" = free
+    bool ever_output = false;  // requested as an output at least once
+    std::string consumer;      // "" = free
     EdgeSink sink;
   };
   struct Chip {

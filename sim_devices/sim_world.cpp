@@ -100,7 +100,8 @@ SimWorld::SimWorld(const SimWorldConfig& config) : config_(config) {
   config_.chamber.initial_c = config_.initial_c;
   chamber_sim_ =
       std::make_unique<ChamberSim>(drivers::chamber_map::generic_plc(1), config_.chamber);
-  table_sim_ = std::make_unique<TurntableSim>(drivers::turntable_map::generic_plc(1));
+  table_sim_ =
+      std::make_unique<TurntableSim>(drivers::turntable_map::generic_plc(1), config_.table);
   chamber_ = serve_chamber(config_.chamber_model, *chamber_sim_, config_.panel,
                            config_.chamber_port, config_.chamber_gateway);
   table_ = serve_turntable(config_.turntable_model, *table_sim_, config_.turntable_port,
@@ -113,9 +114,13 @@ SimWorld::SimWorld(const SimWorldConfig& config) : config_(config) {
   gpio_->set_input("DOOR_SW", true);  // door closed
   gpio_->set_input("ESTOP", false);   // not pressed
   for (int i = 0; i < config_.gyros; ++i) {
-    gyros_.push_back({static_cast<std::uint8_t>(i + 1), sim_serial(config_.preset, i),
-                      config_.pulse_weight_arcsec,
-                      sim_coefficients(config_.seed, i, config_.preset)});
+    const auto node = static_cast<std::uint8_t>(i + 1);
+    AcceptanceTruth acceptance;
+    if (config_.acceptance_truth) acceptance = sim_acceptance_truth(config_.seed, i);
+    if (auto it = config_.acceptance_by_node.find(node); it != config_.acceptance_by_node.end())
+      acceptance = it->second;
+    gyros_.push_back({node, sim_serial(config_.preset, i), config_.pulse_weight_arcsec,
+                      sim_coefficients(config_.seed, i, config_.preset), acceptance});
   }
   if (config_.can_unix_path.empty()) {
     int sv[2];
@@ -149,6 +154,11 @@ void SimWorld::add_boards() {
     b.gyro.thermal = sim_thermal(config_.preset);
     b.gyro.thermal.initial_c = config_.initial_c;
     b.gyro.earth_rate_dph = config_.earth_rate_dph;
+    b.gyro.earth_rate_north_dph = config_.earth_rate_north_dph;
+    b.gyro.acceptance = gyros_[i].acceptance;
+    // The gyros sit on the table: each step they sense its turn (the model outlives the bus).
+    TurntableSim* table = table_sim_.get();
+    b.gyro.table_angle_deg = [table](double t_s) { return table->cumulative_angle_at_deg(t_s); };
     b.gyro.pulse_weight_arcsec = gyros_[i].pulse_weight_arcsec;
     b.gyro.seed = config_.seed * 7919u + i + 1 + config_.noise_run * 0x9E3779B97F4A7C15u;
     b.board_time_offset_us = static_cast<std::uint32_t>(i * 123457u);
@@ -158,6 +168,23 @@ void SimWorld::add_boards() {
   bus_->set_fault_rates(can_rates_, config_.seed);
   for (const auto& [node, channel] : failed_temp_) bus_->board(node).fail_temp_sensor(channel);
   for (std::uint8_t node : silent_boards_) bus_->board(node).set_answering(false);
+}
+
+const AcceptanceTruth& SimWorld::acceptance_truth(std::uint8_t node) const {
+  check_node(node);
+  return gyros_[node - 1].acceptance;
+}
+
+std::vector<PowerUp> SimWorld::power_ups(std::uint8_t node) {
+  check_node(node);
+  return bus_ ? bus_->power_ups(node) : std::vector<PowerUp>{};
+}
+
+bool SimWorld::gyro_powered(std::uint8_t node) const {
+  check_node(node);
+  if (!relay_power()) return true;
+  const std::string line = fmt::format("GYRO_PWR{}", node);
+  return !gpio_->claimed_as_output(line) || gpio_->pin_level(line).value_or(true);
 }
 
 void SimWorld::check_node(std::uint8_t node) const {
@@ -240,7 +267,15 @@ void SimWorld::advance_to(double t_s) {
   if (t_s <= now_s_) return;
   chamber_sim_->step_to(t_s);
   table_sim_->step_to(t_s);
-  if (bus_) bus_->step_to(t_s, chamber_sim_->air_c());
+  if (bus_) {
+    // The relay's level since the station last wrote it holds over the whole step.
+    if (relay_power())
+      for (const auto& g : gyros_) bus_->set_powered(g.node, gyro_powered(g.node));
+    bus_->step_to(t_s, chamber_sim_->air_c());
+  }
+  // The gyros have been stepped to t_s; a second more of track costs nothing and keeps a gyro
+  // whose clock trails the table's by rounding on the exact track.
+  table_sim_->forget_track_before(t_s - 1.0);
   now_s_ = t_s;
 }
 

@@ -40,13 +40,18 @@ struct SimWorldConfig {
   /// as a second run of the same gyros on another day (run --sim --verify).
   std::uint64_t noise_run = 0;
   GyroPreset preset = GyroPreset::station;  ///< coefficients of the simulated gyros
-  double earth_rate_dph = 0;                ///< Earth rate along each gyro's input axis, deg/h
-  double initial_c = 25.0;                  ///< chamber and gyros at t = 0, deg C
-  double pulse_weight_arcsec = 1.5;         ///< every gyro's pulse weight
-  std::string can_unix_path;  ///< empty: socketpair (in-process); else listen on this path
-  int chamber_port = 0;       ///< chamber Modbus TCP port on 127.0.0.1, 0 = ephemeral
-  int turntable_port = 0;     ///< turntable Modbus TCP port on 127.0.0.1, 0 = ephemeral
-  ChamberSimConfig chamber;   ///< chamber model
+  /// The Earth rate's vertical component W sin(lat), deg/h, from the caller: along each gyro's
+  /// input axis when it is mounted as before issue 36 (vertical, no misalignment).
+  double earth_rate_dph = 0;
+  /// Its north component W cos(lat), deg/h, from the caller: what a misaligned or horizontal
+  /// input axis sees of it as the table turns (0: that part of the projection is missing).
+  double earth_rate_north_dph = 0;
+  double initial_c = 25.0;           ///< chamber and gyros at t = 0, deg C
+  double pulse_weight_arcsec = 1.5;  ///< every gyro's pulse weight
+  std::string can_unix_path;         ///< empty: socketpair (in-process); else listen on this path
+  int chamber_port = 0;              ///< chamber Modbus TCP port on 127.0.0.1, 0 = ephemeral
+  int turntable_port = 0;            ///< turntable Modbus TCP port on 127.0.0.1, 0 = ephemeral
+  ChamberSimConfig chamber;          ///< chamber model
   /// Dialects the chamber and table are served in (drivers/registry model names).
   std::string chamber_model = "generic_plc";
   std::string turntable_model = "generic_plc";
@@ -54,6 +59,18 @@ struct SimWorldConfig {
   AclFraming acutrol_framing = AclFraming::bare;  ///< how a simulated ACUTROL frames replies
   /// The chamber is a serial unit behind a TCP-to-RTU gateway (serve_chamber).
   bool chamber_gateway = false;
+  TurntableSimConfig table;  ///< the turntable's limits
+  /// Issue 36: every gyro gets its own seeded acceptance truth (sim_acceptance_truth: scale
+  /// factor, turn-on, warm-up, misalignment), and the gyros' power follows their relays (as
+  /// relay_power). Off: the gyros of before, bit for bit.
+  bool acceptance_truth = false;
+  /// Gyro n is powered while its relay line GYRO_PWRn is high, once a bank has claimed that line
+  /// as an output; a line nobody claimed is a slot without a relay: always powered. Off: always
+  /// powered, whatever the lines do (the default: a safe hold that drops the relays leaves the
+  /// gyros' data as it was before issue 36).
+  bool relay_power = false;
+  /// A gyro's truth by node, over acceptance_truth's (or the all-zero default).
+  std::map<std::uint8_t, AcceptanceTruth> acceptance_by_node;
 };
 
 /// One simulated gyro as the station will see it.
@@ -62,6 +79,7 @@ struct SimGyro {
   std::string serial;
   double pulse_weight_arcsec = 1.5;
   TrueCoefficients truth;
+  AcceptanceTruth acceptance;  ///< its acceptance-test truth (all zero unless configured)
 };
 
 /// The simulated rig. Construction starts the Modbus servers (loopback, configured ports) and
@@ -119,6 +137,14 @@ class SimWorld {
   double now_s() const { return now_s_; }
 
   const std::vector<SimGyro>& gyros() const { return gyros_; }
+  /// Gyro `node`'s acceptance truth, for "figure vs truth"; throws std::invalid_argument for an
+  /// unknown node.
+  const AcceptanceTruth& acceptance_truth(std::uint8_t node) const;
+  /// Gyro `node`'s power-ups so far on the current bus (times on the world's clock, each with its
+  /// turn-on bias); empty before a station connected over can_unix_path.
+  std::vector<PowerUp> power_ups(std::uint8_t node);
+  /// Whether gyro `node` is powered now (relay_power: its relay line; else always).
+  bool gyro_powered(std::uint8_t node) const;
   ChamberSim& chamber() { return *chamber_sim_; }
   TurntableSim& turntable() { return *table_sim_; }
   SimServer& chamber_server() { return *chamber_.server; }
@@ -128,6 +154,7 @@ class SimWorld {
  private:
   void add_boards();
   void check_node(std::uint8_t node) const;
+  bool relay_power() const { return config_.relay_power || config_.acceptance_truth; }
 
   SimWorldConfig config_;
   std::vector<SimGyro> gyros_;

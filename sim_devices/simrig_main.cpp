@@ -52,13 +52,35 @@ struct Options {
   int chamber_unit = 1;           // the chamber's Modbus address (set at its panel)
   std::string chamber_word_order = "low_high";  // F4T floats as set at its panel
   bool chamber_gateway = false;                 // the chamber behind a TCP-to-RTU gateway
+  bool acceptance_truth = false;  // issue 36: scale factor, turn-on, warm-up, misalignment
 };
 
-/// Earth rate along a local-vertical input axis, deg/h: Omega * sin(lat) with the WGS-84
-/// rotation rate Omega = 7.292115e-5 rad/s = 15.041067 deg/h (NIMA TR8350.2, 3.2.4).
+/// The WGS-84 rotation rate Omega = 7.292115e-5 rad/s = 15.041067 deg/h (NIMA TR8350.2, 3.2.4).
+constexpr double kOmegaDph = 7.292115e-5 * 180.0 / M_PI * 3600.0;
+
+/// Earth rate along a local-vertical input axis, deg/h: Omega * sin(lat).
 double earth_rate_up_dph(double latitude_deg) {
-  const double omega_dph = 7.292115e-5 * 180.0 / M_PI * 3600.0;
-  return omega_dph * std::sin(latitude_deg * M_PI / 180.0);
+  return kOmegaDph * std::sin(latitude_deg * M_PI / 180.0);
+}
+
+/// The Earth rate's north component, deg/h: Omega * cos(lat) (Titterton & Weston, eq. 3.41).
+double earth_rate_north_dph(double latitude_deg) {
+  return kOmegaDph * std::cos(latitude_deg * M_PI / 180.0);
+}
+
+/// Each gyro's acceptance truth on stderr, one line each (what `--acceptance-truth` drew).
+void log_acceptance_truth(const sim::SimWorld& world) {
+  for (const auto& g : world.gyros()) {
+    const sim::AcceptanceTruth& a = g.acceptance;
+    fmt::print(stderr,
+               "simrig: node {} {} truth: sf_error_ppm {:.2f} sf_tc_ppm_per_c {:.3f} "
+               "nonlinearity_ppm {:.2f} asymmetry_ppm {:.2f} full_scale_dps {} "
+               "turn_on_sigma_dph {:.4f} warmup_amplitude_dph {:.4f} warmup_tau_s {:.0f} "
+               "misalignment_rad {:.6f} misalignment_azimuth_deg {:.1f}\n",
+               g.node, g.serial, a.sf_error_ppm, a.sf_tc_ppm_per_c, a.nonlinearity_ppm,
+               a.asymmetry_ppm, a.full_scale_dps, a.turn_on_sigma_dph, a.warmup_amplitude_dph,
+               a.warmup_tau_s, a.misalignment_rad, a.misalignment_azimuth_deg);
+  }
 }
 
 /// Why `path` cannot be the CAN socket (empty when it can). The simulator replaces a stale
@@ -214,6 +236,10 @@ void add_options(CLI::App& app, Options& o) {
   app.add_flag("--chamber-gateway", o.chamber_gateway,
                "Modbus chamber: a serial unit behind a TCP-to-RTU gateway (its RTU registers; "
                "exception 0x0B for another unit id)");
+  app.add_flag("--acceptance-truth", o.acceptance_truth,
+               "issue 36: each gyro gets a seeded scale factor error, its temperature "
+               "coefficient, nonlinearity, asymmetry, turn-on bias spread, warm-up and "
+               "misalignment (logged to stderr; docs/SIMRIG.md)");
   app.add_option("--control", o.control,
                  "unix stream socket for fault commands, one per line, one reply line each");
   app.add_option("--send", o.send,
@@ -239,6 +265,8 @@ sim::SimWorldConfig world_config(const Options& o) {
   c.panel.float_words = station::drivers::modbus::parse_float_word_order(o.chamber_word_order);
   c.chamber_gateway = o.chamber_gateway;
   c.earth_rate_dph = earth_rate_up_dph(o.latitude_deg);
+  c.earth_rate_north_dph = earth_rate_north_dph(o.latitude_deg);
+  c.acceptance_truth = o.acceptance_truth;
   return c;
 }
 
@@ -276,6 +304,7 @@ int main(int argc, char** argv) {
       });
     }
     print_config(world, o);
+    if (o.acceptance_truth) log_acceptance_truth(world);
     if (control) fmt::print(stderr, "simrig: fault commands on {}\n", o.control);
     serve(world, world.can_transport(), control.get());
   } catch (const std::exception& e) {

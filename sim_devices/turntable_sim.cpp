@@ -30,7 +30,8 @@ void TurntableSim::step_to(double sim_time_s) {
 double TurntableSim::velocity_demand() const {
   bool enabled = !interlock_open_ && !fault_ && !locked_ && !stopping_;
   if (!enabled || mode_ == 0) return 0.0;
-  if (mode_ == 2) return rate_demand_dps_;
+  if (mode_ == 2)
+    return std::clamp(rate_demand_dps_, -cfg_.max_rate_mode_dps, cfg_.max_rate_mode_dps);
   // Position: the fastest velocity from which the table can still stop at the target,
   // v = sqrt(2 a d), capped at the velocity limit; this yields the trapezoidal profile.
   double d = std::remainder(position_demand_deg_ - angle_deg_, 360.0);
@@ -42,17 +43,22 @@ void TurntableSim::step_once(double dt) {
   double dv_max = cfg_.max_accel_dps2 * dt;
   double v_old = rate_dps_;
   double v_new = v_old + std::clamp(velocity_demand() - v_old, -dv_max, dv_max);
+  track_step((v_new - v_old) / dt);
   // Trapezoidal integration: exact while the acceleration is constant over the step.
-  double next = angle_deg_ + 0.5 * (v_old + v_new) * dt;
+  double turned = 0.5 * (v_old + v_new) * dt;
+  double next = angle_deg_ + turned;
   if (mode_ == 1 && !stopping_) {
     double before = std::remainder(position_demand_deg_ - angle_deg_, 360.0);
     double after = std::remainder(position_demand_deg_ - next, 360.0);
     // Do not overshoot the final approach: snap when the error changes sign at low speed.
     if (before * after <= 0 && std::fabs(v_new) <= dv_max) {
       next = position_demand_deg_;
+      turned = before;
       v_new = 0;
+      snapped_ = true;
     }
   }
+  cumulative_deg_ += turned;
   rate_dps_ = v_new;
   angle_deg_ = wrap360(next);
   if (stopping_ && rate_dps_ == 0) {
@@ -60,6 +66,38 @@ void TurntableSim::step_once(double dt) {
     mode_ = 0;
   }
   if ((interlock_open_ || fault_) && rate_dps_ == 0) mode_ = 0;
+}
+
+// A new track point at the start of a step whose acceleration differs from the one kept (at rest
+// and at a steady rate it is exactly 0: no points), or after a snap.
+void TurntableSim::track_step(double accel_dps2) {
+  if (!snapped_ && accel_dps2 == track_.back().accel_dps2) return;
+  snapped_ = false;
+  track_.push_back({t_s_, cumulative_deg_, rate_dps_, accel_dps2});
+}
+
+double TurntableSim::cumulative_angle_deg() const {
+  std::lock_guard lock(mutex_);
+  return cumulative_deg_;
+}
+
+double TurntableSim::cumulative_angle_at_deg(double t_s) const {
+  std::lock_guard lock(mutex_);
+  if (t_s >= t_s_ - 1e-9) return cumulative_deg_;
+  if (t_s <= track_.front().t_s) return track_.front().angle_deg;
+  auto it = std::upper_bound(track_.begin(), track_.end(), t_s,
+                             [](double t, const TrackPoint& p) { return t < p.t_s; });
+  const TrackPoint& p = *std::prev(it);
+  const double tau_s = t_s - p.t_s;
+  // Constant acceleration from the point on (the trapezoid steps sum to exactly this).
+  return p.angle_deg + p.rate_dps * tau_s + 0.5 * p.accel_dps2 * tau_s * tau_s;
+}
+
+void TurntableSim::forget_track_before(double t_s) {
+  std::lock_guard lock(mutex_);
+  auto it = std::upper_bound(track_.begin(), track_.end(), t_s,
+                             [](double t, const TrackPoint& p) { return t < p.t_s; });
+  if (it - track_.begin() > 1) track_.erase(track_.begin(), std::prev(it));
 }
 
 double TurntableSim::angle_deg() const {
