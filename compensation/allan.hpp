@@ -58,7 +58,8 @@ std::vector<double> integrated_angle(std::span<const double> rate);
 /// freedom of Greenhall & Riley for the noise identified at that tau in its tau-averaged series
 /// (noise_id.hpp, BlockAverages: each formed from the previous tau's, one pass in all). Factors
 /// with fewer than 1 term are skipped. Throws DataError unless rate_hz > 0 is finite,
-/// 0 < confidence < 1 and every sample is finite, or when the result overflows. Pure.
+/// 0 < confidence < 1 and every sample is finite, or when the result overflows. Pure but for
+/// its working memory (12 bytes a sample), which the calling thread keeps for its next curve.
 std::vector<AdevPoint> overlapping_adev(std::span<const double> rate, double rate_hz,
                                         std::span<const std::size_t> m_list,
                                         double confidence = 0.683,
