@@ -1,6 +1,8 @@
 // The end summary of a run (run_summary.hpp).
 #include "station/cli/run_summary.hpp"
 
+#include "station/acceptance/acceptance_json.hpp"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -113,6 +115,7 @@ std::string run_summary_text(const json& r) {
                                    [](const json& g) { return g.contains("fitted"); });
   if (any_fit && r.contains("report")) out += "\nreport: " + r["report"].get<std::string>() + "\n";
   append_verifications(out, r);
+  if (r.contains("acceptance")) out += acceptance_text(r["acceptance"]);
   return out;
 }
 
@@ -123,12 +126,14 @@ std::string report_command(const std::string& db_path, std::int64_t run_id) {
 
 json rig_run_summary(Store& store, std::int64_t run_id, std::string_view state, double t_s,
                      std::int64_t ticks, const std::string& db_path) {
-  return {{"run_id", run_id},
-          {"state", std::string(state)},
-          {"t_s", t_s},
-          {"ticks", ticks},
-          {"gyros", run_results_json(store, run_id)},
-          {"report", report_command(db_path, run_id)}};
+  json j{{"run_id", run_id},
+         {"state", std::string(state)},
+         {"t_s", t_s},
+         {"ticks", ticks},
+         {"gyros", run_results_json(store, run_id)},
+         {"report", report_command(db_path, run_id)}};
+  if (auto a = acceptance_json(run_acceptance(store, run_id)); !a.empty()) j["acceptance"] = a;
+  return j;
 }
 
 }  // namespace station

@@ -10,6 +10,7 @@
 
 #include "compensation/limits.hpp"
 #include "station/builtin_protocols.hpp"
+#include "station/config/acceptance_steps.hpp"
 #include "station/common/text_rule.hpp"
 #include "station/config/toml_reader.hpp"
 
@@ -25,7 +26,10 @@ constexpr KindName kKinds[] = {{StepKind::set_temperature, "set_temperature"},
                                {StepKind::hold, "hold"},
                                {StepKind::record_start, "record_start"},
                                {StepKind::record_stop, "record_stop"},
-                               {StepKind::lock_turntable, "lock_turntable"}};
+                               {StepKind::lock_turntable, "lock_turntable"},
+                               {StepKind::rate_ladder, "rate_ladder"},
+                               {StepKind::positions, "positions"},
+                               {StepKind::power_cycles, "power_cycles"}};
 
 StepKind kind_of(const TomlView& v) {
   const std::string type = v.get_string("type");
@@ -33,7 +37,8 @@ StepKind kind_of(const TomlView& v) {
     if (type == k.name) return k.kind;
   }
   throw v.error("type", fmt::format("unknown step type '{}' (set_temperature, soak, hold, "
-                                    "record_start, record_stop, lock_turntable)",
+                                    "record_start, record_stop, lock_turntable, rate_ladder, "
+                                    "positions, power_cycles)",
                                     type));
 }
 
@@ -97,6 +102,11 @@ Step read_step(const TomlView& v) {
     case StepKind::record_start:
     case StepKind::record_stop:
       v.allow_only({"type", "label"});
+      break;
+    case StepKind::rate_ladder:
+    case StepKind::positions:
+    case StepKind::power_cycles:
+      read_acceptance_step(v, s);
       break;
   }
   s.timeout_s = number_in(v, "timeout_s", 0.0, kMaxStepS, "s");
@@ -178,6 +188,8 @@ std::vector<std::optional<double>> Protocol::nominal_step_durations_s(
       temp = target;
     } else if (s.kind == StepKind::soak || s.kind == StepKind::hold) {
       d = s.duration_s;
+    } else if (is_acceptance_step(s.kind)) {
+      d = acceptance_duration_s(s);
     }
     out.push_back(d);
   }

@@ -18,6 +18,11 @@ enum class StepKind {
   record_start,     ///< open the record window
   record_stop,      ///< close the record window
   lock_turntable,   ///< position the table and engage the lock
+  // The acceptance steps (issue 36; schedules in acceptance_steps.hpp). Their samples are
+  // flagged kAcceptanceStep: the table turned or the gyros were switched, no thermal bin.
+  rate_ladder,   ///< the table at a ladder of rates, each one way then the other (scale factor)
+  positions,     ///< the table at a list of angles (Earth-rate projection, misalignment)
+  power_cycles,  ///< the gyros' power off and on again (turn-on repeatability, warm-up)
 };
 
 /// One protocol step. Fields not used by its kind are ignored.
@@ -34,6 +39,14 @@ struct Step {
   double duration_s = 0;             ///< soak: time stable; hold: time
   double timeout_s = 0;              ///< 0 = none; past it the step ends with a warning
   double position_deg = 0;           ///< lock_turntable
+  std::vector<double> rates_dps;     ///< rate_ladder: rate magnitudes, deg/s (each +, then -)
+  std::vector<double> angles_deg;    ///< positions: table angles, deg
+  double settle_s = 0;    ///< acceptance: after a demand (and the table's travel), before measuring
+  double dwell_s = 0;     ///< acceptance: measuring time per point (power_cycles: powered time), s
+  double accel_dps2 = 0;  ///< rate_ladder: the table's acceleration limit (schedules travel), deg/s^2
+  double rate_tolerance_dps = 0;  ///< rate_ladder: |read-back - demand| allowed while measuring
+  int cycles = 0;                 ///< power_cycles: turn-ons
+  double off_s = 0;               ///< power_cycles: unpowered time before each turn-on, s
 };
 
 /// A parsed protocol with its source text.

@@ -128,6 +128,30 @@ std::optional<TomlView> TomlView::opt_table(std::string_view key) const {
   return TomlView(*n->as_table(), file_, full_key(key));
 }
 
+std::vector<double> TomlView::number_array_in(std::string_view key, double lo, double hi,
+                                              std::string_view unit,
+                                              std::size_t max_count) const {
+  std::vector<double> out;
+  const toml::node* n = find(key);
+  if (n == nullptr) return out;
+  const toml::array* arr = n->as_array();
+  if (arr == nullptr) throw error(key, "expected an array of numbers");
+  if (arr->size() > max_count)
+    throw error(key, fmt::format("{} entries, at most {}", arr->size(), max_count));
+  for (std::size_t i = 0; i < arr->size(); ++i) {
+    const toml::node& e = (*arr)[i];
+    if (!e.is_number()) throw error(key, fmt::format("entry {} is not a number", i));
+    const double v =
+        e.is_integer() ? static_cast<double>(*e.value<std::int64_t>()) : *e.value<double>();
+    if (!std::isfinite(v) || v < lo || v > hi) {
+      throw error(key, fmt::format("entry {}: {:g} is outside {:g}..{:g}{}{}", i, v, lo, hi,
+                                   unit.empty() ? "" : " ", unit));
+    }
+    out.push_back(v);
+  }
+  return out;
+}
+
 std::vector<TomlView> TomlView::table_array(std::string_view key) const {
   std::vector<TomlView> out;
   const toml::node* n = find(key);

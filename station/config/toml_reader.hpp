@@ -38,6 +38,10 @@ class TomlView {
   double get_number(std::string_view key) const;
   long long get_integer(std::string_view key) const;
 
+  /// Array of numbers `key` (empty when absent), each finite and within [lo, hi], at most
+  /// `max_count` of them; throws naming the entry ("entry 2: 400 is outside 0..300 deg/s").
+  std::vector<double> number_array_in(std::string_view key, double lo, double hi,
+                                      std::string_view unit, std::size_t max_count) const;
   /// Sub-table `key` (empty when absent); throws when present with another type.
   std::optional<TomlView> opt_table(std::string_view key) const;
   /// Array of tables `key` ([[key]] entries), each as a view "key[i]".

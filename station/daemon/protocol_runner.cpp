@@ -72,6 +72,11 @@ void ProtocolRunner::enter(const Step& s, const Observation& obs, Actions& a) {
       a.events.push_back({Severity::info, EventKind::record_stop,
                           fmt::format("record window closes at {:.0f} s", obs.t_s)});
       break;
+    case StepKind::rate_ladder:
+    case StepKind::positions:
+    case StepKind::power_cycles:
+      acceptance_.enter(s, progress_.step_index, progress_.step_started_s);
+      break;
     default:
       break;
   }
@@ -107,6 +112,19 @@ void ProtocolRunner::ramp(const Step& s, const Observation& obs, Actions& a) {
   ramp_sent_c_ = sp;
 }
 
+bool ProtocolRunner::in_acceptance_step() const {
+  return !done() &&
+         is_acceptance_step(protocol_.steps[static_cast<std::size_t>(progress_.step_index)].kind);
+}
+
+void ProtocolRunner::accept(const Observation& obs, Actions& a) {
+  auto acts = acceptance_.tick(
+      obs.t_s, {obs.table_rate_dps, obs.table_angle_deg, obs.table_in_position.value_or(false)});
+  if (acts.table) a.table = acts.table;
+  if (acts.gyro_power) a.gyro_power = acts.gyro_power;
+  for (auto& e : acts.events) a.events.push_back(std::move(e));
+}
+
 bool ProtocolRunner::finished(const Step& s, const Observation& obs) {
   const double in_step_s = obs.t_s - progress_.step_started_s;
   switch (s.kind) {
@@ -127,6 +145,10 @@ bool ProtocolRunner::finished(const Step& s, const Observation& obs) {
     }
     case StepKind::hold:
       return in_step_s >= s.duration_s;
+    case StepKind::rate_ladder:
+    case StepKind::positions:
+    case StepKind::power_cycles:
+      return acceptance_.finished(obs.t_s);
     case StepKind::lock_turntable:
       // Done on a reading taken after the lock command that shows the table there and locked.
       return !obs.has_turntable || (lock_sent_s_ && obs.t_s > *lock_sent_s_ && table_at(s, obs) &&
@@ -159,6 +181,7 @@ Actions ProtocolRunner::tick(const Observation& obs) {
     if (!entered_) enter(s, obs, a);
     if (s.kind == StepKind::set_temperature && s.ramp_c_per_h > 0) ramp(s, obs, a);
     if (s.kind == StepKind::lock_turntable) lock_table(s, obs, a);
+    if (is_acceptance_step(s.kind)) accept(obs, a);
     if (finished(s, obs)) {
       advance(obs, a, EventKind::step_done, Severity::info);
       continue;

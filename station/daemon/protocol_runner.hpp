@@ -9,6 +9,7 @@
 #include "drivers/chamber/chamber.hpp"
 #include "drivers/turntable/turntable.hpp"
 #include "station/config/protocol.hpp"
+#include "station/daemon/acceptance_runner.hpp"
 #include "station/store/events.hpp"
 #include "station/store/store.hpp"
 
@@ -23,6 +24,7 @@ struct Observation {
   bool has_turntable = false;
   std::optional<double> table_angle_deg;  ///< empty when there is no turntable or no answer
   std::optional<bool> table_locked;       ///< axis lock read back
+  std::optional<double> table_rate_dps;   ///< empty when there is no turntable or no answer
 };
 
 /// A note for the event log: step_start, step_done, step_timeout, ramp_resume, record_start,
@@ -33,6 +35,7 @@ using RunnerEvent = EventNote;
 struct Actions {
   std::optional<drivers::ChamberCommand> chamber;
   std::optional<drivers::TurntableCommand> table;
+  std::optional<bool> gyro_power;  ///< power_cycles: switch the gyros' relays
   std::vector<RunnerEvent> events;
 };
 
@@ -63,6 +66,10 @@ class ProtocolRunner {
   std::optional<double> setpoint_c() const { return setpoint_c_; }
   /// The setpoint the current ramp last commanded (empty: none yet, or no ramp).
   std::optional<double> ramp_point_c() const { return ramp_sent_c_; }
+  /// An acceptance step is running: its samples are no thermal-bias samples (kAcceptanceStep).
+  bool in_acceptance_step() const;
+  /// Whether the protocol wants the gyros powered (false only in a power cycle's off time).
+  bool gyro_power() const { return !in_acceptance_step() || acceptance_.gyro_power(); }
 
  private:
   void enter(const Step& s, const Observation& obs, Actions& a);
@@ -74,6 +81,7 @@ class ProtocolRunner {
   static bool table_at(const Step& s, const Observation& obs);
   void lock_table(const Step& s, const Observation& obs, Actions& a);
   void ramp(const Step& s, const Observation& obs, Actions& a);
+  void accept(const Observation& obs, Actions& a);
 
   const Protocol& protocol_;
   RunProgress progress_;
@@ -85,6 +93,7 @@ class ProtocolRunner {
   std::optional<double> stable_since_s_;
   /// lock_turntable: when the move and the lock were commanded (readings must come after).
   std::optional<double> move_sent_s_, lock_sent_s_;
+  AcceptanceRunner acceptance_;
 };
 
 }  // namespace station

@@ -179,7 +179,9 @@ void Sequencer::assemble_samples(double t_s, TickData& d) {
     // An angle screened out (plausibility.cpp) is no position.
     if (std::isfinite(table->angle_deg)) d.obs.table_angle_deg = table->angle_deg;
     d.obs.table_locked = table->locked;
+    if (std::isfinite(table->rate_dps)) d.obs.table_rate_dps = table->rate_dps;
   }
+  const int step_flags = runner_->in_acceptance_step() ? kAcceptanceStep : 0;
   d.obs.air_c = d.in.air_c();
   if (d.obs.air_c) last_air_c_ = d.obs.air_c;
   for (std::size_t i = 0; i < config_.slots.size(); ++i) {
@@ -189,7 +191,7 @@ void Sequencer::assemble_samples(double t_s, TickData& d) {
     r.recording = recording;
     r.air_c = d.obs.air_c;
     if (chamber && std::isfinite(chamber->setpoint_c)) r.setpoint_c = chamber->setpoint_c;
-    r.flags = (chamber ? 0 : kChamberMissing) | (safety_.holding() ? kSafeHold : 0);
+    r.flags = (chamber ? 0 : kChamberMissing) | (safety_.holding() ? kSafeHold : 0) | step_flags;
     const dr::counters::CounterReading* rd = nullptr;
     // The board of slot i (its node): the gyro on it is the run's (run_gyros.hpp), whatever
     // serial the rig was built with.
@@ -250,7 +252,10 @@ void Sequencer::act_on_safety(double t_s, const SafetyDecision& d) {
   drive_outputs(t_s, d.outputs);
 }
 
-void Sequencer::drive_outputs(double t_s, const SafetyOutputs& o) {
+void Sequencer::drive_outputs(double t_s, SafetyOutputs o) {
+  // The gyros are powered when safety allows it and the protocol wants it (a power cycle's off
+  // time, issue 36).
+  if (runner_) o.gyro_power = o.gyro_power && runner_->gyro_power();
   for (const auto& failure : outputs_.write(o))
     if (command_failures_++ % 60 == 0)
       emit(t_s, Severity::warn, "gpio", EventKind::output_failed, failure);
@@ -264,6 +269,7 @@ void Sequencer::apply_actions(double t_s, const Actions& a) {
     for (const auto& n : notes) emit(t_s, Severity::warn, "safety", EventKind::clamp, n);
   }
   if (a.table) pending_table_ = a.table;
+  if (a.gyro_power && !safety_.holding()) drive_outputs(t_s, safety_.outputs());
   // Commands are retried every tick until the device accepts them; none while the rig holds
   // (one kept through a hold for a foreign setpoint waits for its end).
   if (safety_.holding()) return;

@@ -174,7 +174,7 @@ class Sequencer {
   void act_on_safety(double t_s, const SafetyDecision& d);
   void apply_actions(double t_s, const Actions& a);
   /// Tower lamps and gyro power relays (configured ones); writes the lines that change.
-  void drive_outputs(double t_s, const SafetyOutputs& o);
+  void drive_outputs(double t_s, SafetyOutputs o);
   void assemble_samples(double t_s, TickData& d);
   /// Ends the run: closes open outages, bins and fits; returns the final state ('incomplete'
   /// instead of 'completed' when a slot lost more than max_lost_share of its record window).

@@ -1,6 +1,9 @@
 // Simulated run: SimWorld + generated config + SimClock + the production sequencer.
 #include "station/sim/sim_run.hpp"
 
+#include "station/acceptance/acceptance_json.hpp"
+#include "station/sim/sim_acceptance_truth.hpp"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -15,6 +18,7 @@
 #include "sim_devices/sim_clock.hpp"
 #include "sim_devices/sim_world.hpp"
 #include "station/common/logging.hpp"
+#include "station/config/acceptance_steps.hpp"
 #include "station/config/protocol.hpp"
 #include "station/daemon/host.hpp"
 #include "station/daemon/rig.hpp"
@@ -166,6 +170,8 @@ sim::SimWorldConfig world_config(const SimRunOptions& o) {
         fmt::format("acutrol framing '{}': expected bare or header", o.acutrol_framing));
   wc.acutrol_framing = *framing;
   wc.earth_rate_dph = compensation::earth_rate_along_axis_dph(o.latitude_deg, {0, 0, 1});
+  // Its north component: what a tilted input axis sees turn with the table (issue 36).
+  wc.earth_rate_north_dph = compensation::earth_rate_along_axis_dph(o.latitude_deg, {0, 1, 0});
   return wc;
 }
 
@@ -271,6 +277,7 @@ RigOptions sim_rig_options(sim::SimWorld& world, const SimRecording& rec, SimTim
 }
 
 nlohmann::json sim_report(Store& store, const RunOutcome& out, const sim::SimWorld& world,
+                          const Protocol& protocol,
                           std::chrono::steady_clock::time_point wall_start) {
   nlohmann::json report{
       {"run_id", out.run_id},
@@ -282,6 +289,8 @@ nlohmann::json sim_report(Store& store, const RunOutcome& out, const sim::SimWor
   for (std::size_t i = 0; i < world.gyros().size(); ++i)
     report["gyros"].push_back(
         gyro_report(store, out.run_id, static_cast<int>(i), world.gyros()[i]));
+  if (auto a = acceptance_json(run_acceptance(store, out.run_id)); !a.empty())
+    report["acceptance"] = with_acceptance_truth(std::move(a), world, protocol);
   return report;
 }
 
@@ -294,7 +303,11 @@ nlohmann::json run_simulated(const SimRunOptions& o) {
   const auto wall_start = std::chrono::steady_clock::now();
   const auto part = sim_part_number(o);
   const Protocol protocol = load_protocol(o.protocol);
-  const sim::SimWorldConfig wc = world_config(o);
+  sim::SimWorldConfig wc = world_config(o);
+  // A protocol with acceptance steps tests what the acceptance truth gives each gyro (issue 36:
+  // a scale factor error, a misalignment, a turn-on bias); the others keep today's gyros.
+  wc.acceptance_truth = std::any_of(protocol.steps.begin(), protocol.steps.end(),
+                                    [](const Step& s) { return is_acceptance_step(s.kind); });
   check_fault_commands(o, wc, protocol);
   sim::SimWorld world(wc);
   const StationConfig config =
@@ -326,7 +339,7 @@ nlohmann::json run_simulated(const SimRunOptions& o) {
   const RunOutcome out = host.run(plan, std::move(so));
   report_faults_not_run(o, out.t_s);
   if (rec.session) rec.session->finish(store, out.run_id);
-  return sim_report(store, out, world, wall_start);
+  return sim_report(store, out, world, plan.protocol, wall_start);
 }
 
 }  // namespace station

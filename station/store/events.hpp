@@ -40,6 +40,7 @@ enum class EventKind {
   ramp_resume,
   record_start,
   record_stop,
+  acceptance_point,
   done,
   // Devices (source: the device)
   connect,

@@ -1,0 +1,114 @@
+// Acceptance figures as JSON.
+#include "station/acceptance/acceptance_json.hpp"
+
+namespace station {
+namespace {
+
+using nlohmann::json;
+namespace comp = station::compensation;
+
+template <class T>
+json not_computed(const comp::Computed<T>& c) {
+  return {{"ok", false}, {"error", c.error()}};
+}
+
+json ladder_json(const LadderFigures& l) {
+  json j{{"step_index", l.step_index}, {"label", l.label}, {"temp_c", l.temp_c},
+         {"points", l.points}, {"missing", l.missing}};
+  if (!l.fit) {
+    j.update(not_computed(l.fit));
+    return j;
+  }
+  const auto& f = *l.fit;
+  j.update({{"ok", true},
+            {"sf_pulse_per_arcsec", f.sf_pulse_per_arcsec},
+            {"sf_se_pulse_per_arcsec", f.sf_se_pulse_per_arcsec},
+            {"bias_dph", f.bias_dph},
+            {"bias_se_dph", f.bias_se_dph},
+            {"nonlinearity_max_ppm_fs", f.nonlinearity_max_ppm_fs},
+            {"nonlinearity_rms_ppm_fs", f.nonlinearity_rms_ppm_fs},
+            {"full_scale_dps", f.full_scale_dps},
+            {"points_used", f.points_used},
+            {"points_excluded", f.points_excluded}});
+  if (f.asymmetry) {
+    j["asymmetry_ppm"] = f.asymmetry->asymmetry_ppm;
+    j["asymmetry_se_ppm"] = f.asymmetry->asymmetry_se_ppm;
+  } else {
+    j["asymmetry_note"] = f.asymmetry_note;
+  }
+  return j;
+}
+
+json positions_json(const PositionFigures& p) {
+  json j{{"step_index", p.step_index}, {"label", p.label}, {"temp_c", p.temp_c},
+         {"points", p.points}, {"excluded", p.excluded}};
+  if (!p.fit) {
+    j.update(not_computed(p.fit));
+    return j;
+  }
+  const auto& f = *p.fit;
+  j.update({{"ok", true},
+            {"tilt_mrad", f.tilt_rad * 1e3},
+            {"tilt_se_mrad", f.tilt_se_rad * 1e3},
+            {"tilt_direction_table_deg", f.tilt_direction_table_deg},
+            {"tilt_direction_se_deg", f.tilt_direction_se_deg},
+            {"bias_dph", f.bias_dph},
+            {"bias_se_dph", f.bias_se_dph},
+            {"amplitude_resolved", f.fit.amplitude_resolved}});
+  return j;
+}
+
+json turn_on_json(const comp::Computed<comp::TurnOnResult>& t, double band_dph) {
+  if (!t) return not_computed(t);
+  const auto& r = t->repeatability;
+  json biases = json::array(), warmups = json::array();
+  for (const auto& f : t->turn_ons) {
+    biases.push_back(f.bias_dph);
+    warmups.push_back(f.warmup_s ? json(*f.warmup_s) : json(nullptr));
+  }
+  return {{"ok", true},
+          {"turn_ons", r.turn_ons},
+          {"repeatability_dph", r.repeatability_dph},
+          {"repeatability_lower_dph", r.repeatability_lower_dph},
+          {"repeatability_upper_dph", r.repeatability_upper_dph},
+          {"confidence", r.confidence},
+          {"mean_bias_dph", r.mean_bias_dph},
+          {"mean_bias_se_dph", t->mean_bias_se_dph},
+          {"max_warmup_s", t->max_warmup_s ? json(*t->max_warmup_s) : json(nullptr)},
+          {"not_settled", t->not_settled},
+          {"band_dph", band_dph},
+          {"biases_dph", biases},
+          {"warmups_s", warmups}};
+}
+
+json sf_vs_temp_json(const comp::Computed<comp::ScaleFactorTemperatureFit>& t) {
+  if (!t) return not_computed(t);
+  return {{"ok", true},
+          {"ref_temp_c", t->ref_temp_c},
+          {"sf_ref_pulse_per_arcsec", t->sf_ref_pulse_per_arcsec},
+          {"sf_ref_se_pulse_per_arcsec", t->sf_ref_se_pulse_per_arcsec},
+          {"tc_ppm_per_c", t->tc_ppm_per_c},
+          {"tc_se_ppm_per_c", t->tc_se_ppm_per_c},
+          {"plateaus", t->plateaus}};
+}
+
+}  // namespace
+
+json acceptance_json(const std::vector<SerialAcceptance>& serials) {
+  json out = json::array();
+  for (const auto& s : serials) {
+    json j{{"serial", s.serial},
+           {"earth_rate_dph", s.earth_rate_dph},
+           {"ladders", json::array()},
+           {"positions", json::array()}};
+    for (const auto& l : s.ladders) j["ladders"].push_back(ladder_json(l));
+    for (const auto& p : s.positions) j["positions"].push_back(positions_json(p));
+    if (s.sf_vs_temp) j["sf_vs_temp"] = sf_vs_temp_json(*s.sf_vs_temp);
+    if (s.turn_on) j["turn_on"] = turn_on_json(*s.turn_on, s.turn_on_band_dph);
+    if (!s.positions_note.empty()) j["positions_note"] = s.positions_note;
+    out.push_back(std::move(j));
+  }
+  return out;
+}
+
+}  // namespace station

@@ -1,0 +1,269 @@
+// A run's acceptance figures from its acceptance_point events and its samples.
+#include "station/acceptance/acceptance_run.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "compensation/earth_rate.hpp"
+#include "station/config/acceptance_steps.hpp"
+#include "station/config/protocol.hpp"
+
+namespace station {
+namespace {
+
+namespace comp = station::compensation;
+
+/// One acceptance_point event as stored.
+struct PointEvent {
+  int point = 0;
+  double measure_s = 0, end_s = 0;
+  std::optional<double> table_mean;
+  bool held = false;
+};
+using StepPoints = std::map<int, std::map<int, PointEvent>>;  // step -> point -> event
+
+StepPoints point_events(Store& store, std::int64_t run_id) {
+  StepPoints out;
+  for (const auto& e : store.event_rows(run_id)) {
+    if (e.kind != "acceptance_point" || !e.data_json) continue;
+    const auto j = nlohmann::json::parse(*e.data_json, nullptr, false);
+    if (!j.is_object() || !j.contains("step_index") || !j.contains("point")) continue;
+    PointEvent p;
+    p.point = j.value("point", 0);
+    p.measure_s = j.value("measure_s", 0.0);
+    p.end_s = j.value("end_s", 0.0);
+    if (j.contains("table_mean") && j["table_mean"].is_number()) p.table_mean = j["table_mean"];
+    p.held = j.value("held", false);
+    out[j.value("step_index", -1)][p.point] = p;  // a resumed run's later event wins
+  }
+  return out;
+}
+
+/// Mean and standard error of the mean of `v`; se empty below two values.
+struct MeanSe {
+  double mean = 0;
+  std::optional<double> se;
+  std::size_t n = 0;
+};
+MeanSe mean_se(const std::vector<double>& v) {
+  MeanSe m;
+  m.n = v.size();
+  if (v.empty()) return m;
+  for (double x : v) m.mean += x;
+  m.mean /= static_cast<double>(v.size());
+  if (v.size() < 2) return m;
+  double ss = 0;
+  for (double x : v) ss += (x - m.mean) * (x - m.mean);
+  m.se = std::sqrt(ss / static_cast<double>(v.size() - 1) / static_cast<double>(v.size()));
+  return m;
+}
+
+/// The samples of [from_s, to_s) with a rate: pulses per second, rate deg/h and sensor A.
+struct Window {
+  std::vector<double> pps, rate_dph, temp_c;
+  double span_s = 0;  ///< the time the samples cover (their intervals), s
+  /// The least error of a mean over the window: its count of pulses is exact to the phase of
+  /// the first and last pulse, two uniform errors of one pulse, sd 1/sqrt(6) pulse (GUM 4.3.7,
+  /// the rectangular distribution, for their difference's triangle): pulses/s.
+  double quantization_pps() const { return span_s > 0 ? 1.0 / (span_s * std::sqrt(6.0)) : 0.0; }
+};
+
+/// The mean of a window's series and its standard error by batch means (Schmeiser, "Batch size
+/// effects in the analysis of simulation output", Oper. Res. 30(3):556, 1982): the series in
+/// up to kBatches consecutive batches of equal count, the error from the spread of the batch
+/// means, never below `floor` (the window's quantization). Not sd/sqrt(n) of the 1 Hz values: their pulse quantization (one pulse is 1.5 deg/h in
+/// a second) is anticorrelated from second to second and would make the error of a 300 s mean
+/// four times what it is; the batch means keep what is left of it and the gyro's own
+/// correlated noise (conservative where quantization dominates a batch).
+MeanSe batch_mean_se(const std::vector<double>& v, double floor) {
+  constexpr std::size_t kBatches = 10, kMinPerBatch = 5;
+  const std::size_t k = std::min(kBatches, v.size() / kMinPerBatch);
+  if (k < 3) {
+    MeanSe m = mean_se(v);
+    if (m.se) m.se = std::max(*m.se, floor);
+    return m;
+  }
+  const std::size_t per = v.size() / k;
+  std::vector<double> means;
+  for (std::size_t b = 0; b < k; ++b) {
+    double sum = 0;
+    for (std::size_t i = b * per; i < (b + 1) * per; ++i) sum += v[i];
+    means.push_back(sum / static_cast<double>(per));
+  }
+  MeanSe m = mean_se(v);
+  m.se = std::max(mean_se(means).se.value_or(0.0), floor);
+  return m;
+}
+Window window_of(const std::vector<SampleRow>& rows, double from_s, double to_s) {
+  Window w;
+  for (const auto& r : rows) {
+    if (r.t_s < from_s || r.t_s >= to_s || !r.net_pulses || !r.interval_s || !r.rate_dph ||
+        !(*r.interval_s > 0) || (r.flags & kBoardFault) != 0 || (r.flags & kSafeHold) != 0)
+      continue;
+    w.pps.push_back(static_cast<double>(*r.net_pulses) / *r.interval_s);
+    w.span_s += *r.interval_s;
+    w.rate_dph.push_back(*r.rate_dph);
+    if (r.temp_c) w.temp_c.push_back(*r.temp_c);
+  }
+  return w;
+}
+
+LadderFigures ladder_of(const Step& s, int index, const std::map<int, PointEvent>& events,
+                        const std::vector<SampleRow>& rows, const RunSlot& slot) {
+  LadderFigures f;
+  f.step_index = index;
+  f.label = s.label;
+  std::vector<comp::LadderPoint> points;
+  std::vector<double> temps;
+  for (const auto& sp : acceptance_schedule(s)) {
+    ++f.points;
+    const auto it = events.find(sp.index);
+    if (it == events.end()) {
+      ++f.missing;
+      continue;
+    }
+    const Window w = window_of(rows, it->second.measure_s, it->second.end_s);
+    const MeanSe out = batch_mean_se(w.pps, w.quantization_pps());
+    comp::LadderPoint p;
+    p.table_rate_dps = it->second.table_mean.value_or(sp.demand);
+    p.earth_rate_dph = slot.earth_rate_dph;
+    p.output_pps = out.mean;
+    p.output_se_pps = out.se.value_or(0.0);
+    p.rate_in_tolerance = it->second.held && out.se && *out.se > 0;
+    points.push_back(p);
+    temps.insert(temps.end(), w.temp_c.begin(), w.temp_c.end());
+  }
+  f.temp_c = mean_se(temps).mean;
+  f.fit = comp::analyze_rate_ladder(points);
+  return f;
+}
+
+PositionFigures positions_of(const Step& s, int index, const std::map<int, PointEvent>& events,
+                             const std::vector<SampleRow>& rows, const RunSlot& slot) {
+  PositionFigures f;
+  f.step_index = index;
+  f.label = s.label;
+  std::vector<comp::PositionPoint> points;
+  std::vector<double> temps;
+  for (const auto& sp : acceptance_schedule(s)) {
+    ++f.points;
+    const auto it = events.find(sp.index);
+    const Window w = it == events.end() ? Window{}
+                                        : window_of(rows, it->second.measure_s, it->second.end_s);
+    const MeanSe out = batch_mean_se(w.rate_dph, w.quantization_pps() * slot.pulse_weight_arcsec);
+    if (it == events.end() || !it->second.held || !out.se || !(*out.se > 0)) {
+      ++f.excluded;
+      continue;
+    }
+    points.push_back({it->second.table_mean.value_or(sp.demand), out.mean, *out.se});
+    temps.insert(temps.end(), w.temp_c.begin(), w.temp_c.end());
+  }
+  f.temp_c = mean_se(temps).mean;
+  // The axis is up: its Earth rate is Omega sin(phi) (earth_rate.hpp), so the site's latitude
+  // is the one the run's slot was given.
+  const double s_phi = std::clamp(slot.earth_rate_dph / comp::kEarthRateDph, -1.0, 1.0);
+  f.fit = comp::analyze_positions_axis_vertical(points, {std::asin(s_phi) * 180.0 / M_PI, 0.0});
+  return f;
+}
+
+/// One turn-on's bias in kTurnOnBinS bins from its power-on, deg/h (rate - Earth rate).
+struct TurnOnBins {
+  std::vector<double> t_s, bias_dph;
+};
+TurnOnBins turn_on_bins(const std::vector<SampleRow>& rows, const PointEvent& e, double earth_dph) {
+  TurnOnBins b;
+  for (double from = e.measure_s; from + kTurnOnBinS <= e.end_s + 1e-9; from += kTurnOnBinS) {
+    const MeanSe m = mean_se(window_of(rows, from, from + kTurnOnBinS).rate_dph);
+    if (m.n * 2 < kTurnOnBinS) continue;  // a bin with under half its samples is no bin
+    b.t_s.push_back(from - e.measure_s + kTurnOnBinS / 2);
+    b.bias_dph.push_back(m.mean - earth_dph);
+  }
+  return b;
+}
+
+/// The warm-up band: three times the sd of the bins in the final windows (pooled over the
+/// turn-ons, about each one's final mean), so noise alone leaves a settled gyro inside it.
+double noise_band_dph(const std::vector<TurnOnBins>& all, const comp::TurnOnWindows& w) {
+  double ss = 0;
+  std::size_t n = 0, groups = 0;
+  for (const auto& b : all) {
+    std::vector<double> v;
+    for (std::size_t i = 0; i < b.t_s.size(); ++i)
+      if (b.t_s[i] >= w.final_start_s && b.t_s[i] <= w.final_end_s) v.push_back(b.bias_dph[i]);
+    const MeanSe m = mean_se(v);
+    for (double x : v) ss += (x - m.mean) * (x - m.mean);
+    n += v.size();
+    groups += v.empty() ? 0 : 1;
+  }
+  return n > groups ? 3.0 * std::sqrt(ss / static_cast<double>(n - groups)) : 0.0;
+}
+
+void turn_ons_of(const Step& s, const std::map<int, PointEvent>& events,
+                 const std::vector<SampleRow>& rows, const RunSlot& slot, SerialAcceptance& out) {
+  std::vector<TurnOnBins> bins;
+  for (const auto& [point, e] : events) bins.push_back(turn_on_bins(rows, e, slot.earth_rate_dph));
+  // After warm-up: the bias over the second half of the powered time, the final value over
+  // its last third.
+  comp::TurnOnWindows w;
+  w.bias_start_s = s.dwell_s / 2;
+  w.bias_end_s = s.dwell_s;
+  w.final_start_s = s.dwell_s * 2 / 3;
+  w.final_end_s = s.dwell_s;
+  w.band_dph = noise_band_dph(bins, w);
+  out.turn_on_band_dph = w.band_dph;
+  std::vector<comp::TurnOnSeries> series;
+  for (const auto& b : bins) series.push_back({b.t_s, b.bias_dph});
+  out.turn_on = comp::analyze_turn_ons(series, w);
+}
+
+void analyze_step(const Protocol& p, int index, const StepPoints& events,
+                  const std::vector<SampleRow>& rows, const RunSlot& slot, SerialAcceptance& out) {
+  const Step& s = p.steps[static_cast<std::size_t>(index)];
+  static const std::map<int, PointEvent> kNone;
+  const auto it = events.find(index);
+  const auto& mine = it == events.end() ? kNone : it->second;
+  if (s.kind == StepKind::rate_ladder) {
+    out.ladders.push_back(ladder_of(s, index, mine, rows, slot));
+  } else if (s.kind == StepKind::positions) {
+    if (slot.axis == "up")
+      out.positions.push_back(positions_of(s, index, mine, rows, slot));
+    else
+      out.positions_note = "positions are analysed for an input axis up only (this one: " +
+                           slot.axis + ")";
+  } else if (s.kind == StepKind::power_cycles) {
+    turn_ons_of(s, mine, rows, slot, out);
+  }
+}
+
+}  // namespace
+
+std::vector<SerialAcceptance> run_acceptance(Store& store, std::int64_t run_id,
+                                             double ref_temp_c) {
+  std::vector<SerialAcceptance> out;
+  const auto run = store.find_run(run_id);
+  if (!run) return out;
+  const Protocol p = parse_protocol(run->protocol_text, "run " + std::to_string(run_id));
+  std::vector<int> steps;
+  for (std::size_t i = 0; i < p.steps.size(); ++i)
+    if (is_acceptance_step(p.steps[i].kind)) steps.push_back(static_cast<int>(i));
+  if (steps.empty()) return out;
+  const StepPoints events = point_events(store, run_id);
+  for (const auto& slot : store.run_slots(run_id)) {
+    SerialAcceptance a;
+    a.serial = slot.serial;
+    a.earth_rate_dph = slot.earth_rate_dph;
+    const auto rows = store.samples(run_id, slot.serial, false);
+    for (int i : steps) analyze_step(p, i, events, rows, slot, a);
+    std::vector<comp::PlateauScaleFactor> plateaus;
+    for (const auto& l : a.ladders)
+      if (l.fit) plateaus.push_back({l.temp_c, l.fit->sf_pulse_per_arcsec, l.fit->sf_se_pulse_per_arcsec});
+    if (plateaus.size() >= 2) a.sf_vs_temp = comp::fit_scale_factor_vs_temperature(plateaus, ref_temp_c);
+    out.push_back(std::move(a));
+  }
+  return out;
+}
+
+}  // namespace station

@@ -1,0 +1,61 @@
+// A run's acceptance figures (issue 36), from what it stored: each acceptance step's
+// acceptance_point events (the windows the runner measured, what the table did) and the 1 Hz
+// samples in those windows, through the maths of compensation/scale_factor.hpp,
+// positions.hpp and turn_on.hpp.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "compensation/positions.hpp"
+#include "compensation/scale_factor.hpp"
+#include "compensation/turn_on.hpp"
+#include "station/store/store.hpp"
+
+namespace station {
+
+/// One rate ladder of one serial (one plateau).
+struct LadderFigures {
+  int step_index = 0;
+  std::string label;
+  double temp_c = 0;  ///< mean of sensor A over the ladder's windows, C
+  int points = 0;     ///< points the schedule has
+  int missing = 0;    ///< points without a measured window (a kill or a hold across it)
+  compensation::Computed<compensation::LadderResult> fit{compensation::NotComputed{"not analysed"}};
+};
+
+/// One set of positions of one serial.
+struct PositionFigures {
+  int step_index = 0;
+  std::string label;
+  double temp_c = 0;
+  int points = 0, excluded = 0;
+  compensation::Computed<compensation::VerticalAxisResult> fit{
+      compensation::NotComputed{"not analysed"}};
+};
+
+/// Everything one serial's acceptance steps gave.
+struct SerialAcceptance {
+  std::string serial;
+  double earth_rate_dph = 0;  ///< the Earth rate along its input axis (the run's slot), deg/h
+  std::vector<LadderFigures> ladders;
+  /// The scale factor against temperature over the ladders (two or more plateaus).
+  std::optional<compensation::Computed<compensation::ScaleFactorTemperatureFit>> sf_vs_temp;
+  std::vector<PositionFigures> positions;
+  std::optional<compensation::Computed<compensation::TurnOnResult>> turn_on;
+  double turn_on_band_dph = 0;  ///< the warm-up band used
+  std::string positions_note;   ///< why positions were not analysed (an axis not up or down)
+};
+
+/// Bin width of a turn-on's bias series, s: long enough that a bin's white noise (ARW 0.003
+/// deg/sqrt(h): 0.023 deg/h) is below a warm-up transient of a few hundredths.
+inline constexpr double kTurnOnBinS = 60.0;
+
+/// The acceptance figures of every serial of run `run_id`; empty when its protocol has no
+/// acceptance step. `ref_temp_c`: the temperature the scale factor is reported at.
+std::vector<SerialAcceptance> run_acceptance(Store& store, std::int64_t run_id,
+                                             double ref_temp_c = 25.0);
+
+}  // namespace station

@@ -1,0 +1,100 @@
+// The end summary's acceptance section.
+#include <fmt/format.h>
+
+#include "station/acceptance/acceptance_json.hpp"
+
+namespace station {
+namespace {
+
+using nlohmann::json;
+
+/// " (true X)" when the object's "true" has `key` (a simulated gyro), else "".
+std::string truth(const json& s, const char* key, const char* format = "{:.4g}") {
+  if (!s.contains("true") || !s["true"].is_object() || !s["true"].contains(key) ||
+      !s["true"][key].is_number())
+    return "";
+  return fmt::format(fmt::runtime(std::string(" (true ") + format + ")"), s["true"][key].get<double>());
+}
+
+std::string ladder_line(const json& s, const json& l) {
+  std::string out = fmt::format("  scale factor  {:<28} {:6.1f} C  ", l.value("label", ""),
+                                l.value("temp_c", 0.0));
+  if (!l.value("ok", false)) return out + "not computed: " + l.value("error", "") + "\n";
+  out += fmt::format("K {:.7f} +- {:.1e} pulse/arcsec{}, bias {:+.3f} +- {:.3f} deg/h, "
+                     "nonlinearity {:.1f} ppm FS{} (rms {:.1f})",
+                     l["sf_pulse_per_arcsec"].get<double>(), l["sf_se_pulse_per_arcsec"].get<double>(),
+                     truth(l, "sf_pulse_per_arcsec", "{:.7f}"), l["bias_dph"].get<double>(),
+                     l["bias_se_dph"].get<double>(), l["nonlinearity_max_ppm_fs"].get<double>(),
+                     truth(l, "nonlinearity_max_ppm_fs", "{:.1f}"),
+                     l["nonlinearity_rms_ppm_fs"].get<double>());
+  if (l.contains("asymmetry_ppm"))
+    out += fmt::format(", asymmetry {:+.1f} +- {:.1f} ppm{}", l["asymmetry_ppm"].get<double>(),
+                       l["asymmetry_se_ppm"].get<double>(), truth(l, "asymmetry_ppm", "{:+.1f}"));
+  const int excluded = l.value("points_excluded", 0) + l.value("missing", 0);
+  out += fmt::format("; {} of {} points", l.value("points_used", 0), l.value("points", 0));
+  if (excluded > 0) out += fmt::format(" ({} left out: the table did not hold its rate)", excluded);
+  return out + "\n";
+}
+
+std::string tc_line(const json& s) {
+  const json& t = s["sf_vs_temp"];
+  if (!t.value("ok", false)) return "  scale factor vs temperature: " + t.value("error", "") + "\n";
+  return fmt::format(
+      "  scale factor vs temperature: K({:g} C) {:.7f} +- {:.1e} pulse/arcsec{}, "
+      "temperature coefficient {:+.2f} +- {:.2f} ppm/C{} over {} plateaus\n",
+      t["ref_temp_c"].get<double>(), t["sf_ref_pulse_per_arcsec"].get<double>(),
+      t["sf_ref_se_pulse_per_arcsec"].get<double>(), truth(t, "sf_ref_pulse_per_arcsec", "{:.7f}"),
+      t["tc_ppm_per_c"].get<double>(), t["tc_se_ppm_per_c"].get<double>(),
+      truth(t, "tc_ppm_per_c", "{:+.2f}"), t["plateaus"].get<int>());
+}
+
+std::string positions_line(const json& s, const json& p) {
+  std::string out = fmt::format("  positions     {:<28} {:6.1f} C  ", p.value("label", ""),
+                                p.value("temp_c", 0.0));
+  if (!p.value("ok", false)) return out + "not computed: " + p.value("error", "") + "\n";
+  out += fmt::format("input-axis tilt {:.3f} +- {:.3f} mrad{} toward {:.0f} +- {:.0f} deg of the "
+                     "table, bias {:+.4f} +- {:.4f} deg/h",
+                     p["tilt_mrad"].get<double>(), p["tilt_se_mrad"].get<double>(),
+                     truth(s, "misalignment_mrad", "{:.3f}"),
+                     p["tilt_direction_table_deg"].get<double>(),
+                     p["tilt_direction_se_deg"].get<double>(), p["bias_dph"].get<double>(),
+                     p["bias_se_dph"].get<double>());
+  if (!p.value("amplitude_resolved", true)) out += " (tilt not resolved: read as an upper bound)";
+  if (p.value("excluded", 0) > 0) out += fmt::format("; {} angles left out", p["excluded"].get<int>());
+  return out + "\n";
+}
+
+std::string turn_on_line(const json& s) {
+  const json& t = s["turn_on"];
+  if (!t.value("ok", false)) return "  turn-on: not computed: " + t.value("error", "") + "\n";
+  std::string warm = t["max_warmup_s"].is_number()
+                         ? fmt::format("longest warm-up {:.0f} s", t["max_warmup_s"].get<double>())
+                         : std::string("no turn-on settled");
+  return fmt::format(
+      "  turn-on: {} turn-ons, repeatability {:.4f} deg/h ({:.0f} % interval {:.4f}..{:.4f}){}, "
+      "mean bias {:+.4f} deg/h; {}{} within +-{:.4f} deg/h of the final value\n",
+      t["turn_ons"].get<int>(), t["repeatability_dph"].get<double>(),
+      100 * t["confidence"].get<double>(), t["repeatability_lower_dph"].get<double>(),
+      t["repeatability_upper_dph"].get<double>(), truth(t, "sigma_dph", "{:.4f}"),
+      t["mean_bias_dph"].get<double>(), warm, truth(t, "warmup_s", "{:.0f} s"),
+      t["band_dph"].get<double>());
+}
+
+}  // namespace
+
+std::string acceptance_text(const json& serials) {
+  if (!serials.is_array() || serials.empty()) return "";
+  std::string out = "\nacceptance: scale factor (rate ladders), input-axis misalignment "
+                    "(positions), turn-on repeatability and warm-up (power cycles)\n";
+  for (const auto& s : serials) {
+    out += s.value("serial", "") + "\n";
+    for (const auto& l : s["ladders"]) out += ladder_line(s, l);
+    if (s.contains("sf_vs_temp")) out += tc_line(s);
+    for (const auto& p : s["positions"]) out += positions_line(s, p);
+    if (s.contains("positions_note")) out += "  positions: " + s["positions_note"].get<std::string>() + "\n";
+    if (s.contains("turn_on")) out += turn_on_line(s);
+  }
+  return out;
+}
+
+}  // namespace station

@@ -1,0 +1,145 @@
+// Acceptance steps: demands along the schedule, and what the table did over each window.
+#include "station/daemon/acceptance_runner.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+namespace station {
+namespace {
+
+namespace dr = station::drivers;
+
+// A point is measured over the whole window when the ticks it saw span all of it but the first
+// and last tick (a run killed or held in the window measured less: left out).
+constexpr double kWindowEdgeS = 2.0;
+// positions: the table is at its angle within this (as lock_turntable's check).
+constexpr double kAngleToleranceDeg = 0.1;
+
+}  // namespace
+
+void AcceptanceRunner::enter(const Step& step, int step_index, double started_s) {
+  if (step_ != &step || step_index_ != step_index || started_s_ != started_s) {
+    step_ = &step;
+    step_index_ = step_index;
+    started_s_ = started_s;
+    points_ = acceptance_schedule(step);
+    current_ = -1;
+    rested_ = false;
+    stats_ = {};
+  }
+  resend_ = true;
+}
+
+void AcceptanceRunner::send(const AcceptancePoint& p, double t_s, AcceptanceActions& a) {
+  const double in_s = t_s - started_s_;
+  switch (step_->kind) {
+    case StepKind::rate_ladder:
+      a.table = dr::TurntableCommand{dr::TurntableMode::rate, std::nullopt, p.demand, false};
+      break;
+    case StepKind::positions:
+      a.table = dr::TurntableCommand{dr::TurntableMode::position, p.demand, std::nullopt, false};
+      break;
+    case StepKind::power_cycles:
+      power_on_ = in_s >= p.measure_s;
+      a.gyro_power = power_on_;
+      break;
+    default:
+      break;
+  }
+}
+
+void AcceptanceRunner::measure(const AcceptancePoint& p, double t_s,
+                               const TableObservation& table) {
+  if (!stats_.first_s) stats_.first_s = t_s;
+  stats_.last_s = t_s;
+  if (step_->kind == StepKind::power_cycles) return;
+  const bool ladder = step_->kind == StepKind::rate_ladder;
+  const std::optional<double> value = ladder ? table.rate_dps : table.angle_deg;
+  if (!value) {
+    stats_.all_in_position = false;  // an unanswered reading is not a held one
+    return;
+  }
+  const double dev =
+      ladder ? std::abs(*value - p.demand) : std::abs(std::remainder(*value - p.demand, 360.0));
+  ++stats_.readings;
+  stats_.sum += ladder ? *value : p.demand + std::remainder(*value - p.demand, 360.0);
+  if (dev > stats_.max_dev) stats_.max_dev = dev;
+  if (!ladder && !table.in_position) stats_.all_in_position = false;
+}
+
+void AcceptanceRunner::close(const AcceptancePoint& p, AcceptanceActions& a) {
+  const double window_s = p.end_s - p.measure_s;
+  const bool spanned =
+      stats_.first_s && stats_.last_s && *stats_.last_s - *stats_.first_s >= window_s - kWindowEdgeS;
+  const bool power = step_->kind == StepKind::power_cycles;
+  const double tolerance =
+      step_->kind == StepKind::rate_ladder ? step_->rate_tolerance_dps : kAngleToleranceDeg;
+  const bool held = spanned && (power || (stats_.readings > 0 && stats_.all_in_position &&
+                                          stats_.max_dev <= tolerance));
+  nlohmann::json data{{"step_index", step_index_},
+                      {"point", p.index},
+                      {"demand", p.demand},
+                      {"measure_s", started_s_ + p.measure_s},
+                      {"end_s", started_s_ + p.end_s},
+                      {"readings", stats_.readings},
+                      {"table_mean", nullptr},
+                      {"table_max_dev", nullptr},
+                      {"held", held}};
+  if (!power && stats_.readings > 0) {
+    data["table_mean"] = stats_.sum / stats_.readings;
+    data["table_max_dev"] = stats_.max_dev;
+  }
+  const char* what = step_->kind == StepKind::rate_ladder ? "rate" : power ? "turn-on" : "angle";
+  a.events.push_back(
+      {held ? Severity::info : Severity::warn, EventKind::acceptance_point,
+       held ? fmt::format("{} {:g} measured ({} table readings)", what, p.demand, stats_.readings)
+            : fmt::format("{} {:g} not held over its window ({} readings, largest deviation "
+                          "{:g}): left out",
+                          what, p.demand, stats_.readings, stats_.max_dev),
+       std::move(data)});
+  stats_ = {};
+}
+
+void AcceptanceRunner::rest(AcceptanceActions& a) {
+  if (step_->kind == StepKind::rate_ladder)
+    a.table = dr::TurntableCommand{dr::TurntableMode::rate, std::nullopt, 0.0, std::nullopt};
+  if (step_->kind == StepKind::power_cycles) {
+    power_on_ = true;
+    a.gyro_power = true;
+  }
+  rested_ = true;
+}
+
+AcceptanceActions AcceptanceRunner::tick(double t_s, const TableObservation& table) {
+  AcceptanceActions a;
+  if (step_ == nullptr) return a;
+  const double in_s = t_s - started_s_;
+  int now = -1;
+  for (const auto& p : points_) {
+    if (in_s < p.end_s) {
+      now = p.index;
+      break;
+    }
+  }
+  if (now != current_ && current_ >= 0) close(points_[static_cast<std::size_t>(current_)], a);
+  if (now < 0) {
+    if (!rested_ || resend_) rest(a);
+    current_ = -1;
+    resend_ = false;
+    return a;
+  }
+  const auto& p = points_[static_cast<std::size_t>(now)];
+  const bool power_edge = step_->kind == StepKind::power_cycles && power_on_ != (in_s >= p.measure_s);
+  if (now != current_ || resend_ || power_edge) send(p, t_s, a);
+  current_ = now;
+  resend_ = false;
+  if (in_s >= p.measure_s) measure(p, t_s, table);
+  return a;
+}
+
+bool AcceptanceRunner::finished(double t_s) const {
+  return step_ != nullptr && rested_ && t_s - started_s_ >= acceptance_duration_s(*step_);
+}
+
+}  // namespace station

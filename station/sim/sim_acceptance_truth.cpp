@@ -1,0 +1,83 @@
+// The acceptance truth of simulated gyros in the figures' terms.
+#include "station/sim/sim_acceptance_truth.hpp"
+
+#include <cmath>
+
+#include "compensation/scale_factor.hpp"
+#include "sim_devices/gyro_acceptance.hpp"
+#include "station/config/acceptance_steps.hpp"
+
+namespace station {
+namespace {
+
+namespace comp = station::compensation;
+
+nlohmann::json serial_truth(const sim::SimGyro& g) {
+  const auto& a = g.acceptance;
+  return {{"sf_pulse_per_arcsec", (1.0 + a.sf_error_ppm * 1e-6) / g.pulse_weight_arcsec},
+          {"sf_tc_ppm_per_c", a.sf_tc_ppm_per_c},
+          {"asymmetry_ppm", a.asymmetry_ppm},
+          {"misalignment_mrad", a.misalignment_rad * 1e3},
+          {"turn_on_sigma_dph", a.turn_on_sigma_dph},
+          {"warmup_tau_s", a.warmup_tau_s},
+          {"warmup_amplitude_dph", a.warmup_amplitude_dph}};
+}
+
+/// The ladder's figures on the gyro's noise-free output: pulses/s = (3600 w_in (1 + e(w, dT))
+/// + Earth) / pulse weight, w_in the table rate along the input axis (gyro_acceptance.hpp).
+nlohmann::json ladder_truth(const sim::SimGyro& g, const Step& step, double temp_c,
+                            double earth_dph) {
+  std::vector<comp::LadderPoint> points;
+  const double dt_c = temp_c - g.truth.ref_temp_c, c = sim::table_coupling(g.acceptance);
+  for (const auto& p : acceptance_schedule(step)) {
+    const double in_dps = p.demand * c;
+    const double e = 1e-6 * sim::scale_factor_error_ppm(g.acceptance, in_dps, dt_c);
+    const double out = (3600.0 * in_dps * (1.0 + e) + earth_dph) / g.pulse_weight_arcsec;
+    points.push_back({p.demand, earth_dph, out, 1.0, true});
+  }
+  const auto fit = comp::analyze_rate_ladder(points);
+  if (!fit) return nullptr;
+  nlohmann::json j{{"sf_pulse_per_arcsec", fit->sf_pulse_per_arcsec},
+                   {"nonlinearity_max_ppm_fs", fit->nonlinearity_max_ppm_fs}};
+  if (fit->asymmetry) j["asymmetry_ppm"] = fit->asymmetry->asymmetry_ppm;
+  return j;
+}
+
+}  // namespace
+
+nlohmann::json with_acceptance_truth(nlohmann::json serials, const sim::SimWorld& world,
+                                     const Protocol& protocol) {
+  for (auto& s : serials) {
+    for (const auto& g : world.gyros()) {
+      if (g.serial != s.value("serial", "")) continue;
+      s["true"] = serial_truth(g);
+      std::vector<comp::PlateauScaleFactor> plateaus;
+      for (auto& l : s["ladders"]) {
+        const int i = l.value("step_index", -1);
+        if (i < 0 || i >= static_cast<int>(protocol.steps.size())) continue;
+        l["true"] = ladder_truth(g, protocol.steps[static_cast<std::size_t>(i)],
+                                 l.value("temp_c", g.truth.ref_temp_c),
+                                 s.value("earth_rate_dph", 0.0));
+        if (l["true"].is_object())
+          plateaus.push_back({l.value("temp_c", 0.0), l["true"]["sf_pulse_per_arcsec"], 1.0});
+      }
+      if (s.contains("sf_vs_temp") && s["sf_vs_temp"].contains("ref_temp_c")) {
+        const auto fit =
+            comp::fit_scale_factor_vs_temperature(plateaus, s["sf_vs_temp"]["ref_temp_c"]);
+        if (fit)
+          s["sf_vs_temp"]["true"] = {{"sf_ref_pulse_per_arcsec", fit->sf_ref_pulse_per_arcsec},
+                                     {"tc_ppm_per_c", fit->tc_ppm_per_c}};
+      }
+      if (s.contains("turn_on") && s["turn_on"].value("band_dph", 0.0) > 0) {
+        // The warm-up time the band gives a noise-free transient A exp(-t/tau): tau ln(|A|/band).
+        const double a = std::abs(g.acceptance.warmup_amplitude_dph);
+        const double band = s["turn_on"]["band_dph"];
+        s["turn_on"]["true"] = {{"sigma_dph", g.acceptance.turn_on_sigma_dph},
+                                {"warmup_s", a > band ? g.acceptance.warmup_tau_s * std::log(a / band) : 0.0}};
+      }
+    }
+  }
+  return serials;
+}
+
+}  // namespace station
