@@ -1,0 +1,207 @@
+// Issue 36's acceptance steps: their keys and schedules, the runner that carries them out, and
+// the shipped acceptance protocol on the simulated rig recovering each simulated figure.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "station/common/input_error.hpp"
+#include "station/config/acceptance_steps.hpp"
+#include "station/config/protocol.hpp"
+#include "station/daemon/acceptance_runner.hpp"
+#include "station/sim/sim_run.hpp"
+#include "station/store/store.hpp"
+#include "tests/station/temp_db.hpp"
+
+namespace {
+
+using station::AcceptanceRunner;
+using station::Step;
+using station::StepKind;
+
+std::string parse_error(const std::string& step_body) {
+  try {
+    station::parse_protocol("name = \"p\"\n[[step]]\n" + step_body, "p.toml");
+  } catch (const station::InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+Step ladder(std::vector<double> rates) {
+  Step s;
+  s.kind = StepKind::rate_ladder;
+  s.rates_dps = std::move(rates);
+  s.settle_s = 2;
+  s.dwell_s = 5;
+  s.accel_dps2 = 10;
+  s.rate_tolerance_dps = 0.05;
+  return s;
+}
+
+}  // namespace
+
+// A ladder's points: +r then -r for each magnitude; the table's travel at its acceleration
+// limit, then the settle time, then the dwell; the step ends with the travel back to rest.
+TEST(AcceptanceSteps, ALaddersScheduleIsTravelSettleDwellPerRate) {
+  const auto pts = station::acceptance_schedule(ladder({10, 100}));
+  ASSERT_EQ(pts.size(), 4u);
+  const double demand[] = {10, -10, 100, -100};
+  const double travel[] = {1.0, 2.0, 11.0, 20.0};  // |change| / 10 deg/s^2
+  double t = 0;
+  for (std::size_t i = 0; i < 4; ++i) {
+    EXPECT_EQ(pts[i].demand, demand[i]);
+    EXPECT_DOUBLE_EQ(pts[i].start_s, t);
+    EXPECT_DOUBLE_EQ(pts[i].measure_s, t + travel[i] + 2);
+    EXPECT_DOUBLE_EQ(pts[i].end_s, t + travel[i] + 2 + 5);
+    t = pts[i].end_s;
+  }
+  EXPECT_DOUBLE_EQ(station::acceptance_duration_s(ladder({10, 100})), t + 10.0 + 2);
+}
+
+TEST(AcceptanceSteps, TheShippedProtocolHasEachKindAndANominalDuration) {
+  const auto p = station::load_protocol("acceptance");
+  int ladders = 0, positions = 0, cycles = 0;
+  for (const auto& s : p.steps) {
+    ladders += s.kind == StepKind::rate_ladder;
+    positions += s.kind == StepKind::positions;
+    cycles += s.kind == StepKind::power_cycles;
+  }
+  EXPECT_EQ(ladders, 3);
+  EXPECT_EQ(positions, 3);
+  EXPECT_EQ(cycles, 1);
+  // The nominal duration counts the acceptance steps' schedules (the soaks' waits are not).
+  EXPECT_GT(p.nominal_duration_s(25.0), 17 * 3600.0);
+  EXPECT_LT(p.nominal_duration_s(25.0), 20 * 3600.0);
+}
+
+TEST(AcceptanceSteps, BadKeysAreNamedWithFileLineAndKey) {
+  const std::string l = "type = \"rate_ladder\"\n";
+  EXPECT_NE(parse_error(l + "rates_dps = [0]\n").find("p.toml:4: key 'step[0].rates_dps': entry 0: a rate must be above 0"),
+            std::string::npos);
+  EXPECT_NE(parse_error(l + "rates_dps = [1, 4000]\n").find("entry 1: 4000 is outside"),
+            std::string::npos);
+  EXPECT_NE(parse_error(l + "rates_dps = \"fast\"\n").find("expected an array of numbers"),
+            std::string::npos);
+  EXPECT_NE(parse_error(l + "rates_dps = [1, \"x\"]\n").find("entry 1 is not a number"),
+            std::string::npos);
+  EXPECT_NE(parse_error(l).find("'step[0].rates_dps': missing"), std::string::npos);
+  EXPECT_NE(parse_error(l + "rates_dps = [1]\ndwell_s = 0\n").find("step[0].dwell_s"),
+            std::string::npos);
+  EXPECT_NE(parse_error(l + "rates_dps = [1]\nspeed = 3\n").find("unknown key"), std::string::npos);
+  EXPECT_NE(parse_error("type = \"positions\"\nangles_deg = [0, 90]\n").find("at least 3 angles"),
+            std::string::npos);
+  EXPECT_NE(parse_error("type = \"power_cycles\"\ncycles = 1\n").find("step[0].cycles"),
+            std::string::npos);
+  EXPECT_EQ(parse_error(l + "rates_dps = [1, 300]\n"), "");
+}
+
+// The runner sends each demand once at its point's start, measures over the window and says per
+// point whether the table held it; a reading off by more than the tolerance leaves it out.
+TEST(AcceptanceRunner, ALadderSendsEachRateAndReportsEachPointHeldOrNot) {
+  const Step s = ladder({10});  // +10: measure 103..108; -10: measure 112..117; end 120
+  AcceptanceRunner r;
+  r.enter(s, 4, 100.0);
+  std::vector<double> sent;
+  std::vector<station::EventNote> events;
+  double rate = 0;
+  for (double t = 100; t <= 121; t += 1) {
+    const double shown = t == 114 ? rate + 0.2 : rate;  // the table slips once in the 2nd window
+    auto a = r.tick(t, {shown, 0.0, false});
+    if (a.table) {
+      ASSERT_TRUE(a.table->rate_dps.has_value());
+      rate = *a.table->rate_dps;
+      sent.push_back(rate);
+      EXPECT_EQ(a.table->lock, t == 117 ? std::nullopt : std::optional<bool>(false));
+    }
+    for (auto& e : a.events) events.push_back(e);
+    EXPECT_EQ(r.finished(t), t >= 120);
+  }
+  EXPECT_EQ(sent, (std::vector<double>{10, -10, 0}));
+  ASSERT_EQ(events.size(), 2u);
+  EXPECT_EQ(events[0].kind, station::EventKind::acceptance_point);
+  EXPECT_TRUE(events[0].data["held"].get<bool>());
+  EXPECT_EQ(events[0].data["readings"].get<int>(), 5);
+  EXPECT_DOUBLE_EQ(events[0].data["measure_s"].get<double>(), 103.0);
+  EXPECT_FALSE(events[1].data["held"].get<bool>());
+  EXPECT_EQ(events[1].severity, station::Severity::warn);
+  EXPECT_NEAR(events[1].data["table_max_dev"].get<double>(), 0.2, 1e-12);
+}
+
+// A run resumed inside a point measured only part of its window: that point is left out.
+TEST(AcceptanceRunner, APointMeasuredOnlyInPartIsLeftOut) {
+  const Step s = ladder({10});
+  AcceptanceRunner r;
+  r.enter(s, 4, 100.0);
+  std::vector<station::EventNote> events;
+  for (double t = 105; t <= 109; t += 1)
+    for (auto& e : r.tick(t, {10.0, 0.0, false}).events) events.push_back(e);
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_FALSE(events[0].data["held"].get<bool>());
+}
+
+TEST(AcceptanceRunner, PowerCyclesSwitchTheGyrosOffThenOnEachCycle) {
+  Step s;
+  s.kind = StepKind::power_cycles;
+  s.cycles = 2;
+  s.off_s = 3;
+  s.dwell_s = 10;  // each cycle: off 0..3, on 3..13
+  AcceptanceRunner r;
+  r.enter(s, 1, 0.0);
+  std::string levels;
+  for (double t = 0; t < 28; t += 1) {
+    r.tick(t, {});
+    levels += r.gyro_power() ? '1' : '0';
+  }
+  EXPECT_EQ(levels, "0001111111111000111111111111");
+  EXPECT_TRUE(r.finished(26));
+}
+
+// The issue's done-means: `run --sim --protocol acceptance` recovers every simulated figure
+// within its stated error (4 SE: one seeded run, several figures), and the thermal record
+// still fits (the acceptance steps' samples never enter a bin).
+TEST(AcceptanceRun, TheShippedProtocolRecoversEachSimulatedFigureWithinItsError) {
+  station::SimRunOptions o;
+  o.db_path = station::testing_support::fresh_db("acceptance");
+  o.protocol = "acceptance";
+  o.progress = false;
+  o.fresh = true;
+  o.gyros = 2;
+  o.seed = 1;
+  const auto r = station::run_simulated(o);
+  ASSERT_TRUE(r.contains("acceptance")) << r.dump();
+  for (const auto& s : r["acceptance"]) {
+    SCOPED_TRACE(s["serial"].get<std::string>());
+    ASSERT_EQ(s["ladders"].size(), 3u);
+    for (const auto& l : s["ladders"]) {
+      ASSERT_TRUE(l["ok"].get<bool>()) << l.dump();
+      const double se = l["sf_se_pulse_per_arcsec"];
+      EXPECT_LE(std::abs(l["sf_pulse_per_arcsec"].get<double>() -
+                         l["true"]["sf_pulse_per_arcsec"].get<double>()), 4 * se);
+      EXPECT_LE(std::abs(l["asymmetry_ppm"].get<double>() - l["true"]["asymmetry_ppm"].get<double>()),
+                4 * l["asymmetry_se_ppm"].get<double>());
+    }
+    const auto& t = s["sf_vs_temp"];
+    ASSERT_TRUE(t["ok"].get<bool>());
+    EXPECT_LE(std::abs(t["tc_ppm_per_c"].get<double>() - t["true"]["tc_ppm_per_c"].get<double>()),
+              4 * t["tc_se_ppm_per_c"].get<double>());
+    ASSERT_EQ(s["positions"].size(), 3u);
+    for (const auto& p : s["positions"]) {
+      ASSERT_TRUE(p["ok"].get<bool>()) << p.dump();
+      EXPECT_LE(std::abs(p["tilt_mrad"].get<double>() - s["true"]["misalignment_mrad"].get<double>()),
+                4 * p["tilt_se_mrad"].get<double>());
+    }
+    ASSERT_TRUE(s["turn_on"]["ok"].get<bool>());
+    EXPECT_EQ(s["turn_on"]["turn_ons"].get<int>(), 4);
+    // The 95 % interval of the turn-on-to-turn-on sigma holds the simulated spread.
+    const double sigma = s["true"]["turn_on_sigma_dph"];
+    EXPECT_LE(s["turn_on"]["repeatability_lower_dph"].get<double>(), sigma);
+    EXPECT_GE(s["turn_on"]["repeatability_upper_dph"].get<double>(), sigma);
+  }
+  for (const auto& g : r["gyros"]) EXPECT_GE(g["bins"].get<int>(), 50) << g.dump();
+  station::Store store(o.db_path, station::OpenMode::read_only);
+  auto st = store.db().prepare(
+      "SELECT count(*) FROM samples WHERE (flags & 32) != 0 AND recording = 1");
+  ASSERT_TRUE(st.step());
+  EXPECT_EQ(st.column_int(0), 0);  // no acceptance step inside this protocol's record window
+}
