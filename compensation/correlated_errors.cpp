@@ -103,25 +103,47 @@ void assess_walk(ErrorModel& model, const std::vector<Point>& grid, const Point&
     model.prior_walk_beyond_search = *k > pb.prior->trust_factor * model.walk_search_max_dph_rt_h;
 }
 
+/// The model's point estimate from the search's best point (none: independent bins).
+ErrorModel with_best_point(ErrorModel model, const Point& best, const Problem& pb, double tau_hi,
+                           double spacing_s) {
+  if (best.q <= 0 && best.u <= kWalkLo && model.mixture.empty())
+    return model;  // no correlated part: independent bins
+  model.method = "white+gm+rrw (REML)";
+  model.on_search_boundary =
+      best.q >= kMaxShare || best.u >= kWalkHi || (best.q > 0 && best.log_tau >= tau_hi - 1e-9);
+  if (best.q > 0) {
+    model.corr_time_s = std::exp(best.log_tau);
+    model.correlated_share = best.q;
+    model.rho_per_bin = std::exp(-spacing_s / model.corr_time_s);
+  }
+  model.rrw_dph_per_sqrt_h = model.sigma_dph * std::sqrt(walk_per_h(pb, best.u));
+  return model;
+}
+
 }  // namespace
 
 ErrorModel estimate_error_model(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
                                 std::span<const double> t_s, std::span<const int> segment,
                                 const NoisePrior* prior) {
-  const Eigen::Index n = x.rows(), p = x.cols();
-  ErrorModel model;
-  if (n < p + kMinBinsForErrorModelExtra || p < 1 ||
-      p + 1 > reml::kMaxColumns) {  // too few bins to estimate three more parameters
-    return ols_only(x, y, prior);
-  }
   Problem pb = make_problem(x, y, t_s, segment);
+  return estimate_error_model(pb, x, y, prior);
+}
+
+ErrorModel estimate_error_model(Problem& pb, const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
+                                const NoisePrior* prior) {
+  const Eigen::Index n = x.rows(), p = x.cols();
+  if (n < p + kMinBinsForErrorModelExtra || p < 1 || p + 1 > reml::kMaxColumns)
+    return ols_only(x, y, prior);  // too few bins to estimate three more parameters
+  ErrorModel model;
   pb.prior = prior != nullptr && !prior->empty() ? prior : nullptr;
   if (pb.prior != nullptr) model.prior = *pb.prior;
   const double hi = pb.tau_hi, spacing_s = pb.spacing_s;
   Point best = iid_point(pb);
   std::vector<Point> grid;
   pb.record = &grid;
-  search(best, pb, whole_box(pb), kCoarseSteps);
+  // The coarse grid on every column of pb: the lack-of-fit search (model_choice.hpp) starts
+  // from the same points. The refinement is this search's own, on the base columns alone.
+  search(best, pb, whole_box(pb), kCoarseSteps, pb.candidates() > 0);
   pb.record = nullptr;
   refine(best, pb);
   if (!std::isfinite(best.profile.minus2_loglik) || !(best.profile.sigma2 > 0)) {
@@ -131,18 +153,8 @@ ErrorModel estimate_error_model(const Eigen::MatrixXd& x, const Eigen::VectorXd&
   model.sigma_dph = std::sqrt(best.profile.sigma2);
   add_mixture(model, grid, best, pb);
   assess_walk(model, grid, best, pb);
-  if (best.q <= 0 && best.u <= kWalkLo && model.mixture.empty())
-    return model;  // no correlated part: independent bins
-  model.method = "white+gm+rrw (REML)";
-  model.on_search_boundary =
-      best.q >= kMaxShare || best.u >= kWalkHi || (best.q > 0 && best.log_tau >= hi - 1e-9);
-  if (best.q > 0) {
-    model.corr_time_s = std::exp(best.log_tau);
-    model.correlated_share = best.q;
-    model.rho_per_bin = std::exp(-spacing_s / model.corr_time_s);
-  }
-  model.rrw_dph_per_sqrt_h = model.sigma_dph * std::sqrt(walk_per_h(pb, best.u));
-  return model;
+  pb.prior = nullptr;  // the prior weighs this search only
+  return with_best_point(model, best, pb, hi, spacing_s);
 }
 
 namespace {

@@ -38,6 +38,10 @@
 
 namespace station::compensation {
 
+namespace model_search {
+struct Problem;
+}
+
 /// The fitted error model of a regression's bins.
 struct ErrorModel {
   /// "white+gm+rrw (REML)" ("ar1+white (REML)" in fits stored before) or "iid" (too few bins
@@ -91,6 +95,12 @@ inline constexpr long kMinBinsForErrorModelExtra = 5;
 ErrorModel estimate_error_model(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
                                 std::span<const double> t_s, std::span<const int> segment,
                                 const NoisePrior* prior = nullptr);
+
+/// The same on a search problem made for y on the columns of x (error_model_search.hpp), which may
+/// carry the lack-of-fit candidates' columns too: its coarse grid is then evaluated on them as well
+/// and kept in `pb` for the candidates' own search (model_choice.hpp).
+ErrorModel estimate_error_model(model_search::Problem& pb, const Eigen::MatrixXd& x,
+                                const Eigen::VectorXd& y, const NoisePrior* prior);
 
 /// Variances of the OLS coefficients of y = X b + e under `model` (its mixture when it has one),
 /// with X = Q R (thin QR, Q `q_basis` n x p, `r_inv` = R^-1): the diagonal of s^2 R^-1 Q' C Q R^-T,

@@ -80,47 +80,54 @@ std::vector<Point> grid_points(const Box& b, int steps) {
                        std::clamp(at(b.q_lo, b.q_hi, c, steps), 0.0, kMaxShare),
                        std::clamp(at(b.u_lo, b.u_hi, d, steps), kWalkLo, kWalkHi),
                        {},
-                       {}});
+                       kNoDeviances});
   return pts;
 }
 
-/// Evaluates each point: its restricted likelihood, or with pb.subsets its maximum likelihoods.
-/// A model the points repeat (q = 0 at every tau, a clamped edge, `known`) is evaluated once;
-/// the others go reml::kLanes to a pass.
-void evaluate(std::vector<Point>& pts, Problem& pb, const Point& known) {
-  std::vector<Point> unique{known};
-  std::vector<std::size_t> which(pts.size());
+/// Evaluates each point: its restricted likelihood, and with `all_columns` its maximum
+/// likelihoods. A model the points repeat (q = 0 at every tau, a clamped edge), `known` or one
+/// pb.evaluated holds is evaluated once: every pass gives a model the same bits. The new ones go
+/// reml::kLanes to a pass; with `all_columns` they are kept in pb.evaluated.
+void evaluate(std::vector<Point>& pts, Problem& pb, const Point& known, bool all_columns) {
+  std::vector<const Point*> from(pts.size(), nullptr);
+  std::vector<Point> fresh;
+  std::map<std::array<double, 3>, std::size_t> fresh_at;
+  std::vector<std::size_t> fresh_of(pts.size());
   std::vector<reml::Model> models;
   for (std::size_t i = 0; i < pts.size(); ++i) {
-    const auto it = std::find_if(unique.begin(), unique.end(),
-                                 [&](const Point& e) { return e.same_model(pts[i]); });
-    which[i] = static_cast<std::size_t>(it - unique.begin());
-    if (it != unique.end()) continue;
-    unique.push_back(pts[i]);
-    models.push_back({&pb.phi_at(pts[i].log_tau), pts[i].q, walk_per_h(pb, pts[i].u)});
+    const auto key = pts[i].model_key();
+    if (known.same_model(pts[i])) {
+      from[i] = &known;
+    } else if (const auto it = pb.evaluated.find(key); it != pb.evaluated.end()) {
+      from[i] = &it->second;
+    } else {
+      const auto [at, added] = fresh_at.try_emplace(key, fresh.size());
+      fresh_of[i] = at->second;
+      if (!added) continue;
+      fresh.push_back(pts[i]);
+      models.push_back({&pb.phi_at(pts[i].log_tau), pts[i].q, walk_per_h(pb, pts[i].u)});
+    }
   }
-  if (pb.subsets.empty()) {
-    std::vector<Profile> found(models.size());
-    reml::profiles(pb.z, pb.dt_h, models, found);
-    for (std::size_t j = 0; j < found.size(); ++j) unique[j + 1].profile = found[j];
-  } else {
-    const std::size_t s = pb.subsets.size();
-    std::vector<double> found(models.size() * s);
-    reml::ml_deviances(pb.z, pb.dt_h, models, pb.subsets, found);
-    for (std::size_t j = 0; j < models.size(); ++j)
-      unique[j + 1].ml.assign(found.begin() + static_cast<long>(j * s),
-                              found.begin() + static_cast<long>((j + 1) * s));
+  std::vector<Profile> found(models.size());
+  std::vector<reml::Deviances> ml(all_columns ? models.size() : 0);
+  reml::evaluate(pb.z, pb.base, pb.dt_h, models, found, ml);
+  for (std::size_t j = 0; j < fresh.size(); ++j) {
+    fresh[j].profile = found[j];
+    if (all_columns) fresh[j].ml = ml[j];
   }
   for (std::size_t i = 0; i < pts.size(); ++i) {
-    pts[i].profile = unique[which[i]].profile;
-    pts[i].ml = unique[which[i]].ml;
+    const Point& e = from[i] != nullptr ? *from[i] : fresh[fresh_of[i]];
+    pts[i].profile = e.profile;
+    pts[i].ml = e.ml;
   }
+  if (all_columns)
+    for (const Point& e : fresh) pb.evaluated.try_emplace(e.model_key(), e);
 }
 
 /// Grid search over the box for the most likely point (the first of equally likely points wins).
-void search(Point& best, Problem& pb, const Box& b, int steps) {
+void search(Point& best, Problem& pb, const Box& b, int steps, bool all_columns) {
   std::vector<Point> pts = grid_points(b, steps);
-  evaluate(pts, pb, best);
+  evaluate(pts, pb, best, all_columns);
   for (const Point& e : pts) {
     if (pb.record) pb.record->push_back(e);
     if (objective(e, pb) < objective(best, pb)) best = e;
@@ -143,15 +150,16 @@ Box refined_box(const Point& c, int round, const Problem& pb) {
 /// Finer searches around the best point so far, each on a grid half as wide.
 void refine(Point& best, Problem& pb) {
   for (int round = 0; round < kRefinements; ++round)
-    search(best, pb, refined_box(best, round, pb), 3);
+    search(best, pb, refined_box(best, round, pb), 3, false);
 }
 
 /// The search's problem: rows [y X], run starts, tau's range from a third of a bin (the
 /// Gauss-Markov part is then white) to ten record lengths (then it is a drift the constant and
 /// the regressors mostly absorb).
 Problem make_problem(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
-                     std::span<const double> t_s, std::span<const int> segment) {
-  const Eigen::Index n = x.rows(), p = x.cols();
+                     std::span<const double> t_s, std::span<const int> segment,
+                     const Eigen::MatrixXd& candidates) {
+  const Eigen::Index n = x.rows(), p = x.cols(), c = candidates.cols();
   Problem pb;
   pb.t_s = t_s;
   pb.segment = segment;
@@ -160,9 +168,11 @@ Problem make_problem(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
   pb.span_h = span_s / 3600.0;
   pb.tau_lo = std::log(pb.spacing_s / 3.0);
   pb.tau_hi = std::log(10.0 * span_s);
-  pb.z.resize(n, p + 1);
+  pb.base = p;
+  pb.z.resize(n, p + 1 + c);
   pb.z.col(0) = y;
-  pb.z.rightCols(p) = x;
+  pb.z.middleCols(1, p) = x;
+  if (c > 0) pb.z.rightCols(c) = candidates;
   step_hours(pb.dt_h, t_s, segment, n);
   return pb;
 }
@@ -173,7 +183,7 @@ Point iid_point(Problem& pb) {
   iid.log_tau = pb.tau_lo;
   iid.u = kWalkLo;  // q = 0 and no walk
   std::vector<Point> one{iid};
-  evaluate(one, pb, Point{0, -1, 0, {}, {}});  // q = -1: no model repeats it
+  evaluate(one, pb, Point{0, -1, 0, {}, kNoDeviances}, true);  // q = -1: no model repeats it
   return one[0];
 }
 

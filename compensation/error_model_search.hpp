@@ -6,6 +6,8 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <array>
+#include <limits>
 #include <map>
 #include <span>
 #include <vector>
@@ -28,27 +30,43 @@ void step_corrs(std::vector<double>& phi, std::span<const double> t_s, std::span
 void step_hours(std::vector<double>& dt_h, std::span<const double> t_s,
                 std::span<const int> segment, Eigen::Index n);
 
+/// Deviances not (yet) found: each infinite.
+inline constexpr reml::Deviances kNoDeviances = [] {
+  reml::Deviances d{};
+  d.fill(std::numeric_limits<double>::infinity());
+  return d;
+}();
+
 struct Point {
   double log_tau = 0, q = 0, u = 0;  // u: log10 of the walk's variance over a run, in s^2
   Profile profile;
-  std::vector<double> ml;  // the maximum likelihood search: -2 l per column subset
+  /// The maximum likelihood search (model_choice.hpp): -2 l of the base, then of the base with
+  /// each candidate; infinite where the point was evaluated on the base columns alone.
+  reml::Deviances ml = kNoDeviances;
   /// Two grid points are one error model when q, the walk and (where q > 0) tau agree.
   bool same_model(const Point& o) const {
     return q == o.q && u == o.u && (q == 0 || log_tau == o.log_tau);
   }
+  /// What same_model compares, as a key.
+  std::array<double, 3> model_key() const { return {q, u, q == 0 ? 0.0 : log_tau}; }
 };
 
-/// What the search needs: the rows [y X], the bin times and runs.
+/// What the search needs: the rows [y X C] (the base columns X, then the lack-of-fit candidates
+/// C of model_choice.hpp, if any), the bin times and runs, and every point evaluated on all of
+/// them (the error model's coarse grid serves the candidates' search too).
 struct Problem {
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> z;
+  Eigen::Index base = 0;  ///< X's columns: z's columns 1..base
   std::span<const double> t_s;
   std::span<const int> segment;
   double span_h = 1, spacing_s = 1, tau_lo = 0, tau_hi = 0;  // tau's range: log s
   std::vector<double> dt_h;
   std::map<double, std::vector<double>> phi;  // step correlations by log tau, made once each
   std::vector<Point>* record = nullptr;
-  std::span<const reml::Columns> subsets;  // non-empty: the maximum likelihood search
-  const NoisePrior* prior = nullptr;       // the part's noise (noise_prior.hpp), if given
+  const NoisePrior* prior = nullptr;                 // the part's noise (noise_prior.hpp), if given
+  std::map<std::array<double, 3>, Point> evaluated;  // on every column, by Point::model_key
+
+  Eigen::Index candidates() const { return z.cols() - 1 - base; }
 
   const std::vector<double>& phi_at(double log_tau) {
     auto [it, added] = phi.try_emplace(log_tau);
@@ -71,22 +89,26 @@ double walk_per_h(const Problem& pb, double u);
 double walk_dph_rt_h(const Point& e, const Problem& pb);
 /// What the restricted-likelihood search minimizes: -2 l_R, plus -2 log prior with pb.prior.
 double objective(const Point& e, const Problem& pb);
-/// The search's problem for y on the columns of x, bins at t_s in runs `segment`.
+/// The search's problem for y on the columns of x, bins at t_s in runs `segment`; with
+/// `candidates`, their columns follow x's (at most reml::kMaxColumns columns in all, y's too).
 Problem make_problem(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
-                     std::span<const double> t_s, std::span<const int> segment);
+                     std::span<const double> t_s, std::span<const int> segment,
+                     const Eigen::MatrixXd& candidates = {});
 /// The whole search box of a problem.
 Box whole_box(const Problem& pb);
 /// The box of refinement round `round` around c: the coarse grid's spacing halved each round.
 Box refined_box(const Point& c, int round, const Problem& pb);
 /// The box's grid, `steps` points each way, clamped to the search's range, in grid order.
 std::vector<Point> grid_points(const Box& b, int steps);
-/// Evaluates each point: its restricted likelihood, or with pb.subsets its maximum likelihoods.
-void evaluate(std::vector<Point>& pts, Problem& pb, const Point& known);
-/// Grid search over the box for the point of least objective().
-void search(Point& best, Problem& pb, const Box& b, int steps);
+/// Evaluates each point: its restricted likelihood on the base columns, and with `all_columns`
+/// its maximum likelihoods too (kept in pb.evaluated). A model pb.evaluated or `known` holds is
+/// taken from there.
+void evaluate(std::vector<Point>& pts, Problem& pb, const Point& known, bool all_columns);
+/// Grid search over the box for the point of least objective(), evaluated as `evaluate` does.
+void search(Point& best, Problem& pb, const Box& b, int steps, bool all_columns);
 /// Finer searches around the best point so far, each on a grid half as wide.
 void refine(Point& best, Problem& pb);
-/// Independent bins (q = 0, no walk): the search's starting point, evaluated.
+/// Independent bins (q = 0, no walk): the search's starting point, evaluated on every column.
 Point iid_point(Problem& pb);
 
 }  // namespace station::compensation::model_search

@@ -11,6 +11,7 @@
 #include "compensation/earth_rate.hpp"
 #include "compensation/fit_diagnostics.hpp"
 #include "compensation/limits.hpp"
+#include "compensation/model_choice.hpp"
 
 namespace station::compensation {
 namespace {
@@ -183,7 +184,20 @@ void set_walk_errors(FitResult& res, const Eigen::MatrixXd& q_basis, const Eigen
     res.std_errors_walk_not_excluded.push_back(std::sqrt(v(j)) / scale(j));
 }
 
-FitResult fit_impl(const ModelInput& in, const ModelSpec& spec, const ErrorModel* fixed) {
+/// The error model: `fixed` if given, else estimated on the basis q_basis; with `lack_of_fit`,
+/// on the lack-of-fit problem made there (its candidates' coarse grid evaluated on the way).
+ErrorModel error_model_for(const ModelInput& in, const ModelSpec& spec,
+                           const Eigen::MatrixXd& q_basis, const Eigen::VectorXd& y,
+                           const ErrorModel* fixed, model_search::Problem* lack_of_fit) {
+  if (fixed != nullptr) return *fixed;
+  const NoisePrior* prior = spec.noise_prior ? &*spec.noise_prior : nullptr;
+  if (lack_of_fit == nullptr) return estimate_error_model(q_basis, y, in.t_s, in.segment, prior);
+  *lack_of_fit = lack_of_fit_problem(in, spec, q_basis, candidates_for(in, spec));
+  return estimate_error_model(*lack_of_fit, q_basis, y, prior);
+}
+
+FitResult fit_impl(const ModelInput& in, const ModelSpec& spec, const ErrorModel* fixed,
+                   model_search::Problem* lack_of_fit) {
   const std::size_t p = spec.terms.size() + 1;
   const std::size_t n = in.bias_dph.size();
   if (n <= p) {
@@ -216,10 +230,7 @@ FitResult fit_impl(const ModelInput& in, const ModelSpec& spec, const ErrorModel
   // The error model sees the orthonormal basis Q of the design (same column space, so the same
   // likelihood) and the sandwich is formed from Q and R^-1: neither squares X's condition.
   const Eigen::MatrixXd q_basis = qr.householderQ() * Eigen::MatrixXd::Identity(x.rows(), pi);
-  res.error_model = fixed != nullptr
-                        ? *fixed
-                        : estimate_error_model(q_basis, y, in.t_s, in.segment,
-                                               spec.noise_prior ? &*spec.noise_prior : nullptr);
+  res.error_model = error_model_for(in, spec, q_basis, y, fixed, lack_of_fit);
   const Eigen::VectorXd var_model =
       model_variances(res.error_model, q_basis, r_inv, in, var_scaled);
   // Lag rule of Newey & West (1994): L = floor(4 (n/100)^(2/9)).
@@ -240,13 +251,14 @@ FitResult fit_impl(const ModelInput& in, const ModelSpec& spec, const ErrorModel
 }  // namespace
 
 FitResult fit_model(const ModelInput& in, const ModelSpec& spec) {
-  FitResult res = fit_impl(in, spec, nullptr);
-  diagnose_fit(in, res);
+  model_search::Problem lack_of_fit;
+  FitResult res = fit_impl(in, spec, nullptr, &lack_of_fit);
+  diagnose_fit(in, res, lack_of_fit);
   return res;
 }
 
 FitResult fit_model_under(const ModelInput& in, const ModelSpec& spec, const ErrorModel& model) {
-  return fit_impl(in, spec, &model);
+  return fit_impl(in, spec, &model, nullptr);
 }
 
 std::vector<double> predict(const FitResult& fit, const ModelInput& in) {

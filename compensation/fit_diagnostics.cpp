@@ -110,13 +110,13 @@ double candidate_z_critical(std::size_t candidates) {
   return candidates == 0 ? 0.0 : kZCritical[std::min<std::size_t>(candidates, 4) - 1];
 }
 
-void diagnose_fit(const ModelInput& in, FitResult& fit) {
+void diagnose_fit(const ModelInput& in, FitResult& fit, model_search::Problem& lack_of_fit) {
   warn_collinear(in, fit);
   const std::vector<Term> tried = candidates_for(in, fit.spec);
   if (tried.empty()) return;
   fit.candidate_z_critical = candidate_z_critical(tried.size());
-  const std::vector<double> lr = extension_likelihood_ratios(
-      in, fit.spec, tried, fit.candidate_z_critical * fit.candidate_z_critical);
+  const std::vector<double> lr =
+      extension_likelihood_ratios(lack_of_fit, fit.candidate_z_critical * fit.candidate_z_critical);
   std::optional<std::size_t> best;  // index into fit.candidates
   FitResult best_fit;
   for (std::size_t k = 0; k < tried.size(); ++k) {

@@ -17,6 +17,7 @@
 // temperature, and runs at two heating rates (ramp_10 with ramp_20) separate them.
 #pragma once
 
+#include "compensation/error_model_search.hpp"
 #include "compensation/fit.hpp"
 
 namespace station::compensation {
@@ -33,6 +34,8 @@ double candidate_z_critical(std::size_t candidates);
 
 /// Fills fit.candidates, fit.candidate_z_critical and adds the warnings. Candidates whose data
 /// are missing (dT/dt of a 1 Hz record) or whose extended fit is impossible are skipped.
-void diagnose_fit(const ModelInput& in, FitResult& fit);
+/// `lack_of_fit`: the fit's lack_of_fit_problem (model_choice.hpp) with candidates_for(in,
+/// fit.spec), on which the fit's error model was estimated (its coarse grid is reused).
+void diagnose_fit(const ModelInput& in, FitResult& fit, model_search::Problem& lack_of_fit);
 
 }  // namespace station::compensation

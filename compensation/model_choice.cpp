@@ -32,76 +32,72 @@ void refine_subset(std::vector<Point>& best, std::size_t s, Problem& pb) {
   for (int round = 0; round < kRefinements; ++round) {
     const Point centre = best[s];
     std::vector<Point> pts = grid_points(refined_box(centre, round, pb), 3);
-    evaluate(pts, pb, centre);
+    evaluate(pts, pb, centre, true);
     keep_best(best, pts);
   }
 }
 
+/// Each of `extra`'s columns orthogonalized against the orthonormal columns of q and scaled to
+/// unit norm; zeros where q spans it.
+Eigen::MatrixXd candidate_columns(const Eigen::MatrixXd& q, const Eigen::MatrixXd& extra) {
+  Eigen::MatrixXd out(extra.rows(), extra.cols());
+  for (Eigen::Index j = 0; j < extra.cols(); ++j) {
+    Eigen::VectorXd c = extra.col(j) - q * (q.transpose() * extra.col(j));
+    c -= q * (q.transpose() * c);  // twice is enough (Giraud et al., Numer. Math. 101:87, 2005)
+    const double norm = c.norm();
+    const double scale = extra.col(j).norm();
+    out.col(j) = norm > 1e-10 * scale ? Eigen::VectorXd(c / norm) : Eigen::VectorXd::Zero(q.rows());
+  }
+  return out;
+}
+
 }  // namespace
 
-std::vector<double> max_ml_deviances(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
-                                     std::span<const std::vector<int>> subsets,
-                                     std::span<const double> t_s, std::span<const int> segment,
-                                     double refine_from_lr) {
-  std::vector<reml::Columns> cols;
-  std::size_t widest = 0;
-  for (const auto& s : subsets) {
-    cols.emplace_back();
-    for (const int c : s) cols.back().push_back(c + 1);  // z's column 0 is y
-    widest = std::max(widest, s.size());
-  }
-  Problem pb = make_problem(x, y, t_s, segment);
-  pb.subsets = cols;
-  std::vector<Point> best(subsets.size(), iid_point(pb));
-  const bool enough = x.rows() >= static_cast<Eigen::Index>(widest) + kMinBinsForErrorModelExtra;
-  if (enough) {
+Problem lack_of_fit_problem(const ModelInput& in, const ModelSpec& spec,
+                            const Eigen::MatrixXd& q_basis, const std::vector<Term>& tried) {
+  ModelSpec all = spec;
+  all.terms.insert(all.terms.end(), tried.begin(), tried.end());
+  const auto c = static_cast<Eigen::Index>(tried.size());
+  const Eigen::MatrixXd extra = design_matrix(in, all).rightCols(c);
+  const Eigen::Map<const Eigen::VectorXd> y(in.bias_dph.data(), q_basis.rows());
+  return make_problem(q_basis, y, in.t_s, in.segment, candidate_columns(q_basis, extra));
+}
+
+std::vector<double> max_ml_deviances(Problem& pb, double refine_from_lr) {
+  std::vector<Point> best(static_cast<std::size_t>(1 + pb.candidates()), iid_point(pb));
+  if (pb.z.rows() >= pb.base + 1 + kMinBinsForErrorModelExtra) {
     std::vector<Point> pts = grid_points(whole_box(pb), kCoarseSteps);
-    evaluate(pts, pb, best[0]);
+    evaluate(pts, pb, best[0], true);
     keep_best(best, pts);
     refine_subset(best, 0, pb);
     for (std::size_t s = 1; s < best.size(); ++s)
       if (best[0].ml[0] - best[s].ml[s] >= refine_from_lr - kRefinementGain)
         refine_subset(best, s, pb);
   }
-  std::vector<double> out(subsets.size());
+  std::vector<double> out(best.size());
   for (std::size_t s = 0; s < best.size(); ++s) out[s] = best[s].ml[s];
   return out;
 }
 
-Eigen::MatrixXd base_and_candidates(const Eigen::MatrixXd& x, Eigen::Index p) {
-  const Eigen::HouseholderQR<Eigen::MatrixXd> qr(x.leftCols(p));
-  const Eigen::MatrixXd q = qr.householderQ() * Eigen::MatrixXd::Identity(x.rows(), p);
-  Eigen::MatrixXd out(x.rows(), x.cols());
-  out.leftCols(p) = q;
-  for (Eigen::Index j = p; j < x.cols(); ++j) {
-    Eigen::VectorXd c = x.col(j) - q * (q.transpose() * x.col(j));
-    c -= q * (q.transpose() * c);  // twice is enough (Giraud et al., Numer. Math. 101:87, 2005)
-    const double norm = c.norm();
-    const double scale = x.col(j).norm();
-    out.col(j) = norm > 1e-10 * scale ? Eigen::VectorXd(c / norm) : Eigen::VectorXd::Zero(x.rows());
-  }
-  return out;
+std::vector<double> extension_likelihood_ratios(Problem& pb, double bound_lr) {
+  const std::vector<double> dev = max_ml_deviances(pb, bound_lr);
+  std::vector<double> lr(dev.size() - 1);
+  for (std::size_t k = 0; k < lr.size(); ++k)
+    lr[k] = std::isfinite(dev[k + 1]) && std::isfinite(dev[0]) ? dev[0] - dev[k + 1] : 0.0;
+  return lr;
 }
 
 std::vector<double> extension_likelihood_ratios(const ModelInput& in, const ModelSpec& spec,
                                                 const std::vector<Term>& tried, double bound_lr) {
-  ModelSpec all = spec;
-  all.terms.insert(all.terms.end(), tried.begin(), tried.end());
-  const auto p = static_cast<Eigen::Index>(spec.terms.size() + 1);
-  const Eigen::MatrixXd x = base_and_candidates(design_matrix(in, all), p);
-  const Eigen::Map<const Eigen::VectorXd> y(in.bias_dph.data(),
-                                            static_cast<Eigen::Index>(in.bias_dph.size()));
-  std::vector<std::vector<int>> subsets(tried.size() + 1);
-  for (int j = 0; j < p; ++j) subsets[0].push_back(j);
-  for (std::size_t k = 0; k < tried.size(); ++k) {
-    subsets[k + 1] = subsets[0];
-    subsets[k + 1].push_back(static_cast<int>(p + static_cast<Eigen::Index>(k)));
-  }
-  const std::vector<double> dev = max_ml_deviances(x, y, subsets, in.t_s, in.segment, bound_lr);
-  std::vector<double> lr(tried.size());
-  for (std::size_t k = 0; k < tried.size(); ++k)
-    lr[k] = std::isfinite(dev[k + 1]) && std::isfinite(dev[0]) ? dev[0] - dev[k + 1] : 0.0;
-  return lr;
+  // The basis as fit_model makes it (fit.cpp): the QR of the design with unit-norm columns.
+  Eigen::MatrixXd x = design_matrix(in, spec);
+  const Eigen::VectorXd scale =
+      x.colwise().norm().transpose().unaryExpr([](double v) { return v > 0 ? v : 1.0; });
+  x = x * scale.cwiseInverse().asDiagonal();
+  const Eigen::HouseholderQR<Eigen::MatrixXd> qr(x);
+  const Eigen::MatrixXd q_basis = qr.householderQ() * Eigen::MatrixXd::Identity(x.rows(), x.cols());
+  Problem pb = lack_of_fit_problem(in, spec, q_basis, tried);
+  return extension_likelihood_ratios(pb, bound_lr);
 }
 
 }  // namespace station::compensation

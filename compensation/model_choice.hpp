@@ -20,33 +20,36 @@
 #include <span>
 #include <vector>
 
+#include "compensation/error_model_search.hpp"
 #include "compensation/fit.hpp"
 
 namespace station::compensation {
 
-/// -2 x the maximum log-likelihood (constants dropped) of y = X_s b + e for each column subset s
-/// of `x` (0-based column indices), each maximized over its own error model. `x` should be well
-/// conditioned (an orthonormal basis of the base model with each extra column orthogonalized
-/// against it); at most reml::kMaxColumns - 1 columns. With fewer than the largest subset's
-/// columns + kMinBinsForErrorModelExtra bins only independent bins are considered (then the
-/// differences are the classical least-squares likelihood ratios n log(RSS_0 / RSS_1)).
-/// Subset 0 is the base; each is searched on the coarse grid, the base refined around its best,
-/// another subset only when its ratio to the base comes within reach of `refine_from_lr` (the
-/// bound a test will hold it to): elsewhere its deviance is the coarse grid's, a little high.
-std::vector<double> max_ml_deviances(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
-                                     std::span<const std::vector<int>> subsets,
-                                     std::span<const double> t_s, std::span<const int> segment,
-                                     double refine_from_lr = 0);
+/// The lack-of-fit search's problem (error_model_search.hpp) for the fit of `in` on `spec`:
+/// y, the fit's orthonormal basis `q_basis` (X = Q R of the column-scaled design) and each
+/// candidate of `tried` orthogonalized against it and scaled to unit norm (a candidate the base
+/// already spans is left as zeros: its fit reads as no improvement). estimate_error_model on it
+/// evaluates its coarse grid on every column, which the candidates' search then reuses.
+model_search::Problem lack_of_fit_problem(const ModelInput& in, const ModelSpec& spec,
+                                          const Eigen::MatrixXd& q_basis,
+                                          const std::vector<Term>& tried);
 
-/// An orthonormal basis of the first `p` columns of `x` followed by each later column
-/// orthogonalized against that basis and scaled to unit norm: the base model and each candidate
-/// column well conditioned for max_ml_deviances. A candidate that the base columns already span
-/// is left as zeros (its subset's fit then fails and reads as no improvement).
-Eigen::MatrixXd base_and_candidates(const Eigen::MatrixXd& x, Eigen::Index p);
+/// -2 x the maximum log-likelihood (constants dropped) of y on the base ([0]) and on the base
+/// with each candidate ([1 + k]), each maximized over its own error model. With fewer than the
+/// base's columns + 1 + kMinBinsForErrorModelExtra bins only independent bins are considered
+/// (then the differences are the classical least-squares likelihood ratios n log(RSS_0 / RSS_1)).
+/// Each is searched on the coarse grid (the points pb already holds are not evaluated again),
+/// the base refined around its best, a candidate only when its ratio to the base comes within
+/// reach of `refine_from_lr` (the bound a test will hold it to): elsewhere its deviance is the
+/// coarse grid's, a little high.
+std::vector<double> max_ml_deviances(model_search::Problem& pb, double refine_from_lr = 0);
 
-/// The likelihood ratio of spec + t against spec for each t of `tried`, every model with its own
-/// error model; 0 where one cannot be fitted. `bound_lr`: the bound a test will hold them to
+/// The likelihood ratio of the base + each candidate of pb against the base, every model with its
+/// own error model; 0 where one cannot be fitted. `bound_lr`: the bound a test will hold them to
 /// (max_ml_deviances refines the ones within reach of it).
+std::vector<double> extension_likelihood_ratios(model_search::Problem& pb, double bound_lr);
+
+/// The same for spec + t against spec for each t of `tried`, on a problem made here.
 std::vector<double> extension_likelihood_ratios(const ModelInput& in, const ModelSpec& spec,
                                                 const std::vector<Term>& tried, double bound_lr);
 

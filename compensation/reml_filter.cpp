@@ -29,13 +29,16 @@ struct Gathered {
   std::array<double, L> sum_log_f{};
 };
 
+// Inlined into each instruction set's copy of the pass (pass_on below), so it is compiled there.
+#define STATION_INLINE inline __attribute__((always_inline))
+
 /// The lanes' covariance of the two states (units of s^2) and their gains at one bin.
 struct Riccati {
   double pgg[L], pgr[L], prr[L], f[L], inv_f[L], kg[L], kr[L];
 
   /// Time update over dt hours (Harvey sec. 3.2.1): the Gauss-Markov part decays by phi towards
   /// its stationary variance q, the walk's variance grows by w dt.
-  void predict(const double* q, const double* w, const double* ph, double dt) {
+  STATION_INLINE void predict(const double* q, const double* w, const double* ph, double dt) {
     for (int l = 0; l < L; ++l) {
       pgg[l] = ph[l] * ph[l] * pgg[l] + q[l] * (1.0 - ph[l] * ph[l]);
       pgr[l] = ph[l] * pgr[l];
@@ -43,7 +46,7 @@ struct Riccati {
     }
   }
   /// The innovation variance f (states plus white, 1 - q) and the two gains.
-  void gains(const double* q) {
+  STATION_INLINE void gains(const double* q) {
     for (int l = 0; l < L; ++l) {
       f[l] = pgg[l] + 2 * pgr[l] + prr[l] + (1.0 - q[l]);
       inv_f[l] = 1.0 / f[l];
@@ -52,7 +55,7 @@ struct Riccati {
     }
   }
   /// P <- P - K f K' (the Joseph form is not needed: f >= 1 - q keeps it well conditioned).
-  void update() {
+  STATION_INLINE void update() {
     for (int l = 0; l < L; ++l) {
       pgg[l] -= kg[l] * kg[l] * f[l];
       pgr[l] -= kg[l] * kr[l] * f[l];
@@ -64,13 +67,13 @@ struct Riccati {
 /// One pass over the bins for L models at once, K columns fixed at compile time. Every loop's
 /// innermost index is the lane, so the compiler vectorizes across models.
 template <int K>
-Gathered pass(const double* z, Eigen::Index n, const std::vector<double>& dt_h,
-              const std::array<Model, L>& md) {
+STATION_INLINE Gathered pass(const double* z, Eigen::Index stride, Eigen::Index n,
+                             const std::vector<double>& dt_h, const std::array<Model, L>& md) {
   double m[K * K][L] = {}, g[K][L] = {}, r[K][L] = {}, v[K][L];
   double q[L], w[L], ph[L], sum_log_f[L] = {}, prod_f[L];
   Riccati p{};
   for (int l = 0; l < L; ++l) q[l] = md[l].q, w[l] = md[l].w_per_h, prod_f[l] = 1;
-  for (Eigen::Index i = 0; i < n; ++i, z += K) {
+  for (Eigen::Index i = 0; i < n; ++i, z += stride) {
     const auto iu = static_cast<std::size_t>(i);
     const double dt = dt_h[iu];
     for (int l = 0; l < L; ++l) ph[l] = (*md[l].phi)[iu];
@@ -113,82 +116,107 @@ Gathered pass(const double* z, Eigen::Index n, const std::vector<double>& dt_h,
   return out;
 }
 
+/// The pass for k columns, the copy compiled for the instruction set the caller was compiled for.
 template <int... Ks>
-Gathered pass_for(int k, const double* z, Eigen::Index n, const std::vector<double>& dt_h,
-                  const std::array<Model, L>& md, std::integer_sequence<int, Ks...>) {
+STATION_INLINE Gathered pass_for(int k, const double* z, Eigen::Index stride, Eigen::Index n,
+                                 const std::vector<double>& dt_h, const std::array<Model, L>& md,
+                                 std::integer_sequence<int, Ks...>) {
   Gathered out;
-  ((k == Ks + 2 ? (out = pass<Ks + 2>(z, n, dt_h, md), true) : false) || ...);
+  ((k == Ks + 2 ? (out = pass<Ks + 2>(z, stride, n, dt_h, md), true) : false) || ...);
   return out;
 }
 
-/// The likelihood from what one lane gathered.
-Profile finish(const SmallMatrix& m, double sum_log_f, Eigen::Index n) {
-  const Eigen::Index p = m.rows() - 1;
-  const SmallMatrix mxx = m.bottomRightCorner(p, p).selfadjointView<Eigen::Upper>();
-  const SmallVector mxy = m.row(0).tail(p).transpose();
+using Columns2To10 = std::make_integer_sequence<int, kMaxColumns - 1>;
+
+// The same pass for SSE2 (every x86-64) and for AVX2, whose 256-bit registers hold all L = 4
+// lanes of a step: twice the work per instruction. Both copies do the same IEEE operations on
+// each lane in the same order (no FMA: target "avx2" does not enable contraction into fused
+// multiply-adds), so the likelihoods are the same bits whichever runs.
+Gathered pass_default(int k, const double* z, Eigen::Index stride, Eigen::Index n,
+                      const std::vector<double>& dt_h, const std::array<Model, L>& md) {
+  return pass_for(k, z, stride, n, dt_h, md, Columns2To10{});
+}
+
+#if defined(__x86_64__) && defined(__GNUC__)
+__attribute__((target("avx2"))) Gathered pass_avx2(int k, const double* z, Eigen::Index stride,
+                                                   Eigen::Index n, const std::vector<double>& dt_h,
+                                                   const std::array<Model, L>& md) {
+  return pass_for(k, z, stride, n, dt_h, md, Columns2To10{});
+}
+#endif
+
+/// One pass, on the widest of the two the CPU has (asked once).
+/// The first k columns of z's rows (`stride` apart).
+Gathered pass_on_cpu(int k, const double* z, Eigen::Index stride, Eigen::Index n,
+                     const std::vector<double>& dt_h, const std::array<Model, L>& md) {
+#if defined(__x86_64__) && defined(__GNUC__)
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  if (avx2) return pass_avx2(k, z, stride, n, dt_h, md);
+#endif
+  return pass_default(k, z, stride, n, dt_h, md);
+}
+
+/// The likelihoods from what one lane gathered over y and columns 1..p (the base) of z: the
+/// restricted one, and with `ml` the maximum likelihood of the base and of the base with each
+/// later gathered column.
+Profile finish(const SmallMatrix& g, Eigen::Index p, double sum_log_f, Eigen::Index n,
+               Deviances* ml) {
+  const SmallMatrix mxx = g.block(1, 1, p, p).selfadjointView<Eigen::Upper>();
+  const SmallVector mxy = g.row(0).segment(1, p).transpose();
   const Eigen::LDLT<SmallMatrix> ldlt(mxx);
-  const double rss = m(0, 0) - mxy.dot(ldlt.solve(mxy));
+  const SmallVector beta = ldlt.solve(mxy);
+  const double rss = g(0, 0) - mxy.dot(beta);
   Profile out;
   const auto dof = static_cast<double>(n - p);
+  if (ml != nullptr) ml->fill(std::numeric_limits<double>::infinity());
   if (!(rss > 0) || ldlt.info() != Eigen::Success) return out;
   out.sigma2 = rss / dof;
   out.minus2_loglik = sum_log_f + ldlt.vectorD().array().log().sum() + dof * std::log(out.sigma2);
-  return out;
-}
-
-/// -2 l of y on the columns `cols` from what one lane gathered (see ml_deviances).
-double ml_deviance(const SmallMatrix& m, double sum_log_f, Eigen::Index n, const Columns& cols) {
-  const auto p = static_cast<Eigen::Index>(cols.size());
-  SmallMatrix mxx(p, p);
-  SmallVector mxy(p);
-  for (Eigen::Index a = 0; a < p; ++a) {
-    const int ca = cols[static_cast<std::size_t>(a)];
-    mxy(a) = m(0, ca);
-    for (Eigen::Index b = 0; b < p; ++b) {
-      const int cb = cols[static_cast<std::size_t>(b)];
-      mxx(a, b) = m(std::min(ca, cb), std::max(ca, cb));  // the upper triangle holds it
-    }
-  }
-  const Eigen::LDLT<SmallMatrix> ldlt(mxx);
-  const double rss = m(0, 0) - mxy.dot(ldlt.solve(mxy));
-  if (!(rss > 0) || ldlt.info() != Eigen::Success) return std::numeric_limits<double>::infinity();
+  if (ml == nullptr) return out;
   const auto nd = static_cast<double>(n);
-  return sum_log_f + nd * std::log(rss / nd);
+  (*ml)[0] = sum_log_f + nd * std::log(rss / nd);
+  for (Eigen::Index c = p + 1; c < g.rows(); ++c) {
+    // Adding column c: RSS falls by e^2 / d, e = g_cy - g_cx b, d = g_cc - g_cx M^-1 g_xc, the
+    // Schur complement of the base's M = X' F^-1 X (e.g. Seber & Lee, Linear Regression
+    // Analysis, 2nd ed., 2003, sec. 3.7). A column the base spans (zeros) has d = 0: no fall.
+    const SmallVector mxc = g.col(c).segment(1, p);
+    const double d = g(c, c) - mxc.dot(ldlt.solve(mxc)), e = g(0, c) - mxc.dot(beta);
+    const double rss_c = d > 0 ? rss - e * e / d : rss;
+    if (rss_c > 0) (*ml)[static_cast<std::size_t>(c - p)] = sum_log_f + nd * std::log(rss_c / nd);
+  }
+  return out;
 }
 
 }  // namespace
 
 namespace {
 
-/// Every model's pass, kLanes at a time; `take(model index, gathered, lane)` for each.
+/// Every model's pass over z's first `cols` columns, kLanes at a time; `take(model index,
+/// gathered, lane)` for each.
 template <typename Take>
-void each_pass(const RowMajor& z, const std::vector<double>& dt_h, std::span<const Model> models,
-               Take take) {
+void each_pass(const RowMajor& z, Eigen::Index cols, const std::vector<double>& dt_h,
+               std::span<const Model> models, Take take) {
   for (std::size_t first = 0; first < models.size(); first += L) {
     const std::size_t lanes = std::min<std::size_t>(L, models.size() - first);
     std::array<Model, L> md;
     for (std::size_t l = 0; l < L; ++l) md[l] = models[first + std::min(l, lanes - 1)];
-    const Gathered g = pass_for(static_cast<int>(z.cols()), z.data(), z.rows(), dt_h, md,
-                                std::make_integer_sequence<int, kMaxColumns - 1>{});
+    const Gathered g = pass_on_cpu(static_cast<int>(cols), z.data(), z.cols(), z.rows(), dt_h, md);
     for (std::size_t l = 0; l < lanes; ++l) take(first + l, g, l);
   }
 }
 
 }  // namespace
 
-void ml_deviances(const RowMajor& z, const std::vector<double>& dt_h, std::span<const Model> models,
-                  std::span<const Columns> subsets, std::span<double> out) {
-  const std::size_t s = subsets.size();
-  each_pass(z, dt_h, models, [&](std::size_t i, const Gathered& g, std::size_t l) {
-    for (std::size_t j = 0; j < s; ++j)
-      out[i * s + j] = ml_deviance(g.m[l], g.sum_log_f[l], z.rows(), subsets[j]);
-  });
-}
-
 void profiles(const RowMajor& z, const std::vector<double>& dt_h, std::span<const Model> models,
               std::span<Profile> out) {
-  each_pass(z, dt_h, models, [&](std::size_t i, const Gathered& g, std::size_t l) {
-    out[i] = finish(g.m[l], g.sum_log_f[l], z.rows());
+  evaluate(z, z.cols() - 1, dt_h, models, out);
+}
+
+void evaluate(const RowMajor& z, Eigen::Index base, const std::vector<double>& dt_h,
+              std::span<const Model> models, std::span<Profile> out, std::span<Deviances> ml) {
+  const Eigen::Index cols = ml.empty() ? base + 1 : z.cols();
+  each_pass(z, cols, dt_h, models, [&](std::size_t i, const Gathered& g, std::size_t l) {
+    out[i] = finish(g.m[l], base, g.sum_log_f[l], z.rows(), ml.empty() ? nullptr : &ml[i]);
   });
 }
 

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <array>
 #include <limits>
 #include <span>
 #include <vector>
@@ -38,16 +39,24 @@ struct Profile {
 void profiles(const RowMajor& z, const std::vector<double>& dt_h, std::span<const Model> models,
               std::span<Profile> out);
 
-/// Columns of z (1..p; y is column 0) a regression uses.
-using Columns = std::vector<int>;
+/// The most candidate columns a pass can carry beside y and one base column.
+inline constexpr int kMaxCandidates = kMaxColumns - 2;
 
-/// -2 x the maximum log-likelihood (not the restricted one), the regression coefficients and s^2
-/// concentrated out at their maximum-likelihood values (s^2 = RSS_GLS / n), constants dropped:
-///   -2 l = sum log f + n log(RSS_GLS / n)        (Harvey 1989, sec. 3.4, eq. 3.4.10),
-/// of y on each column subset under each model, out[model * subsets.size() + subset]. Unlike
-/// the restricted likelihood, whose term log |X' F^-1 X| changes with the columns, these compare
-/// across subsets: the same y, the same n, nested column sets give likelihood ratios.
-void ml_deviances(const RowMajor& z, const std::vector<double>& dt_h, std::span<const Model> models,
-                  std::span<const Columns> subsets, std::span<double> out);
+/// -2 x the maximum log-likelihood (not the restricted one) of y on the base columns ([0]) and on
+/// the base with each candidate column ([1 + k]), infinity where one cannot be fitted.
+using Deviances = std::array<double, kMaxCandidates + 1>;
+
+/// Each model's restricted likelihood of y (column 0 of z) on the base columns 1..base, from a
+/// pass over those columns alone; or, with `ml` (one per model), from a pass over every column of
+/// z, which also gives the maximum likelihood of y on the base and on the base with each later
+/// column (a candidate), the regression coefficients and s^2 concentrated out at their
+/// maximum-likelihood values (s^2 = RSS_GLS / n), constants dropped:
+///   -2 l = sum log f + n log(RSS_GLS / n)        (Harvey 1989, sec. 3.4, eq. 3.4.10).
+/// Unlike the restricted likelihood, whose term log |X' F^-1 X| changes with the columns, these
+/// compare across column sets: the same y, the same n, nested sets give likelihood ratios.
+/// A candidate's RSS is the base's less its Schur complement, e^2 / d (one factorization of the
+/// base's X' F^-1 X serves the restricted likelihood and every candidate).
+void evaluate(const RowMajor& z, Eigen::Index base, const std::vector<double>& dt_h,
+              std::span<const Model> models, std::span<Profile> out, std::span<Deviances> ml = {});
 
 }  // namespace station::compensation::reml
