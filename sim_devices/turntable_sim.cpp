@@ -50,8 +50,10 @@ void TurntableSim::step_once(double dt) {
   if (mode_ == 1 && !stopping_) {
     double before = std::remainder(position_demand_deg_ - angle_deg_, 360.0);
     double after = std::remainder(position_demand_deg_ - next, 360.0);
-    // Do not overshoot the final approach: snap when the error changes sign at low speed.
-    if (before * after <= 0 && std::fabs(v_new) <= dv_max) {
+    // Do not overshoot the final approach: snap when the error changes sign at low speed (up
+    // to two steps' worth of acceleration: with exactly one, rounding let a table coming from
+    // rate mode hunt about its demand at that speed for ever, refusing the lock).
+    if (before * after <= 0 && std::fabs(v_new) <= 2 * dv_max) {
       next = position_demand_deg_;
       turned = before;
       v_new = 0;

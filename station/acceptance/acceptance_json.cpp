@@ -1,6 +1,8 @@
 // Acceptance figures as JSON.
 #include "station/acceptance/acceptance_json.hpp"
 
+#include <cmath>
+
 namespace station {
 namespace {
 
@@ -13,8 +15,9 @@ json not_computed(const comp::Computed<T>& c) {
 }
 
 json ladder_json(const LadderFigures& l) {
-  json j{{"step_index", l.step_index}, {"label", l.label}, {"temp_c", l.temp_c},
-         {"points", l.points}, {"missing", l.missing}};
+  json j{{"step_index", l.step_index}, {"label", l.label}, {"points", l.points},
+         {"missing", l.missing}};
+  if (std::isfinite(l.temp_c)) j["temp_c"] = l.temp_c;
   if (!l.fit) {
     j.update(not_computed(l.fit));
     return j;
@@ -40,8 +43,9 @@ json ladder_json(const LadderFigures& l) {
 }
 
 json positions_json(const PositionFigures& p) {
-  json j{{"step_index", p.step_index}, {"label", p.label}, {"temp_c", p.temp_c},
-         {"points", p.points}, {"excluded", p.excluded}};
+  json j{{"step_index", p.step_index}, {"label", p.label}, {"points", p.points},
+         {"excluded", p.excluded}};
+  if (std::isfinite(p.temp_c)) j["temp_c"] = p.temp_c;
   if (!p.fit) {
     j.update(not_computed(p.fit));
     return j;

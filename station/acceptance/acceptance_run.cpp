@@ -100,8 +100,10 @@ MeanSe batch_mean_se(const std::vector<double>& v, double floor) {
 Window window_of(const std::vector<SampleRow>& rows, double from_s, double to_s) {
   Window w;
   for (const auto& r : rows) {
-    if (r.t_s < from_s || r.t_s >= to_s || !r.net_pulses || !r.interval_s || !r.rate_dph ||
-        !(*r.interval_s > 0) || (r.flags & kBoardFault) != 0 || (r.flags & kSafeHold) != 0)
+    // A sample covers the interval before its tick: only those wholly inside the window.
+    if (!r.interval_s || r.t_s - *r.interval_s < from_s - 1e-6 || r.t_s > to_s + 1e-6 ||
+        !r.net_pulses || !r.rate_dph || !(*r.interval_s > 0) || (r.flags & kBoardFault) != 0 ||
+        (r.flags & kSafeHold) != 0)
       continue;
     w.pps.push_back(static_cast<double>(*r.net_pulses) / *r.interval_s);
     w.span_s += *r.interval_s;
@@ -128,7 +130,9 @@ LadderFigures ladder_of(const Step& s, int index, const std::map<int, PointEvent
     const Window w = window_of(rows, it->second.measure_s, it->second.end_s);
     const MeanSe out = batch_mean_se(w.pps, w.quantization_pps());
     comp::LadderPoint p;
-    p.table_rate_dps = it->second.table_mean.value_or(sp.demand);
+    // The table turns about up: an input axis down senses it negated (its Earth rate is the
+    // slot's, already signed).
+    p.table_rate_dps = (slot.axis == "down" ? -1.0 : 1.0) * it->second.table_mean.value_or(sp.demand);
     p.earth_rate_dph = slot.earth_rate_dph;
     p.output_pps = out.mean;
     p.output_se_pps = out.se.value_or(0.0);
@@ -136,7 +140,7 @@ LadderFigures ladder_of(const Step& s, int index, const std::map<int, PointEvent
     points.push_back(p);
     temps.insert(temps.end(), w.temp_c.begin(), w.temp_c.end());
   }
-  f.temp_c = mean_se(temps).mean;
+  f.temp_c = temps.empty() ? std::nan("") : mean_se(temps).mean;
   f.fit = comp::analyze_rate_ladder(points);
   return f;
 }
@@ -161,7 +165,7 @@ PositionFigures positions_of(const Step& s, int index, const std::map<int, Point
     points.push_back({it->second.table_mean.value_or(sp.demand), out.mean, *out.se});
     temps.insert(temps.end(), w.temp_c.begin(), w.temp_c.end());
   }
-  f.temp_c = mean_se(temps).mean;
+  f.temp_c = temps.empty() ? std::nan("") : mean_se(temps).mean;
   // The axis is up: its Earth rate is Omega sin(phi) (earth_rate.hpp), so the site's latitude
   // is the one the run's slot was given.
   const double s_phi = std::clamp(slot.earth_rate_dph / comp::kEarthRateDph, -1.0, 1.0);
@@ -204,7 +208,8 @@ double noise_band_dph(const std::vector<TurnOnBins>& all, const comp::TurnOnWind
 void turn_ons_of(const Step& s, const std::map<int, PointEvent>& events,
                  const std::vector<SampleRow>& rows, const RunSlot& slot, SerialAcceptance& out) {
   std::vector<TurnOnBins> bins;
-  for (const auto& [point, e] : events) bins.push_back(turn_on_bins(rows, e, slot.earth_rate_dph));
+  for (const auto& [point, e] : events)  // a turn-on a hold or a kill cut short is left out
+    if (e.held) bins.push_back(turn_on_bins(rows, e, slot.earth_rate_dph));
   // After warm-up: the bias over the second half of the powered time, the final value over
   // its last third.
   comp::TurnOnWindows w;
@@ -226,7 +231,11 @@ void analyze_step(const Protocol& p, int index, const StepPoints& events,
   const auto it = events.find(index);
   const auto& mine = it == events.end() ? kNone : it->second;
   if (s.kind == StepKind::rate_ladder) {
-    out.ladders.push_back(ladder_of(s, index, mine, rows, slot));
+    LadderFigures f = ladder_of(s, index, mine, rows, slot);
+    if (slot.axis != "up" && slot.axis != "down")
+      f.fit = comp::NotComputed{"a ladder is analysed for an input axis along the table's (up or "
+                                "down); this one is " + slot.axis};
+    out.ladders.push_back(std::move(f));
   } else if (s.kind == StepKind::positions) {
     if (slot.axis == "up")
       out.positions.push_back(positions_of(s, index, mine, rows, slot));
@@ -259,7 +268,7 @@ std::vector<SerialAcceptance> run_acceptance(Store& store, std::int64_t run_id,
     for (int i : steps) analyze_step(p, i, events, rows, slot, a);
     std::vector<comp::PlateauScaleFactor> plateaus;
     for (const auto& l : a.ladders)
-      if (l.fit) plateaus.push_back({l.temp_c, l.fit->sf_pulse_per_arcsec, l.fit->sf_se_pulse_per_arcsec});
+      if (l.fit && std::isfinite(l.temp_c)) plateaus.push_back({l.temp_c, l.fit->sf_pulse_per_arcsec, l.fit->sf_se_pulse_per_arcsec});
     if (plateaus.size() >= 2) a.sf_vs_temp = comp::fit_scale_factor_vs_temperature(plateaus, ref_temp_c);
     out.push_back(std::move(a));
   }

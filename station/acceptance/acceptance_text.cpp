@@ -16,10 +16,17 @@ std::string truth(const json& s, const char* key, const char* format = "{:.4g}")
   return fmt::format(fmt::runtime(std::string(" (true ") + format + ")"), s["true"][key].get<double>());
 }
 
-std::string ladder_line(const json& s, const json& l) {
-  std::string out = fmt::format("  scale factor  {:<28} {:6.1f} C  ", l.value("label", ""),
-                                l.value("temp_c", 0.0));
-  if (!l.value("ok", false)) return out + "not computed: " + l.value("error", "") + "\n";
+/// The gyro's temperature over the step ("  25.0 C"), or "   - C" when no sample had one.
+std::string temp(const json& step) {
+  return step.contains("temp_c") ? fmt::format("{:6.1f} C", step["temp_c"].get<double>())
+                                 : std::string("     - C");
+}
+
+std::string ladder_line(const json& l) {
+  std::string out = fmt::format("  scale factor  {:<28} {}  ", l.value("label", ""), temp(l));
+  if (!l.value("ok", false))
+    return out + "not computed: " + l.value("error", "") +
+           fmt::format(" ({} of {} points not measured)\n", l.value("missing", 0), l.value("points", 0));
   out += fmt::format("K {:.7f} +- {:.1e} pulse/arcsec{}, bias {:+.3f} +- {:.3f} deg/h, "
                      "nonlinearity {:.1f} ppm FS{} (rms {:.1f})",
                      l["sf_pulse_per_arcsec"].get<double>(), l["sf_se_pulse_per_arcsec"].get<double>(),
@@ -32,7 +39,10 @@ std::string ladder_line(const json& s, const json& l) {
                        l["asymmetry_se_ppm"].get<double>(), truth(l, "asymmetry_ppm", "{:+.1f}"));
   const int excluded = l.value("points_excluded", 0) + l.value("missing", 0);
   out += fmt::format("; {} of {} points", l.value("points_used", 0), l.value("points", 0));
-  if (excluded > 0) out += fmt::format(" ({} left out: the table did not hold its rate)", excluded);
+  if (excluded > 0)
+    out += fmt::format(" ({} left out: the table did not hold its rate, or a stop, kill or safe "
+                       "hold cut its window short)",
+                       excluded);
   return out + "\n";
 }
 
@@ -49,8 +59,7 @@ std::string tc_line(const json& s) {
 }
 
 std::string positions_line(const json& s, const json& p) {
-  std::string out = fmt::format("  positions     {:<28} {:6.1f} C  ", p.value("label", ""),
-                                p.value("temp_c", 0.0));
+  std::string out = fmt::format("  positions     {:<28} {}  ", p.value("label", ""), temp(p));
   if (!p.value("ok", false)) return out + "not computed: " + p.value("error", "") + "\n";
   out += fmt::format("input-axis tilt {:.3f} +- {:.3f} mrad{} toward {:.0f} +- {:.0f} deg of the "
                      "table, bias {:+.4f} +- {:.4f} deg/h",
@@ -64,6 +73,22 @@ std::string positions_line(const json& s, const json& p) {
   return out + "\n";
 }
 
+/// The simulated turn-on spread, and with the bias windows' own noise (what the sd should show).
+std::string sigma_truth(const json& t) {
+  if (!t.contains("true") || !t["true"].contains("sigma_with_noise_dph")) return "";
+  return fmt::format(" (true {:.4f}; with the windows' noise {:.4f})",
+                     t["true"]["sigma_dph"].get<double>(),
+                     t["true"]["sigma_with_noise_dph"].get<double>());
+}
+
+/// The simulated warm-up under the same band: none when the transient never leaves it.
+std::string warmup_truth(const json& t) {
+  if (!t.contains("true") || !t["true"].contains("warmup_s")) return "";
+  const double w = t["true"]["warmup_s"];
+  return w > 0 ? fmt::format(" (true {:.0f} s)", w)
+               : std::string(" (true: the simulated transient stays inside the band)");
+}
+
 std::string turn_on_line(const json& s) {
   const json& t = s["turn_on"];
   if (!t.value("ok", false)) return "  turn-on: not computed: " + t.value("error", "") + "\n";
@@ -75,9 +100,22 @@ std::string turn_on_line(const json& s) {
       "mean bias {:+.4f} deg/h; {}{} within +-{:.4f} deg/h of the final value\n",
       t["turn_ons"].get<int>(), t["repeatability_dph"].get<double>(),
       100 * t["confidence"].get<double>(), t["repeatability_lower_dph"].get<double>(),
-      t["repeatability_upper_dph"].get<double>(), truth(t, "sigma_dph", "{:.4f}"),
-      t["mean_bias_dph"].get<double>(), warm, truth(t, "warmup_s", "{:.0f} s"),
+      t["repeatability_upper_dph"].get<double>(), sigma_truth(t),
+      t["mean_bias_dph"].get<double>(), warm, warmup_truth(t),
       t["band_dph"].get<double>());
+}
+
+std::string verdict_line(const json& v) {
+  if (v.value("pass", false))
+    return fmt::format("  acceptance verdict ({}): PASS, {} limits\n", v.value("part", ""),
+                       v.value("checked", 0));
+  std::string out = fmt::format("  acceptance verdict ({}): FAIL", v.value("part", ""));
+  const char* sep = ": ";
+  for (const auto& f : v["failed"]) {
+    out += sep + f.get<std::string>();
+    sep = "; ";
+  }
+  return out + "\n";
 }
 
 }  // namespace
@@ -88,11 +126,12 @@ std::string acceptance_text(const json& serials) {
                     "(positions), turn-on repeatability and warm-up (power cycles)\n";
   for (const auto& s : serials) {
     out += s.value("serial", "") + "\n";
-    for (const auto& l : s["ladders"]) out += ladder_line(s, l);
+    for (const auto& l : s["ladders"]) out += ladder_line(l);
     if (s.contains("sf_vs_temp")) out += tc_line(s);
     for (const auto& p : s["positions"]) out += positions_line(s, p);
     if (s.contains("positions_note")) out += "  positions: " + s["positions_note"].get<std::string>() + "\n";
     if (s.contains("turn_on")) out += turn_on_line(s);
+    if (s.contains("verdict")) out += verdict_line(s["verdict"]);
   }
   return out;
 }

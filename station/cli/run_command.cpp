@@ -157,7 +157,8 @@ int run_real(const RunOptions& o) {
   rec.start(o, tap, plan.config, plan.protocol);
   OneRunControl control(g_stop, g_abort);
   LiveService live(live_options(o, o.db, config.name, false), control);
-  SequencerOptions so = real_hooks(o, slot_part_limits(plan.config, o.parts), rec, live);
+  const auto part_limits = slot_part_limits(plan.config, o.parts);
+  SequencerOptions so = real_hooks(o, part_limits, rec, live);
   // Progress: a redrawn line on a terminal, a line every 5 minutes of run time in a log, and
   // systemd's status line under a service.
   ProgressDisplay progress(stderr, ::isatty(STDERR_FILENO) != 0, 300.0, config.bin_s,
@@ -171,7 +172,8 @@ int run_real(const RunOptions& o) {
   if (rec.session) rec.session->finish(store, out.run_id);
   sd_notify(0, "STOPPING=1");
   std::cout << run_summary_text(
-      rig_run_summary(store, out.run_id, to_string(out.state), out.t_s, out.ticks, o.db));
+      rig_run_summary(store, out.run_id, to_string(out.state), out.t_s, out.ticks, o.db,
+                      part_limits));
   live.exit_if_abandoned(0);
   return 0;
 }

@@ -2,6 +2,7 @@
 #include "station/cli/run_summary.hpp"
 
 #include "station/acceptance/acceptance_json.hpp"
+#include "station/acceptance/acceptance_verdict.hpp"
 
 #include <fmt/format.h>
 
@@ -125,14 +126,18 @@ std::string report_command(const std::string& db_path, std::int64_t run_id) {
 }
 
 json rig_run_summary(Store& store, std::int64_t run_id, std::string_view state, double t_s,
-                     std::int64_t ticks, const std::string& db_path) {
+                     std::int64_t ticks, const std::string& db_path,
+                     const std::map<std::string, PartLimits>& part_limits) {
   json j{{"run_id", run_id},
          {"state", std::string(state)},
          {"t_s", t_s},
          {"ticks", ticks},
          {"gyros", run_results_json(store, run_id)},
          {"report", report_command(db_path, run_id)}};
-  if (auto a = acceptance_json(run_acceptance(store, run_id)); !a.empty()) j["acceptance"] = a;
+  if (auto a = acceptance_json(run_acceptance(store, run_id)); !a.empty()) {
+    judge_acceptance(a, part_limits);
+    j["acceptance"] = std::move(a);
+  }
   return j;
 }
 

@@ -4,10 +4,12 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
 
+#include "station/parts/part_file.hpp"
 #include "station/store/store.hpp"
 
 namespace station {
@@ -21,8 +23,11 @@ std::string run_summary_text(const nlohmann::json& report);
 
 /// The report object of a run on a rig, read back from the store: run_id, state, t_s, ticks,
 /// gyros (run_results_json) and "report": the `station report` command for its database.
+/// With acceptance steps, "acceptance": each serial's figures (acceptance/acceptance_json),
+/// judged against `part_limits` (by serial) where its part has acceptance limits.
 nlohmann::json rig_run_summary(Store& store, std::int64_t run_id, std::string_view state,
-                               double t_s, std::int64_t ticks, const std::string& db_path);
+                               double t_s, std::int64_t ticks, const std::string& db_path,
+                               const std::map<std::string, PartLimits>& part_limits = {});
 
 /// The command that writes run `run_id`'s report from `db_path` (shell-quoted where needed).
 std::string report_command(const std::string& db_path, std::int64_t run_id);

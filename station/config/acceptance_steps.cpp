@@ -3,7 +3,10 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
+#include <optional>
+#include <string>
 
 namespace station {
 namespace {
@@ -31,8 +34,12 @@ void read_ladder(const TomlView& v, Step& s) {
     if (!(s.rates_dps[i] > 0))
       throw v.error("rates_dps", fmt::format("entry {}: a rate must be above 0 deg/s", i));
   }
-  s.settle_s = time_in(v, "settle_s", 10.0, 0.0);
-  s.dwell_s = time_in(v, "dwell_s", 60.0, 1.0);
+  if (s.rates_dps.size() < 2)
+    throw v.error("rates_dps", "needs at least 2 rates (4 points: a line and its residuals)");
+  // The first sample in a window covers the second before it: settle at least two ticks so it
+  // never holds the table's travel; a window of 10 s or more gives its mean an error.
+  s.settle_s = time_in(v, "settle_s", 10.0, 2.0);
+  s.dwell_s = time_in(v, "dwell_s", 60.0, 10.0);
   s.accel_dps2 = v.opt_number_in("accel_dps2", 0.01, 1e4, "deg/s^2").value_or(10.0);
   s.rate_tolerance_dps =
       v.opt_number_in("rate_tolerance_dps", 1e-6, 100.0, "deg/s").value_or(0.05);
@@ -43,8 +50,18 @@ void read_positions(const TomlView& v, Step& s) {
   s.angles_deg = v.number_array_in("angles_deg", -kMaxAngleDeg, kMaxAngleDeg, "deg", kMaxPoints);
   if (s.angles_deg.size() < 3)
     throw v.error("angles_deg", "needs at least 3 angles (a cosine has 3 unknowns)");
-  s.settle_s = time_in(v, "settle_s", 30.0, 0.0);
-  s.dwell_s = time_in(v, "dwell_s", 300.0, 1.0);
+  std::vector<double> distinct;
+  for (double a : s.angles_deg) {
+    const bool seen = std::any_of(distinct.begin(), distinct.end(), [a](double d) {
+      return std::abs(std::remainder(a - d, 360.0)) < 1e-9;
+    });
+    if (!seen) distinct.push_back(a);
+  }
+  if (distinct.size() < 3)
+    throw v.error("angles_deg", fmt::format("{} distinct angles (mod 360), needs at least 3",
+                                            distinct.size()));
+  s.settle_s = time_in(v, "settle_s", 30.0, 2.0);
+  s.dwell_s = time_in(v, "dwell_s", 300.0, 10.0);
 }
 
 void read_power_cycles(const TomlView& v, Step& s) {
@@ -52,7 +69,9 @@ void read_power_cycles(const TomlView& v, Step& s) {
   s.cycles = static_cast<int>(
       v.opt_integer_in("cycles", 2, static_cast<long long>(kMaxPoints)).value_or(5));
   s.off_s = time_in(v, "off_s", 60.0, 1.0);
-  s.dwell_s = time_in(v, "on_s", 1800.0, 10.0);
+  // The turn-on's bias is the mean of the second half's 60 s bins, the warm-up needs bins before
+  // it: four bins at least.
+  s.dwell_s = time_in(v, "on_s", 1800.0, 240.0);
 }
 
 }  // namespace
@@ -73,7 +92,28 @@ void read_acceptance_step(const TomlView& v, Step& s) {
       read_power_cycles(v, s);
       break;
     default:
-      break;
+      return;
+  }
+  if (const double d = acceptance_duration_s(s); d > kMaxTimeS)
+    throw v.error("type", fmt::format("the step takes {:g} days, longer than the longest step "
+                                      "(7 days)", d / 86400.0));
+}
+
+void check_tables_locked(const std::vector<Step>& steps, const std::string& path) {
+  std::optional<std::size_t> released;  // a step that turned the table, not locked since
+  for (std::size_t i = 0; i <= steps.size(); ++i) {
+    const bool end = i == steps.size();
+    if (!end && steps[i].kind == StepKind::lock_turntable) released.reset();
+    if (released && (end || steps[i].kind == StepKind::record_start)) {
+      const Step& r = steps[*released];
+      throw InputError(fmt::format(
+          "{}:{}: key 'step[{}].type': {} leaves the table released: a lock_turntable step must "
+          "follow it before {}",
+          path, r.line, *released, r.kind == StepKind::rate_ladder ? "rate_ladder" : "positions",
+          end ? "the protocol ends" : "the record window opens"));
+    }
+    if (!end && (steps[i].kind == StepKind::rate_ladder || steps[i].kind == StepKind::positions))
+      released = i;
   }
 }
 

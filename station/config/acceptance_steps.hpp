@@ -4,6 +4,7 @@
 // windows the runner measured.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "station/config/protocol.hpp"
@@ -37,5 +38,9 @@ double acceptance_duration_s(const Step& s);
 /// Reads the keys of an acceptance step into `s` (its kind already set); throws InputError
 /// naming the key ("FILE:LINE: key 'step[4].rates_dps': entry 2: 4000 is outside 0..1000 deg/s").
 void read_acceptance_step(const TomlView& v, Step& s);
+/// A rate_ladder or positions step leaves the table turning or unlocked at an angle: a
+/// lock_turntable step must follow it before the record window opens or the protocol ends.
+/// Throws InputError naming the step.
+void check_tables_locked(const std::vector<Step>& steps, const std::string& path);
 
 }  // namespace station

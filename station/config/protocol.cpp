@@ -149,6 +149,7 @@ Protocol parse_protocol(const std::string& text, const std::string& path) {
     }
     if (start || stop) recording = start;
   }
+  check_tables_locked(p.steps, path);
   p.check_step_times(std::nullopt, std::nullopt);
   return p;
 }

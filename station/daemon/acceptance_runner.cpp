@@ -18,6 +18,23 @@ constexpr double kAngleToleranceDeg = 0.1;
 
 }  // namespace
 
+void check_acceptance_rig(const Protocol& protocol, const StationConfig& config,
+                          bool has_turntable) {
+  for (std::size_t i = 0; i < protocol.steps.size(); ++i) {
+    const Step& s = protocol.steps[i];
+    const auto where = fmt::format("{}:{}: step[{}] {}", protocol.path, s.line, i, to_string(s.kind));
+    if ((s.kind == StepKind::rate_ladder || s.kind == StepKind::positions) && !has_turntable)
+      throw InputError(where + ": this rig has no turntable");
+    if (s.kind != StepKind::power_cycles) continue;
+    for (std::size_t k = 0; k < config.slots.size(); ++k) {
+      if (config.slots[k].relay.empty())
+        throw InputError(fmt::format("{}: slot {} has no relay (its [[slot]] relay = \"LINE\"): "
+                                     "its gyro could not be switched off",
+                                     where, k + 1));
+    }
+  }
+}
+
 void AcceptanceRunner::enter(const Step& step, int step_index, double started_s) {
   if (step_ != &step || step_index_ != step_index || started_s_ != started_s) {
     step_ = &step;
@@ -28,7 +45,23 @@ void AcceptanceRunner::enter(const Step& step, int step_index, double started_s)
     rested_ = false;
     stats_ = {};
   }
+  // Entered again (after a safe hold: the table stopped, the relays off): the point being
+  // measured lost part of its window and, for power cycles, its turn-on.
+  if (current_ >= 0 && stats_.first_s) cut_ = true;
   resend_ = true;
+}
+
+AcceptanceActions AcceptanceRunner::leave() {
+  AcceptanceActions a;
+  if (step_ == nullptr) return a;
+  if (current_ >= 0) {
+    cut_ = true;
+    close(points_[static_cast<std::size_t>(current_)], a);
+  }
+  current_ = -1;
+  rest(a);
+  step_ = nullptr;
+  return a;
 }
 
 void AcceptanceRunner::send(const AcceptancePoint& p, double t_s, AcceptanceActions& a) {
@@ -75,8 +108,9 @@ void AcceptanceRunner::close(const AcceptancePoint& p, AcceptanceActions& a) {
   const bool power = step_->kind == StepKind::power_cycles;
   const double tolerance =
       step_->kind == StepKind::rate_ladder ? step_->rate_tolerance_dps : kAngleToleranceDeg;
-  const bool held = spanned && (power || (stats_.readings > 0 && stats_.all_in_position &&
-                                          stats_.max_dev <= tolerance));
+  const bool held = spanned && !cut_ &&
+                    (power || (stats_.readings > 0 && stats_.all_in_position &&
+                               stats_.max_dev <= tolerance));
   nlohmann::json data{{"step_index", step_index_},
                       {"point", p.index},
                       {"demand", p.demand},
@@ -93,12 +127,19 @@ void AcceptanceRunner::close(const AcceptancePoint& p, AcceptanceActions& a) {
   const char* what = step_->kind == StepKind::rate_ladder ? "rate" : power ? "turn-on" : "angle";
   a.events.push_back(
       {held ? Severity::info : Severity::warn, EventKind::acceptance_point,
-       held ? fmt::format("{} {:g} measured ({} table readings)", what, p.demand, stats_.readings)
-            : fmt::format("{} {:g} not held over its window ({} readings, largest deviation "
-                          "{:g}): left out",
-                          what, p.demand, stats_.readings, stats_.max_dev),
+       held ? (power ? fmt::format("{} {:g} measured", what, p.demand)
+                     : fmt::format("{} {:g} measured ({} table readings)", what, p.demand,
+                                   stats_.readings))
+       : !spanned || cut_
+           ? fmt::format("{} {:g} measured over part of its window only (a stop, a kill or a "
+                         "safe hold): left out",
+                         what, p.demand)
+           : fmt::format("{} {:g} not held over its window ({} readings, largest deviation "
+                         "{:g}): left out",
+                         what, p.demand, stats_.readings, stats_.max_dev),
        std::move(data)});
   stats_ = {};
+  cut_ = false;
 }
 
 void AcceptanceRunner::rest(AcceptanceActions& a) {

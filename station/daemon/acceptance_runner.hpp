@@ -8,9 +8,16 @@
 
 #include "drivers/turntable/turntable.hpp"
 #include "station/config/acceptance_steps.hpp"
+#include "station/config/config.hpp"
 #include "station/store/events.hpp"
 
 namespace station {
+
+/// Refuses (InputError, before the run exists) a protocol whose acceptance steps this rig cannot
+/// carry out: a rate_ladder or positions step without a turntable, a power_cycles step while a
+/// slot has no relay (its gyro would never be switched off, and its turn-ons would be made up).
+void check_acceptance_rig(const Protocol& protocol, const StationConfig& config,
+                          bool has_turntable);
 
 /// What the table showed this tick (empty: no answer).
 struct TableObservation {
@@ -34,6 +41,9 @@ class AcceptanceRunner {
   AcceptanceActions tick(double t_s, const TableObservation& table);
   /// The whole schedule has run (the ladder's table back at rest).
   bool finished(double t_s) const;
+  /// The step ends early (its timeout): the point being measured is closed (left out, its window
+  /// cut short) and the table sent to rest, the gyros powered.
+  AcceptanceActions leave();
   /// Whether the gyros are to be powered (false only in a power cycle's off time).
   bool gyro_power() const { return power_on_; }
 
@@ -57,6 +67,7 @@ class AcceptanceRunner {
   bool resend_ = false;  ///< entered again: send the current demand at the next tick
   bool rested_ = false;  ///< the end-of-step demand was sent
   bool power_on_ = true;
+  bool cut_ = false;  ///< the current point's window was interrupted (a safe hold): left out
   PointStats stats_;
 };
 

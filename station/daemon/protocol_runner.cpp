@@ -117,12 +117,16 @@ bool ProtocolRunner::in_acceptance_step() const {
          is_acceptance_step(protocol_.steps[static_cast<std::size_t>(progress_.step_index)].kind);
 }
 
-void ProtocolRunner::accept(const Observation& obs, Actions& a) {
-  auto acts = acceptance_.tick(
-      obs.t_s, {obs.table_rate_dps, obs.table_angle_deg, obs.table_in_position.value_or(false)});
+void ProtocolRunner::merge(AcceptanceActions acts, Actions& a) {
   if (acts.table) a.table = acts.table;
   if (acts.gyro_power) a.gyro_power = acts.gyro_power;
   for (auto& e : acts.events) a.events.push_back(std::move(e));
+}
+
+void ProtocolRunner::accept(const Observation& obs, Actions& a) {
+  merge(acceptance_.tick(obs.t_s, {obs.table_rate_dps, obs.table_angle_deg,
+                                   obs.table_in_position.value_or(false)}),
+        a);
 }
 
 bool ProtocolRunner::finished(const Step& s, const Observation& obs) {
@@ -187,6 +191,7 @@ Actions ProtocolRunner::tick(const Observation& obs) {
       continue;
     }
     if (s.timeout_s > 0 && obs.t_s - progress_.step_started_s > s.timeout_s) {
+      if (is_acceptance_step(s.kind)) merge(acceptance_.leave(), a);
       advance(obs, a, EventKind::step_timeout, Severity::warn);
       continue;
     }

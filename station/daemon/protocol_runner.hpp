@@ -82,6 +82,7 @@ class ProtocolRunner {
   void lock_table(const Step& s, const Observation& obs, Actions& a);
   void ramp(const Step& s, const Observation& obs, Actions& a);
   void accept(const Observation& obs, Actions& a);
+  static void merge(AcceptanceActions acts, Actions& a);
 
   const Protocol& protocol_;
   RunProgress progress_;

@@ -181,7 +181,12 @@ void Sequencer::assemble_samples(double t_s, TickData& d) {
     d.obs.table_locked = table->locked;
     if (std::isfinite(table->rate_dps)) d.obs.table_rate_dps = table->rate_dps;
   }
-  const int step_flags = runner_->in_acceptance_step() ? kAcceptanceStep : 0;
+  // A sample of an acceptance step, or one taken while the table turns (a ladder's table still
+  // slowing after its step ended): the rate holds the table's, no thermal bias. 0.001 deg/s is
+  // 3.6 deg/h, hundreds of times a bias.
+  constexpr double kTableStillDps = 1e-3;
+  const bool turning = d.obs.table_rate_dps && std::abs(*d.obs.table_rate_dps) > kTableStillDps;
+  const int step_flags = runner_->in_acceptance_step() || turning ? kAcceptanceStep : 0;
   d.obs.air_c = d.in.air_c();
   if (d.obs.air_c) last_air_c_ = d.obs.air_c;
   for (std::size_t i = 0; i < config_.slots.size(); ++i) {
@@ -268,7 +273,10 @@ void Sequencer::apply_actions(double t_s, const Actions& a) {
     pending_chamber_ = safety_.clamp(*a.chamber, notes);
     for (const auto& n : notes) emit(t_s, Severity::warn, "safety", EventKind::clamp, n);
   }
-  if (a.table) pending_table_ = a.table;
+  if (a.table) {
+    pending_table_ = a.table;
+    if (a.table->lock) table_released_ = !*a.table->lock;
+  }
   if (a.gyro_power && !safety_.holding()) drive_outputs(t_s, safety_.outputs());
   // Commands are retried every tick until the device accepts them; none while the rig holds
   // (one kept through a hold for a foreign setpoint waits for its end).

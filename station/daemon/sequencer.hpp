@@ -166,6 +166,8 @@ class Sequencer {
   drivers::Result<void> command_chamber(const drivers::ChamberCommand& c);
   drivers::Result<void> command_table(const drivers::TurntableCommand& c);
   drivers::Result<void> stop_table();
+  /// At the end of a run whose protocol left the table released: a controlled stop.
+  void rest_table(double t_s);
   void apply_safety(double t_s, TickData& d);
   /// Stores an event per GPIO edge of a reading.
   void note_edges(double t_s, const RigReading& in);
@@ -228,6 +230,9 @@ class Sequencer {
   } phase_s_;
   std::optional<drivers::ChamberCommand> pending_chamber_;
   std::optional<drivers::TurntableCommand> pending_table_;
+  /// The protocol released the table's lock (an acceptance step turns it) and has not locked it
+  /// again: a run that ends so stops the table (rest_table).
+  bool table_released_ = false;
 };
 
 }  // namespace station

@@ -71,4 +71,13 @@ drivers::Result<void> Sequencer::stop_table() {
   return rig_.turntable->stop();
 }
 
+void Sequencer::rest_table(double t_s) {
+  if (!table_released_ || !rig_.turntable) return;
+  if (auto r = stop_table(); !r)
+    emit(t_s, Severity::error, "table", EventKind::stop_failed,
+         "the run ended with the table released and turning, and the stop failed: " +
+             r.error().message);
+  table_released_ = false;
+}
+
 }  // namespace station

@@ -24,6 +24,7 @@
 namespace station {
 
 RunState Sequencer::finish(RunState end_state, double t_s) {
+  rest_table(t_s);                        // a ladder stopped or timed out mid-step
   drive_outputs(t_s, SafetyOutputs{});    // the run is over: gyro power off, lamps dark
   const auto lossy = close_outages(t_s);  // serial -> why its record window is incomplete
   const RunState state =
@@ -62,6 +63,7 @@ RunState Sequencer::finish(RunState end_state, double t_s) {
 }
 
 RunState Sequencer::abort(double t_s) {
+  rest_table(t_s);
   drive_outputs(t_s, SafetyOutputs{});  // gyro power off, lamps dark
   for (const auto& o : outages_.close_all(t_s))
     emit(t_s, Severity::warn, o.device, EventKind::outage,
@@ -141,6 +143,7 @@ void Sequencer::restore_outages(std::int64_t run_id, double last_s) {
 void Sequencer::create_run() {
   // A ramp that would take longer than any step may is refused before the run exists.
   protocol_.check_step_times(config_.limits.min_setpoint_c, config_.limits.max_setpoint_c);
+  check_acceptance_rig(protocol_, config_, rig_.turntable != nullptr);
   RunInfo info{protocol_.name,
                protocol_.text,
                config_.text,

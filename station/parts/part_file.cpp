@@ -25,18 +25,6 @@ std::optional<double> positive(const TomlView& v, std::string_view key) {
   return x;
 }
 
-LimitRange read_range(const TomlView& part, std::string_view key) {
-  const auto t = part.opt_table(key);
-  if (!t) return {};
-  t->allow_only({"min", "max"});
-  LimitRange r{t->opt_number("min"), t->opt_number("max")};
-  if (!r.min && !r.max) throw part.error(key, "give min, max or both");
-  if (r.min && r.max && *r.min > *r.max) {
-    throw t->error("min", fmt::format("min {:g} is above max {:g}", *r.min, *r.max));
-  }
-  return r;
-}
-
 /// A noise term of [noise]: above 0 (or 0 where `zero_ok`: K = 0, no walk) and at most
 /// kMaxNoiseTerm; -0 read as 0.
 std::optional<double> noise_term(const TomlView& t, std::string_view key, bool zero_ok) {
@@ -89,7 +77,8 @@ std::optional<std::string> read_model(const TomlView& part) {
 PartLimits read_part(const TomlView& v, const std::string& number) {
   v.allow_only({"description", "B0_dph", "k1_dph_per_c", "k0_dph_per_c", "max_std_after_dph",
                 "max_std_ratio", "max_adev_floor_dph", "min_complete_bins", "max_k1_se_dph_per_c",
-                "max_k0_se_dph_per_c", "max_verify_std_dph", "max_verify_ratio", "model", "noise"});
+                "max_k0_se_dph_per_c", "max_verify_std_dph", "max_verify_ratio", "model", "noise",
+                "acceptance"});
   PartLimits p;
   p.number = number;
   p.description = v.opt_string("description").value_or("");
@@ -109,23 +98,8 @@ PartLimits read_part(const TomlView& v, const std::string& number) {
   p.max_verify_ratio = positive(v, "max_verify_ratio");
   p.model = read_model(v);
   p.noise = read_noise(v);
+  p.acceptance = read_acceptance_limits(v);
   return p;
-}
-
-json range_json(const LimitRange& r) {
-  json j = json::object();
-  if (r.min) j["min"] = *r.min;
-  if (r.max) j["max"] = *r.max;
-  return j;
-}
-
-LimitRange range_from_json(const json& j, const char* key) {
-  if (!j.contains(key)) return {};
-  const json& r = j.at(key);
-  LimitRange out;
-  if (r.contains("min")) out.min = r.at("min").get<double>();
-  if (r.contains("max")) out.max = r.at("max").get<double>();
-  return out;
 }
 
 template <typename T>
@@ -211,6 +185,7 @@ json part_limits_json(const PartLimits& p) {
   put("max_verify_ratio", p.max_verify_ratio);
   put("model", p.model);
   if (p.noise) j["noise"] = noise_json(*p.noise);
+  if (p.acceptance) j["acceptance"] = acceptance_limits_json(*p.acceptance);
   return j;
 }
 
@@ -232,6 +207,7 @@ PartLimits part_limits_from_json(const json& j) {
     p.max_verify_ratio = opt_from_json<double>(j, "max_verify_ratio");
     p.model = opt_from_json<std::string>(j, "model");
     if (j.contains("noise")) p.noise = noise_prior_from_json(j.at("noise"));
+    if (j.contains("acceptance")) p.acceptance = acceptance_limits_from_json(j.at("acceptance"));
     return p;
   } catch (const json::exception& e) {
     throw std::invalid_argument(fmt::format("stored part limits: {}", e.what()));

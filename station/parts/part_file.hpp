@@ -10,13 +10,10 @@
 
 #include "compensation/noise_prior.hpp"
 #include "station/config/config.hpp"
+#include "station/parts/acceptance_limits.hpp"
+#include "station/parts/limit_range.hpp"
 
 namespace station {
-
-/// A closed interval; either end may be open (absent).
-struct LimitRange {
-  std::optional<double> min, max;
-};
 
 /// What a gyro of one part number must show to pass. Every limit is optional: an absent one is
 /// not checked.
@@ -40,6 +37,8 @@ struct PartLimits {
   /// The part's noise ([part."PN".noise]): a prior on the fit's error model
   /// (compensation/noise_prior.hpp), from the data sheet or `station adev`'s term fit.
   std::optional<compensation::NoisePrior> noise;
+  /// Limits of the acceptance steps' figures ([part."PN".acceptance], issue 36).
+  std::optional<AcceptanceLimits> acceptance;
 };
 
 /// A whole part file.

@@ -72,7 +72,12 @@ nlohmann::json with_acceptance_truth(nlohmann::json serials, const sim::SimWorld
         // The warm-up time the band gives a noise-free transient A exp(-t/tau): tau ln(|A|/band).
         const double a = std::abs(g.acceptance.warmup_amplitude_dph);
         const double band = s["turn_on"]["band_dph"];
+        // The sd of the turn-on biases holds each one's estimation noise (its window's SE) beside
+        // the turn-on spread: what the figure should show is their root sum of squares.
+        const double se = s["turn_on"].value("mean_bias_se_dph", 0.0);
         s["turn_on"]["true"] = {{"sigma_dph", g.acceptance.turn_on_sigma_dph},
+                                {"sigma_with_noise_dph",
+                                 std::hypot(g.acceptance.turn_on_sigma_dph, se)},
                                 {"warmup_s", a > band ? g.acceptance.warmup_tau_s * std::log(a / band) : 0.0}};
       }
     }

@@ -2,6 +2,7 @@
 #include "station/sim/sim_run.hpp"
 
 #include "station/acceptance/acceptance_json.hpp"
+#include "station/acceptance/acceptance_verdict.hpp"
 #include "station/sim/sim_acceptance_truth.hpp"
 
 #include <fmt/format.h>
@@ -278,6 +279,7 @@ RigOptions sim_rig_options(sim::SimWorld& world, const SimRecording& rec, SimTim
 
 nlohmann::json sim_report(Store& store, const RunOutcome& out, const sim::SimWorld& world,
                           const Protocol& protocol,
+                          const std::map<std::string, PartLimits>& part_limits,
                           std::chrono::steady_clock::time_point wall_start) {
   nlohmann::json report{
       {"run_id", out.run_id},
@@ -289,8 +291,10 @@ nlohmann::json sim_report(Store& store, const RunOutcome& out, const sim::SimWor
   for (std::size_t i = 0; i < world.gyros().size(); ++i)
     report["gyros"].push_back(
         gyro_report(store, out.run_id, static_cast<int>(i), world.gyros()[i]));
-  if (auto a = acceptance_json(run_acceptance(store, out.run_id)); !a.empty())
+  if (auto a = acceptance_json(run_acceptance(store, out.run_id)); !a.empty()) {
+    judge_acceptance(a, part_limits);
     report["acceptance"] = with_acceptance_truth(std::move(a), world, protocol);
+  }
   return report;
 }
 
@@ -336,10 +340,11 @@ nlohmann::json run_simulated(const SimRunOptions& o) {
     if (plan.resume && stored) rec.session->tap().pause(true);
   }
   if (o.extend) o.extend(so);
+  const auto part_limits = so.part_limits;  // the end summary judges the acceptance figures too
   const RunOutcome out = host.run(plan, std::move(so));
   report_faults_not_run(o, out.t_s);
   if (rec.session) rec.session->finish(store, out.run_id);
-  return sim_report(store, out, world, plan.protocol, wall_start);
+  return sim_report(store, out, world, plan.protocol, part_limits, wall_start);
 }
 
 }  // namespace station

@@ -81,8 +81,9 @@ enum SampleFlag : int {
   kTempsMissing = 1 << 2,    ///< the gyro's temperatures did not arrive or failed
   kBoardFault = 1 << 3,      ///< the board reported a fault flag
   kSafeHold = 1 << 4,        ///< the rig was in safe hold (door open / e-stop)
-  /// An acceptance step ran (rate_ladder, positions, power_cycles): the table turned or the
-  /// gyros were switched, so the rate is no thermal bias (issue 36).
+  /// An acceptance step ran (rate_ladder, positions, power_cycles: the gyros switched, the
+  /// table turned), or the table turned (faster than 0.001 deg/s): the rate is no thermal bias
+  /// (issue 36).
   kAcceptanceStep = 1 << 5,
 };
 /// Samples with these flags are recorded but left out of the bins.

@@ -6,6 +6,8 @@
 #include <string>
 
 #include "station/common/input_error.hpp"
+#include "station/config/config.hpp"
+#include "station/acceptance/acceptance_verdict.hpp"
 #include "station/config/acceptance_steps.hpp"
 #include "station/config/protocol.hpp"
 #include "station/daemon/acceptance_runner.hpp"
@@ -86,14 +88,56 @@ TEST(AcceptanceSteps, BadKeysAreNamedWithFileLineAndKey) {
   EXPECT_NE(parse_error(l + "rates_dps = [1, \"x\"]\n").find("entry 1 is not a number"),
             std::string::npos);
   EXPECT_NE(parse_error(l).find("'step[0].rates_dps': missing"), std::string::npos);
-  EXPECT_NE(parse_error(l + "rates_dps = [1]\ndwell_s = 0\n").find("step[0].dwell_s"),
+  EXPECT_NE(parse_error(l + "rates_dps = [1, 2]\ndwell_s = 0\n").find("step[0].dwell_s"),
             std::string::npos);
   EXPECT_NE(parse_error(l + "rates_dps = [1]\nspeed = 3\n").find("unknown key"), std::string::npos);
   EXPECT_NE(parse_error("type = \"positions\"\nangles_deg = [0, 90]\n").find("at least 3 angles"),
             std::string::npos);
   EXPECT_NE(parse_error("type = \"power_cycles\"\ncycles = 1\n").find("step[0].cycles"),
             std::string::npos);
-  EXPECT_EQ(parse_error(l + "rates_dps = [1, 300]\n"), "");
+  EXPECT_NE(parse_error(l + "rates_dps = [5]\n").find("at least 2 rates"), std::string::npos);
+  EXPECT_NE(parse_error(l + "rates_dps = [1, 2]\nsettle_s = 0\n").find("step[0].settle_s"),
+            std::string::npos);
+  EXPECT_NE(parse_error("type = \"positions\"\nangles_deg = [0, 360, -360]\n")
+                .find("1 distinct angles"),
+            std::string::npos);
+  EXPECT_NE(parse_error("type = \"power_cycles\"\non_s = 100\n").find("step[0].on_s"),
+            std::string::npos);
+}
+
+// A ladder or positions step leaves the table released: a lock must follow before the record
+// window opens or the protocol ends (else the thermal record runs with the table loose).
+TEST(AcceptanceSteps, ATableTurnedMustBeLockedBeforeRecordingOrTheEnd) {
+  const std::string ladder = "type = \"rate_ladder\"\nrates_dps = [1, 2]\n";
+  EXPECT_NE(parse_error(ladder).find("p.toml:2: key 'step[0].type': rate_ladder leaves the table "
+                                     "released: a lock_turntable step must follow it before the "
+                                     "protocol ends"),
+            std::string::npos);
+  EXPECT_NE(parse_error(ladder + "[[step]]\ntype = \"record_start\"\n").find("record window opens"),
+            std::string::npos);
+  EXPECT_EQ(parse_error(ladder + "[[step]]\ntype = \"lock_turntable\"\n"), "");
+  EXPECT_EQ(parse_error("type = \"power_cycles\"\n"), "");  // the table never moves
+}
+
+TEST(AcceptanceSteps, PowerCyclesNeedARelayOnEverySlotAndTableStepsATable) {
+  const auto p = station::parse_protocol(
+      "name = \"p\"\n[[step]]\ntype = \"power_cycles\"\n[[step]]\ntype = \"rate_ladder\"\n"
+      "rates_dps = [1, 2]\n[[step]]\ntype = \"lock_turntable\"\n",
+      "p.toml");
+  station::StationConfig c;
+  c.slots.resize(2);
+  c.slots[0].relay = "GYRO_PWR1";
+  try {
+    station::check_acceptance_rig(p, c, true);
+    ADD_FAILURE() << "a slot without a relay was accepted";
+  } catch (const station::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("p.toml:2: step[0] power_cycles: slot 2 has no relay"),
+              std::string::npos)
+        << e.what();
+  }
+  c.slots[1].relay = "GYRO_PWR2";
+  EXPECT_NO_THROW(station::check_acceptance_rig(p, c, true));
+  EXPECT_THROW(station::check_acceptance_rig(p, c, false), station::InputError);
 }
 
 // The runner sends each demand once at its point's start, measures over the window and says per
@@ -140,6 +184,35 @@ TEST(AcceptanceRunner, APointMeasuredOnlyInPartIsLeftOut) {
   EXPECT_FALSE(events[0].data["held"].get<bool>());
 }
 
+// A step's timeout ends it mid-point: the point is left out and the table sent to rest.
+TEST(AcceptanceRunner, LeavingEarlyLeavesThePointOutAndRestsTheTable) {
+  const Step s = ladder({10});
+  AcceptanceRunner r;
+  r.enter(s, 4, 100.0);
+  for (double t = 100; t <= 105; t += 1) r.tick(t, {10.0, 0.0, false});
+  const auto a = r.leave();
+  ASSERT_TRUE(a.table.has_value());
+  EXPECT_EQ(a.table->rate_dps, std::optional<double>(0.0));
+  ASSERT_EQ(a.events.size(), 1u);
+  EXPECT_FALSE(a.events[0].data["held"].get<bool>());
+  EXPECT_NE(a.events[0].message.find("part of its window"), std::string::npos);
+}
+
+// A safe hold inside a window (the runner entered again) leaves that point out.
+TEST(AcceptanceRunner, ASafeHoldInsideAWindowLeavesThatPointOut) {
+  const Step s = ladder({10});
+  AcceptanceRunner r;
+  r.enter(s, 4, 100.0);
+  std::vector<station::EventNote> events;
+  for (double t = 100; t <= 120; t += 1) {
+    if (t == 105) r.enter(s, 4, 100.0);  // back from a hold
+    for (auto& e : r.tick(t, {t < 108 ? 10.0 : -10.0, 0.0, false}).events) events.push_back(e);
+  }
+  ASSERT_EQ(events.size(), 2u);
+  EXPECT_FALSE(events[0].data["held"].get<bool>());
+  EXPECT_TRUE(events[1].data["held"].get<bool>());
+}
+
 TEST(AcceptanceRunner, PowerCyclesSwitchTheGyrosOffThenOnEachCycle) {
   Step s;
   s.kind = StepKind::power_cycles;
@@ -168,6 +241,8 @@ TEST(AcceptanceRun, TheShippedProtocolRecoversEachSimulatedFigureWithinItsError)
   o.fresh = true;
   o.gyros = 2;
   o.seed = 1;
+  o.parts_path = std::string(STATION_SOURCE_DIR) + "/station/parts/example_parts.toml";
+  o.part_number = "GX-200";
   const auto r = station::run_simulated(o);
   ASSERT_TRUE(r.contains("acceptance")) << r.dump();
   for (const auto& s : r["acceptance"]) {
@@ -191,10 +266,15 @@ TEST(AcceptanceRun, TheShippedProtocolRecoversEachSimulatedFigureWithinItsError)
       EXPECT_LE(std::abs(p["tilt_mrad"].get<double>() - s["true"]["misalignment_mrad"].get<double>()),
                 4 * p["tilt_se_mrad"].get<double>());
     }
+    // The example part's acceptance limits: every figure checked, each within them.
+    ASSERT_TRUE(s.contains("verdict"));
+    EXPECT_TRUE(s["verdict"]["pass"].get<bool>()) << s["verdict"].dump();
+    EXPECT_EQ(s["verdict"]["checked"].get<int>(), 13);
     ASSERT_TRUE(s["turn_on"]["ok"].get<bool>());
     EXPECT_EQ(s["turn_on"]["turn_ons"].get<int>(), 4);
-    // The 95 % interval of the turn-on-to-turn-on sigma holds the simulated spread.
-    const double sigma = s["true"]["turn_on_sigma_dph"];
+    // The 95 % interval of the turn-on-to-turn-on sigma holds the simulated spread together with
+    // each turn-on bias's own estimation noise (the spread a perfect gyro's windows would show).
+    const double sigma = s["turn_on"]["true"]["sigma_with_noise_dph"];
     EXPECT_LE(s["turn_on"]["repeatability_lower_dph"].get<double>(), sigma);
     EXPECT_GE(s["turn_on"]["repeatability_upper_dph"].get<double>(), sigma);
   }
@@ -204,4 +284,57 @@ TEST(AcceptanceRun, TheShippedProtocolRecoversEachSimulatedFigureWithinItsError)
       "SELECT count(*) FROM samples WHERE (flags & 32) != 0 AND recording = 1");
   ASSERT_TRUE(st.step());
   EXPECT_EQ(st.column_int(0), 0);  // no acceptance step inside this protocol's record window
+}
+
+// A ladder's timeout mid-step (the review's case): the table is sent to rest, every sample taken
+// while it still turns is flagged, none enters a bin, and the run's end leaves it stopped.
+TEST(AcceptanceRun, ALadderThatTimesOutRestsTheTableAndFlagsWhileItTurns) {
+  const std::string path = station::testing_support::fresh_db("ladder_timeout") + ".toml";
+  {
+    std::FILE* f = std::fopen(path.c_str(), "w");
+    ASSERT_NE(f, nullptr);
+    std::fputs("name = \"timeout\"\n[[step]]\ntype = \"lock_turntable\"\n[[step]]\n"
+               "type = \"rate_ladder\"\nrates_dps = [100, 200]\ndwell_s = 600\ntimeout_s = 60\n"
+               "[[step]]\ntype = \"lock_turntable\"\n[[step]]\ntype = \"record_start\"\n"
+               "[[step]]\ntype = \"hold\"\nduration_s = 1800\n",
+               f);
+    std::fclose(f);
+  }
+  station::SimRunOptions o;
+  o.db_path = station::testing_support::fresh_db("ladder_timeout");
+  o.protocol = path;
+  o.progress = false;
+  o.fresh = true;
+  o.gyros = 1;
+  const auto r = station::run_simulated(o);
+  EXPECT_EQ(r["state"], "completed") << r.dump();
+  station::Store store(o.db_path, station::OpenMode::read_only);
+  auto turning = store.db().prepare(
+      "SELECT count(*), sum((flags & 32) != 0) FROM samples WHERE abs(rate_dph) > 1000");
+  ASSERT_TRUE(turning.step());
+  EXPECT_GT(turning.column_int(0), 60);
+  EXPECT_EQ(turning.column_int(0), turning.column_int(1));  // every one of them flagged
+  auto last = store.db().prepare("SELECT max(t_s) FROM samples WHERE abs(rate_dph) > 1000");
+  ASSERT_TRUE(last.step());
+  EXPECT_LT(last.column_double(0), 200.0);  // at rest within the travel back from 100 deg/s
+}
+
+// A figure beyond its limit fails named; a limit whose figure the run did not measure fails too.
+TEST(AcceptanceVerdict, AFigureBeyondItsLimitOrNotMeasuredFails) {
+  auto serials = nlohmann::json::parse(R"([{"serial": "A", "ladders": [
+      {"label": "hot", "ok": true, "nonlinearity_max_ppm_fs": 120.0, "asymmetry_ppm": -20.0,
+       "sf_pulse_per_arcsec": 0.66667}], "positions": []}])");
+  station::PartLimits part;
+  part.number = "GX";
+  part.acceptance = station::AcceptanceLimits{};
+  part.acceptance->max_nonlinearity_ppm_fs = 100;
+  part.acceptance->max_asymmetry_ppm = 30;
+  part.acceptance->max_tilt_mrad = 2;
+  part.acceptance->sf_pulse_per_arcsec = {0.6666, 0.6668};
+  station::judge_acceptance(serials, {{"A", part}});
+  const auto& v = serials[0]["verdict"];
+  EXPECT_FALSE(v["pass"].get<bool>());
+  EXPECT_EQ(v["checked"].get<int>(), 4);
+  EXPECT_EQ(v["failed"], (nlohmann::json{"nonlinearity at 'hot' 120 ppm FS above 100",
+                                         "tilt not measured"}));
 }

@@ -1,0 +1,90 @@
+// Acceptance figures against a part's limits.
+#include "station/acceptance/acceptance_verdict.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+namespace station {
+namespace {
+
+using nlohmann::json;
+
+/// One verdict being built: each limit checked, each failure in words.
+struct Judge {
+  int checked = 0;
+  json failed = json::array();
+
+  void range(const std::string& what, const json& value, const LimitRange& r, const char* unit) {
+    if (!r.min && !r.max) return;
+    ++checked;
+    if (!value.is_number()) {
+      failed.push_back(what + " not measured");
+      return;
+    }
+    const double v = value;
+    if (r.min && v < *r.min) failed.push_back(fmt::format("{} {:.7g} {} below {:g}", what, v, unit, *r.min));
+    if (r.max && v > *r.max) failed.push_back(fmt::format("{} {:.7g} {} above {:g}", what, v, unit, *r.max));
+  }
+  void at_most(const std::string& what, const json& value, const std::optional<double>& max,
+               const char* unit) {
+    if (!max) return;
+    ++checked;
+    if (!value.is_number())
+      failed.push_back(what + " not measured");
+    else if (std::abs(value.get<double>()) > *max)
+      failed.push_back(fmt::format("{} {:.4g} {} above {:g}", what, value.get<double>(), unit, *max));
+  }
+};
+
+json figure(const json& obj, const char* key) {
+  return obj.is_object() && obj.value("ok", false) && obj.contains(key) ? obj[key] : json();
+}
+
+/// The scale factor a part is held to: K at 25 C of the temperature model, else the one ladder's.
+json scale_factor(const json& s) {
+  if (s.contains("sf_vs_temp")) return figure(s["sf_vs_temp"], "sf_ref_pulse_per_arcsec");
+  if (s["ladders"].size() == 1) return figure(s["ladders"][0], "sf_pulse_per_arcsec");
+  return json();
+}
+
+void judge_each(Judge& j, const json& list, const char* key, const std::optional<double>& max,
+                const char* what, const char* unit) {
+  if (!max) return;
+  if (list.empty()) j.at_most(what, json(), max, unit);
+  for (const auto& x : list)
+    j.at_most(fmt::format("{} at '{}'", what, x.value("label", "")), figure(x, key), max, unit);
+}
+
+json verdict_of(const json& s, const PartLimits& part) {
+  const auto& a = *part.acceptance;
+  Judge j;
+  j.range("scale factor", scale_factor(s), a.sf_pulse_per_arcsec, "pulse/arcsec");
+  j.range("temperature coefficient",
+          s.contains("sf_vs_temp") ? figure(s["sf_vs_temp"], "tc_ppm_per_c") : json(),
+          a.sf_tc_ppm_per_c, "ppm/C");
+  judge_each(j, s["ladders"], "nonlinearity_max_ppm_fs", a.max_nonlinearity_ppm_fs,
+             "nonlinearity", "ppm FS");
+  judge_each(j, s["ladders"], "asymmetry_ppm", a.max_asymmetry_ppm, "asymmetry", "ppm");
+  judge_each(j, s["positions"], "tilt_mrad", a.max_tilt_mrad, "tilt", "mrad");
+  const json turn_on = s.value("turn_on", json());
+  j.at_most("turn-on repeatability", figure(turn_on, "repeatability_dph"),
+            a.max_turn_on_repeatability_dph, "deg/h");
+  j.at_most("warm-up", figure(turn_on, "max_warmup_s"), a.max_warmup_s, "s");
+  return {{"part", part.number},
+          {"pass", j.failed.empty()},
+          {"checked", j.checked},
+          {"failed", j.failed}};
+}
+
+}  // namespace
+
+void judge_acceptance(json& serials, const std::map<std::string, PartLimits>& by_serial) {
+  for (auto& s : serials) {
+    const auto it = by_serial.find(s.value("serial", ""));
+    if (it == by_serial.end() || !it->second.acceptance) continue;
+    s["verdict"] = verdict_of(s, it->second);
+  }
+}
+
+}  // namespace station
