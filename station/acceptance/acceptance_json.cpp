@@ -14,14 +14,20 @@ json not_computed(const comp::Computed<T>& c) {
   return {{"ok", false}, {"error", c.error()}};
 }
 
+/// A step's head (step_index, label, points, temp_c) with its own `counts`, and {"ok": false,
+/// "error"} when its fit was not computed.
+template <class Figures>
+json step_json(const Figures& f, const json& counts) {
+  json j{{"step_index", f.step_index}, {"label", f.label}, {"points", f.points}};
+  j.update(counts);
+  if (std::isfinite(f.temp_c)) j["temp_c"] = f.temp_c;
+  if (!f.fit) j.update(not_computed(f.fit));
+  return j;
+}
+
 json ladder_json(const LadderFigures& l) {
-  json j{{"step_index", l.step_index}, {"label", l.label}, {"points", l.points},
-         {"missing", l.missing}};
-  if (std::isfinite(l.temp_c)) j["temp_c"] = l.temp_c;
-  if (!l.fit) {
-    j.update(not_computed(l.fit));
-    return j;
-  }
+  json j = step_json(l, {{"missing", l.missing}});
+  if (!l.fit) return j;
   const auto& f = *l.fit;
   j.update({{"ok", true},
             {"sf_pulse_per_arcsec", f.sf_pulse_per_arcsec},
@@ -43,13 +49,8 @@ json ladder_json(const LadderFigures& l) {
 }
 
 json positions_json(const PositionFigures& p) {
-  json j{{"step_index", p.step_index}, {"label", p.label}, {"points", p.points},
-         {"excluded", p.excluded}};
-  if (std::isfinite(p.temp_c)) j["temp_c"] = p.temp_c;
-  if (!p.fit) {
-    j.update(not_computed(p.fit));
-    return j;
-  }
+  json j = step_json(p, {{"excluded", p.excluded}});
+  if (!p.fit) return j;
   const auto& f = *p.fit;
   j.update({{"ok", true},
             {"tilt_mrad", f.tilt_rad * 1e3},

@@ -18,4 +18,8 @@ nlohmann::json acceptance_json(const std::vector<SerialAcceptance>& serials);
 /// where the object has it. Empty for an empty array.
 std::string acceptance_text(const nlohmann::json& serials);
 
+/// A serial's "verdict" (judge_acceptance) in words: "PASS, 13 limits", or "FAIL: " and each
+/// failure (the end summary, `fit`, `history`).
+std::string acceptance_verdict_text(const nlohmann::json& verdict);
+
 }  // namespace station

@@ -1,11 +1,10 @@
 // A run's acceptance figures from its acceptance_point events and its samples.
 #include "station/acceptance/acceptance_run.hpp"
 
-#include <nlohmann/json.hpp>
-
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <nlohmann/json.hpp>
 
 #include "compensation/earth_rate.hpp"
 #include "station/config/acceptance_steps.hpp"
@@ -74,10 +73,11 @@ struct Window {
 /// The mean of a window's series and its standard error by batch means (Schmeiser, "Batch size
 /// effects in the analysis of simulation output", Oper. Res. 30(3):556, 1982): the series in
 /// up to kBatches consecutive batches of equal count, the error from the spread of the batch
-/// means, never below `floor` (the window's quantization). Not sd/sqrt(n) of the 1 Hz values: their pulse quantization (one pulse is 1.5 deg/h in
-/// a second) is anticorrelated from second to second and would make the error of a 300 s mean
-/// four times what it is; the batch means keep what is left of it and the gyro's own
-/// correlated noise (conservative where quantization dominates a batch).
+/// means, never below `floor` (the window's quantization). Not sd/sqrt(n) of the 1 Hz values: their
+/// pulse quantization (one pulse is 1.5 deg/h in a second) is anticorrelated from second to second
+/// and would make the error of a 300 s mean four times what it is; the batch means keep what is
+/// left of it and the gyro's own correlated noise (conservative where quantization dominates a
+/// batch).
 MeanSe batch_mean_se(const std::vector<double>& v, double floor) {
   constexpr std::size_t kBatches = 10, kMinPerBatch = 5;
   const std::size_t k = std::min(kBatches, v.size() / kMinPerBatch);
@@ -113,6 +113,34 @@ Window window_of(const std::vector<SampleRow>& rows, double from_s, double to_s)
   return w;
 }
 
+/// A point of a step's schedule with its event (nullptr: no window was measured, a kill or a
+/// hold across it) and the samples of its window (none without an event).
+struct WalkedPoint {
+  AcceptancePoint scheduled;
+  const PointEvent* event = nullptr;
+  Window window;
+};
+
+/// The step's schedule walked point by point: what ladders and positions both start from.
+std::vector<WalkedPoint> walk_schedule(const Step& s, const std::map<int, PointEvent>& events,
+                                       const std::vector<SampleRow>& rows) {
+  std::vector<WalkedPoint> out;
+  for (const auto& sp : acceptance_schedule(s)) {
+    WalkedPoint w{sp};
+    if (const auto it = events.find(sp.index); it != events.end()) {
+      w.event = &it->second;
+      w.window = window_of(rows, it->second.measure_s, it->second.end_s);
+    }
+    out.push_back(std::move(w));
+  }
+  return out;
+}
+
+/// The mean of sensor A over the temperatures a step kept, C; NaN when it kept none.
+double mean_temp_c(const std::vector<double>& temps) {
+  return temps.empty() ? std::nan("") : mean_se(temps).mean;
+}
+
 LadderFigures ladder_of(const Step& s, int index, const std::map<int, PointEvent>& events,
                         const std::vector<SampleRow>& rows, const RunSlot& slot) {
   LadderFigures f;
@@ -120,27 +148,26 @@ LadderFigures ladder_of(const Step& s, int index, const std::map<int, PointEvent
   f.label = s.label;
   std::vector<comp::LadderPoint> points;
   std::vector<double> temps;
-  for (const auto& sp : acceptance_schedule(s)) {
+  for (const auto& w : walk_schedule(s, events, rows)) {
     ++f.points;
-    const auto it = events.find(sp.index);
-    if (it == events.end()) {
+    if (w.event == nullptr) {
       ++f.missing;
       continue;
     }
-    const Window w = window_of(rows, it->second.measure_s, it->second.end_s);
-    const MeanSe out = batch_mean_se(w.pps, w.quantization_pps());
+    const MeanSe out = batch_mean_se(w.window.pps, w.window.quantization_pps());
     comp::LadderPoint p;
     // The table turns about up: an input axis down senses it negated (its Earth rate is the
     // slot's, already signed).
-    p.table_rate_dps = (slot.axis == "down" ? -1.0 : 1.0) * it->second.table_mean.value_or(sp.demand);
+    p.table_rate_dps =
+        (slot.axis == "down" ? -1.0 : 1.0) * w.event->table_mean.value_or(w.scheduled.demand);
     p.earth_rate_dph = slot.earth_rate_dph;
     p.output_pps = out.mean;
     p.output_se_pps = out.se.value_or(0.0);
-    p.rate_in_tolerance = it->second.held && out.se && *out.se > 0;
+    p.rate_in_tolerance = w.event->held && out.se && *out.se > 0;
     points.push_back(p);
-    temps.insert(temps.end(), w.temp_c.begin(), w.temp_c.end());
+    temps.insert(temps.end(), w.window.temp_c.begin(), w.window.temp_c.end());
   }
-  f.temp_c = temps.empty() ? std::nan("") : mean_se(temps).mean;
+  f.temp_c = mean_temp_c(temps);
   f.fit = comp::analyze_rate_ladder(points);
   return f;
 }
@@ -152,20 +179,18 @@ PositionFigures positions_of(const Step& s, int index, const std::map<int, Point
   f.label = s.label;
   std::vector<comp::PositionPoint> points;
   std::vector<double> temps;
-  for (const auto& sp : acceptance_schedule(s)) {
+  for (const auto& w : walk_schedule(s, events, rows)) {
     ++f.points;
-    const auto it = events.find(sp.index);
-    const Window w = it == events.end() ? Window{}
-                                        : window_of(rows, it->second.measure_s, it->second.end_s);
-    const MeanSe out = batch_mean_se(w.rate_dph, w.quantization_pps() * slot.pulse_weight_arcsec);
-    if (it == events.end() || !it->second.held || !out.se || !(*out.se > 0)) {
+    const MeanSe out =
+        batch_mean_se(w.window.rate_dph, w.window.quantization_pps() * slot.pulse_weight_arcsec);
+    if (w.event == nullptr || !w.event->held || !out.se || !(*out.se > 0)) {
       ++f.excluded;
       continue;
     }
-    points.push_back({it->second.table_mean.value_or(sp.demand), out.mean, *out.se});
-    temps.insert(temps.end(), w.temp_c.begin(), w.temp_c.end());
+    points.push_back({w.event->table_mean.value_or(w.scheduled.demand), out.mean, *out.se});
+    temps.insert(temps.end(), w.window.temp_c.begin(), w.window.temp_c.end());
   }
-  f.temp_c = temps.empty() ? std::nan("") : mean_se(temps).mean;
+  f.temp_c = mean_temp_c(temps);
   // The axis is up: its Earth rate is Omega sin(phi) (earth_rate.hpp), so the site's latitude
   // is the one the run's slot was given.
   const double s_phi = std::clamp(slot.earth_rate_dph / comp::kEarthRateDph, -1.0, 1.0);
@@ -233,15 +258,17 @@ void analyze_step(const Protocol& p, int index, const StepPoints& events,
   if (s.kind == StepKind::rate_ladder) {
     LadderFigures f = ladder_of(s, index, mine, rows, slot);
     if (slot.axis != "up" && slot.axis != "down")
-      f.fit = comp::NotComputed{"a ladder is analysed for an input axis along the table's (up or "
-                                "down); this one is " + slot.axis};
+      f.fit = comp::NotComputed{
+          "a ladder is analysed for an input axis along the table's (up or "
+          "down); this one is " +
+          slot.axis};
     out.ladders.push_back(std::move(f));
   } else if (s.kind == StepKind::positions) {
     if (slot.axis == "up")
       out.positions.push_back(positions_of(s, index, mine, rows, slot));
     else
-      out.positions_note = "positions are analysed for an input axis up only (this one: " +
-                           slot.axis + ")";
+      out.positions_note =
+          "positions are analysed for an input axis up only (this one: " + slot.axis + ")";
   } else if (s.kind == StepKind::power_cycles) {
     turn_ons_of(s, mine, rows, slot, out);
   }
@@ -249,8 +276,7 @@ void analyze_step(const Protocol& p, int index, const StepPoints& events,
 
 }  // namespace
 
-std::vector<SerialAcceptance> run_acceptance(Store& store, std::int64_t run_id,
-                                             double ref_temp_c) {
+std::vector<SerialAcceptance> run_acceptance(Store& store, std::int64_t run_id, double ref_temp_c) {
   std::vector<SerialAcceptance> out;
   const auto run = store.find_run(run_id);
   if (!run) return out;
@@ -268,8 +294,10 @@ std::vector<SerialAcceptance> run_acceptance(Store& store, std::int64_t run_id,
     for (int i : steps) analyze_step(p, i, events, rows, slot, a);
     std::vector<comp::PlateauScaleFactor> plateaus;
     for (const auto& l : a.ladders)
-      if (l.fit && std::isfinite(l.temp_c)) plateaus.push_back({l.temp_c, l.fit->sf_pulse_per_arcsec, l.fit->sf_se_pulse_per_arcsec});
-    if (plateaus.size() >= 2) a.sf_vs_temp = comp::fit_scale_factor_vs_temperature(plateaus, ref_temp_c);
+      if (l.fit && std::isfinite(l.temp_c))
+        plateaus.push_back({l.temp_c, l.fit->sf_pulse_per_arcsec, l.fit->sf_se_pulse_per_arcsec});
+    if (plateaus.size() >= 2)
+      a.sf_vs_temp = comp::fit_scale_factor_vs_temperature(plateaus, ref_temp_c);
     out.push_back(std::move(a));
   }
   return out;

@@ -13,7 +13,8 @@ std::string truth(const json& s, const char* key, const char* format = "{:.4g}")
   if (!s.contains("true") || !s["true"].is_object() || !s["true"].contains(key) ||
       !s["true"][key].is_number())
     return "";
-  return fmt::format(fmt::runtime(std::string(" (true ") + format + ")"), s["true"][key].get<double>());
+  return fmt::format(fmt::runtime(std::string(" (true ") + format + ")"),
+                     s["true"][key].get<double>());
 }
 
 /// The gyro's temperature over the step ("  25.0 C"), or "   - C" when no sample had one.
@@ -26,23 +27,25 @@ std::string ladder_line(const json& l) {
   std::string out = fmt::format("  scale factor  {:<28} {}  ", l.value("label", ""), temp(l));
   if (!l.value("ok", false))
     return out + "not computed: " + l.value("error", "") +
-           fmt::format(" ({} of {} points not measured)\n", l.value("missing", 0), l.value("points", 0));
-  out += fmt::format("K {:.7f} +- {:.1e} pulse/arcsec{}, bias {:+.3f} +- {:.3f} deg/h, "
-                     "nonlinearity {:.1f} ppm FS{} (rms {:.1f})",
-                     l["sf_pulse_per_arcsec"].get<double>(), l["sf_se_pulse_per_arcsec"].get<double>(),
-                     truth(l, "sf_pulse_per_arcsec", "{:.7f}"), l["bias_dph"].get<double>(),
-                     l["bias_se_dph"].get<double>(), l["nonlinearity_max_ppm_fs"].get<double>(),
-                     truth(l, "nonlinearity_max_ppm_fs", "{:.1f}"),
-                     l["nonlinearity_rms_ppm_fs"].get<double>());
+           fmt::format(" ({} of {} points not measured)\n", l.value("missing", 0),
+                       l.value("points", 0));
+  out += fmt::format(
+      "K {:.7f} +- {:.1e} pulse/arcsec{}, bias {:+.3f} +- {:.3f} deg/h, "
+      "nonlinearity {:.1f} ppm FS{} (rms {:.1f})",
+      l["sf_pulse_per_arcsec"].get<double>(), l["sf_se_pulse_per_arcsec"].get<double>(),
+      truth(l, "sf_pulse_per_arcsec", "{:.7f}"), l["bias_dph"].get<double>(),
+      l["bias_se_dph"].get<double>(), l["nonlinearity_max_ppm_fs"].get<double>(),
+      truth(l, "nonlinearity_max_ppm_fs", "{:.1f}"), l["nonlinearity_rms_ppm_fs"].get<double>());
   if (l.contains("asymmetry_ppm"))
     out += fmt::format(", asymmetry {:+.1f} +- {:.1f} ppm{}", l["asymmetry_ppm"].get<double>(),
                        l["asymmetry_se_ppm"].get<double>(), truth(l, "asymmetry_ppm", "{:+.1f}"));
   const int excluded = l.value("points_excluded", 0) + l.value("missing", 0);
   out += fmt::format("; {} of {} points", l.value("points_used", 0), l.value("points", 0));
   if (excluded > 0)
-    out += fmt::format(" ({} left out: the table did not hold its rate, or a stop, kill or safe "
-                       "hold cut its window short)",
-                       excluded);
+    out += fmt::format(
+        " ({} left out: the table did not hold its rate, or a stop, kill or safe "
+        "hold cut its window short)",
+        excluded);
   return out + "\n";
 }
 
@@ -61,15 +64,16 @@ std::string tc_line(const json& s) {
 std::string positions_line(const json& s, const json& p) {
   std::string out = fmt::format("  positions     {:<28} {}  ", p.value("label", ""), temp(p));
   if (!p.value("ok", false)) return out + "not computed: " + p.value("error", "") + "\n";
-  out += fmt::format("input-axis tilt {:.3f} +- {:.3f} mrad{} toward {:.0f} +- {:.0f} deg of the "
-                     "table, bias {:+.4f} +- {:.4f} deg/h",
-                     p["tilt_mrad"].get<double>(), p["tilt_se_mrad"].get<double>(),
-                     truth(s, "misalignment_mrad", "{:.3f}"),
-                     p["tilt_direction_table_deg"].get<double>(),
-                     p["tilt_direction_se_deg"].get<double>(), p["bias_dph"].get<double>(),
-                     p["bias_se_dph"].get<double>());
+  out += fmt::format(
+      "input-axis tilt {:.3f} +- {:.3f} mrad{} toward {:.0f} +- {:.0f} deg of the "
+      "table, bias {:+.4f} +- {:.4f} deg/h",
+      p["tilt_mrad"].get<double>(), p["tilt_se_mrad"].get<double>(),
+      truth(s, "misalignment_mrad", "{:.3f}"), p["tilt_direction_table_deg"].get<double>(),
+      p["tilt_direction_se_deg"].get<double>(), p["bias_dph"].get<double>(),
+      p["bias_se_dph"].get<double>());
   if (!p.value("amplitude_resolved", true)) out += " (tilt not resolved: read as an upper bound)";
-  if (p.value("excluded", 0) > 0) out += fmt::format("; {} angles left out", p["excluded"].get<int>());
+  if (p.value("excluded", 0) > 0)
+    out += fmt::format("; {} angles left out", p["excluded"].get<int>());
   return out + "\n";
 }
 
@@ -100,36 +104,40 @@ std::string turn_on_line(const json& s) {
       "mean bias {:+.4f} deg/h; {}{} within +-{:.4f} deg/h of the final value\n",
       t["turn_ons"].get<int>(), t["repeatability_dph"].get<double>(),
       100 * t["confidence"].get<double>(), t["repeatability_lower_dph"].get<double>(),
-      t["repeatability_upper_dph"].get<double>(), sigma_truth(t),
-      t["mean_bias_dph"].get<double>(), warm, warmup_truth(t),
-      t["band_dph"].get<double>());
+      t["repeatability_upper_dph"].get<double>(), sigma_truth(t), t["mean_bias_dph"].get<double>(),
+      warm, warmup_truth(t), t["band_dph"].get<double>());
 }
 
 std::string verdict_line(const json& v) {
-  if (v.value("pass", false))
-    return fmt::format("  acceptance verdict ({}): PASS, {} limits\n", v.value("part", ""),
-                       v.value("checked", 0));
-  std::string out = fmt::format("  acceptance verdict ({}): FAIL", v.value("part", ""));
-  const char* sep = ": ";
-  for (const auto& f : v["failed"]) {
-    out += sep + f.get<std::string>();
-    sep = "; ";
-  }
-  return out + "\n";
+  return fmt::format("  acceptance verdict ({}): {}\n", v.value("part", ""),
+                     acceptance_verdict_text(v));
 }
 
 }  // namespace
 
+std::string acceptance_verdict_text(const json& v) {
+  if (v.value("pass", false)) return fmt::format("PASS, {} limits", v.value("checked", 0));
+  std::string out = "FAIL";
+  const char* sep = ": ";
+  for (const auto& f : v.value("failed", json::array())) {
+    out += sep + f.get<std::string>();
+    sep = "; ";
+  }
+  return out;
+}
+
 std::string acceptance_text(const json& serials) {
   if (!serials.is_array() || serials.empty()) return "";
-  std::string out = "\nacceptance: scale factor (rate ladders), input-axis misalignment "
-                    "(positions), turn-on repeatability and warm-up (power cycles)\n";
+  std::string out =
+      "\nacceptance: scale factor (rate ladders), input-axis misalignment "
+      "(positions), turn-on repeatability and warm-up (power cycles)\n";
   for (const auto& s : serials) {
     out += s.value("serial", "") + "\n";
     for (const auto& l : s["ladders"]) out += ladder_line(l);
     if (s.contains("sf_vs_temp")) out += tc_line(s);
     for (const auto& p : s["positions"]) out += positions_line(s, p);
-    if (s.contains("positions_note")) out += "  positions: " + s["positions_note"].get<std::string>() + "\n";
+    if (s.contains("positions_note"))
+      out += "  positions: " + s["positions_note"].get<std::string>() + "\n";
     if (s.contains("turn_on")) out += turn_on_line(s);
     if (s.contains("verdict")) out += verdict_line(s["verdict"]);
   }

@@ -5,6 +5,8 @@
 
 #include <cmath>
 
+#include "station/store/acceptance_results.hpp"
+
 namespace station {
 namespace {
 
@@ -23,8 +25,10 @@ struct Judge {
       return;
     }
     const double v = value;
-    if (r.min && v < *r.min) failed.push_back(fmt::format("{} {:.7g} {} below {:g}", what, v, unit, *r.min));
-    if (r.max && v > *r.max) failed.push_back(fmt::format("{} {:.7g} {} above {:g}", what, v, unit, *r.max));
+    if (r.min && v < *r.min)
+      failed.push_back(fmt::format("{} {:.7g} {} below {:g}", what, v, unit, *r.min));
+    if (r.max && v > *r.max)
+      failed.push_back(fmt::format("{} {:.7g} {} above {:g}", what, v, unit, *r.max));
   }
   void at_most(const std::string& what, const json& value, const std::optional<double>& max,
                const char* unit) {
@@ -33,19 +37,13 @@ struct Judge {
     if (!value.is_number())
       failed.push_back(what + " not measured");
     else if (std::abs(value.get<double>()) > *max)
-      failed.push_back(fmt::format("{} {:.4g} {} above {:g}", what, value.get<double>(), unit, *max));
+      failed.push_back(
+          fmt::format("{} {:.4g} {} above {:g}", what, value.get<double>(), unit, *max));
   }
 };
 
 json figure(const json& obj, const char* key) {
   return obj.is_object() && obj.value("ok", false) && obj.contains(key) ? obj[key] : json();
-}
-
-/// The scale factor a part is held to: K at 25 C of the temperature model, else the one ladder's.
-json scale_factor(const json& s) {
-  if (s.contains("sf_vs_temp")) return figure(s["sf_vs_temp"], "sf_ref_pulse_per_arcsec");
-  if (s["ladders"].size() == 1) return figure(s["ladders"][0], "sf_pulse_per_arcsec");
-  return json();
 }
 
 void judge_each(Judge& j, const json& list, const char* key, const std::optional<double>& max,
@@ -59,12 +57,14 @@ void judge_each(Judge& j, const json& list, const char* key, const std::optional
 json verdict_of(const json& s, const PartLimits& part) {
   const auto& a = *part.acceptance;
   Judge j;
-  j.range("scale factor", scale_factor(s), a.sf_pulse_per_arcsec, "pulse/arcsec");
+  const auto k = held_scale_factor(s);  // K at 25 C of the temperature model, else the ladder's
+  j.range("scale factor", k ? json(k->k_pulse_per_arcsec) : json(), a.sf_pulse_per_arcsec,
+          "pulse/arcsec");
   j.range("temperature coefficient",
           s.contains("sf_vs_temp") ? figure(s["sf_vs_temp"], "tc_ppm_per_c") : json(),
           a.sf_tc_ppm_per_c, "ppm/C");
-  judge_each(j, s["ladders"], "nonlinearity_max_ppm_fs", a.max_nonlinearity_ppm_fs,
-             "nonlinearity", "ppm FS");
+  judge_each(j, s["ladders"], "nonlinearity_max_ppm_fs", a.max_nonlinearity_ppm_fs, "nonlinearity",
+             "ppm FS");
   judge_each(j, s["ladders"], "asymmetry_ppm", a.max_asymmetry_ppm, "asymmetry", "ppm");
   judge_each(j, s["positions"], "tilt_mrad", a.max_tilt_mrad, "tilt", "mrad");
   const json turn_on = s.value("turn_on", json());

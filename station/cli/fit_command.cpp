@@ -8,11 +8,14 @@
 
 #include "compensation/cross_validation.hpp"
 #include "compensation/model_selection.hpp"
+#include "station/acceptance/acceptance_json.hpp"
+#include "station/acceptance/acceptance_record.hpp"
 #include "station/cli/commands.hpp"
 #include "station/cli/exit_status.hpp"
 #include "station/common/input_error.hpp"
 #include "station/parts/deliverable_terms.hpp"
 #include "station/parts/judged_fit.hpp"
+#include "station/store/acceptance_results.hpp"
 #include "station/store/calibration.hpp"
 #include "station/store/fit_json.hpp"
 #include "station/store/fit_model_choice.hpp"
@@ -28,6 +31,7 @@ struct FitOptions {
   std::optional<std::int64_t> run;
   double ref_temp_c = 25.0;
   bool all = false, json = false, cv = false, select = false;
+  bool acceptance = false;   ///< --acceptance: the fitted runs' acceptance figures computed again
   bool terms_given = false;  ///< --terms was on the command line (a part's model gives way)
 };
 
@@ -98,6 +102,44 @@ nlohmann::json fit_json(const JudgedFit& jf) {
   j["verdict"] = jf.verdict ? verdict_json(*jf.verdict) : nlohmann::json();
   j["adev_floor_dph"] = jf.adev_floor_dph ? nlohmann::json(*jf.adev_floor_dph) : nlohmann::json();
   return j;
+}
+
+/// `--acceptance`: the acceptance figures of every run the fits used (and of --run, fitted or
+/// not) computed again and stored (record_acceptance, the run's end's code path), judged against
+/// the part the fit is judged against.
+void recompute_acceptance(Store& store, const std::vector<JudgedFit>& fits,
+                          std::optional<std::int64_t> run_id, const PartChoice& choice) {
+  std::set<std::int64_t> runs;
+  for (const auto& f : fits) runs.insert(f.fit.runs.begin(), f.fit.runs.end());
+  if (run_id) runs.insert(*run_id);
+  for (const auto run : runs) {
+    std::map<std::string, PartLimits> limits;
+    for (const auto& slot : store.run_slots(run))
+      if (auto l = limits_for(store, slot.serial, {run}, choice)) limits[slot.serial] = *l;
+    record_acceptance(store, run, limits);
+  }
+}
+
+/// The serial's acceptance beside its thermal verdict: the stored figures of the newest of the
+/// fit's runs that has them; null when none has.
+nlohmann::json fit_acceptance_json(Store& store, const SerialFit& f) {
+  const auto row = newest_acceptance_row(store, f.serial, f.runs);
+  if (!row) return nullptr;
+  return {{"run_id", row->run_id},
+          {"part_number", row->part_number ? nlohmann::json(*row->part_number) : nullptr},
+          {"verdict", row->figures.value("verdict", nlohmann::json())},
+          {"sf_pulse_per_arcsec",
+           row->sf_pulse_per_arcsec ? nlohmann::json(*row->sf_pulse_per_arcsec) : nullptr}};
+}
+
+std::string fit_acceptance_text(const nlohmann::json& a) {
+  if (a.is_null()) return "";
+  const std::string verdict = a["verdict"].is_null()
+                                  ? std::string("not judged (no acceptance limits)")
+                                  : acceptance_verdict_text(a["verdict"]);
+  return fmt::format("  acceptance verdict (run {}{}): {}\n", a["run_id"].get<std::int64_t>(),
+                     a["part_number"].is_null() ? "" : ", " + a["part_number"].get<std::string>(),
+                     verdict);
 }
 
 void print_fit(const JudgedFit& jf) {
@@ -180,6 +222,7 @@ int run_fit(const FitOptions& o) {
   // Serials with nothing to fit: one line each on stderr, and exit status 1 (the others stored).
   for (const auto& s : result.skipped) fmt::print(stderr, "station: fit skipped: {}\n", s);
   const auto& fits = result.fits;
+  if (o.acceptance) recompute_acceptance(store, fits, o.run, choice);
   const int status = result.skipped.empty() ? 0 : 1;
   if (o.json) {
     nlohmann::json arr = nlohmann::json::array();
@@ -187,6 +230,7 @@ int run_fit(const FitOptions& o) {
       arr.push_back(fit_json(f));
       const auto choice = load_fit_model_choice(store, f.fit.fit_id);
       arr.back()["model_choice"] = choice ? *choice : nlohmann::json();
+      arr.back()["acceptance"] = fit_acceptance_json(store, f.fit);
       if (o.cv) arr.back()["cross_validation"] = cv_json(cross_validate(store, f.fit), f.fit.runs);
     }
     std::cout << (o.all ? arr : arr[0]).dump(2) << '\n';
@@ -194,6 +238,7 @@ int run_fit(const FitOptions& o) {
   }
   for (const auto& f : fits) {
     print_fit(f);
+    fmt::print("{}", fit_acceptance_text(fit_acceptance_json(store, f.fit)));
     if (o.cv) print_cv(cross_validate(store, f.fit), f.fit.runs);
   }
   return status;
@@ -228,6 +273,10 @@ void add_fit_commands(CLI::App& app, CommandStatus& status) {
                 "with two or more runs, by likelihood ratio with one; prints the models tried and "
                 "stores the choice with the fit")
       ->excludes(all);
+  fit->add_flag("--acceptance", o->acceptance,
+                "compute the acceptance figures of the fitted runs again (an older run, another "
+                "part file) and store them; without it the figures stored at each run's end are "
+                "shown");
   fit->add_flag("--cv", o->cv,
                 "leave-one-run-out cross-validation: prediction error on each held-out run "
                 "beside the in-sample residual (two or more runs)");

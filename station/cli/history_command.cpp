@@ -8,6 +8,8 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
+#include "station/acceptance/acceptance_history.hpp"
+#include "station/acceptance/acceptance_json.hpp"
 #include "station/cli/commands.hpp"
 #include "station/cli/exit_status.hpp"
 #include "station/common/input_error.hpp"
@@ -168,31 +170,122 @@ void print_history(const std::string& serial, const std::vector<SerialRun>& runs
                kDriftZetaLimit);
 }
 
-fleet::FleetSerialHistory read_history(const HistoryOptions& o) {
+json acceptance_row_json(const AcceptanceRow& r) {
+  const json& v = r.figures.contains("verdict") ? r.figures["verdict"] : json();
+  return {{"run_id", r.run_id},
+          {"computed_utc", r.computed_utc},
+          {"sf_pulse_per_arcsec", opt(r.sf_pulse_per_arcsec)},
+          {"sf_se_pulse_per_arcsec", opt(r.sf_se_pulse_per_arcsec)},
+          {"sf_temp_c", opt(r.sf_temp_c)},
+          {"tc_ppm_per_c", opt(r.tc_ppm_per_c)},
+          {"tc_se_ppm_per_c", opt(r.tc_se_ppm_per_c)},
+          {"nonlinearity_max_ppm_fs", opt(r.nonlinearity_max_ppm_fs)},
+          {"asymmetry_ppm", opt(r.asymmetry_ppm)},
+          {"tilt_mrad", opt(r.tilt_mrad)},
+          {"turn_on_repeatability_dph", opt(r.turn_on_repeatability_dph)},
+          {"max_warmup_s", opt(r.max_warmup_s)},
+          {"verdict", v}};
+}
+
+/// "acceptance": each run's stored figures; "scale_factor_drift": K's (and TC's) change from
+/// run to run with its combined SE. Both null with --pg (not in the fleet yet).
+json acceptance_history_json(const std::optional<std::vector<AcceptanceRow>>& rows) {
+  if (!rows) return {{"acceptance", nullptr}, {"scale_factor_drift", nullptr}};
+  json runs = json::array(), drift = json::array();
+  for (const auto& r : *rows) runs.push_back(acceptance_row_json(r));
+  for (const auto& d : scale_factor_drift(*rows))
+    drift.push_back({{"run_id", d.run_id},
+                     {"previous_run_id", d.previous_run_id},
+                     {"delta_ppm", d.delta_ppm},
+                     {"se_ppm", d.se_ppm},
+                     {"zeta", opt(d.zeta)},
+                     {"tc_delta_ppm_per_c", opt(d.tc_delta_ppm_per_c)},
+                     {"tc_se_ppm_per_c", opt(d.tc_se_ppm_per_c)},
+                     {"tc_zeta", opt(d.tc_zeta)},
+                     {"temp_gap_c", opt(d.temp_gap_c)},
+                     {"drift", d.drift}});
+  return {{"acceptance", runs}, {"scale_factor_drift", drift}};
+}
+
+/// "PASS, 13 limits (GX-200)", or "not judged" where the part had no acceptance limits.
+std::string row_verdict_text(const AcceptanceRow& r) {
+  if (!r.figures.contains("verdict")) return "not judged";
+  return fmt::format("{} ({})", acceptance_verdict_text(r.figures["verdict"]),
+                     r.part_number.value_or("?"));
+}
+
+std::string pm_text(const std::optional<double>& v, const std::optional<double>& se,
+                    const char* format) {
+  if (!v) return "-";
+  return fmt::format(fmt::runtime(format), *v) + (se ? fmt::format(" +- {:.1e}", *se) : "");
+}
+
+void print_drift(const ScaleFactorDrift& d) {
+  std::string tc;
+  if (d.tc_delta_ppm_per_c)
+    tc = fmt::format(", TC {:+.3f} +- {:.3f} ppm/C", *d.tc_delta_ppm_per_c, *d.tc_se_ppm_per_c);
+  fmt::print("  scale factor run {} from run {}: {:+.1f} +- {:.1f} ppm (zeta {}){}{}{}\n", d.run_id,
+             d.previous_run_id, d.delta_ppm, d.se_ppm,
+             d.zeta ? fmt::format("{:.1f}", *d.zeta) : "undefined", tc,
+             d.temp_gap_c ? fmt::format(" (K held {:+.1f} C apart)", *d.temp_gap_c) : "",
+             d.drift
+                 ? fmt::format(": DRIFT beyond {:.0f} combined standard errors", kDriftZetaLimit)
+                 : "");
+}
+
+void print_acceptance_history(const std::optional<std::vector<AcceptanceRow>>& rows) {
+  if (!rows) {
+    fmt::print("  acceptance figures: not in the fleet database yet (give --db)\n");
+    return;
+  }
+  if (rows->empty()) return;
+  fmt::print("  {:>6} {:>28} {:>7} {:>24}  acceptance verdict\n", "run", "K pulse/arcsec", "at C",
+             "TC ppm/C");
+  for (const auto& r : *rows)
+    fmt::print("  {:>6} {:>28} {:>7} {:>24}  {}\n", r.run_id,
+               pm_text(r.sf_pulse_per_arcsec, r.sf_se_pulse_per_arcsec, "{:.7f}"),
+               r.sf_temp_c ? fmt::format("{:.1f}", *r.sf_temp_c) : "-",
+               pm_text(r.tc_ppm_per_c, r.tc_se_ppm_per_c, "{:+.3f}"), row_verdict_text(r));
+  for (const auto& d : scale_factor_drift(*rows)) print_drift(d);
+}
+
+/// What history reads: the runs, fits and releases, and the acceptance figures (empty with
+/// --pg: the fleet does not hold them yet).
+struct HistoryRead {
+  fleet::FleetSerialHistory h;
+  std::optional<std::vector<AcceptanceRow>> acceptance;
+};
+
+HistoryRead read_history(const HistoryOptions& o) {
   if (!o.pg.empty()) {
     if (auto why = pg_url_problem(o.pg)) throw InputError(fmt::format("--pg: {}", *why));
     fleet::PgConnection pg({o.pg, {}});
-    return fleet::fleet_serial_history(pg, o.serial);
+    return {fleet::fleet_serial_history(pg, o.serial), std::nullopt};
   }
   Store store(o.db, OpenMode::read_only);
-  fleet::FleetSerialHistory h{serial_runs(store, o.serial), serial_fits(store, o.serial),
-                              releases_of(store, o.serial)};
+  HistoryRead r{
+      {serial_runs(store, o.serial), serial_fits(store, o.serial), releases_of(store, o.serial)},
+      acceptance_rows_of_serial(store, o.serial)};
   store.db().check_unchanged();
-  return h;
+  return r;
 }
 
 void run_history(const HistoryOptions& o) {
   if (o.db.empty() == o.pg.empty()) throw InputError("give one of --db DB or --pg URL");
-  const auto [runs, fits, releases] = read_history(o);
+  const auto [got, acceptance] = read_history(o);
+  const auto& [runs, fits, releases] = got;
   if (runs.empty() && fits.empty())
     throw InputError(
         fmt::format("{}: no run or fit of serial '{}'", o.pg.empty() ? o.db : o.pg, o.serial));
   const auto h = serial_history_stats(fits);
   if (o.json) {
-    std::cout << history_json(o.serial, runs, fits, h, releases).dump(2) << '\n';
+    json j = history_json(o.serial, runs, fits, h, releases);
+    j.update(acceptance_history_json(acceptance));
+    std::cout << j.dump(2) << '\n';
     return;
   }
   print_history(o.serial, runs, fits, h, releases);
+  print_acceptance_history(acceptance);
 }
 
 }  // namespace

@@ -1,16 +1,16 @@
 // The end summary of a run (run_summary.hpp).
 #include "station/cli/run_summary.hpp"
 
-#include "station/acceptance/acceptance_json.hpp"
-#include "station/acceptance/acceptance_verdict.hpp"
-
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <iterator>
 
+#include "station/acceptance/acceptance_json.hpp"
+#include "station/acceptance/acceptance_record.hpp"
 #include "station/parts/run_results.hpp"
 #include "station/parts/verdict.hpp"
+#include "station/store/acceptance_results.hpp"
 
 namespace station {
 namespace {
@@ -104,6 +104,19 @@ std::string shell_word(const std::string& s) {
   return out + "'";
 }
 
+/// The run's acceptance figures as its end stored them; computed again only when none are stored
+/// (the store failed at the end, logged then); empty without acceptance steps.
+json summary_acceptance(Store& store, std::int64_t run_id,
+                        const std::map<std::string, PartLimits>& part_limits) {
+  json a = stored_acceptance_json(store, run_id);
+  if (!a.empty()) return a;
+  try {
+    return judged_acceptance(store, run_id, part_limits);
+  } catch (const std::exception&) {  // logged at the run's end; the thermal summary stands
+    return json::array();
+  }
+}
+
 }  // namespace
 
 std::string run_summary_text(const json& r) {
@@ -134,10 +147,8 @@ json rig_run_summary(Store& store, std::int64_t run_id, std::string_view state, 
          {"ticks", ticks},
          {"gyros", run_results_json(store, run_id)},
          {"report", report_command(db_path, run_id)}};
-  if (auto a = acceptance_json(run_acceptance(store, run_id)); !a.empty()) {
-    judge_acceptance(a, part_limits);
+  if (auto a = summary_acceptance(store, run_id, part_limits); !a.empty())
     j["acceptance"] = std::move(a);
-  }
   return j;
 }
 

@@ -41,6 +41,7 @@ void AcceptanceRunner::enter(const Step& step, int step_index, double started_s)
     step_index_ = step_index;
     started_s_ = started_s;
     points_ = acceptance_schedule(step);
+    duration_s_ = acceptance_duration_s(step);
     current_ = -1;
     rested_ = false;
     stats_ = {};
@@ -180,7 +181,7 @@ AcceptanceActions AcceptanceRunner::tick(double t_s, const TableObservation& tab
 }
 
 bool AcceptanceRunner::finished(double t_s) const {
-  return step_ != nullptr && rested_ && t_s - started_s_ >= acceptance_duration_s(*step_);
+  return step_ != nullptr && rested_ && t_s - started_s_ >= duration_s_;
 }
 
 }  // namespace station

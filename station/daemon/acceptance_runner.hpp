@@ -63,6 +63,7 @@ class AcceptanceRunner {
   int step_index_ = -1;
   double started_s_ = 0;
   std::vector<AcceptancePoint> points_;
+  double duration_s_ = 0;  ///< acceptance_duration_s of the step, taken at enter, s
   int current_ = -1;    ///< point whose demand was sent
   bool resend_ = false;  ///< entered again: send the current demand at the next tick
   bool rested_ = false;  ///< the end-of-step demand was sent

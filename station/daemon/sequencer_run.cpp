@@ -8,6 +8,7 @@
 
 #include "compensation/earth_rate.hpp"
 #include "drivers/common/tap.hpp"
+#include "station/acceptance/acceptance_record.hpp"
 #include "station/common/logging.hpp"
 #include "station/daemon/resume.hpp"
 #include "station/daemon/sequencer.hpp"
@@ -56,6 +57,7 @@ RunState Sequencer::finish(RunState end_state, double t_s) {
       emit(t_s, Severity::warn, "seq", EventKind::fit_skipped, e.what());
     }
   }
+  record_acceptance_at_end(store_, run_id_, options_.part_limits);  // a failure only logged
   store_.finish_run(run_id_, state);
   emit(t_s, Severity::info, "seq", EventKind::run_end,
        fmt::format("run {} {}", run_id_, to_string(state)), {{"state", to_string(state)}});

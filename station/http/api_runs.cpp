@@ -6,6 +6,7 @@
 #include "station/release/releases.hpp"
 #include "station/release/verification.hpp"
 #include "station/report/report_page.hpp"
+#include "station/store/acceptance_results.hpp"
 #include "station/store/fit_json.hpp"
 #include "station/store/run_fits.hpp"
 
@@ -142,6 +143,16 @@ std::optional<nlohmann::json> events_json(Store& store, std::int64_t run_id,
                       {"message", st.column_text(5)}});
   }
   return nlohmann::json{{"events", events}, {"next", next}};
+}
+
+std::optional<nlohmann::json> acceptance_results_json(Store& store, std::int64_t run_id) {
+  if (!run_exists(store, run_id)) return std::nullopt;
+  nlohmann::json serials = nlohmann::json::array(), computed = nullptr;
+  for (auto& r : acceptance_rows_of_run(store, run_id)) {
+    computed = r.computed_utc;
+    serials.push_back(std::move(r.figures));
+  }
+  return nlohmann::json{{"run_id", run_id}, {"computed_utc", computed}, {"serials", serials}};
 }
 
 }  // namespace station::http

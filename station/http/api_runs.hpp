@@ -1,4 +1,5 @@
-// The API's read side over the database (schemas/api.md): runs, one run, its bins, its events.
+// The API's read side over the database (schemas/api.md): runs, one run, its bins, its events,
+// its acceptance figures.
 // Each function takes a read-only Store and returns the JSON body, or nullopt for an unknown run.
 #pragma once
 
@@ -16,5 +17,8 @@ std::optional<nlohmann::json> run_json(Store& store, std::int64_t run_id);
 std::optional<nlohmann::json> bins_json(Store& store, std::int64_t run_id,
                                         const std::optional<nlohmann::json>& live);
 std::optional<nlohmann::json> events_json(Store& store, std::int64_t run_id, std::int64_t since_id);
+/// The run's acceptance figures as stored when it ended (migration 12): {"run_id",
+/// "computed_utc" (null: none stored), "serials": [acceptance_json's objects with "verdict"]}.
+std::optional<nlohmann::json> acceptance_results_json(Store& store, std::int64_t run_id);
 
 }  // namespace station::http

@@ -168,4 +168,12 @@ void HttpServer::event_stream(const httplib::Request& req, httplib::Response& re
       [this](bool) { hub_.metrics().stream_clients(streams_.fetch_sub(1) - 1); });
 }
 
+// A run's acceptance figures as its end stored them (migration 12): none while it runs.
+void HttpServer::get_acceptance(const httplib::Request& req, httplib::Response& res) {
+  const auto id = path_id(req, res, "run id");
+  if (!id) return;
+  db_read(req, res,
+          [&](Store& st) { send_run_json(res, *id, acceptance_results_json(st, *id)); });
+}
+
 }  // namespace station::http

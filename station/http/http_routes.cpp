@@ -25,6 +25,7 @@ std::span<const HttpServer::Route> HttpServer::route_table() {
       {"GET", "/api/runs/{id}", R"(/api/runs/([^/]+))", &S::get_run},
       {"GET", "/api/runs/{id}/bins", R"(/api/runs/([^/]+)/bins)", &S::get_bins},
       {"GET", "/api/runs/{id}/events", R"(/api/runs/([^/]+)/events)", &S::get_events},
+      {"GET", "/api/runs/{id}/acceptance", R"(/api/runs/([^/]+)/acceptance)", &S::get_acceptance},
       {"GET", "/reports/NAME", R"(/reports/([^/]+))", &S::get_report},
       {"GET", "/api/events/stream", "/api/events/stream", &S::event_stream},
       {"POST", "/api/runs", "/api/runs", &S::start_run},

@@ -103,6 +103,7 @@ class HttpServer {
   void get_run(const httplib::Request& req, httplib::Response& res);
   void get_bins(const httplib::Request& req, httplib::Response& res);
   void get_events(const httplib::Request& req, httplib::Response& res);
+  void get_acceptance(const httplib::Request& req, httplib::Response& res);
   void get_report(const httplib::Request& req, httplib::Response& res);
   void event_stream(const httplib::Request& req, httplib::Response& res);
   void start_run(const httplib::Request& req, httplib::Response& res);

@@ -1,0 +1,187 @@
+// Acceptance figures stored per (run, serial): migration 12.
+#include "station/store/acceptance_results.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace station {
+namespace {
+
+using nlohmann::json;
+
+/// A figure of a step's object: a number when the step was computed and has it.
+std::optional<double> figure(const json& obj, const char* key) {
+  if (!obj.is_object() || !obj.value("ok", false) || !obj.contains(key) || !obj[key].is_number())
+    return std::nullopt;
+  return obj[key].get<double>();
+}
+
+/// The step of `list` whose `key` is largest in magnitude, with its `se_key`.
+std::pair<std::optional<double>, std::optional<double>> largest(const json& list, const char* key,
+                                                                const char* se_key) {
+  std::pair<std::optional<double>, std::optional<double>> out;
+  if (!list.is_array()) return out;
+  for (const auto& x : list) {
+    const auto v = figure(x, key);
+    if (v && (!out.first || std::abs(*v) > std::abs(*out.first)))
+      out = {v, se_key == nullptr ? std::nullopt : figure(x, se_key)};
+  }
+  return out;
+}
+
+// The columns after run_id and serial, in the order rows are bound and read.
+constexpr const char* kColumns =
+    "computed_utc, part_number, pass, sf_pulse_per_arcsec, sf_se_pulse_per_arcsec, sf_temp_c, "
+    "tc_ppm_per_c, tc_se_ppm_per_c, nonlinearity_max_ppm_fs, asymmetry_ppm, asymmetry_se_ppm, "
+    "tilt_mrad, tilt_se_mrad, turn_on_repeatability_dph, turn_on_repeatability_lower_dph, "
+    "turn_on_repeatability_upper_dph, max_warmup_s, figures_json";
+
+/// The row's optional figures in kColumns' order (from sf_pulse_per_arcsec).
+std::vector<std::optional<double>*> numbers(AcceptanceRow& r) {
+  return {&r.sf_pulse_per_arcsec,
+          &r.sf_se_pulse_per_arcsec,
+          &r.sf_temp_c,
+          &r.tc_ppm_per_c,
+          &r.tc_se_ppm_per_c,
+          &r.nonlinearity_max_ppm_fs,
+          &r.asymmetry_ppm,
+          &r.asymmetry_se_ppm,
+          &r.tilt_mrad,
+          &r.tilt_se_mrad,
+          &r.turn_on_repeatability_dph,
+          &r.turn_on_repeatability_lower_dph,
+          &r.turn_on_repeatability_upper_dph,
+          &r.max_warmup_s};
+}
+
+/// Whether the database has the table: a read command opens an older file as it is (version 11 or
+/// below: no figures stored, none to read).
+bool has_table(Store& store) {
+  return store.db().schema_version() >= kAcceptanceResultsVersion;
+}
+
+std::vector<AcceptanceRow> read_rows(StatementLease& st) {
+  std::vector<AcceptanceRow> out;
+  while (st->step()) {
+    AcceptanceRow r;
+    r.run_id = st->column_int(0);
+    r.serial = st->column_text(1);
+    r.computed_utc = st->column_text(2);
+    if (!st->column_is_null(3)) r.part_number = st->column_text(3);
+    if (!st->column_is_null(4)) r.pass = st->column_int(4) != 0;
+    int c = 5;
+    for (auto* v : numbers(r)) {
+      if (!st->column_is_null(c)) *v = st->column_double(c);
+      ++c;
+    }
+    r.figures = json::parse(st->column_text(c));
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
+}  // namespace
+
+std::optional<HeldScaleFactor> held_scale_factor(const json& serial) {
+  if (serial.contains("sf_vs_temp")) {
+    const json& t = serial["sf_vs_temp"];
+    const auto k = figure(t, "sf_ref_pulse_per_arcsec");
+    if (!k) return std::nullopt;
+    return HeldScaleFactor{*k, figure(t, "sf_ref_se_pulse_per_arcsec").value_or(0.0),
+                           figure(t, "ref_temp_c")};
+  }
+  if (!serial.contains("ladders") || serial["ladders"].size() != 1) return std::nullopt;
+  const json& l = serial["ladders"][0];
+  const auto k = figure(l, "sf_pulse_per_arcsec");
+  if (!k) return std::nullopt;
+  return HeldScaleFactor{
+      *k, figure(l, "sf_se_pulse_per_arcsec").value_or(0.0),
+      l.contains("temp_c") ? std::optional(l["temp_c"].get<double>()) : std::nullopt};
+}
+
+AcceptanceRow acceptance_row(std::int64_t run_id, const json& serial) {
+  AcceptanceRow r;
+  r.run_id = run_id;
+  r.serial = serial.value("serial", "");
+  r.figures = serial;
+  if (serial.contains("verdict")) {
+    r.part_number = serial["verdict"].value("part", "");
+    r.pass = serial["verdict"].value("pass", false);
+  }
+  if (const auto k = held_scale_factor(serial)) {
+    r.sf_pulse_per_arcsec = k->k_pulse_per_arcsec;
+    r.sf_se_pulse_per_arcsec = k->se_pulse_per_arcsec;
+    r.sf_temp_c = k->temp_c;
+  }
+  const json none;
+  const json& t = serial.contains("sf_vs_temp") ? serial["sf_vs_temp"] : none;
+  r.tc_ppm_per_c = figure(t, "tc_ppm_per_c");
+  r.tc_se_ppm_per_c = figure(t, "tc_se_ppm_per_c");
+  const json& ladders = serial.contains("ladders") ? serial["ladders"] : none;
+  r.nonlinearity_max_ppm_fs = largest(ladders, "nonlinearity_max_ppm_fs", nullptr).first;
+  std::tie(r.asymmetry_ppm, r.asymmetry_se_ppm) =
+      largest(ladders, "asymmetry_ppm", "asymmetry_se_ppm");
+  std::tie(r.tilt_mrad, r.tilt_se_mrad) = largest(
+      serial.contains("positions") ? serial["positions"] : none, "tilt_mrad", "tilt_se_mrad");
+  const json& on = serial.contains("turn_on") ? serial["turn_on"] : none;
+  r.turn_on_repeatability_dph = figure(on, "repeatability_dph");
+  r.turn_on_repeatability_lower_dph = figure(on, "repeatability_lower_dph");
+  r.turn_on_repeatability_upper_dph = figure(on, "repeatability_upper_dph");
+  r.max_warmup_s = figure(on, "max_warmup_s");
+  return r;
+}
+
+void replace_acceptance_rows(Store& store, std::int64_t run_id,
+                             const std::vector<AcceptanceRow>& rows) {
+  store.flush();
+  Transaction tx(store.db());
+  auto del = store.db().prepare("DELETE FROM acceptance_results WHERE run_id = ?");
+  del.bind(1, run_id);
+  del.step();
+  auto ins = store.db().prepare(std::string("INSERT INTO acceptance_results (run_id, serial, ") +
+                                kColumns + ") VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)");
+  const std::string now = utc_now_iso();
+  for (auto r : rows) {
+    ins.bind(1, run_id).bind(2, r.serial).bind(3, now);
+    r.part_number ? ins.bind(4, *r.part_number) : ins.bind_null(4);
+    r.pass ? ins.bind(5, *r.pass ? 1 : 0) : ins.bind_null(5);
+    int c = 6;
+    for (auto* v : numbers(r)) ins.bind(c++, *v);
+    ins.bind(c, r.figures.dump());
+    ins.step();
+    ins.reset();
+  }
+  tx.commit();
+}
+
+std::vector<AcceptanceRow> acceptance_rows_of_run(Store& store, std::int64_t run_id) {
+  if (!has_table(store)) return {};
+  auto st = store.cached(std::string("SELECT run_id, serial, ") + kColumns +
+                         " FROM acceptance_results WHERE run_id = ? ORDER BY rowid");
+  st->bind(1, run_id);
+  return read_rows(st);
+}
+
+std::vector<AcceptanceRow> acceptance_rows_of_serial(Store& store, const std::string& serial) {
+  if (!has_table(store)) return {};
+  auto st = store.cached(std::string("SELECT run_id, serial, ") + kColumns +
+                         " FROM acceptance_results WHERE serial = ? ORDER BY run_id");
+  st->bind(1, serial);
+  return read_rows(st);
+}
+
+std::optional<AcceptanceRow> newest_acceptance_row(Store& store, const std::string& serial,
+                                                   const std::vector<std::int64_t>& runs) {
+  std::optional<AcceptanceRow> out;
+  for (auto& r : acceptance_rows_of_serial(store, serial))  // oldest run first
+    if (std::find(runs.begin(), runs.end(), r.run_id) != runs.end()) out = std::move(r);
+  return out;
+}
+
+json stored_acceptance_json(Store& store, std::int64_t run_id) {
+  json out = json::array();
+  for (auto& r : acceptance_rows_of_run(store, run_id)) out.push_back(std::move(r.figures));
+  return out;
+}
+
+}  // namespace station
