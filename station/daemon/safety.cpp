@@ -69,7 +69,10 @@ Protocol Safety::clamp_protocol(const Protocol& p, std::vector<std::string>& not
 }
 
 SafetyInputs safety_inputs(const RigReading& in, std::optional<double> air_c) {
-  return {in.chamber, in.table_interlock_open, in.door_closed, in.estop_pressed, air_c};
+  std::optional<bool> drive_fault;
+  if (in.table) drive_fault = in.table->fault;
+  return {in.chamber,     in.table_interlock_open, drive_fault,
+          in.door_closed, in.estop_pressed,        air_c};
 }
 
 std::vector<std::string> Safety::judge(const std::optional<drivers::ChamberState>& chamber) const {
@@ -113,6 +116,7 @@ constexpr CauseWords kCauseWords[] = {
     {&SafetyCauses::chamber_door_open, "chamber door open", "chamber door closed"},
     {&SafetyCauses::door_open, "interlock open", "interlock closed"},
     {&SafetyCauses::table_interlock_open, "turntable interlock open", "turntable interlock closed"},
+    {&SafetyCauses::table_drive_fault, "turntable drive fault", "turntable drive fault cleared"},
     {&SafetyCauses::inputs_unreadable, "interlock / e-stop unreadable",
      "interlock / e-stop readable again"},
 };
@@ -169,6 +173,9 @@ SafetyDecision Safety::decide(const SafetyInputs& in) {
   // interlock, its high-limit trip as an e-stop.
   SafetyCauses c = causes_;
   if (in.table_interlock_open) c.table_interlock_open = *in.table_interlock_open;
+  // A drive fault: the drive is disabled and the table coasts, so no rate or position demand is
+  // held; the hold stops the run's steps until someone clears the fault at the drive.
+  if (in.table_drive_fault) c.table_drive_fault = *in.table_drive_fault;
   if (in.door_closed) c.door_open = !*in.door_closed;
   if (in.estop_pressed) c.estop_pressed = *in.estop_pressed;
   if (in.chamber) {
@@ -304,10 +311,11 @@ SafetyOutputs idle_outputs(bool fault) {
 
 SafetyOutputs Safety::outputs() const {
   SafetyOutputs o;
-  // Red: a fault (e-stop, readings out of limits, a broken sensor); amber: safe hold; green:
-  // running. The gyros are powered while the run goes on and cut in every safe hold (the RLG's
-  // discharge supply is high voltage; a hold is when a person may reach into the chamber).
-  o.red = limits_fault_ || causes_.estop() || causes_.sensor_fault();
+  // Red: a fault (e-stop, readings out of limits, a broken sensor, a faulted drive); amber: safe
+  // hold; green: running. The gyros are powered while the run goes on and cut in every safe hold
+  // (the RLG's discharge supply is high voltage; a hold is when a person may reach into the
+  // chamber).
+  o.red = limits_fault_ || causes_.estop() || causes_.device_fault();
   o.amber = holding_ && !o.red;
   o.green = !holding_;
   o.gyro_power = !holding_;

@@ -26,9 +26,10 @@ struct SafetySources {
 struct SafetyInputs {
   std::optional<drivers::ChamberState> chamber;  ///< also its door and high-limit alarms
   std::optional<bool> table_interlock_open;
-  std::optional<bool> door_closed;    ///< the GPIO interlock line (closed = safe)
-  std::optional<bool> estop_pressed;  ///< the GPIO e-stop line
-  std::optional<double> air_c;        ///< last finite air reading (where a hold keeps the chamber)
+  std::optional<bool> table_drive_fault;  ///< the turntable's drive-fault bit
+  std::optional<bool> door_closed;        ///< the GPIO interlock line (closed = safe)
+  std::optional<bool> estop_pressed;      ///< the GPIO e-stop line
+  std::optional<double> air_c;  ///< last finite air reading (where a hold keeps the chamber)
   /// The chamber's air read this tick was no reading (plausibility.hpp): kBlindTicks in a row
   /// hold, as an unreadable interlock does.
   bool air_implausible = false;
@@ -53,6 +54,7 @@ SafetyOutputs idle_outputs(bool fault);
 /// own last reading, never another source's), so a hold clears once every cause read clear.
 struct SafetyCauses {
   bool table_interlock_open = false;       ///< the turntable's interlock input
+  bool table_drive_fault = false;          ///< the turntable's drive fault (drive disabled)
   bool door_open = false;                  ///< the GPIO door interlock line
   bool chamber_door_open = false;          ///< the chamber's own door alarm
   bool estop_pressed = false;              ///< the GPIO e-stop line
@@ -66,10 +68,12 @@ struct SafetyCauses {
     return table_interlock_open || door_open || chamber_door_open || inputs_unreadable;
   }
   bool estop() const { return estop_pressed || chamber_high_limit; }
-  /// A device fault someone must repair (tower lamp red): a broken sensor.
-  bool sensor_fault() const { return chamber_sensor_break || chamber_air_implausible; }
+  /// A device fault someone must repair (tower lamp red): a broken sensor, a faulted drive.
+  bool device_fault() const {
+    return chamber_sensor_break || chamber_air_implausible || table_drive_fault;
+  }
   bool any() const {
-    return interlock_open() || estop() || sensor_fault() || setpoint_foreign ||
+    return interlock_open() || estop() || device_fault() || setpoint_foreign ||
            !out_of_limits.empty();
   }
   /// The active causes in words ("chamber high-limit trip; GPIO e-stop pressed"), or "none".

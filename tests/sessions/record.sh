@@ -1,18 +1,20 @@
 #!/usr/bin/env bash
 # Re-records the shipped sessions (tests/sessions/*/) with the simulated rig, for when the
 # station's behaviour changed on purpose: `tests/sessions/record.sh build/station/station`.
-# Each session is the protocol session_cycle.toml on one simulated gyro (seed 1), with faults
-# injected at fixed ticks; logs and result are gzip-compressed (read as .gz transparently).
+# Each session is the protocol session_cycle.toml (the acceptance_* ones: session_acceptance.toml)
+# on one simulated gyro (seed 1), with faults injected at fixed ticks; logs and result are
+# gzip-compressed (read as .gz transparently).
 set -euo pipefail
 station=${1:?usage: record.sh PATH/TO/station}
 here=$(cd "$(dirname "$0")" && pwd)
 tmp=$(mktemp -d)
+protocol=session_cycle.toml
 trap 'rm -rf "$tmp"' EXIT
 run_sim() {
   local name=$1
   shift
   "$station" run --sim --gyros 1 --seed 1 --db "$tmp/$name.db" \
-    --protocol "$here/session_cycle.toml" --record "$here/$name" "$@" >/dev/null
+    --protocol "$here/$protocol" --record "$here/$name" "$@" >/dev/null
 }
 finish() {
   gzip -9 -n "$here/$1"/*.log "$here/$1/result.json" "$here/$1/digest.txt"
@@ -64,3 +66,10 @@ curl -fsS -X POST --data "" -H "Authorization: Bearer $(cat "$tmp/aborted_api.db
   "http://127.0.0.1:$port/api/runs/1/abort" >/dev/null
 wait "$daemon"
 finish aborted_api
+# Issue 36: the acceptance steps at room temperature (power cycles through the relays, a rate
+# ladder, positions): the table's rate and angle demands and its read-back on the wire.
+protocol=session_acceptance.toml
+record acceptance_room
+# The turntable's drive faults in the middle of the ladder for 60 s: a safe hold (table stopped,
+# gyros unpowered), the points it cut left out, the ladder resumed after it.
+record acceptance_ladder_fault --fault "1420:table fault on" --fault "1480:table fault off"

@@ -5,10 +5,10 @@
 #include <cmath>
 #include <string>
 
-#include "station/common/input_error.hpp"
-#include "station/config/config.hpp"
 #include "station/acceptance/acceptance_verdict.hpp"
+#include "station/common/input_error.hpp"
 #include "station/config/acceptance_steps.hpp"
+#include "station/config/config.hpp"
 #include "station/config/protocol.hpp"
 #include "station/daemon/acceptance_runner.hpp"
 #include "station/sim/sim_run.hpp"
@@ -79,7 +79,8 @@ TEST(AcceptanceSteps, TheShippedProtocolHasEachKindAndANominalDuration) {
 
 TEST(AcceptanceSteps, BadKeysAreNamedWithFileLineAndKey) {
   const std::string l = "type = \"rate_ladder\"\n";
-  EXPECT_NE(parse_error(l + "rates_dps = [0]\n").find("p.toml:4: key 'step[0].rates_dps': entry 0: a rate must be above 0"),
+  EXPECT_NE(parse_error(l + "rates_dps = [0]\n")
+                .find("p.toml:4: key 'step[0].rates_dps': entry 0: a rate must be above 0"),
             std::string::npos);
   EXPECT_NE(parse_error(l + "rates_dps = [1, 4000]\n").find("entry 1: 4000 is outside"),
             std::string::npos);
@@ -98,9 +99,9 @@ TEST(AcceptanceSteps, BadKeysAreNamedWithFileLineAndKey) {
   EXPECT_NE(parse_error(l + "rates_dps = [5]\n").find("at least 2 rates"), std::string::npos);
   EXPECT_NE(parse_error(l + "rates_dps = [1, 2]\nsettle_s = 0\n").find("step[0].settle_s"),
             std::string::npos);
-  EXPECT_NE(parse_error("type = \"positions\"\nangles_deg = [0, 360, -360]\n")
-                .find("1 distinct angles"),
-            std::string::npos);
+  EXPECT_NE(
+      parse_error("type = \"positions\"\nangles_deg = [0, 360, -360]\n").find("1 distinct angles"),
+      std::string::npos);
   EXPECT_NE(parse_error("type = \"power_cycles\"\non_s = 100\n").find("step[0].on_s"),
             std::string::npos);
 }
@@ -252,9 +253,11 @@ TEST(AcceptanceRun, TheShippedProtocolRecoversEachSimulatedFigureWithinItsError)
       ASSERT_TRUE(l["ok"].get<bool>()) << l.dump();
       const double se = l["sf_se_pulse_per_arcsec"];
       EXPECT_LE(std::abs(l["sf_pulse_per_arcsec"].get<double>() -
-                         l["true"]["sf_pulse_per_arcsec"].get<double>()), 4 * se);
-      EXPECT_LE(std::abs(l["asymmetry_ppm"].get<double>() - l["true"]["asymmetry_ppm"].get<double>()),
-                4 * l["asymmetry_se_ppm"].get<double>());
+                         l["true"]["sf_pulse_per_arcsec"].get<double>()),
+                4 * se);
+      EXPECT_LE(
+          std::abs(l["asymmetry_ppm"].get<double>() - l["true"]["asymmetry_ppm"].get<double>()),
+          4 * l["asymmetry_se_ppm"].get<double>());
     }
     const auto& t = s["sf_vs_temp"];
     ASSERT_TRUE(t["ok"].get<bool>());
@@ -263,8 +266,9 @@ TEST(AcceptanceRun, TheShippedProtocolRecoversEachSimulatedFigureWithinItsError)
     ASSERT_EQ(s["positions"].size(), 3u);
     for (const auto& p : s["positions"]) {
       ASSERT_TRUE(p["ok"].get<bool>()) << p.dump();
-      EXPECT_LE(std::abs(p["tilt_mrad"].get<double>() - s["true"]["misalignment_mrad"].get<double>()),
-                4 * p["tilt_se_mrad"].get<double>());
+      EXPECT_LE(
+          std::abs(p["tilt_mrad"].get<double>() - s["true"]["misalignment_mrad"].get<double>()),
+          4 * p["tilt_se_mrad"].get<double>());
     }
     // The example part's acceptance limits: every figure checked, each within them.
     ASSERT_TRUE(s.contains("verdict"));
@@ -280,8 +284,8 @@ TEST(AcceptanceRun, TheShippedProtocolRecoversEachSimulatedFigureWithinItsError)
   }
   for (const auto& g : r["gyros"]) EXPECT_GE(g["bins"].get<int>(), 50) << g.dump();
   station::Store store(o.db_path, station::OpenMode::read_only);
-  auto st = store.db().prepare(
-      "SELECT count(*) FROM samples WHERE (flags & 32) != 0 AND recording = 1");
+  auto st =
+      store.db().prepare("SELECT count(*) FROM samples WHERE (flags & 32) != 0 AND recording = 1");
   ASSERT_TRUE(st.step());
   EXPECT_EQ(st.column_int(0), 0);  // no acceptance step inside this protocol's record window
 }
@@ -293,11 +297,12 @@ TEST(AcceptanceRun, ALadderThatTimesOutRestsTheTableAndFlagsWhileItTurns) {
   {
     std::FILE* f = std::fopen(path.c_str(), "w");
     ASSERT_NE(f, nullptr);
-    std::fputs("name = \"timeout\"\n[[step]]\ntype = \"lock_turntable\"\n[[step]]\n"
-               "type = \"rate_ladder\"\nrates_dps = [100, 200]\ndwell_s = 600\ntimeout_s = 60\n"
-               "[[step]]\ntype = \"lock_turntable\"\n[[step]]\ntype = \"record_start\"\n"
-               "[[step]]\ntype = \"hold\"\nduration_s = 1800\n",
-               f);
+    std::fputs(
+        "name = \"timeout\"\n[[step]]\ntype = \"lock_turntable\"\n[[step]]\n"
+        "type = \"rate_ladder\"\nrates_dps = [100, 200]\ndwell_s = 600\ntimeout_s = 60\n"
+        "[[step]]\ntype = \"lock_turntable\"\n[[step]]\ntype = \"record_start\"\n"
+        "[[step]]\ntype = \"hold\"\nduration_s = 1800\n",
+        f);
     std::fclose(f);
   }
   station::SimRunOptions o;
@@ -319,6 +324,45 @@ TEST(AcceptanceRun, ALadderThatTimesOutRestsTheTableAndFlagsWhileItTurns) {
   EXPECT_LT(last.column_double(0), 200.0);  // at rest within the travel back from 100 deg/s
 }
 
+// Issue 36: the turntable's drive faults in the middle of a ladder (the campaign's table fault,
+// here at fixed ticks; tests/sessions/acceptance_ladder_fault records the same on the wire). The
+// run holds safe (a safe_hold naming the drive fault, cleared once the fault is), the points the
+// hold cut are left out and counted, the ladder is still analysed from the rest, and not one
+// second is lost: a sample for every tick of the run.
+TEST(AcceptanceRun, ADriveFaultMidLadderHoldsSafeAndLeavesItsPointsOut) {
+  station::SimRunOptions o;
+  o.db_path = station::testing_support::fresh_db("ladder_drive_fault");
+  o.protocol = std::string(STATION_SOURCE_DIR) + "/tests/sessions/session_acceptance.toml";
+  o.progress = false;
+  o.fresh = true;
+  o.gyros = 1;
+  o.faults = {{1420.0, "table fault on"}, {1480.0, "table fault off"}};
+  const auto r = station::run_simulated(o);
+  ASSERT_EQ(r["state"], "completed") << r.dump();
+  station::Store store(o.db_path, station::OpenMode::read_only);
+  const auto count = [&](const std::string& sql) {
+    auto st = store.db().prepare(sql);
+    EXPECT_TRUE(st.step()) << sql;
+    return st.column_int(0);
+  };
+  EXPECT_EQ(count("SELECT count(*) FROM events WHERE kind = 'safe_hold' AND t_s = 1420 "
+                  "AND message LIKE '%turntable drive fault%'"),
+            1);
+  EXPECT_EQ(count("SELECT count(*) FROM events WHERE kind = 'safe_hold_cleared' AND t_s = 1480"),
+            1);
+  // Points 1 (-1 deg/s, 1402..1462 s) and 2 (+10 deg/s, 1473..1533 s) overlap the hold.
+  EXPECT_EQ(
+      count(
+          "SELECT count(*) FROM events WHERE kind = 'acceptance_point' AND "
+          "json_extract(data_json, '$.step_index') = 2 AND json_extract(data_json, '$.held') = 0"),
+      2);
+  const auto last = count("SELECT max(t_s) FROM samples");
+  EXPECT_EQ(count("SELECT count(DISTINCT t_s) FROM samples"), last + 1);  // every tick, 0..end
+  const auto& ladders = r["acceptance"][0]["ladders"];
+  ASSERT_EQ(ladders.size(), 1u) << r["acceptance"].dump();
+  EXPECT_TRUE(ladders[0]["ok"].get<bool>()) << ladders[0].dump();
+}
+
 // A figure beyond its limit fails named; a limit whose figure the run did not measure fails too.
 TEST(AcceptanceVerdict, AFigureBeyondItsLimitOrNotMeasuredFails) {
   auto serials = nlohmann::json::parse(R"([{"serial": "A", "ladders": [
@@ -335,6 +379,6 @@ TEST(AcceptanceVerdict, AFigureBeyondItsLimitOrNotMeasuredFails) {
   const auto& v = serials[0]["verdict"];
   EXPECT_FALSE(v["pass"].get<bool>());
   EXPECT_EQ(v["checked"].get<int>(), 4);
-  EXPECT_EQ(v["failed"], (nlohmann::json{"nonlinearity at 'hot' 120 ppm FS above 100",
-                                         "tilt not measured"}));
+  EXPECT_EQ(v["failed"],
+            (nlohmann::json{"nonlinearity at 'hot' 120 ppm FS above 100", "tilt not measured"}));
 }

@@ -307,6 +307,8 @@ TEST(Safety, EveryInputTrippedThenClearedHoldsThenClears) {
        [](station::SafetyInputs& in) { in.door_closed = false; }},
       {"table interlock", "turntable interlock open", false, true,
        [](station::SafetyInputs& in) { in.table_interlock_open = true; }},
+      {"table drive fault", "turntable drive fault", false, true,
+       [](station::SafetyInputs& in) { in.table_drive_fault = true; }},
   };
   const station::SafetySources shapes[] = {
       {false, false, false}, {false, true, true}, {true, true, true}};
@@ -321,6 +323,7 @@ TEST(Safety, EveryInputTrippedThenClearedHoldsThenClears) {
       if (!sources.gpio_estop) clear.estop_pressed.reset();
       if (!sources.gpio_interlock) clear.door_closed.reset();
       if (sources.table) clear.table_interlock_open = false;
+      if (sources.table) clear.table_drive_fault = false;
       ASSERT_FALSE(s.decide(clear).holding);
       auto tripped = clear;
       trip.apply(tripped);
@@ -337,6 +340,29 @@ TEST(Safety, EveryInputTrippedThenClearedHoldsThenClears) {
       EXPECT_FALSE(s.decide(clear).holding);
     }
   }
+}
+
+// Issue 36: a turntable drive fault (status bit 2; the drive disabled, the table coasting) is a
+// fault someone must clear at the drive: the hold stops the table and cuts the gyros' power, and
+// the tower lamp is red, not amber.
+TEST(Safety, ATableDriveFaultHoldsRed) {
+  station::Safety s(limits(), {true, true, true});
+  auto clear = inputs(20.0, 25.0);
+  clear.table_interlock_open = false;
+  clear.table_drive_fault = false;
+  ASSERT_FALSE(s.decide(clear).holding);
+  auto fault = clear;
+  fault.table_drive_fault = true;
+  const auto d = s.decide(fault);
+  ASSERT_TRUE(d.entered);
+  EXPECT_TRUE(d.stop_table);
+  EXPECT_TRUE(d.outputs.red);
+  EXPECT_FALSE(d.outputs.amber);
+  EXPECT_FALSE(d.outputs.gyro_power);
+  const auto c = s.decide(clear);
+  EXPECT_TRUE(c.cleared);
+  EXPECT_NE(c.events.back().message.find("turntable drive fault cleared"), std::string::npos)
+      << c.events.back().message;
 }
 
 // A source that cannot be read keeps its own last reading: a high-limit trip on a chamber that
