@@ -54,12 +54,6 @@ std::vector<std::optional<double>*> numbers(AcceptanceRow& r) {
           &r.max_warmup_s};
 }
 
-/// Whether the database has the table: a read command opens an older file as it is (version 11 or
-/// below: no figures stored, none to read).
-bool has_table(Store& store) {
-  return store.db().schema_version() >= kAcceptanceResultsVersion;
-}
-
 std::vector<AcceptanceRow> read_rows(StatementLease& st) {
   std::vector<AcceptanceRow> out;
   while (st->step()) {
@@ -155,7 +149,6 @@ void replace_acceptance_rows(Store& store, std::int64_t run_id,
 }
 
 std::vector<AcceptanceRow> acceptance_rows_of_run(Store& store, std::int64_t run_id) {
-  if (!has_table(store)) return {};
   auto st = store.cached(std::string("SELECT run_id, serial, ") + kColumns +
                          " FROM acceptance_results WHERE run_id = ? ORDER BY rowid");
   st->bind(1, run_id);
@@ -163,7 +156,6 @@ std::vector<AcceptanceRow> acceptance_rows_of_run(Store& store, std::int64_t run
 }
 
 std::vector<AcceptanceRow> acceptance_rows_of_serial(Store& store, const std::string& serial) {
-  if (!has_table(store)) return {};
   auto st = store.cached(std::string("SELECT run_id, serial, ") + kColumns +
                          " FROM acceptance_results WHERE serial = ? ORDER BY run_id");
   st->bind(1, serial);

@@ -14,9 +14,6 @@
 
 namespace station {
 
-/// The schema version that added the table (schemas/migrations/012_acceptance_results.sql).
-inline constexpr int kAcceptanceResultsVersion = 12;
-
 /// The scale factor a serial is held to (its verdict, its row, history's drift): K at the
 /// reference temperature of the temperature model over its ladders, else its one ladder's K at
 /// that ladder's temperature.
