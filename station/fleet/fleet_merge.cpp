@@ -57,29 +57,33 @@ std::string prune_sql(const FleetTable& t) {
 
 }  // namespace
 
+void append_copy_row(const Statement& st, std::string& out) {
+  const int n = st.column_count();
+  for (int c = 0; c < n; ++c) {
+    if (c > 0) out += '\t';
+    switch (st.column_type(c)) {
+      case SQLITE_NULL:
+        append_copy_field(out, std::nullopt);
+        break;
+      case SQLITE_INTEGER:
+        fmt::format_to(std::back_inserter(out), "{}", st.column_int(c));
+        break;
+      case SQLITE_FLOAT:
+        fmt::format_to(std::back_inserter(out), "{}", st.column_double(c));
+        break;
+      default: {
+        const std::string text = st.column_text(c);
+        append_copy_field(out, std::string_view(text));
+      }
+    }
+  }
+  out += '\n';
+}
+
 EncodedRows encode_rows(Statement& st, int watermark_col) {
   EncodedRows out;
   while (st.step()) {
-    const int n = st.column_count();
-    for (int c = 0; c < n; ++c) {
-      if (c > 0) out.data += '\t';
-      switch (st.column_type(c)) {
-        case SQLITE_NULL:
-          append_copy_field(out.data, std::nullopt);
-          break;
-        case SQLITE_INTEGER:
-          out.data += std::to_string(st.column_int(c));
-          break;
-        case SQLITE_FLOAT:
-          out.data += fmt::format("{}", st.column_double(c));
-          break;
-        default: {
-          const std::string text = st.column_text(c);
-          append_copy_field(out.data, std::string_view(text));
-        }
-      }
-    }
-    out.data += '\n';
+    append_copy_row(st, out.data);
     if (watermark_col >= 0) {
       out.last = st.column_double(watermark_col);
       if (!out.first) out.first = out.last;

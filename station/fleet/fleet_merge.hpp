@@ -24,6 +24,8 @@ struct EncodedRows {
 /// decimal, reals as the shortest text that reads back to the same double (fmt "{}"), text as
 /// is. `watermark_col` < 0: none.
 EncodedRows encode_rows(Statement& st, int watermark_col = -1);
+/// Appends the row `st` stands on to `out` as one COPY text line, encoded as encode_rows does.
+void append_copy_row(const Statement& st, std::string& out);
 
 /// Copies `rows` into the transaction's staging table for `t` (emptied first).
 void stage_rows(PgConnection& pg, const FleetTable& t, const EncodedRows& rows);

@@ -213,24 +213,42 @@ void Forwarder::send_run(std::int64_t run_id, const std::string& uuid, Sent& sen
 }
 
 // Appended rows resume at the server's high-water mark, and restate the row at the mark: the
-// file must hold it, with the same content, or the two have parted (held).
+// file must hold it, with the same content, or the two have parted (held); that row alone is
+// staged and compared. The rows after it cannot be on the server (the mark is its highest, read
+// in this transaction, and one process at a time forwards a file: the writer's lock), so they go
+// straight into the central table by one COPY, read from SQLite as the server takes them: no
+// staging table, no merge (issue 37: INSERT ... ON CONFLICT from a staged copy was 2.4 s and
+// the divergence join over the whole batch 0.4 s of a 13 h run's 4.2 s). Two copies of one file
+// forwarding at once would meet a duplicate key: the item is refused, retried, and compared.
 void Forwarder::append_from(const FleetTable& t, Statement& st, std::optional<double> mark,
-                            int mark_col, Sent& sent, std::int64_t& budget,
-                            const std::string& run_uuid, std::int64_t run_id,
+                            int mark_col, Sent& sent, std::int64_t& budget, std::int64_t run_id,
                             std::optional<double>& reached) {
-  const auto rows = encode_rows(st, mark_col);
-  if (mark && rows.first != mark)
-    throw held(Item::run, run_id,
-               fmt::format("the server holds {} this file does not have", t.name));
-  stage_rows(*pg_, t, rows);
-  if (const auto diverged = mark ? first_diverged(*pg_, t) : std::nullopt)
-    throw held(Item::run, run_id, *diverged);
-  const std::int64_t fresh = rows.rows - (mark ? 1 : 0);
+  bool row = st.step();
+  if (mark) {
+    if (!row || st.column_double(mark_col) != *mark)
+      throw held(Item::run, run_id,
+                 fmt::format("the server holds {} this file does not have", t.name));
+    EncodedRows at{{}, 1, mark, mark};
+    append_copy_row(st, at.data);
+    stage_rows(*pg_, t, at);
+    if (const auto diverged = first_diverged(*pg_, t)) throw held(Item::run, run_id, *diverged);
+    row = st.step();
+  }
+  std::int64_t fresh = 0;
+  reached = mark;
+  if (row) {
+    sent.rows += pg_->copy_in(fmt::format("{} ({})", t.name, t.columns), [&](std::string& piece) {
+      for (; row && piece.size() < kPgCopyPieceBytes; row = st.step()) {
+        append_copy_row(st, piece);
+        reached = st.column_double(mark_col);
+        ++fresh;
+      }
+      return row;
+    });
+  }
   sent.appended += fresh;
   budget -= fresh;
   if (budget <= 0) sent.complete = false;
-  reached = rows.last ? rows.last : mark;
-  sent.rows += merge_staged(*pg_, t, run_uuid);
 }
 
 void Forwarder::append_events(std::int64_t run_id, const std::string& run_uuid, Sent& sent,
@@ -244,7 +262,7 @@ void Forwarder::append_events(std::int64_t run_id, const std::string& run_uuid, 
   bind_named(st, ":after", static_cast<std::int64_t>(mark.value_or(1)) - 1);  // from the mark
   bind_named(st, ":limit", budget + 1);
   std::optional<double> reached;
-  append_from(t, st, mark, 1, sent, budget, run_uuid, run_id, reached);
+  append_from(t, st, mark, 1, sent, budget, run_id, reached);
   if (reached) sent.events_after = static_cast<std::int64_t>(*reached);
 }
 
@@ -268,7 +286,7 @@ void Forwarder::append_samples(std::int64_t run_id, const std::string& run_uuid,
       // t_s > the double just below the mark: from the mark itself.
       bind_named(st, ":after", mark ? std::nextafter(*mark, -HUGE_VAL) : kBeforeAnySample);
       bind_named(st, ":limit", budget + 1);
-      append_from(t, st, mark, 2, sent, budget, run_uuid, run_id, reached);
+      append_from(t, st, mark, 2, sent, budget, run_id, reached);
     } else {
       sent.complete = false;
     }

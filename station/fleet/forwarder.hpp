@@ -95,8 +95,8 @@ class Forwarder {
   void append_samples(std::int64_t run_id, const std::string& run_uuid, Sent& sent,
                       std::int64_t& budget);
   void append_from(const FleetTable& t, Statement& st, std::optional<double> mark, int mark_col,
-                   Sent& sent, std::int64_t& budget, const std::string& run_uuid,
-                   std::int64_t run_id, std::optional<double>& reached);
+                   Sent& sent, std::int64_t& budget, std::int64_t run_id,
+                   std::optional<double>& reached);
   void acknowledge(Item item, std::int64_t local_id, std::int64_t changes, const Sent& sent);
   void record_error(Item item, std::int64_t local_id, const std::string& error, bool hold);
 

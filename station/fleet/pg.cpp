@@ -262,39 +262,66 @@ PgResult PgConnection::exec(std::string_view sql,
   });
 }
 
-// The data goes in pieces (PQputCopyData returns 0 while libpq's buffer is full on a
-// non-blocking connection: wait until the socket takes more), then PQputCopyEnd, then the
-// COPY's own result, all under one deadline.
-long long PgConnection::copy_in(std::string_view table_and_columns, std::string_view data) {
+// A piece at a time: PQputCopyData (it returns 0 while libpq's buffer is full on a non-blocking
+// connection: wait until the socket takes more), then PQflush until the socket has it all, so
+// the next piece is made while the server reads this one; then PQputCopyEnd and the COPY's own
+// result, all under one deadline (libpq-copy.html, libpq-async.html).
+long long PgConnection::copy_in(std::string_view table_and_columns,
+                                const std::function<bool(std::string&)>& fill) {
   const std::string sql = fmt::format("COPY {} FROM STDIN", table_and_columns);
   exec(sql);
   const auto started = Clock::now();
   const auto deadline = call_deadline();
-  constexpr std::size_t kPieceBytes = 64 * 1024;
-  for (std::size_t at = 0; at < data.size();) {
-    const auto piece = data.substr(at, kPieceBytes);
-    const int put = PQputCopyData(live(sql), piece.data(), static_cast<int>(piece.size()));
-    if (put < 0) lost(sql);
-    if (put == 0) {
-      wait_socket(true, deadline, sql, started);
-      if (PQconsumeInput(conn_.get()) == 0) lost(sql);
-      continue;
+  std::string piece;
+  piece.reserve(kPgCopyPieceBytes + kPgCopyPieceBytes / 4);
+  for (bool more = true; more;) {
+    piece.clear();
+    try {
+      more = fill(piece);
+    } catch (const std::exception& e) {  // the rows could not be made: the COPY fails, no row
+      end_copy(e.what(), deadline, sql, started);
+      throw;
     }
-    at += piece.size();
+    if (!piece.empty()) put_copy_piece(piece, deadline, sql, started);
   }
-  // As above: what the server sent meanwhile (an error, a NOTICE) must be read, or the socket
-  // stays readable, poll returns at once and the loop spins until the deadline.
-  for (int put; (put = PQputCopyEnd(live(sql), nullptr)) != 1;) {
-    if (put < 0) lost(sql);
-    wait_socket(true, deadline, sql, started);
-    if (PQconsumeInput(conn_.get()) == 0) lost(sql);
+  return end_copy(nullptr, deadline, sql, started);
+}
+
+long long PgConnection::copy_in(std::string_view table_and_columns, std::string_view data) {
+  return copy_in(table_and_columns, [data](std::string& piece) mutable {
+    piece.assign(data.substr(0, kPgCopyPieceBytes));
+    data.remove_prefix(piece.size());
+    return !data.empty();
+  });
+}
+
+void PgConnection::put_copy_piece(std::string_view piece, Deadline deadline, std::string_view what,
+                                  Deadline started) {
+  for (int put;
+       (put = PQputCopyData(live(what), piece.data(), static_cast<int>(piece.size()))) != 1;) {
+    if (put < 0) lost(what);
+    wait_socket(true, deadline, what, started);
+    if (PQconsumeInput(conn_.get()) == 0) lost(what);
   }
-  flush(deadline, sql, started);
-  PGresult* raw = next_result(deadline, sql, started);
-  const long long rows = raw != nullptr ? std::atoll(PQcmdTuples(raw)) : 0;
-  check(raw, sql);
+  flush(deadline, what, started);
+}
+
+// As above: what the server sent meanwhile (an error, a NOTICE) must be read, or the socket
+// stays readable, poll returns at once and the loop spins until the deadline. After a CopyFail
+// the COPY's error result is the one expected: it is read and dropped.
+long long PgConnection::end_copy(const char* why, Deadline deadline, std::string_view what,
+                                 Deadline started) {
+  for (int put; (put = PQputCopyEnd(live(what), why)) != 1;) {
+    if (put < 0) lost(what);
+    wait_socket(true, deadline, what, started);
+    if (PQconsumeInput(conn_.get()) == 0) lost(what);
+  }
+  flush(deadline, what, started);
+  std::unique_ptr<PGresult, PgClear> result(next_result(deadline, what, started));
   // Drain: libpq returns NULL after the last result of the COPY.
-  while (PGresult* extra = next_result(deadline, sql, started)) PQclear(extra);
+  while (PGresult* extra = next_result(deadline, what, started)) PQclear(extra);
+  const long long rows = result ? std::atoll(PQcmdTuples(result.get())) : 0;
+  if (why == nullptr) check(result.release(), what);
   return rows;
 }
 

@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstddef>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -51,6 +52,8 @@ inline constexpr double kPgCancelTimeoutS = 5;
 /// How often a wait looks at the caller's stop and how soon a slow call is first reported.
 inline constexpr double kPgPollSliceS = 0.1;
 inline constexpr double kPgSlowCallS = 2;
+/// What a COPY hands libpq at a time (PQputCopyData): a few socket buffers' worth.
+inline constexpr std::size_t kPgCopyPieceBytes = 64 * 1024;
 
 struct PgFinish {
   void operator()(PGconn* c) const noexcept { PQfinish(c); }
@@ -115,6 +118,12 @@ class PgConnection {
   /// COPY `table_and_columns` FROM STDIN (text format); `data` is the rows already encoded
   /// (copy_field / '\t' / '\n'). Returns the number of rows the server took.
   long long copy_in(std::string_view table_and_columns, std::string_view data);
+  /// The same, the rows made while they are sent: `fill` appends the next rows to its (emptied)
+  /// buffer, about kPgCopyPieceBytes at a time, and returns false once none are left. Each piece
+  /// goes to the socket before the next is made, so the caller reads and encodes at the server's
+  /// pace, holding one piece.
+  long long copy_in(std::string_view table_and_columns,
+                    const std::function<bool(std::string&)>& fill);
   /// Asks the server to cancel the statement in flight (PQcancel with the PGcancel made at
   /// connect, libpq-cancel.html), waiting at most kPgCancelTimeoutS. False: no answer.
   bool cancel() const;
@@ -134,6 +143,11 @@ class PgConnection {
   void flush(Deadline deadline, std::string_view what, Deadline started);
   /// The next result of the call in flight (nullptr: the call is done).
   PGresult* next_result(Deadline deadline, std::string_view what, Deadline started);
+  /// Hands libpq one piece of a COPY's data and sends it (waiting while the socket is full).
+  void put_copy_piece(std::string_view piece, Deadline deadline, std::string_view what,
+                      Deadline started);
+  /// Ends a COPY (CopyFail with `why` when `why` is given) and reads its result.
+  long long end_copy(const char* why, Deadline deadline, std::string_view what, Deadline started);
   /// Sends with `send` (PQsendQuery...), then reads every result: the first error, else the last.
   PgResult run(std::string_view what, const std::function<int(PGconn*)>& send);
   [[noreturn]] void abandon(std::string_view what, bool stopping, double limit_s);

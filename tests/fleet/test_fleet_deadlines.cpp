@@ -72,7 +72,7 @@ class FrozenBackend {
 /// row is staged, nothing committed).
 void freeze_at_copy(PgProxy& proxy, FrozenBackend& backend) {
   proxy.on_client([&backend](std::string_view bytes) {
-    if (!backend.frozen() && bytes.find("COPY stage_events") != std::string_view::npos)
+    if (!backend.frozen() && bytes.find("COPY events (") != std::string_view::npos)
       backend.freeze();
   });
 }
@@ -131,7 +131,7 @@ TEST_F(FleetDeadline, AFrozenBackendMidCopyTimesOutThenEveryRowArrivesOnce) {
     EXPECT_TRUE(backend.frozen()) << "the pass returned only once the backend was resumed";
   }
   EXPECT_NE(error.find("timed out"), std::string::npos) << error;
-  EXPECT_NE(error.find("COPY stage_events"), std::string::npos) << "names the call: " << error;
+  EXPECT_NE(error.find("COPY events ("), std::string::npos) << "names the call: " << error;
   EXPECT_NE(error.find(proxy.dir()), std::string::npos) << "names the server: " << error;
   EXPECT_EQ(server_count("runs"), 0) << "nothing of the cut item was committed";
   EXPECT_TRUE(backend.thaw());
@@ -228,7 +228,7 @@ TEST_F(FleetDeadline, SyncEndsWithTheCallThatTimedOutThenSendsEveryRowOnce) {
   }
   EXPECT_EQ(WEXITSTATUS(rc), 1) << out;
   EXPECT_NE(out.find("station: error: PostgreSQL " + proxy.dir()), std::string::npos) << out;
-  EXPECT_NE(out.find("COPY stage_events"), std::string::npos) << out;
+  EXPECT_NE(out.find("COPY events ("), std::string::npos) << out;
   EXPECT_NE(out.find("timed out"), std::string::npos) << out;
   EXPECT_TRUE(backend.thaw());
   out = capture(kStation + " sync --json --db " + db + " --pg '" + target().url + "'", rc);

@@ -304,4 +304,40 @@ TEST_F(FleetForward, ARefusedItemWaitsItsTurnAndTheOthersGoOn) {
   EXPECT_EQ(count("fits"), 2);
 }
 
+// Issue 37: a COPY streamed piece by piece while its rows are made (how samples travel). Rows of
+// many pieces arrive whole; rows that cannot be made (the fill throws) fail the COPY with nothing
+// written; a row the server refuses mid-stream (a duplicate key) is the COPY's error; after either
+// the connection goes on.
+TEST_F(FleetForward, AStreamedCopyArrivesWholeOrNotAtAll) {
+  fleet::PgConnection pg(target());
+  pg.exec("CREATE TABLE streamed (k bigint PRIMARY KEY, note text)");
+  const auto rows = [](std::int64_t first, std::int64_t n, std::int64_t fail_at) {
+    return [=, k = first](std::string& piece) mutable {
+      for (; k < first + n && piece.size() < fleet::kPgCopyPieceBytes; ++k) {
+        if (k == fail_at) throw std::runtime_error("row cannot be read");
+        fmt::format_to(std::back_inserter(piece), "{}\tnote {}\n", k, k);
+      }
+      return k < first + n;
+    };
+  };
+  constexpr std::int64_t kRows = 20'000;  // ~330 kB: six pieces
+  const auto sum_sql = "SELECT count(*), sum(k) FROM streamed";
+  EXPECT_EQ(pg.copy_in("streamed (k, note)", rows(0, kRows, -1)), kRows);
+  EXPECT_EQ(pg.exec(sum_sql).integer(0, 0), kRows);
+  EXPECT_EQ(pg.exec(sum_sql).integer(0, 1), kRows * (kRows - 1) / 2);
+  EXPECT_THROW(pg.copy_in("streamed (k, note)", rows(kRows, kRows, kRows + 15'000)),
+               std::runtime_error);
+  EXPECT_TRUE(pg.ok());
+  EXPECT_EQ(pg.exec(sum_sql).integer(0, 0), kRows) << "a failed COPY wrote rows";
+  std::string refused;
+  try {
+    pg.copy_in("streamed (k, note)", rows(kRows - 1, kRows, -1));
+  } catch (const fleet::PgError& e) {
+    refused = e.what();
+  }
+  EXPECT_NE(refused.find("duplicate key"), std::string::npos) << refused;
+  EXPECT_TRUE(pg.ok());
+  EXPECT_EQ(pg.exec(sum_sql).integer(0, 0), kRows);
+}
+
 }  // namespace
