@@ -22,6 +22,9 @@ std::vector<std::uint8_t> bytes_of(std::string_view s) {
 }  // namespace
 
 RecordedLineWire::RecordedLineWire(std::string device, std::vector<SessionLogLine> lines)
+    : RecordedLineWire(std::move(device), ReplayFeed<SessionLogLine>(std::move(lines))) {}
+
+RecordedLineWire::RecordedLineWire(std::string device, ReplayFeed<SessionLogLine> lines)
     : device_(std::move(device)), lines_(std::move(lines)) {}
 
 bool RecordedLineWire::recorded_error(std::string_view what) {
@@ -29,8 +32,8 @@ bool RecordedLineWire::recorded_error(std::string_view what) {
   if (l == nullptr || l->direction != "event" || l->kind != "ascii-error" || l->bytes.size() != 4 ||
       l->detail.find(what) == std::string::npos)
     return false;
-  ++next_;
-  errno = drivers::errno_of_bytes(std::span<const std::uint8_t, 4>(l->bytes.data(), 4));
+  const auto& e = lines_.take();
+  errno = drivers::errno_of_bytes(std::span<const std::uint8_t, 4>(e.bytes.data(), 4));
   return true;
 }
 
@@ -40,13 +43,13 @@ int RecordedLineWire::open(double) {
   if (l == nullptr || l->direction != "event" || l->kind != "ascii-connect")
     throw ReplayDivergence(device_, l ? describe(*l) : "no more exchanges", "connect",
                            l ? l->t_s : 0);
-  ++next_;
+  (void)lines_.take();
   return 0;
 }
 
 void RecordedLineWire::close() {
   const SessionLogLine* l = peek();
-  if (l != nullptr && l->direction == "event" && l->kind == "ascii-disconnect") ++next_;
+  if (l != nullptr && l->direction == "event" && l->kind == "ascii-disconnect") (void)lines_.take();
 }
 
 int RecordedLineWire::send(std::string_view bytes, double) {
@@ -57,7 +60,7 @@ int RecordedLineWire::send(std::string_view bytes, double) {
   if (l == nullptr || l->direction != "tx" || l->kind != "ascii" || l->bytes != sent)
     throw ReplayDivergence(device_, l ? describe(*l) : "no more exchanges",
                            "tx ascii " + hex_field(sent), l ? l->t_s : 0);
-  ++next_;
+  (void)lines_.take();
   if (recorded_error(" send '")) return -1;
   return static_cast<int>(bytes.size());
 }
@@ -69,8 +72,8 @@ bool RecordedLineWire::open_reply() {
   if (l == nullptr || l->direction != "rx" || l->kind != "ascii")
     throw ReplayDivergence(device_, l ? describe(*l) : "no more exchanges", "the reply",
                            l ? l->t_s : 0);
-  ++next_;
-  reply_.assign(l->bytes.begin(), l->bytes.end());
+  const auto& r = lines_.take();
+  reply_.assign(r.bytes.begin(), r.bytes.end());
   reply_open_ = true;
   return true;
 }
@@ -88,7 +91,7 @@ int RecordedLineWire::receive(std::string& line, std::string_view terminator, do
 int RecordedLineWire::receive_exact(std::string& bytes, std::size_t n, double) {
   if (!open_reply()) return -1;
   if (reply_.size() < n) {
-    const SessionLogLine* l = next_ > 0 ? &lines_[next_ - 1] : nullptr;
+    const SessionLogLine* l = lines_.taken() > 0 ? &lines_.last() : nullptr;
     throw ReplayDivergence(device_, l ? describe(*l) : "no more exchanges",
                            fmt::format("{} more reply bytes", n), l ? l->t_s : 0);
   }

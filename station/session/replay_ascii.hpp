@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "drivers/ascii/line_wire.hpp"
+#include "station/session/replay_feed.hpp"
 #include "station/session/replay_modbus.hpp"
 #include "station/session/session_log.hpp"
 
@@ -18,6 +19,8 @@ namespace station {
 class RecordedLineWire final : public drivers::ascii::LineWire {
  public:
   RecordedLineWire(std::string device, std::vector<SessionLogLine> lines);
+  /// The lines as the replay pulls them from ascii.log.
+  RecordedLineWire(std::string device, ReplayFeed<SessionLogLine> lines);
   int open(double timeout_s) override;
   void close() override;
   int send(std::string_view bytes, double timeout_s) override;
@@ -25,13 +28,11 @@ class RecordedLineWire final : public drivers::ascii::LineWire {
               std::size_t max_bytes) override;
   int receive_exact(std::string& bytes, std::size_t n, double timeout_s) override;
   void flush() override {}
-  std::size_t remaining() const { return lines_.size() - next_; }
-  std::vector<SessionLogLine> consumed() const {
-    return {lines_.begin(), lines_.begin() + static_cast<std::ptrdiff_t>(next_)};
-  }
+  std::size_t remaining() { return lines_.remaining(); }
+  const std::vector<SessionLogLine>& consumed() const { return lines_.consumed(); }
 
  private:
-  const SessionLogLine* peek() const { return next_ < lines_.size() ? &lines_[next_] : nullptr; }
+  const SessionLogLine* peek() { return lines_.peek(); }
   /// The next line is a recorded failure whose message contains `what` (" send '", " reply to
   /// '", " connect "): consumed, errno set, true.
   bool recorded_error(std::string_view what);
@@ -40,8 +41,7 @@ class RecordedLineWire final : public drivers::ascii::LineWire {
   bool open_reply();
 
   std::string device_;
-  std::vector<SessionLogLine> lines_;
-  std::size_t next_ = 0;
+  ReplayFeed<SessionLogLine> lines_;
   std::string reply_;        // what is left of the reply being read in parts
   bool reply_open_ = false;  // a reply is being read in parts
 };

@@ -18,14 +18,21 @@ bool is_sync(const can_frame& f) {
 
 }  // namespace
 
+bool is_sync_frame(const can_frame& frame) {
+  return is_sync(frame);
+}
+
 ReplayCanTransport::ReplayCanTransport(std::vector<CandumpRecord> records)
+    : ReplayCanTransport(std::make_shared<ReplayFeed<CandumpRecord>>(std::move(records))) {}
+
+ReplayCanTransport::ReplayCanTransport(std::shared_ptr<ReplayFeed<CandumpRecord>> records)
     : records_(std::move(records)) {}
 
 Result<void> ReplayCanTransport::send(const can_frame& frame) {
   if (!is_sync(frame)) return {};
-  for (std::size_t i = cursor_; i < records_.size(); ++i) {
-    if (is_sync(records_[i].frame) && records_[i].frame.data[0] == frame.data[0]) {
-      cursor_ = i + 1;
+  for (std::size_t i = 0; const CandumpRecord* r = records_->peek(i); ++i) {
+    if (is_sync(r->frame) && r->frame.data[0] == frame.data[0]) {
+      for (std::size_t k = 0; k <= i; ++k) (void)records_->take();
       ++syncs_sent_;
       return {};
     }
@@ -35,10 +42,11 @@ Result<void> ReplayCanTransport::send(const can_frame& frame) {
 }
 
 Result<can_frame> ReplayCanTransport::receive(std::chrono::milliseconds) {
-  if (cursor_ >= records_.size() || is_sync(records_[cursor_].frame)) {
+  const CandumpRecord* next = records_->peek();
+  if (next == nullptr || is_sync(next->frame)) {
     return make_error(ErrorKind::timeout, "replay: no more frames for this latch");
   }
-  const auto& r = records_[cursor_++];
+  const auto& r = records_->take();
   last_rx_time_s_ = static_cast<double>(r.time_sec) + 1e-6 * static_cast<double>(r.time_usec);
   return r.frame;
 }

@@ -3,10 +3,12 @@
 // recorded session goes through the same counter-board driver again.
 #pragma once
 
+#include <memory>
 #include <vector>
 
 #include "drivers/can/can_transport.hpp"
 #include "drivers/can/candump_log.hpp"
+#include "station/session/replay_feed.hpp"
 
 namespace station {
 
@@ -15,6 +17,8 @@ namespace station {
 class ReplayCanTransport final : public drivers::can::CanTransport {
  public:
   explicit ReplayCanTransport(std::vector<drivers::can::CandumpRecord> records);
+  /// The records as the replay pulls them from can.log.
+  explicit ReplayCanTransport(std::shared_ptr<ReplayFeed<drivers::can::CandumpRecord>> records);
 
   /// Non-SYNC frames are accepted and dropped; a SYNC not in the rest of the log is
   /// ErrorKind::disconnected (the log has ended).
@@ -26,18 +30,18 @@ class ReplayCanTransport final : public drivers::can::CanTransport {
   /// SYNC frames sent so far (ticks the replay has started).
   std::size_t syncs_sent() const { return syncs_sent_; }
   /// The records played back or skipped so far.
-  std::vector<drivers::can::CandumpRecord> consumed() const {
-    return {records_.begin(), records_.begin() + static_cast<std::ptrdiff_t>(cursor_)};
-  }
+  const std::vector<drivers::can::CandumpRecord>& consumed() const { return records_->consumed(); }
 
  private:
-  std::vector<drivers::can::CandumpRecord> records_;
-  std::size_t cursor_ = 0;
+  std::shared_ptr<ReplayFeed<drivers::can::CandumpRecord>> records_;
   std::size_t syncs_sent_ = 0;
   double last_rx_time_s_ = 0;
 };
 
 /// The latch sequences of the SYNC frames in `records`, in order.
 std::vector<std::uint8_t> logged_syncs(const std::vector<drivers::can::CandumpRecord>& records);
+
+/// Whether `frame` is a SYNC (schemas/can_frames.md): a tick's start.
+bool is_sync_frame(const can_frame& frame);
 
 }  // namespace station

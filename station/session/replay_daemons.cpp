@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <deque>
 #include <filesystem>
 #include <future>
 #include <limits>
@@ -18,6 +19,7 @@
 #include "station/session/replay_ascii.hpp"
 #include "station/session/replay_can.hpp"
 #include "station/session/replay_clock.hpp"
+#include "station/session/replay_feed.hpp"
 #include "station/session/replay_gpio.hpp"
 #include "station/session/replay_modbus.hpp"
 #include "station/session/session_log.hpp"
@@ -28,92 +30,138 @@ namespace {
 namespace fs = std::filesystem;
 namespace dr = station::drivers;
 
-/// Everything the session's three logs hold, in order.
+/// The session's logs, each read once from its start to its end as the replayed daemons ask.
 struct SessionLogs {
-  std::vector<SessionLogLine> modbus, ascii, gpio;
-  std::vector<dr::can::CandumpRecord> can;
+  CanLogStream can;
+  SessionLogStream modbus, gpio;
+  std::optional<SessionLogStream> ascii;  // absent before issue 20
+  std::int64_t can_records = 0;           // records taken from `can`
 
-  explicit SessionLogs(const std::string& dir) {
-    // The CAN log is read on a second thread while the Modbus and GPIO logs are read here: the
-    // files are independent, and reading them is most of a long replay's set-up.
-    auto can_log = std::async(std::launch::async, [path = (fs::path(dir) / "can.log").string()] {
-      return read_session_can_log(path);
-    });
-    modbus = read_session_log((fs::path(dir) / "modbus.log").string());
-    const auto ascii_log = fs::path(dir) / "ascii.log";  // absent before issue 20
+  explicit SessionLogs(const std::string& dir)
+      : can((fs::path(dir) / "can.log").string()),
+        modbus((fs::path(dir) / "modbus.log").string()),
+        gpio((fs::path(dir) / "gpio.log").string()) {
+    const auto ascii_log = fs::path(dir) / "ascii.log";
     if (fs::exists(ascii_log) || fs::exists(ascii_log.string() + ".gz"))
-      ascii = read_session_log(ascii_log.string());
-    gpio = read_session_log((fs::path(dir) / "gpio.log").string());
-    can = can_log.get();  // rethrows the reader's InputError
+      ascii.emplace(ascii_log.string());
   }
 };
 
-/// The lines [from, to) of a log (1-based line numbers as the file counts them) appended to
-/// `out`, moved out of `lines`.
-void take_lines(std::vector<SessionLogLine>& lines, std::int64_t from, std::int64_t to,
-                std::vector<SessionLogLine>& out) {
-  const bool all = lines.empty() || (lines.front().line_no >= from && lines.back().line_no < to);
-  if (all && out.empty()) {  // a session without restarts: no copy at all
-    out = std::move(lines);
-    lines.clear();
-    return;
-  }
-  for (auto& l : lines)
-    if (l.line_no >= from && l.line_no < to) out.push_back(std::move(l));
+/// The lines [from, to) of `log` (1-based line numbers as the file counts them), pulled one at a
+/// time: what one daemon's life answers from.
+ReplayFeed<SessionLogLine>::Pull lines_between(SessionLogStream* log, std::int64_t from,
+                                               std::int64_t to) {
+  return [log, from, to](SessionLogLine& out) {
+    if (log == nullptr) return false;
+    while (log->peek() != nullptr && log->peek()->line_no < from) (void)log->take();
+    if (log->peek() == nullptr || log->peek()->line_no >= to) return false;
+    out = log->take();
+    return true;
+  };
 }
 
+/// One log of several devices (modbus.log, ascii.log) split by device as each asks: the lines of
+/// the others read on the way wait for theirs (a tick's worth: the daemon asks in log order).
+class DeviceSplit {
+ public:
+  explicit DeviceSplit(ReplayFeed<SessionLogLine> lines) : lines_(std::move(lines)) {}
+  ReplayFeed<SessionLogLine>::Pull of(const std::string& device) {
+    return [this, device](SessionLogLine& out) {
+      auto& mine = waiting_[device];
+      while (mine.empty()) {
+        if (lines_.peek() == nullptr) return false;
+        SessionLogLine l = lines_.take();
+        if (l.device == device) {
+          out = std::move(l);
+          return true;
+        }
+        waiting_[l.device].push_back(std::move(l));
+      }
+      out = std::move(mine.front());
+      mine.pop_front();
+      return true;
+    };
+  }
+
+ private:
+  ReplayFeed<SessionLogLine> lines_;
+  std::map<std::string, std::deque<SessionLogLine>> waiting_;
+};
+
 /// The replay transports of every device for one daemon's life (one segment of a session: the
-/// whole run, or the part before a kill, or after a resume).
+/// whole run, or the part before a kill, or after a resume), each pulling its lines from the logs.
 struct ReplayRig {
-  std::map<std::string, std::vector<SessionLogLine>> modbus;  ///< by device
-  std::map<std::string, std::vector<SessionLogLine>> ascii;   ///< by device
-  std::vector<SessionLogLine> gpio;
-  std::vector<dr::can::CandumpRecord> can;
-  std::vector<double> sync_times_s;
+  DeviceSplit modbus, ascii;
+  ReplayFeed<SessionLogLine> gpio;
+  std::shared_ptr<ReplayFeed<dr::can::CandumpRecord>> can;
+  std::vector<double> sync_times_s;  ///< of the SYNC frames read from the CAN log so far
+  bool keep;                         ///< keep what was replayed (a resumed simulation asks again)
   std::map<std::string, const RecordedModbusWire*> wires;
   std::map<std::string, const RecordedLineWire*> line_wires;
   const ReplayCanTransport* can_transport = nullptr;
   const ReplayGpioBank* gpio_bank = nullptr;
 
-  ReplayRig(std::vector<SessionLogLine> modbus_lines, std::vector<SessionLogLine> ascii_lines,
-            std::vector<SessionLogLine> gpio_lines, std::vector<dr::can::CandumpRecord> can_records)
-      : gpio(std::move(gpio_lines)), can(std::move(can_records)) {
-    for (const auto& [lines, by_device] :
-         {std::pair{&modbus_lines, &modbus}, std::pair{&ascii_lines, &ascii}}) {
-      std::vector<SessionLogLine>* to = nullptr;  // the last line's device's (lines come in runs)
-      for (auto& l : *lines) {
-        if (to == nullptr || to->back().device != l.device) to = &(*by_device)[l.device];
-        to->push_back(std::move(l));
-      }
+  ReplayRig(ReplayFeed<SessionLogLine> modbus_lines, ReplayFeed<SessionLogLine> ascii_lines,
+            ReplayFeed<SessionLogLine> gpio_lines, std::vector<dr::can::CandumpRecord> can_prefix,
+            ReplayFeed<dr::can::CandumpRecord>::Pull can_pull, bool keep_consumed)
+      : modbus(std::move(modbus_lines)),
+        ascii(std::move(ascii_lines)),
+        gpio(std::move(gpio_lines)),
+        keep(keep_consumed) {
+    for (const auto& r : can_prefix) note_sync(r);
+    can = std::make_shared<ReplayFeed<dr::can::CandumpRecord>>(
+        std::move(can_prefix),
+        [this, pull = std::move(can_pull)](dr::can::CandumpRecord& r) {
+          if (!pull(r)) return false;
+          note_sync(r);
+          return true;
+        },
+        keep);
+  }
+  ReplayRig(const ReplayRig&) = delete;
+  ReplayRig& operator=(const ReplayRig&) = delete;
+
+  void note_sync(const dr::can::CandumpRecord& r) {
+    if (is_sync_frame(r.frame))
+      sync_times_s.push_back(static_cast<double>(r.time_sec) + 1e-6 * r.time_usec);
+  }
+  /// The SYNC frames of this life's CAN log stamped at or before `t_s` (read ahead to the first
+  /// after it).
+  std::size_t syncs_logged_by(double t_s) {
+    while ((sync_times_s.empty() || sync_times_s.back() <= t_s) &&
+           can->peek(can->read_ahead()) != nullptr) {
     }
-    for (const auto& r : can)
-      if ((r.frame.can_id & CAN_EFF_MASK) == 0x080)  // SYNC (schemas/can_frames.md)
-        sync_times_s.push_back(static_cast<double>(r.time_sec) + 1e-6 * r.time_usec);
+    return static_cast<std::size_t>(
+        std::upper_bound(sync_times_s.begin(), sync_times_s.end(), t_s) - sync_times_s.begin());
   }
   RigOptions options(const dr::Clock& clock) {
     RigOptions o;
     o.clock = &clock;
     o.modbus_wire_factory = [this](const std::string& device, const dr::modbus::Endpoint&) {
-      // Each factory runs once per device: the recording moves into its transport.
-      auto w = std::make_unique<RecordedModbusWire>(device, std::move(modbus[device]));
+      // Each factory runs once per device: its lines go to its transport as it asks.
+      auto w = std::make_unique<RecordedModbusWire>(
+          device, ReplayFeed<SessionLogLine>({}, modbus.of(device), keep));
       wires[device] = w.get();
       return w;
     };
     o.line_wire_factory = [this](const std::string& device, const dr::ascii::LineEndpoint&) {
-      auto w = std::make_unique<RecordedLineWire>(device, std::move(ascii[device]));
+      auto w = std::make_unique<RecordedLineWire>(
+          device, ReplayFeed<SessionLogLine>({}, ascii.of(device), keep));
       line_wires[device] = w.get();
       return w;
     };
     o.can_transport_factory = [this] {
-      auto t = std::make_unique<ReplayCanTransport>(std::move(can));
+      auto t = std::make_unique<ReplayCanTransport>(can);
       can_transport = t.get();
       return t;
     };
     o.replayed_can = true;
     o.gpio_factory = [this](const dr::gpio::GpioConfig& g) {
-      auto b = std::make_unique<ReplayGpioBank>(g, std::move(gpio), sync_times_s, [this] {
-        return can_transport != nullptr ? can_transport->syncs_sent() : std::size_t{0};
-      });
+      auto b = std::make_unique<ReplayGpioBank>(
+          g, std::move(gpio), [this](double t_s) { return syncs_logged_by(t_s); },
+          [this] {
+            return can_transport != nullptr ? can_transport->syncs_sent() : std::size_t{0};
+          });
       gpio_bank = b.get();
       return b;
     };
@@ -124,9 +172,9 @@ struct ReplayRig {
                 std::vector<SessionLogLine>& gpio_out,
                 std::vector<dr::can::CandumpRecord>& can_out) const {
     for (const auto& [device, wire] : wires)
-      for (auto& l : wire->consumed()) modbus_out.push_back(std::move(l));
+      for (const auto& l : wire->consumed()) modbus_out.push_back(l);
     for (const auto& [device, wire] : line_wires)
-      for (auto& l : wire->consumed()) ascii_out.push_back(std::move(l));
+      for (const auto& l : wire->consumed()) ascii_out.push_back(l);
     for (auto* out : {&modbus_out, &ascii_out})
       std::sort(out->begin(), out->end(),
                 [](const auto& a, const auto& b) { return a.line_no < b.line_no; });
@@ -178,42 +226,52 @@ class DaemonReplay {
   /// The run's id, 0 when a divergence ended it (reported in the report).
   std::int64_t run() {
     for (std::size_t k = 0; k <= resumes_.size(); ++k) {
-      ReplayRig devices = take(k < resumes_.size() ? &resumes_[k] : nullptr);
-      if (const auto id = segment(k, devices)) return *id;
+      const auto devices = take(k < resumes_.size() ? &resumes_[k] : nullptr);
+      if (const auto id = segment(k, *devices)) return *id;
     }
     return 0;
   }
 
  private:
   /// The recorded devices of daemon k, which ran until `killed` (nullptr: to the end).
-  ReplayRig take(const SessionResume* killed) {
+  std::unique_ptr<ReplayRig> take(const SessionResume* killed) {
     const auto end = [killed](std::int64_t lines) {
       return killed ? lines + 1 : std::numeric_limits<std::int64_t>::max();
     };
-    std::vector<SessionLogLine> modbus = std::move(modbus_prefix_), gpio = std::move(gpio_prefix_);
-    std::vector<SessionLogLine> ascii = std::move(ascii_prefix_);
-    take_lines(logs_.modbus, modbus_from_, end(killed ? killed->modbus_lines : 0), modbus);
-    take_lines(logs_.ascii, ascii_from_, end(killed ? killed->ascii_lines : 0), ascii);
-    take_lines(logs_.gpio, gpio_from_, end(killed ? killed->gpio_lines : 0), gpio);
-    std::vector<dr::can::CandumpRecord> can = std::move(can_prefix_);
-    const auto can_to = killed ? std::min<std::size_t>(static_cast<std::size_t>(killed->can_lines),
-                                                       logs_.can.size())
-                               : logs_.can.size();
-    if (can.empty() && can_from_ == 0 && can_to == logs_.can.size()) {
-      can = std::move(logs_.can);
-      logs_.can.clear();
-    } else {
-      can.reserve(can.size() + (can_to - static_cast<std::size_t>(can_from_)));
-      for (auto i = static_cast<std::size_t>(can_from_); i < can_to; ++i)
-        can.push_back(std::move(logs_.can[i]));
-    }
+    // A resumed simulation's daemon asks what the killed one replayed again: kept only then.
+    const bool keep = !resumes_.empty() && session_.sim_seed.has_value();
+    // Modbus and ASCII lines are kept by each device's feed, GPIO's by its one.
+    auto feed = [&](std::vector<SessionLogLine>& prefix, SessionLogStream* log, std::int64_t from,
+                    std::int64_t lines, bool keep_here = false) {
+      return ReplayFeed<SessionLogLine>(std::move(prefix), lines_between(log, from, end(lines)),
+                                        keep_here);
+    };
+    const std::int64_t can_to =
+        killed ? killed->can_lines : std::numeric_limits<std::int64_t>::max();
+    auto can_pull = [this, from = can_from_, can_to](dr::can::CandumpRecord& r) {
+      for (; logs_.can_records < can_to; ++logs_.can_records) {
+        if (!logs_.can.next(r)) return false;
+        if (logs_.can_records >= from) return ++logs_.can_records, true;
+      }
+      return false;
+    };
+    auto rig = std::make_unique<ReplayRig>(
+        feed(modbus_prefix_, &logs_.modbus, modbus_from_, killed ? killed->modbus_lines : 0),
+        feed(ascii_prefix_, logs_.ascii ? &*logs_.ascii : nullptr, ascii_from_,
+             killed ? killed->ascii_lines : 0),
+        feed(gpio_prefix_, &logs_.gpio, gpio_from_, killed ? killed->gpio_lines : 0, keep),
+        std::move(can_prefix_), can_pull, keep);
+    modbus_prefix_.clear();
+    ascii_prefix_.clear();
+    gpio_prefix_.clear();
+    can_prefix_.clear();
     if (killed) {
       modbus_from_ = killed->modbus_lines + 1;
       ascii_from_ = killed->ascii_lines + 1;
       gpio_from_ = killed->gpio_lines + 1;
-      can_from_ = static_cast<std::int64_t>(can_to);
+      can_from_ = killed->can_lines;
     }
-    return ReplayRig(std::move(modbus), std::move(ascii), std::move(gpio), std::move(can));
+    return rig;
   }
 
   /// Daemon k's life: the run's id when it ended the run, 0 on a divergence, nullopt when it

@@ -30,21 +30,21 @@ std::string describe(const SessionLogLine& l) {
 
 }  // namespace
 
-ReplayGpioBank::ReplayGpioBank(dr::gpio::GpioConfig config, std::vector<SessionLogLine> lines,
-                               std::vector<double> sync_times_s,
+ReplayGpioBank::ReplayGpioBank(dr::gpio::GpioConfig config, ReplayFeed<SessionLogLine> lines,
+                               std::function<std::size_t(double)> syncs_logged_by,
                                std::function<std::size_t()> syncs_sent)
     : config_(std::move(config)),
       lines_(std::move(lines)),
-      sync_times_s_(std::move(sync_times_s)),
+      syncs_logged_by_(std::move(syncs_logged_by)),
       syncs_sent_(std::move(syncs_sent)) {}
 
 const SessionLogLine& ReplayGpioBank::expect(const char* kind, std::string_view role,
                                              const std::string& asked) {
-  if (next_ >= lines_.size()) throw ReplayDivergence("gpio", "no more exchanges", asked, 0);
-  const SessionLogLine& l = lines_[next_];
-  if (l.kind != kind || role_of(l) != role || l.bytes.size() != 1)
-    throw ReplayDivergence("gpio", describe(l), asked, l.t_s);
-  ++next_;
+  const SessionLogLine* next = lines_.peek();
+  if (next == nullptr) throw ReplayDivergence("gpio", "no more exchanges", asked, 0);
+  if (next->kind != kind || role_of(*next) != role || next->bytes.size() != 1)
+    throw ReplayDivergence("gpio", describe(*next), asked, next->t_s);
+  const SessionLogLine& l = lines_.take();
   signal();
   return l;
 }
@@ -63,12 +63,9 @@ void ReplayGpioBank::signal() {
   // The next exchange is an edge drained between ticks when no more SYNCs preceded it than the
   // replay has sent: a tick's own drain comes after that tick's SYNC. (Stamps: SYNCs truncated
   // to the microsecond, session lines rounded, so one instant never orders an edge first.)
-  const auto before_edge = [this](double t_s) {
-    return static_cast<std::size_t>(
-        std::upper_bound(sync_times_s_.begin(), sync_times_s_.end(), t_s) - sync_times_s_.begin());
-  };
-  set(next_ < lines_.size() && lines_[next_].kind == "gpio-edge" &&
-      before_edge(lines_[next_].t_s) <= (syncs_sent_ ? syncs_sent_() : 0));
+  const SessionLogLine* next = lines_.peek();
+  set(next != nullptr && next->kind == "gpio-edge" &&
+      syncs_logged_by_(next->t_s) <= (syncs_sent_ ? syncs_sent_() : 0));
 }
 
 dr::Result<void> ReplayGpioBank::open() {
@@ -108,9 +105,9 @@ void ReplayGpioBank::close() {
   // Releasing the lines drove the outputs to their safe levels (the recording's last writes);
   // taken when they are next, never thrown from here (a replay may have stopped early).
   for (const auto& line : config_.lines) {
-    if (line.direction != dr::gpio::GpioDirection::output || next_ >= lines_.size()) continue;
-    const SessionLogLine& l = lines_[next_];
-    if (l.kind == "gpio-write" && role_of(l) == line.role) ++next_;
+    const SessionLogLine* l = lines_.peek();
+    if (line.direction != dr::gpio::GpioDirection::output || l == nullptr) continue;
+    if (l->kind == "gpio-write" && role_of(*l) == line.role) (void)lines_.take();
   }
   open_ = false;
   efd_.reset();
@@ -118,8 +115,8 @@ void ReplayGpioBank::close() {
 
 dr::Result<std::vector<dr::gpio::GpioEdge>> ReplayGpioBank::read_events() {
   std::vector<dr::gpio::GpioEdge> out;
-  while (next_ < lines_.size() && lines_[next_].kind == "gpio-edge") {
-    const SessionLogLine& l = lines_[next_++];
+  while (lines_.peek() != nullptr && lines_.peek()->kind == "gpio-edge") {
+    const SessionLogLine& l = lines_.take();
     const auto* cfg = dr::gpio::find_role(config_, role_of(l));
     if (cfg == nullptr || l.bytes.size() != 1)
       throw ReplayDivergence("gpio", describe(l), "an edge of a configured line", l.t_s);

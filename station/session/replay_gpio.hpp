@@ -10,17 +10,19 @@
 
 #include "drivers/common/unique_fd.hpp"
 #include "drivers/gpio/gpio_bank.hpp"
+#include "station/session/replay_feed.hpp"
 #include "station/session/session_log.hpp"
 
 namespace station {
 
 class ReplayGpioBank final : public drivers::gpio::GpioBank {
  public:
-  /// `sync_times_s`: the stamps of the recording's SYNC frames (ticks), and `syncs_sent` how
-  /// many the replay has sent: an edge is offered between ticks only when the recording drained
-  /// it before the next tick's SYNC.
-  ReplayGpioBank(drivers::gpio::GpioConfig config, std::vector<SessionLogLine> lines,
-                 std::vector<double> sync_times_s, std::function<std::size_t()> syncs_sent);
+  /// `syncs_logged_by(t_s)`: how many of the recording's SYNC frames (ticks) are stamped at or
+  /// before t_s, and `syncs_sent` how many the replay has sent: an edge is offered between ticks
+  /// only when the recording drained it before the next tick's SYNC.
+  ReplayGpioBank(drivers::gpio::GpioConfig config, ReplayFeed<SessionLogLine> lines,
+                 std::function<std::size_t(double)> syncs_logged_by,
+                 std::function<std::size_t()> syncs_sent);
   drivers::Result<void> open() override;
   drivers::Result<bool> read(std::string_view role) override;
   drivers::Result<void> write(std::string_view role, bool active) override;
@@ -31,23 +33,20 @@ class ReplayGpioBank final : public drivers::gpio::GpioBank {
   void set_tap(drivers::Tap*) override {}
   const drivers::gpio::GpioConfig& config() const override { return config_; }
   /// Exchanges not replayed yet.
-  std::size_t remaining() const { return lines_.size() - next_; }
+  std::size_t remaining() { return lines_.remaining(); }
   /// The exchanges replayed so far (a resumed simulation asks them again).
-  std::vector<SessionLogLine> consumed() const {
-    return {lines_.begin(), lines_.begin() + static_cast<std::ptrdiff_t>(next_)};
-  }
+  const std::vector<SessionLogLine>& consumed() const { return lines_.consumed(); }
 
  private:
   const SessionLogLine& expect(const char* kind, std::string_view role, const std::string& asked);
   void signal();  ///< the event fd readable iff the next exchange is an edge
 
   drivers::gpio::GpioConfig config_;
-  std::vector<SessionLogLine> lines_;
-  std::size_t next_ = 0;
+  ReplayFeed<SessionLogLine> lines_;
   drivers::UniqueFd efd_;
   bool readable_ = false;  ///< what the event fd holds (only this bank reads or writes it)
   bool open_ = false;
-  std::vector<double> sync_times_s_;
+  std::function<std::size_t(double)> syncs_logged_by_;
   std::function<std::size_t()> syncs_sent_;
 };
 

@@ -27,6 +27,9 @@ ReplayDivergence::ReplayDivergence(std::string d, std::string rec, std::string a
       t_s(t) {}
 
 RecordedModbusWire::RecordedModbusWire(std::string device, std::vector<SessionLogLine> lines)
+    : RecordedModbusWire(std::move(device), ReplayFeed<SessionLogLine>(std::move(lines))) {}
+
+RecordedModbusWire::RecordedModbusWire(std::string device, ReplayFeed<SessionLogLine> lines)
     : device_(std::move(device)), lines_(std::move(lines)) {}
 
 const SessionLogLine& RecordedModbusWire::expect(const char* direction, const char* kind,
@@ -36,15 +39,14 @@ const SessionLogLine& RecordedModbusWire::expect(const char* direction, const ch
   if (l == nullptr) throw ReplayDivergence(device_, "no more exchanges", asked(), 0);
   if (l->direction != direction || l->kind != kind || (bytes != nullptr && l->bytes != *bytes))
     throw ReplayDivergence(device_, describe(*l), asked(), l->t_s);
-  ++next_;
-  return *l;
+  return lines_.take();
 }
 
 const std::vector<std::uint8_t>* RecordedModbusWire::reply(const char* kind, const Asked& asked) {
   const SessionLogLine* l = peek();
   if (l != nullptr && l->direction == "event" && l->kind == "error" && l->bytes.size() == 4) {
-    ++next_;
-    errno = mb::errno_of_bytes(std::span<const std::uint8_t, 4>(l->bytes.data(), 4));
+    const auto& e = lines_.take();
+    errno = mb::errno_of_bytes(std::span<const std::uint8_t, 4>(e.bytes.data(), 4));
     return nullptr;
   }
   return &expect("rx", kind, nullptr, [&asked] { return "the reply to " + asked(); }).bytes;
@@ -63,7 +65,7 @@ int RecordedModbusWire::open(double) {
 
 void RecordedModbusWire::close() {
   const SessionLogLine* l = peek();
-  if (l != nullptr && l->direction == "event" && l->kind == "disconnect") ++next_;
+  if (l != nullptr && l->direction == "event" && l->kind == "disconnect") (void)lines_.take();
 }
 
 // The request's description is built only for a divergence: a long replay asks ~10^6 times.

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "drivers/modbus/modbus_wire.hpp"
+#include "station/session/replay_feed.hpp"
 #include "station/session/session_log.hpp"
 
 namespace station {
@@ -28,6 +29,8 @@ class ReplayDivergence : public std::runtime_error {
 class RecordedModbusWire final : public drivers::modbus::ModbusWire {
  public:
   RecordedModbusWire(std::string device, std::vector<SessionLogLine> lines);
+  /// The lines as the replay pulls them from modbus.log.
+  RecordedModbusWire(std::string device, ReplayFeed<SessionLogLine> lines);
   int open(double timeout_s) override;
   void close() override;
   int read(drivers::modbus::FunctionCode fc, int unit, std::uint16_t addr, int count,
@@ -35,11 +38,9 @@ class RecordedModbusWire final : public drivers::modbus::ModbusWire {
   int write(int unit, std::uint16_t addr, std::span<const std::uint16_t> words) override;
   void flush() override {}
   /// Exchanges not asked for yet (0 at the end of a faithful replay).
-  std::size_t remaining() const { return lines_.size() - next_; }
+  std::size_t remaining() { return lines_.remaining(); }
   /// The exchanges replayed so far (a resumed simulation asks them again).
-  std::vector<SessionLogLine> consumed() const {
-    return {lines_.begin(), lines_.begin() + static_cast<std::ptrdiff_t>(next_)};
-  }
+  const std::vector<SessionLogLine>& consumed() const { return lines_.consumed(); }
 
  private:
   /// Describes the daemon's request, for a divergence only.
@@ -50,11 +51,10 @@ class RecordedModbusWire final : public drivers::modbus::ModbusWire {
                                const std::vector<std::uint8_t>* bytes, const Asked& asked);
   /// After a request: its reply's bytes, or nullptr for its recorded error (errno set).
   const std::vector<std::uint8_t>* reply(const char* kind, const Asked& asked);
-  const SessionLogLine* peek() const { return next_ < lines_.size() ? &lines_[next_] : nullptr; }
+  const SessionLogLine* peek() { return lines_.peek(); }
 
   std::string device_;
-  std::vector<SessionLogLine> lines_;
-  std::size_t next_ = 0;
+  ReplayFeed<SessionLogLine> lines_;
 };
 
 }  // namespace station

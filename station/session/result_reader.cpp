@@ -4,6 +4,8 @@
 
 #include <fmt/format.h>
 
+#include <istream>
+#include <streambuf>
 #include <vector>
 
 #include "station/common/input_error.hpp"
@@ -76,28 +78,43 @@ class TickStreamingSax final : public nlohmann::json_sax<json> {
   json root_;
 };
 
+/// The file's lines, each with a newline, as a stream the parser reads: a line in memory at a time
+/// (the text the parser sees, and so a "byte N" it names, is that of read_session_log's lines).
+class LineStreamBuf final : public std::streambuf {
+ public:
+  explicit LineStreamBuf(const std::string& path) : reader_(path) {}
+  const std::string& file() const { return reader_.file(); }
+
+ protected:
+  int_type underflow() override {
+    std::string_view line;
+    int line_no = 0;
+    if (!reader_.next(line, line_no)) return traits_type::eof();
+    line_.assign(line);
+    line_.push_back('\n');
+    setg(line_.data(), line_.data(), line_.data() + line_.size());
+    return traits_type::to_int_type(line_.front());
+  }
+
+ private:
+  LogLineReader reader_;
+  std::string line_;
+};
+
 }  // namespace
 
 json read_result_file(const std::string& path, const std::function<void(json&&)>& on_tick) {
-  std::string text;
-  const std::string file = for_each_line(path, [&text](std::string_view line, int) {
-    text.append(line);
-    text.push_back('\n');
-  });
+  LineStreamBuf text(path);
+  std::istream in(&text);
+  const std::string file = text.file();
   TickStreamingSax sax(file, on_tick);
-  json::sax_parse(text, &sax);
+  json::sax_parse(in, &sax);
   json root = sax.take_root();
   if (!root.is_object()) throw InputError(fmt::format("{}: not a JSON object", file));
   // An array's elements went to on_tick and left it empty; anything else was kept (fuzz finding).
   if (const auto t = root.find("ticks"); t != root.end() && !(t->is_array() && t->empty()))
     throw InputError(fmt::format("{}: key 'ticks': not an array", file));
   return root;
-}
-
-RecordedResult read_recorded_result(const std::string& path) {
-  RecordedResult r;
-  r.head = read_result_file(path, [&r](json&& tick) { r.ticks.push_back(std::move(tick)); });
-  return r;
 }
 
 }  // namespace station

@@ -16,13 +16,4 @@ namespace station {
 nlohmann::json read_result_file(const std::string& path,
                                 const std::function<void(nlohmann::json&&)>& on_tick);
 
-/// A whole result.json as read: its head and its ticks in order.
-struct RecordedResult {
-  nlohmann::json head;
-  std::vector<nlohmann::json> ticks;
-};
-
-/// Reads `path` (or `path`.gz) whole with read_result_file. Throws InputError as it does.
-RecordedResult read_recorded_result(const std::string& path);
-
 }  // namespace station

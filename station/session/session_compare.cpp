@@ -251,14 +251,14 @@ nlohmann::json ReplayReport::json() const {
            max_abs_difference.is_null() ? nlohmann::json::object() : max_abs_difference}};
 }
 
-ReplayReport compare_with_store(const RecordedResult& recorded_result,
-                                const std::string& result_path, Store& store, std::int64_t run_id,
+ReplayReport compare_with_store(const std::string& result_path, Store& store, std::int64_t run_id,
                                 double rtol, double atol) {
   ReplayReport r;
   Comparer c{rtol, atol, r};
   TickComparer ticks(c, store, run_id);
-  for (const auto& tick : recorded_result.ticks) ticks.recorded(tick);
-  const json& recorded = recorded_result.head;
+  // Each recorded tick compared as it is read, with the replayed store's, then forgotten.
+  const json recorded =
+      read_result_file(result_path, [&ticks](json&& tick) { ticks.recorded(tick); });
   r.ticks = ticks.finish();
   const auto version = recorded.value("format_version", json());
   if (version != kSessionFormatVersion)

@@ -62,21 +62,28 @@ std::optional<double> sample_number(const SampleRow& r, std::size_t column) {
 }
 
 TickCursor::TickCursor(Store& store, std::int64_t run_id) {
-  for (const auto& slot : store.run_slots(run_id))
-    by_slot_.push_back(store.samples(run_id, slot.serial, false));
-  next_.assign(by_slot_.size(), 0);
+  for (const auto& slot : store.run_slots(run_id)) {
+    readers_.emplace_back(store, run_id, slot.serial, false);
+    SampleRow r;
+    ahead_.push_back(readers_.back().next(r) ? std::optional(std::move(r)) : std::nullopt);
+  }
+  taken_.resize(readers_.size());
 }
 
 bool TickCursor::next(double& t_s, std::vector<const SampleRow*>& rows) {
   // A merge of the slots' series (each sorted by t_s); slot order within a tick.
   t_s = INFINITY;
-  for (std::size_t k = 0; k < by_slot_.size(); ++k)
-    if (next_[k] < by_slot_[k].size()) t_s = std::min(t_s, by_slot_[k][next_[k]].t_s);
+  for (const auto& a : ahead_)
+    if (a) t_s = std::min(t_s, a->t_s);
   if (!std::isfinite(t_s)) return false;
   rows.clear();
-  for (std::size_t k = 0; k < by_slot_.size(); ++k)
-    if (next_[k] < by_slot_[k].size() && by_slot_[k][next_[k]].t_s == t_s)
-      rows.push_back(&by_slot_[k][next_[k]++]);
+  for (std::size_t k = 0; k < ahead_.size(); ++k) {
+    if (!ahead_[k] || ahead_[k]->t_s != t_s) continue;
+    taken_[k] = std::move(*ahead_[k]);
+    rows.push_back(&taken_[k]);
+    SampleRow r;
+    ahead_[k] = readers_[k].next(r) ? std::optional(std::move(r)) : std::nullopt;
+  }
   return true;
 }
 

@@ -79,16 +79,18 @@ nlohmann::json sample_row_json(const SampleRow& r);
 /// building the JSON — for comparing millions of rows.
 std::optional<double> sample_number(const SampleRow& r, std::size_t column);
 
-/// The run's stored ticks one at a time, in time order, with the samples of a tick in slot order.
+/// The run's stored ticks one at a time, in time order, with the samples of a tick in slot order:
+/// read from the store as they are asked for (a row ahead per slot), never held whole.
 class TickCursor {
  public:
   TickCursor(Store& store, std::int64_t run_id);
-  /// The next tick's time and samples (pointers valid while the cursor lives); false at the end.
+  /// The next tick's time and samples (pointers valid until the next call); false at the end.
   bool next(double& t_s, std::vector<const SampleRow*>& rows);
 
  private:
-  std::vector<std::vector<SampleRow>> by_slot_;
-  std::vector<std::size_t> next_;
+  std::vector<SampleReader> readers_;            // per slot
+  std::vector<std::optional<SampleRow>> ahead_;  // per slot: its next sample
+  std::vector<SampleRow> taken_;                 // per slot: the tick's sample handed out
 };
 
 /// Calls `each(t_s, rows)` for every tick of the run in time order, with the stored samples of

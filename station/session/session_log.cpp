@@ -74,58 +74,104 @@ dr::Result<SessionLogLine> parse_session_line(std::string_view line) {
   return out;
 }
 
-std::string for_each_line(const std::string& path,
-                          const std::function<void(std::string_view, int)>& each) {
-  std::string file = path;
-  if (!std::filesystem::exists(file) && std::filesystem::exists(path + ".gz")) file = path + ".gz";
+struct LogLineReader::Gz {
+  GzHandle handle;
+};
+
+LogLineReader::LogLineReader(const std::string& path) : file_(path) {
+  if (!std::filesystem::exists(file_) && std::filesystem::exists(path + ".gz"))
+    file_ = path + ".gz";
   // zlib reads a file that is not gzip-compressed as it is.
-  GzHandle in(gzopen(file.c_str(), "rb"));
-  if (!in) throw InputError(fmt::format("{}: cannot open the session log", file));
+  in_ = std::make_unique<Gz>(Gz{GzHandle(gzopen(file_.c_str(), "rb"))});
+  if (!in_->handle) throw InputError(fmt::format("{}: cannot open the session log", file_));
   // Large reads, lines split in place: a session log has millions of lines (a small file gets a
   // small buffer).
   std::error_code ec;
-  const auto size = std::filesystem::file_size(file, ec);
-  const std::size_t kChunk =
+  const auto size = std::filesystem::file_size(file_, ec);
+  chunk_ =
       ec ? std::size_t{1} << 20 : std::clamp<std::size_t>(size + 1, 4096, std::size_t{1} << 20);
-  gzbuffer(in.get(), static_cast<unsigned>(kChunk));
-  std::string buf;
-  std::size_t begin = 0;  // first byte of buf not yet handed out
-  int line_no = 0;
-  const auto take = [&](std::string_view line) {
-    ++line_no;
-    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-    if (!line.empty()) each(line, line_no);
-  };
-  for (;;) {
-    buf.erase(0, begin);
-    begin = 0;
-    const std::size_t had = buf.size();
-    buf.resize(had + kChunk);
-    const int n = gzread(in.get(), buf.data() + had, static_cast<unsigned>(kChunk));
-    buf.resize(had + static_cast<std::size_t>(std::max(n, 0)));
-    if (n <= 0) break;
-    for (std::size_t nl; (nl = buf.find('\n', begin)) != std::string::npos; begin = nl + 1)
-      take(std::string_view(buf).substr(begin, nl - begin));
-  }
+  gzbuffer(in_->handle.get(), static_cast<unsigned>(chunk_));
+}
+
+LogLineReader::~LogLineReader() = default;
+LogLineReader::LogLineReader(LogLineReader&&) noexcept = default;
+
+bool LogLineReader::refill() {
+  buf_.erase(0, begin_);
+  begin_ = 0;
+  const std::size_t had = buf_.size();
+  buf_.resize(had + chunk_);
+  const int n = gzread(in_->handle.get(), buf_.data() + had, static_cast<unsigned>(chunk_));
+  buf_.resize(had + static_cast<std::size_t>(std::max(n, 0)));
+  if (n > 0) return true;
+  eof_ = true;
   int err = Z_OK;
-  gzerror(in.get(), &err);
+  gzerror(in_->handle.get(), &err);
   if (err != Z_OK && err != Z_STREAM_END)
-    throw InputError(fmt::format("{}:{}: corrupt compressed data", file, line_no + 1));
-  if (begin < buf.size()) take(std::string_view(buf).substr(begin));
-  return file;
+    throw InputError(fmt::format("{}:{}: corrupt compressed data", file_, line_no_ + 1));
+  return false;
+}
+
+bool LogLineReader::next(std::string_view& line, int& line_no) {
+  for (;;) {
+    const auto nl = buf_.find('\n', begin_);
+    if (nl == std::string::npos && !eof_ && refill()) continue;
+    if (begin_ >= buf_.size()) return false;  // the end (a last line without newline taken)
+    const auto end = nl == std::string::npos ? buf_.size() : nl;
+    line = std::string_view(buf_).substr(begin_, end - begin_);
+    begin_ = nl == std::string::npos ? buf_.size() : nl + 1;
+    ++line_no_;
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    if (line.empty()) continue;
+    line_no = line_no_;
+    return true;
+  }
+}
+
+std::string for_each_line(const std::string& path,
+                          const std::function<void(std::string_view, int)>& each) {
+  LogLineReader reader(path);
+  std::string_view line;
+  int line_no = 0;
+  while (reader.next(line, line_no)) each(line, line_no);
+  return reader.file();
+}
+
+const SessionLogLine* SessionLogStream::peek() {
+  if (next_) return &*next_;
+  std::string_view line;
+  int line_no = 0;
+  if (!reader_.next(line, line_no)) return nullptr;
+  auto parsed = parse_session_line(line);
+  if (!parsed)
+    throw InputError(fmt::format("{}:{}: {}", reader_.file(), line_no, parsed.error().message));
+  parsed.value().line_no = line_no;
+  next_ = std::move(parsed).value();
+  return &*next_;
+}
+
+SessionLogLine SessionLogStream::take() {
+  SessionLogLine out = std::move(*next_);
+  next_.reset();
+  return out;
+}
+
+bool CanLogStream::next(drivers::can::CandumpRecord& record) {
+  std::string_view line;
+  int line_no = 0;
+  while (reader_.next(line, line_no)) {
+    if (line.find_first_not_of(" \t") == std::string::npos) continue;
+    auto r = drivers::can::parse_candump_line(line);
+    if (!r) throw InputError(fmt::format("{}:{}: {}", reader_.file(), line_no, r.error().message));
+    record = std::move(r).value();
+    return true;
+  }
+  return false;
 }
 
 void read_session_log(const std::string& path, const std::function<void(SessionLogLine&&)>& each) {
-  const std::string file = for_each_line(path, [&](std::string_view line, int line_no) {
-    auto parsed = parse_session_line(line);
-    if (!parsed) {
-      const bool gz = !std::filesystem::exists(path);
-      throw InputError(
-          fmt::format("{}{}:{}: {}", path, gz ? ".gz" : "", line_no, parsed.error().message));
-    }
-    parsed.value().line_no = line_no;
-    each(std::move(parsed).value());
-  });
+  SessionLogStream stream(path);
+  while (stream.peek() != nullptr) each(stream.take());
 }
 
 namespace {
@@ -150,16 +196,8 @@ std::vector<SessionLogLine> read_session_log(const std::string& path) {
 std::vector<drivers::can::CandumpRecord> read_session_can_log(const std::string& path) {
   std::vector<drivers::can::CandumpRecord> out;
   out.reserve(expected_lines(path, 40));
-  for_each_line(path, [&](std::string_view line, int line_no) {
-    if (line.find_first_not_of(" \t") == std::string::npos) return;
-    auto r = drivers::can::parse_candump_line(line);
-    if (!r) {
-      const bool gz = !std::filesystem::exists(path);
-      throw InputError(
-          fmt::format("{}{}:{}: {}", path, gz ? ".gz" : "", line_no, r.error().message));
-    }
-    out.push_back(std::move(r).value());
-  });
+  CanLogStream stream(path);
+  for (drivers::can::CandumpRecord r; stream.next(r);) out.push_back(std::move(r));
   return out;
 }
 

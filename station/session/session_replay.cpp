@@ -9,7 +9,6 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <future>
 #include <optional>
 
 #include "station/common/input_error.hpp"
@@ -119,9 +118,6 @@ ReplayReport header_differs(const std::string& header_path, const nlohmann::json
 ReplayReport replay_and_compare(const ReplayOptions& o, const RecordedSession& session,
                                 const std::string& result_path) {
   const std::string db = fresh_db_path(o);
-  // result.json is parsed on another thread while the daemon replays.
-  auto recorded =
-      std::async(std::launch::async, [result_path] { return read_recorded_result(result_path); });
   ReplayReport report;
   {
     Store store(db);
@@ -133,7 +129,7 @@ ReplayReport replay_and_compare(const ReplayOptions& o, const RecordedSession& s
     });
     if (run_id != 0) {
       store.flush();
-      report = compare_with_store(recorded.get(), result_path, store, run_id, o.rtol, o.atol);
+      report = compare_with_store(result_path, store, run_id, o.rtol, o.atol);
     }
   }
   if (o.db.empty()) {

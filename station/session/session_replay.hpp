@@ -9,7 +9,6 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "station/session/result_reader.hpp"
 #include "station/store/store.hpp"
 
 namespace station {
@@ -45,10 +44,10 @@ struct ReplayReport {
 /// not hold) is a difference, reported with the tick, the device and both requests.
 ReplayReport replay_session(const ReplayOptions& o);
 
-/// Compares the recorded result.json (`recorded`, read from `result_path`) with run `run_id` of
-/// `store` (the replayed run): tick by tick, then bins, events and fits. Throws InputError naming
-/// the file when it is not a result.json of this format version.
-ReplayReport compare_with_store(const RecordedResult& recorded, const std::string& result_path,
-                                Store& store, std::int64_t run_id, double rtol, double atol);
+/// Compares the recorded result.json at `result_path` (or its .gz), read as it is compared, with
+/// run `run_id` of `store` (the replayed run): tick by tick, then bins, events and fits. Throws
+/// InputError naming the file when it is not a result.json of this format version.
+ReplayReport compare_with_store(const std::string& result_path, Store& store, std::int64_t run_id,
+                                double rtol, double atol);
 
 }  // namespace station

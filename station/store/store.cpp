@@ -208,32 +208,40 @@ Store::~Store() {
   }
 }
 
+SampleReader::SampleReader(Store& store, std::int64_t run_id, const std::string& serial,
+                           bool recording_only)
+    : st_(store.db().prepare(fmt::format(
+          "SELECT t_s, net_pulses, interval_s, rate_dph, temp_c, temp2_c, air_c, setpoint_c, "
+          "flags, recording FROM samples WHERE run_id = ? AND serial = ? {} ORDER BY t_s",
+          recording_only ? "AND recording = 1" : ""))),
+      serial_(serial) {
+  st_.bind(1, run_id).bind(2, serial);
+}
+
+bool SampleReader::next(SampleRow& r) {
+  if (!st_.step()) return false;
+  auto opt = [&](int c) {
+    return st_.column_is_null(c) ? std::nullopt : std::optional(st_.column_double(c));
+  };
+  r.serial = serial_;
+  r.t_s = st_.column_double(0);
+  r.net_pulses = st_.column_is_null(1) ? std::nullopt : std::optional(st_.column_int(1));
+  r.interval_s = opt(2);
+  r.rate_dph = opt(3);
+  r.temp_c = opt(4);
+  r.temp2_c = opt(5);
+  r.air_c = opt(6);
+  r.setpoint_c = opt(7);
+  r.flags = static_cast<int>(st_.column_int(8));
+  r.recording = st_.column_int(9) != 0;
+  return true;
+}
+
 std::vector<SampleRow> Store::samples(std::int64_t run_id, const std::string& serial,
                                       bool recording_only) {
-  auto st = db_.prepare(fmt::format(
-      "SELECT t_s, net_pulses, interval_s, rate_dph, temp_c, temp2_c, air_c, setpoint_c, flags, "
-      "recording FROM samples WHERE run_id = ? AND serial = ? {} ORDER BY t_s",
-      recording_only ? "AND recording = 1" : ""));
-  st.bind(1, run_id).bind(2, serial);
+  SampleReader reader(*this, run_id, serial, recording_only);
   std::vector<SampleRow> out;
-  auto opt = [&](int c) {
-    return st.column_is_null(c) ? std::nullopt : std::optional(st.column_double(c));
-  };
-  while (st.step()) {
-    SampleRow r;
-    r.serial = serial;
-    r.t_s = st.column_double(0);
-    if (!st.column_is_null(1)) r.net_pulses = st.column_int(1);
-    r.interval_s = opt(2);
-    r.rate_dph = opt(3);
-    r.temp_c = opt(4);
-    r.temp2_c = opt(5);
-    r.air_c = opt(6);
-    r.setpoint_c = opt(7);
-    r.flags = static_cast<int>(st.column_int(8));
-    r.recording = st.column_int(9) != 0;
-    out.push_back(std::move(r));
-  }
+  for (SampleRow r; reader.next(r);) out.push_back(r);
   return out;
 }
 

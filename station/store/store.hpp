@@ -162,6 +162,7 @@ class Store {
   }
   ~Store();
   /// Samples of one serial in a run, by time (recording window only when asked).
+  /// (SampleReader: the same, a row at a time.)
   std::vector<SampleRow> samples(std::int64_t run_id, const std::string& serial,
                                  bool recording_only);
   /// Number of samples stored for a run.
@@ -217,6 +218,19 @@ class Store {
   std::optional<Transaction> batch_;
   std::unordered_map<std::string, Statement> cache_;  // by SQL text; nodes never move
   int ticks_per_commit_ = 1, batch_ticks_ = 0;
+};
+
+/// The samples of one serial in a run, by time, read a row at a time (what Store::samples
+/// returns, without holding them).
+class SampleReader {
+ public:
+  SampleReader(Store& store, std::int64_t run_id, const std::string& serial, bool recording_only);
+  /// The next sample into `row`; false after the last.
+  bool next(SampleRow& row);
+
+ private:
+  Statement st_;
+  std::string serial_;
 };
 
 /// Current UTC time as ISO-8601 with milliseconds.
