@@ -75,6 +75,10 @@ def check_finished(port, db, run_id, printed):
 
 
 def check_running_and_bad(port, running_id):
+    deadline = time.time() + 30  # the daemon listens before its run is in the database
+    while api.request(port, "GET", f"/api/runs/{running_id}").status != 200 and \
+            time.time() < deadline:
+        time.sleep(0.1)
     r, body = api.get_json(port, f"/api/runs/{running_id}/acceptance")
     api.check(r.status == 200 and body == {"run_id": running_id, "computed_utc": None,
                                             "serials": []},
