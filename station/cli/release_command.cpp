@@ -46,6 +46,9 @@ void run_release(const ReleaseOptions& o) {
   const ReleaseRow r = release_fit(store, {o.fit_id, o.by, o.note, o.override_reason});
   fmt::print("{}: fit {} is the released calibration ({}, release {})\n", r.serial, r.fit_id,
              release_text(r), r.id);
+  // What `export` will carry beside the bias model (gyro_tc/4), or that it leaves the scale alone.
+  if (const auto fit = store.find_fit(r.fit_id))
+    fmt::print("  {}\n", scale_factor_text(find_scale_factor(store, *fit)));
   if (r.override_reason)
     fmt::print(stderr, "station: warning: fit {} released over its verdict: {}\n", r.fit_id,
                *r.override_reason);
@@ -111,6 +114,9 @@ void run_export(const ExportOptions& o) {
     std::cout << blocks_c_header(blocks, o.c_name);
   } else if (o.format == "px4") {
     std::cout << block_px4(blocks.front(), o.px4);
+    if (blocks.front().scale_factor.model)
+      fmt::print(stderr, "station: warning: {}: {}\n", blocks.front().serial,
+                 px4_scale_factor_note(blocks.front()));
   } else {
     nlohmann::json arr = nlohmann::json::array();
     for (const auto& b : blocks) arr.push_back(block_json(b));

@@ -73,12 +73,75 @@ std::string csv_field(const std::string& text) {
   return out + "\"";
 }
 
+/// The initializers after crc32 (gyro_tc/4), zeros when not measured: every field initialized
+/// (-Wextra's missing-field-initializers stays quiet), so the header needs this gyro_tc.h.
+std::string c_scale_factor(const gyro_tc_block& c) {
+  if (c.sf_measured == 0)
+    return ",\n    0, 0, 0, 0, 0, 0, 0, 0 /* scale factor: not measured (sf_measured 0) */";
+  return fmt::format(
+      ",\n    1, /* sf_measured */\n"
+      "    {:.17g}, {:.17g}, /* sf_k0_pulse_per_arcsec, sf_tc_ppm_per_c */\n"
+      "    {:.17g}, {:.17g}, {:.17g}, /* sf_t_ref_c, sf_t_min_c, sf_t_max_c */\n"
+      "    {:.17g}, {:.17g} /* pulse_weight_arcsec, earth_rate_dph */",
+      c.sf_k0_pulse_per_arcsec, c.sf_tc_ppm_per_c, c.sf_t_ref_c, c.sf_t_min_c, c.sf_t_max_c,
+      c.pulse_weight_arcsec, c.earth_rate_dph);
+}
+
 std::string release_summary(const CoefficientBlock& b) {
   return comment_safe(b.release ? release_text(*b.release)
                                 : "NOT RELEASED (exported with --fit; not the gyro's calibration)");
 }
 
+constexpr const char* kScaleModel =
+    "K(T) = sf_k0*(1 + sf_tc_ppm*1e-6*(clamp(T, sf_t_min_c, sf_t_max_c) - sf_t_ref_c)) "
+    "pulse/arcsec, "
+    "s = K(T)*pulse_weight_arcsec; rate = (nominal_rate - B - earth_rate_dph)/s + earth_rate_dph, "
+    "nominal_rate = pulses/s * pulse_weight_arcsec (deg/h); not measured: rate = nominal_rate - B";
+
+/// The scale factor for people: one line, comment-safe.
+std::string scale_factor_summary(const CoefficientBlock& b) {
+  return comment_safe(scale_factor_text(b.scale_factor));
+}
+
+json scale_factor_json(const ScaleFactorSource& s) {
+  if (!s.model) return {{"measured", false}, {"note", s.note}};
+  const ScaleFactorModel& m = *s.model;
+  return {{"measured", true},
+          {"model", kScaleModel},
+          {"k0_pulse_per_arcsec", m.k0_pulse_per_arcsec},
+          {"k0_se_pulse_per_arcsec", m.k0_se_pulse_per_arcsec},
+          {"tc_ppm_per_c", m.tc_ppm_per_c},
+          {"tc_se_ppm_per_c", m.tc_se_ppm_per_c ? json(*m.tc_se_ppm_per_c) : json(nullptr)},
+          {"t_ref_c", m.t_ref_c},
+          {"span", {{"t_min_c", m.t_min_c}, {"t_max_c", m.t_max_c}}},
+          {"outside_span", "clamp"},
+          {"plateaus", m.plateaus},
+          {"runs", m.runs},
+          {"pulse_weight_arcsec", m.pulse_weight_arcsec},
+          {"earth_rate_dph", m.earth_rate_dph},
+          {"note", s.note}};
+}
+
+/// The CSV's scale-factor cells (the header's last 12 columns): empty numbers when not measured.
+std::string scale_factor_cells(const ScaleFactorSource& s) {
+  if (!s.model) return fmt::format("not measured,,,,,,,,,,,{}", csv_field(s.note));
+  const ScaleFactorModel& m = *s.model;
+  return fmt::format(
+      "measured,{:.17g},{:.17g},{:.17g},{},{:.17g},{:.17g},{:.17g},{},{:.17g},{:.17g},{}",
+      m.k0_pulse_per_arcsec, m.k0_se_pulse_per_arcsec, m.tc_ppm_per_c,
+      m.tc_se_ppm_per_c ? fmt::format("{:.17g}", *m.tc_se_ppm_per_c) : "", m.t_ref_c, m.t_min_c,
+      m.t_max_c, fmt::join(m.runs, ";"), m.pulse_weight_arcsec, m.earth_rate_dph,
+      csv_field(s.note));
+}
+
 }  // namespace
+
+std::string px4_scale_factor_note(const CoefficientBlock& b) {
+  if (!b.scale_factor.model) return scale_factor_summary(b);
+  return "SCALE FACTOR NOT IN THIS FILE: PX4's TC_G parameters hold no scale factor, so PX4 "
+         "applies the bias alone (as gyro_tc_correct); export json, csv or c for it. Measured " +
+         scale_factor_summary(b);
+}
 
 double dph_to_rad_per_s(double dph) {
   return dph * std::numbers::pi / (180.0 * 3600.0);
@@ -113,6 +176,7 @@ json block_json(const CoefficientBlock& b) {
           {"std_ratio", b.std_ratio ? json(*b.std_ratio) : json(nullptr)},
           {"verdict", b.verdict_json ? json::parse(*b.verdict_json) : json(nullptr)},
           {"model_choice", b.model_choice_json ? json::parse(*b.model_choice_json) : json(nullptr)},
+          {"scale_factor", scale_factor_json(b.scale_factor)},
           {"released", b.release.has_value()},
           {"release", b.release ? release_json(*b.release) : json(nullptr)},
           {"software_version", b.software_version},
@@ -127,7 +191,9 @@ std::string blocks_csv(const std::vector<CoefficientBlock>& blocks) {
       "serial,part_number,fit_id,term,value,std_error,unit,t_ref_c,t_min_c,t_max_c,grad_min_c,"
       "grad_max_c,outside_span,bin_s,runs,verdict,failed_limits,released,released_utc,released_by,"
       "note,override,"
-      "software_version,crc32\n";
+      "software_version,crc32,scale_factor,sf_k0_pulse_per_arcsec,sf_k0_se_pulse_per_arcsec,"
+      "sf_tc_ppm_per_c,sf_tc_se_ppm_per_c,sf_t_ref_c,sf_t_min_c,sf_t_max_c,sf_runs,"
+      "pulse_weight_arcsec,earth_rate_dph,sf_note\n";
   for (const auto& b : blocks) {
     // The verdict on every row (a CSV has no header block): pass, fail or empty for no part,
     // and the failed limits joined by ';'.
@@ -141,7 +207,7 @@ std::string blocks_csv(const std::vector<CoefficientBlock>& blocks) {
       out += fmt::format(
           "{},{},{},{},{:.17g},{:.17g},{},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},clamp,{},{},{},{}"
           ","
-          "{},{},{},{},{},{},0x{:08x}\n",
+          "{},{},{},{},{},{},0x{:08x},{}\n",
           csv_field(b.serial), csv_field(b.part_number), b.fit_id, b.names[i], b.coefficients[i],
           b.std_errors[i], sc::coefficient_unit(b.names[i]), b.t_ref_c, b.t_min_c, b.t_max_c,
           b.grad_min_c, b.grad_max_c, b.bin_s ? fmt::format("{:g}", *b.bin_s) : "",
@@ -150,7 +216,7 @@ std::string blocks_csv(const std::vector<CoefficientBlock>& blocks) {
           csv_field(b.release ? b.release->released_by : ""),
           csv_field(b.release ? b.release->note : ""),
           csv_field(b.release && b.release->override_reason ? *b.release->override_reason : ""),
-          b.software_version, b.crc32);
+          b.software_version, b.crc32, scale_factor_cells(b.scale_factor));
     }
   }
   return out;
@@ -161,15 +227,16 @@ std::string blocks_c_header(const std::vector<CoefficientBlock>& blocks, const s
   for (const char c : name) guard += static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
   std::string out = fmt::format(
       "/* Gyro thermal-bias calibrations, written by `station export --format c` (station {}).\n"
-      " * Apply with gyro_tc_correct() from gyro_tc.h; check each with gyro_tc_verify() first.\n"
-      " * Model: {} */\n"
+      " * Apply with gyro_tc_rate_dph() (bias and scale factor) or gyro_tc_correct() (bias) from\n"
+      " * gyro_tc.h; check each with gyro_tc_verify() first.\n"
+      " * Model: {}.\n * Scale factor: {} */\n"
       "#ifndef {}_H\n#define {}_H\n\n#include \"gyro_tc.h\"\n",
-      blocks.empty() ? "" : blocks.front().software_version, kModel, guard, guard);
+      blocks.empty() ? "" : blocks.front().software_version, kModel, kScaleModel, guard, guard);
   std::string table;
   for (const auto& b : blocks) {
     const gyro_tc_block c = b.c_block();
     out += fmt::format(
-        "\n/* {}: fit {} over runs {}, terms {}; {}; verdict {} */\n"
+        "\n/* {}: fit {} over runs {}, terms {}; {}; verdict {}\n * {} */\n"
         "static const gyro_tc_block {} = {{\n"
         "    {}, {}, {}LL, {}, /* serial, part, fit, released */\n"
         "    {:.17g}, /* t_ref_c */\n"
@@ -178,14 +245,14 @@ std::string blocks_c_header(const std::vector<CoefficientBlock>& blocks, const s
         "    {:.17g}, /* b0_dph */\n"
         "    {{{:.17g}, {:.17g}, {:.17g}, {:.17g}}}, /* k1..k4 */\n"
         "    {:.17g}, /* k0_dph_per_c */\n"
-        "    0x{:08x}u}};\n",
+        "    0x{:08x}u{}}};\n",
         comment_safe(b.serial), b.fit_id, fmt::join(b.runs, ","), comment_safe(b.terms),
         release_summary(b),
         !b.verdict_json ? "none"
                         : (json::parse(*b.verdict_json).value("pass", false) ? "pass" : "FAIL"),
-        c_identifier(name, b), c_string(b.serial), c_string(b.part_number), b.fit_id, c.released,
-        c.t_ref_c, c.t_min_c, c.t_max_c, c.grad_min_c, c.grad_max_c, c.b0_dph, c.k_dph[0],
-        c.k_dph[1], c.k_dph[2], c.k_dph[3], c.k0_dph_per_c, c.crc32);
+        scale_factor_summary(b), c_identifier(name, b), c_string(b.serial), c_string(b.part_number),
+        b.fit_id, c.released, c.t_ref_c, c.t_min_c, c.t_max_c, c.grad_min_c, c.grad_max_c, c.b0_dph,
+        c.k_dph[0], c.k_dph[1], c.k_dph[2], c.k_dph[3], c.k0_dph_per_c, c.crc32, c_scale_factor(c));
     table += fmt::format("    &{},\n", c_identifier(name, b));
   }
   out += fmt::format(
@@ -211,9 +278,9 @@ std::string block_px4(const CoefficientBlock& b, Px4Slot slot) {
       "px4`\n# serial {}, fit {} over runs {}, {}, crc32 0x{:08x}\n"
       "# Units: rad/s (converted from deg/h). PX4 subtracts X0 + X1 dT + X2 dT^2 + X3 dT^3, "
       "dT = clamp(T, TMIN, TMAX) - TREF;\n# TC_G{}_ID is 0: set it to the sensor's device id. "
-      "Enable with TC_G_ENABLE = 1.\n# Vehicle-Id Component-Id Name Value Type\n",
+      "Enable with TC_G_ENABLE = 1.\n# {}\n# Vehicle-Id Component-Id Name Value Type\n",
       comment_safe(b.serial), b.fit_id, fmt::join(b.runs, ","), release_summary(b), b.crc32,
-      slot.instance);
+      slot.instance, px4_scale_factor_note(b));
   const auto row = [&out](const std::string& name, double v) {
     out += fmt::format("1\t1\t{}\t{:.17g}\t9\n", name, v);
   };

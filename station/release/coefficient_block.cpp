@@ -75,6 +75,31 @@ void check_finite(const CoefficientBlock& b) {
                       b.fit_id, b.serial));
 }
 
+/// A scale-factor model the C function could not apply (a value not finite, K(T) not positive
+/// over its span: gyro_tc_scale_factor_ok) is not attached, and the block says why: the bias
+/// model still travels.
+void drop_unusable_scale_factor(CoefficientBlock& b) {
+  const auto& m = b.scale_factor.model;
+  if (!m) return;
+  const double v[] = {m->k0_pulse_per_arcsec,
+                      m->k0_se_pulse_per_arcsec,
+                      m->tc_ppm_per_c,
+                      m->tc_se_ppm_per_c.value_or(0.0),
+                      m->t_ref_c,
+                      m->t_min_c,
+                      m->t_max_c,
+                      m->pulse_weight_arcsec,
+                      m->earth_rate_dph};
+  const bool finite =
+      std::all_of(std::begin(v), std::end(v), [](double x) { return std::isfinite(x); });
+  const gyro_tc_block c = b.c_block();
+  if (finite && gyro_tc_scale_factor_ok(&c) != 0) return;
+  b.scale_factor = {
+      std::nullopt,
+      fmt::format("not attached: the scale factor of run {} ({}) is {}", fmt::join(m->runs, ","),
+                  b.scale_factor.note, finite ? "not positive over its span" : "not finite")};
+}
+
 }  // namespace
 
 std::optional<std::string> undeliverable_term(const sc::FitResult& fit) {
@@ -102,6 +127,16 @@ gyro_tc_block CoefficientBlock::c_block() const {
   for (int i = 0; i < 4; ++i) c.k_dph[i] = coefficient_or_zero(fmt::format("k{}", i + 1));
   c.k0_dph_per_c = coefficient_or_zero("k0");
   c.crc32 = crc32;
+  if (const auto& m = scale_factor.model) {
+    c.sf_measured = 1;
+    c.sf_k0_pulse_per_arcsec = m->k0_pulse_per_arcsec;
+    c.sf_tc_ppm_per_c = m->tc_ppm_per_c;
+    c.sf_t_ref_c = m->t_ref_c;
+    c.sf_t_min_c = m->t_min_c;
+    c.sf_t_max_c = m->t_max_c;
+    c.pulse_weight_arcsec = m->pulse_weight_arcsec;
+    c.earth_rate_dph = m->earth_rate_dph;
+  }
   return c;
 }
 
@@ -172,6 +207,8 @@ CoefficientBlock make_block(Store& store, const FitRecord& fit,
   b.bin_s = runs_bin_s(store, fit.runs);
   b.std_ratio = fit.eval.std_ratio;
   b.std_after_dph = fit.eval.std_after_dph;
+  b.scale_factor = find_scale_factor(store, fit);
+  drop_unusable_scale_factor(b);
   b.release = release;
   b.software_version = STATION_VERSION;
   check_finite(b);

@@ -13,6 +13,7 @@
 #include "compensation/fit.hpp"
 #include "station/release/gyro_tc.h"
 #include "station/release/releases.hpp"
+#include "station/release/scale_factor_source.hpp"
 #include "station/store/store.hpp"
 
 namespace station {
@@ -38,6 +39,8 @@ struct CoefficientBlock {
   std::optional<std::string> verdict_json;       ///< the fit's verdict (empty: none)
   /// How the fit's model was chosen (fits.model_choice_json; empty: terms given by hand).
   std::optional<std::string> model_choice_json;
+  /// The scale-factor model (gyro_tc/4) or why there is none (find_scale_factor).
+  ScaleFactorSource scale_factor;
   std::optional<ReleaseRow> release;  ///< empty: exported without release
   std::string software_version;       ///< the station's version
   std::uint32_t crc32 = 0;            ///< of canonical
@@ -49,12 +52,12 @@ struct CoefficientBlock {
   double coefficient_or_zero(const std::string& name) const;
 };
 
-/// Builds the block of a stored fit: the spans are the min and max of T and gradT over the 1 Hz
-/// samples of the fit's complete bins, as stored with the fit (FitRecord::span; found from the
-/// samples only for a fit stored before migration 8), so every bin mean the fit used and every
-/// sample in it lies inside them. Throws ReleaseRefused for an undeliverable term, and
-/// InputError when the fit's runs hold no such sample, a value is not finite, or the canonical
-/// text would not fit GYRO_TC_CANONICAL_MAX.
+/// Builds the block of a stored fit, with the serial's scale factor (find_scale_factor): the spans
+/// are the min and max of T and gradT over the 1 Hz samples of the fit's complete bins, as stored
+/// with the fit (FitRecord::span; found from the samples only for a fit stored before migration 8),
+/// so every bin mean the fit used and every sample in it lies inside them. Throws ReleaseRefused
+/// for an undeliverable term, and InputError when the fit's runs hold no such sample, a value is
+/// not finite, or the canonical text would not fit GYRO_TC_CANONICAL_MAX.
 CoefficientBlock make_block(Store& store, const FitRecord& fit,
                             const std::optional<ReleaseRow>& release);
 

@@ -9,6 +9,16 @@
  * PX4 Devguide "Thermal Calibration and Compensation"): the polynomial is never extrapolated.
  * A term the fit did not have has coefficient 0.
  *
+ * Scale factor (issue 36; IEEE Std 647-2006 for ring laser gyros, IEEE Std 952-1997 for
+ * fibre-optic gyros: the scale factor and its temperature sensitivity; station README "The
+ * acceptance test"): when sf_measured is 1 the block also holds
+ *   K(T) = K0 (1 + TC 1e-6 (T - sf_t_ref_c)),  pulses per arc-second,
+ * with T clamped to the span of plateau temperatures the rate ladders covered (the bias's rule),
+ * and gyro_tc_rate_dph() applies both models: the input rate is the output divided by K(T), and
+ * the thermal bias, fitted on rates at the nominal pulse weight w, is put in input units first
+ * (gyro_tc_rate_dph's comment). When sf_measured is 0 ("scale factor: not measured") the scale is
+ * left alone: gyro_tc_rate_dph() is the rate minus the bias model.
+ *
  * The checksum is CRC-32 (ISO-HDLC: reflected polynomial 0xEDB88320, init and final XOR
  * 0xFFFFFFFF; zlib's crc32) over the canonical text gyro_tc_canonical() writes: a consumer
  * recomputes it with gyro_tc_verify() before use and refuses a block that does not match. */
@@ -39,6 +49,16 @@ typedef struct gyro_tc_block {
   double k_dph[4];         /* k1..k4: deg/h/C, deg/h/C^2, deg/h/C^3, deg/h/C^4 */
   double k0_dph_per_c;     /* k0 (gradient), deg/h/C */
   uint32_t crc32;          /* CRC-32 of gyro_tc_canonical() */
+  /* gyro_tc/4: the scale-factor model. After crc32, so a block written for an earlier header
+   * (its initializer ends at crc32) still compiles, with sf_measured 0 and its text and checksum
+   * unchanged (GCC's -Wextra notes the missing initializers; export again to silence it). */
+  int sf_measured;               /* 1: the model below is present; 0: not measured */
+  double sf_k0_pulse_per_arcsec; /* K0: the scale factor at sf_t_ref_c, pulses per arc-second */
+  double sf_tc_ppm_per_c;        /* TC: its temperature coefficient, ppm/C (0: one plateau) */
+  double sf_t_ref_c;             /* T_ref of K0, deg C */
+  double sf_t_min_c, sf_t_max_c; /* plateau temperatures the ladders covered: T clamped to it */
+  double pulse_weight_arcsec;    /* w: the nominal pulse weight the bias model was fitted at */
+  double earth_rate_dph;         /* E: the Earth rate along the input axis in those runs */
 } gyro_tc_block;
 
 static inline double gyro_tc_clamp(double x, double lo, double hi) {
@@ -64,6 +84,31 @@ static inline double gyro_tc_bias_dph(const gyro_tc_block *b, double temp_c, dou
 static inline double gyro_tc_correct(const gyro_tc_block *b, double bias_dph, double temp_c,
                                      double grad_c) {
   return bias_dph - gyro_tc_bias_dph(b, temp_c, grad_c);
+}
+
+/* The scale factor K(T) at temp_c, pulses per arc-second, T clamped to [sf_t_min_c, sf_t_max_c];
+ * meaningful only when sf_measured is 1. */
+static inline double gyro_tc_scale_factor_pulse_per_arcsec(const gyro_tc_block *b, double temp_c) {
+  const double dt = gyro_tc_clamp(temp_c, b->sf_t_min_c, b->sf_t_max_c) - b->sf_t_ref_c;
+  return b->sf_k0_pulse_per_arcsec * (1.0 + b->sf_tc_ppm_per_c * 1e-6 * dt);
+}
+
+/* The corrected input rate, deg/h, from the gyro's output as a rate at the nominal pulse weight:
+ * nominal_rate_dph = output pulses per second * pulse_weight_arcsec (arcsec/s is deg/h), the rate
+ * the station records and fits the bias on.
+ * Without a scale factor: nominal_rate_dph - B(T, gradT).
+ * With one, s = K(T) w (the output per input relative to nominal, 1 + its error):
+ *   input rate        nominal_rate_dph / s            (= output pulses per second / K(T))
+ *   bias, input units (B + E) / s - E                  (the fit saw (E + bias) s - E at rest)
+ *   corrected         nominal_rate_dph / s - ((B + E) / s - E) = (nominal_rate_dph - B - E) / s + E
+ * so the bias model is not corrected twice for the scale error of the Earth rate it absorbed. */
+static inline double gyro_tc_rate_dph(const gyro_tc_block *b, double nominal_rate_dph,
+                                      double temp_c, double grad_c) {
+  const double bias_dph = gyro_tc_bias_dph(b, temp_c, grad_c);
+  double s;
+  if (!b->sf_measured) return nominal_rate_dph - bias_dph;
+  s = gyro_tc_scale_factor_pulse_per_arcsec(b, temp_c) * b->pulse_weight_arcsec;
+  return (nominal_rate_dph - bias_dph - b->earth_rate_dph) / s + b->earth_rate_dph;
 }
 
 /* One number as %.17g with '.' as the decimal point whatever the locale (a consumer that set
@@ -113,7 +158,10 @@ static inline int gyro_tc_put_number(char *buf, size_t n, size_t *len, const cha
  * earlier checksum of such a block still verifies. One of a block whose serial or part holds ';'
  * or '%' (accepted before the station's text rule) does not: version 2 covered the raw text.
  * The station refuses to re-export such a released block rather than ship a checksum that one
- * of the two headers rejects. */
+ * of the two headers rejects. Version 4 is a block with a scale factor (sf_measured 1): version
+ * 3's escaping, and after k0 the fields sf_k0, sf_tc_ppm, sf_t_ref_c, sf_t_min_c, sf_t_max_c,
+ * pulse_weight_arcsec, earth_rate_dph; a block without one writes version 2's or 3's text as
+ * before, byte for byte. */
 static inline int gyro_tc_canonical(const gyro_tc_block *b, char *buf, size_t n) {
   const double v[] = {b->t_ref_c,  b->t_min_c,  b->t_max_c,  b->grad_min_c, b->grad_max_c,
                       b->b0_dph,   b->k_dph[0], b->k_dph[1], b->k_dph[2],   b->k_dph[3],
@@ -121,13 +169,20 @@ static inline int gyro_tc_canonical(const gyro_tc_block *b, char *buf, size_t n)
   static const char *const key[] = {"t_ref_c", "t_min_c", "t_max_c", "grad_min_c", "grad_max_c",
                                     "b0_dph",  "k1",      "k2",      "k3",         "k4",
                                     "k0"};
+  const double sf[] = {
+      b->sf_k0_pulse_per_arcsec, b->sf_tc_ppm_per_c, b->sf_t_ref_c, b->sf_t_min_c, b->sf_t_max_c,
+      b->pulse_weight_arcsec,    b->earth_rate_dph};
+  static const char *const sf_key[] = {"sf_k0",         "sf_tc_ppm",  "sf_t_ref_c",
+                                       "sf_t_min_c",    "sf_t_max_c", "pulse_weight_arcsec",
+                                       "earth_rate_dph"};
   const int escaped = strpbrk(b->serial, ";%") != NULL || strpbrk(b->part_number, ";%") != NULL;
+  const char *version = b->sf_measured ? "gyro_tc/4" : (escaped ? "gyro_tc/3" : "gyro_tc/2");
   char num[40];
   size_t len = 0;
   int i, w;
   if (n == 0) return -1;
   buf[0] = '\0';
-  if (gyro_tc_put_field(buf, n, &len, escaped ? "gyro_tc/3" : "gyro_tc/2") != 0 ||
+  if (gyro_tc_put_field(buf, n, &len, version) != 0 ||
       gyro_tc_put_number(buf, n, &len, "serial", "") != 0 ||
       gyro_tc_put_field(buf, n, &len, b->serial) != 0 ||
       gyro_tc_put_number(buf, n, &len, "part", "") != 0 ||
@@ -139,6 +194,10 @@ static inline int gyro_tc_canonical(const gyro_tc_block *b, char *buf, size_t n)
   for (i = 0; i < 11; ++i) {
     gyro_tc_number(num, sizeof num, v[i]);
     if (gyro_tc_put_number(buf, n, &len, key[i], num) != 0) return -1;
+  }
+  for (i = 0; b->sf_measured && i < 7; ++i) {
+    gyro_tc_number(num, sizeof num, sf[i]);
+    if (gyro_tc_put_number(buf, n, &len, sf_key[i], num) != 0) return -1;
   }
   return (int)len;
 }
@@ -155,12 +214,24 @@ static inline uint32_t gyro_tc_crc32(const char *s, size_t n) {
   return crc ^ 0xFFFFFFFFu;
 }
 
-/* 1 when the block's checksum matches its contents and its spans are ordered, else 0. */
+/* 1 when a scale-factor model is absent, or present and usable: its span ordered, w > 0, and
+ * K(T) > 0 over the span (a scale factor that reaches 0 cannot be divided by); else 0. */
+static inline int gyro_tc_scale_factor_ok(const gyro_tc_block *b) {
+  if (b->sf_measured == 0) return 1;
+  return b->sf_measured == 1 && b->sf_t_min_c <= b->sf_t_max_c && b->pulse_weight_arcsec > 0 &&
+         b->sf_k0_pulse_per_arcsec > 0 &&
+         gyro_tc_scale_factor_pulse_per_arcsec(b, b->sf_t_min_c) > 0 &&
+         gyro_tc_scale_factor_pulse_per_arcsec(b, b->sf_t_max_c) > 0;
+}
+
+/* 1 when the block's checksum matches its contents, its spans are ordered and its scale-factor
+ * model (if any) is usable (gyro_tc_scale_factor_ok), else 0. */
 static inline int gyro_tc_verify(const gyro_tc_block *b) {
   char text[GYRO_TC_CANONICAL_MAX];
   const int len = gyro_tc_canonical(b, text, sizeof text);
   if (len < 0) return 0;
   if (!(b->t_min_c <= b->t_max_c) || !(b->grad_min_c <= b->grad_max_c)) return 0;
+  if (!gyro_tc_scale_factor_ok(b)) return 0;
   return gyro_tc_crc32(text, (size_t)len) == b->crc32;
 }
 

@@ -202,7 +202,7 @@ TEST(Cli, SimRunThenFitAllAndExport) {
   EXPECT_EQ(csv.out.rfind("serial,part_number,fit_id,term,value,std_error,unit,t_ref_c,t_min_c,"
                           "t_max_c,grad_min_c,grad_max_c,outside_span,bin_s,runs,verdict,"
                           "failed_limits,released,released_utc,released_by,note,override,"
-                          "software_version,crc32\n",
+                          "software_version,crc32,scale_factor,",
                           0),
             0u)
       << csv.out;

@@ -1,7 +1,9 @@
-// The round trip of issue 21: a released fit exported in every format, read back as a consumer
-// would, applied with the shipped C function gyro_tc_correct() (the C header compiled by a C
-// compiler for --format c) to the run's own 1 Hz record and bins, and compared with the
-// station's compensated values. The checksum is checked against zlib's independent CRC-32.
+// The round trip of issue 21, the formats: a released fit exported as JSON, CSV and a PX4
+// parameter file, read back as a consumer would and applied with gyro_tc.h to the run's own bins
+// and 1 Hz record, compared with the station's compensated values; the scale factor in each
+// format, or the format saying it has none (issue 36); text in a block escaped for each reader.
+// The checksum is checked against zlib's independent CRC-32. The C function on the compiled
+// header: test_gyro_tc_function.cpp.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -16,74 +18,19 @@
 #include <string>
 #include <vector>
 
-#include "station/release/block_formats.hpp"
-#include "station/store/calibration.hpp"
-#include "tests/station/release_fixture.hpp"
-#include "tests/station/rig_process.hpp"
+#include "tests/station/export_fixture.hpp"
 
 namespace {
 
 namespace sc = station::compensation;
 using nlohmann::json;
-using station::testing_support::calibrated_db;
+using station::testing_support::block_from_json;
+using station::testing_support::export_records;
+using station::testing_support::ExportRoundTrip;
+using station::testing_support::slurp;
+using station::testing_support::worst_relative;
 
-/// Bins and 1 Hz record of one gyro in one run, with the station's compensated values.
-struct Record {
-  sc::ModelData data;
-  std::vector<double> station_dph;
-};
-
-std::vector<Record> records(station::Store& store, const station::FitRecord& fit) {
-  std::vector<Record> out;
-  for (const auto run : fit.runs) {
-    for (auto d : {store.model_data(fit.serial, {run}),
-                   station::fitted_record_model_data(store, run, fit.serial)}) {
-      Record r{d, sc::compensate(fit.fit, d.view())};
-      out.push_back(std::move(r));
-    }
-  }
-  return out;
-}
-
-/// Applies `b` to every record; the largest difference from the station, relative to the
-/// largest bias magnitude (the scale of the numbers involved).
-double worst_relative(const gyro_tc_block& b, const std::vector<Record>& recs) {
-  double worst = 0;
-  for (const auto& r : recs) {
-    double scale = 0;
-    for (const double x : r.data.bias_dph) scale = std::max(scale, std::abs(x));
-    for (std::size_t i = 0; i < r.station_dph.size(); ++i) {
-      const double c = gyro_tc_correct(&b, r.data.bias_dph[i], r.data.temp_c[i], r.data.grad_c[i]);
-      worst = std::max(worst, std::abs(c - r.station_dph[i]) / scale);
-    }
-  }
-  return worst;
-}
-
-gyro_tc_block from_json(const json& j, std::string& serial, std::string& part) {
-  serial = j["serial"].get<std::string>();
-  part = j["part_number"].is_null() ? "" : j["part_number"].get<std::string>();
-  gyro_tc_block b{};
-  b.serial = serial.c_str();
-  b.part_number = part.c_str();
-  b.fit_id = j["fit_id"].get<long long>();
-  b.released = j["released"].get<bool>() ? 1 : 0;
-  b.t_ref_c = j["t_ref_c"].get<double>();
-  const auto& s = j["span"];
-  b.t_min_c = s["t_min_c"].get<double>();
-  b.t_max_c = s["t_max_c"].get<double>();
-  b.grad_min_c = s["grad_min_c"].get<double>();
-  b.grad_max_c = s["grad_max_c"].get<double>();
-  const auto& c = j["coefficients"];
-  b.b0_dph = c.value("B0", 0.0);
-  for (int i = 0; i < 4; ++i) b.k_dph[i] = c.value("k" + std::to_string(i + 1), 0.0);
-  b.k0_dph_per_c = c.value("k0", 0.0);
-  b.crc32 =
-      static_cast<uint32_t>(std::stoul(j["checksum"]["crc32"].get<std::string>(), nullptr, 16));
-  return b;
-}
-
-/// The CSV's rows by column name.
+/// The CSV's rows by column name (its cells here hold no comma).
 std::vector<std::map<std::string, std::string>> csv_rows(const std::string& text) {
   std::istringstream in(text);
   std::string line;
@@ -102,34 +49,6 @@ std::vector<std::map<std::string, std::string>> csv_rows(const std::string& text
   return rows;
 }
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-class ExportRoundTrip : public ::testing::Test {
- protected:
-  void SetUp() override {
-    cal_ = calibrated_db("export-roundtrip", 1);
-    store_.emplace(cal_.path, station::OpenMode::existing);
-    serial_ = cal_.report["gyros"][0]["serial"].get<std::string>();
-    rel_ = station::current_release(*store_, serial_);
-    ASSERT_TRUE(rel_);
-    fit_ = *store_->find_fit(rel_->fit_id);
-    block_ = station::make_block(*store_, fit_, rel_);
-    recs_ = records(*store_, fit_);
-  }
-  station::testing_support::CalibratedDb cal_;
-  std::optional<station::Store> store_;
-  std::string serial_;
-  std::optional<station::ReleaseRow> rel_;
-  station::FitRecord fit_;
-  station::CoefficientBlock block_;
-  std::vector<Record> recs_;
-};
-
 TEST_F(ExportRoundTrip, JsonBlockVerifiesAndReproducesTheStation) {
   const json j = json::parse(station::block_json(block_).dump(2));
   EXPECT_EQ(j["release"]["by"], rel_->released_by);
@@ -142,7 +61,7 @@ TEST_F(ExportRoundTrip, JsonBlockVerifiesAndReproducesTheStation) {
       crc32(0L, reinterpret_cast<const Bytef*>(canon.data()), static_cast<uInt>(canon.size()));
   EXPECT_EQ(j["checksum"]["crc32"].get<std::string>(), fmt::format("0x{:08x}", z));
   std::string sn, pn;
-  gyro_tc_block b = from_json(j, sn, pn);
+  gyro_tc_block b = block_from_json(j, sn, pn);
   EXPECT_EQ(gyro_tc_verify(&b), 1);
   EXPECT_LE(worst_relative(b, recs_), 1e-9);
   // Every bin mean and every binned sample lies inside the span: no clamping on the fit's data.
@@ -246,54 +165,6 @@ TEST_F(ExportRoundTrip, CsvRowsReproduceTheStation) {
   EXPECT_LE(worst_relative(b, recs_), 1e-9);
 }
 
-// The C header, compiled by the C compiler with -std=c99 -pedantic -Werror next to gyro_tc.h,
-// applied by a C program to the 1 Hz record written as text.
-TEST_F(ExportRoundTrip, CHeaderCompiledAsCReproducesTheStation) {
-  const std::string cc = STATION_C_COMPILER;
-  if (cc.empty() || std::system((cc + " --version >/dev/null 2>&1").c_str()) != 0)
-    GTEST_SKIP() << "no C compiler (" << cc << "): the C header is not compiled";
-  const std::string dir = ::testing::TempDir() + "gyro_tc_c_" + std::to_string(getpid());
-  ASSERT_EQ(std::system(("mkdir -p " + dir).c_str()), 0);
-  std::ofstream(dir + "/calibrations.h") << station::blocks_c_header({block_});
-  std::ofstream(dir + "/apply.c") << R"(#include <locale.h>
-#include <stdio.h>
-#include "calibrations.h"
-int main(void) {
-  double bias, t, g;
-  const gyro_tc_block *b = gyro_tc_calibrations_blocks[0];
-  if (GYRO_TC_CALIBRATIONS_BLOCK_COUNT != 1 || !gyro_tc_verify(b) || !b->released) return 3;
-  /* A consumer in a decimal-comma locale still verifies (where the machine has one). */
-  if (setlocale(LC_NUMERIC, "de_DE.UTF-8") != NULL && !gyro_tc_verify(b)) return 4;
-  setlocale(LC_NUMERIC, "C");
-  while (scanf("%lf %lf %lf", &bias, &t, &g) == 3) printf("%.17g\n", gyro_tc_correct(b, bias, t, g));
-  return 0;
-}
-)";
-  const std::string build = cc + " -std=c99 -pedantic -Wall -Wextra -Werror -I" +
-                            STATION_SOURCE_DIR + "/station/release " + dir + "/apply.c -o " + dir +
-                            "/apply 2>" + dir + "/cc.log";
-  ASSERT_EQ(std::system(build.c_str()), 0) << slurp(dir + "/cc.log");
-  const Record& rec = recs_.back();  // the 1 Hz record
-  {
-    std::ofstream in(dir + "/in.txt");
-    for (std::size_t i = 0; i < rec.station_dph.size(); ++i)
-      in << fmt::format("{:.17g} {:.17g} {:.17g}\n", rec.data.bias_dph[i], rec.data.temp_c[i],
-                        rec.data.grad_c[i]);
-  }
-  ASSERT_EQ(std::system((dir + "/apply <" + dir + "/in.txt >" + dir + "/out.txt").c_str()), 0)
-      << "the C program refused the block (exit 3: checksum)";
-  std::ifstream out(dir + "/out.txt");
-  double scale = 0, worst = 0, v = 0;
-  for (const double x : rec.data.bias_dph) scale = std::max(scale, std::abs(x));
-  std::size_t n = 0;
-  while (out >> v) {
-    worst = std::max(worst, std::abs(v - rec.station_dph[n]) / scale);
-    ++n;
-  }
-  EXPECT_EQ(n, rec.station_dph.size());
-  EXPECT_LE(worst, 1e-9);
-}
-
 // PX4's TC_G layout holds a cubic in dT: a released dT,dT2,dT3 fit round-trips through the
 // parameter file (rad/s there), a gradient model is refused.
 TEST_F(ExportRoundTrip, Px4ParameterFileReproducesACubicFitAndRefusesAGradient) {
@@ -328,7 +199,7 @@ TEST_F(ExportRoundTrip, Px4ParameterFileReproducesACubicFitAndRefusesAGradient) 
   b.grad_max_c = 1e9;
   b.b0_dph = p.at("TC_G1_X0_2") * to_dph;
   for (int i = 1; i <= 3; ++i) b.k_dph[i - 1] = p.at(fmt::format("TC_G1_X{}_2", i)) * to_dph;
-  EXPECT_LE(worst_relative(b, records(*store_, rec)), 1e-9);
+  EXPECT_LE(worst_relative(b, export_records(*store_, rec)), 1e-9);
 }
 
 // Text in a block's comments cannot end the comment: no code or parameter line gets in.
@@ -350,29 +221,48 @@ TEST_F(ExportRoundTrip, CommentTextCannotInjectCodeOrParameters) {
   EXPECT_EQ(px4.find("\n1\t1\tTC_G0_TMAX\t999"), std::string::npos) << px4;
 }
 
-TEST(GyroTc, ClampsTemperatureAndGradientToTheSpanTheFitSaw) {
-  gyro_tc_block b{};
-  b.serial = "X";
-  b.part_number = "";
-  b.t_ref_c = 25;
-  b.t_min_c = -40;
-  b.t_max_c = 70;
-  b.grad_min_c = -0.5;
-  b.grad_max_c = 1.5;
-  b.b0_dph = 0.1;
-  b.k_dph[0] = 2e-3;
-  b.k_dph[1] = -1e-5;
-  b.k0_dph_per_c = 0.03;
-  // Inside: the polynomial written out by hand.
-  const double dt = 10 - 25.0;
-  EXPECT_NEAR(gyro_tc_bias_dph(&b, 10, 0.4), 0.1 + 2e-3 * dt - 1e-5 * dt * dt + 0.03 * 0.4, 1e-15);
-  // Outside: the value at the edge of the span, never an extrapolation.
-  EXPECT_DOUBLE_EQ(gyro_tc_bias_dph(&b, 95, 3), gyro_tc_bias_dph(&b, 70, 1.5));
-  EXPECT_DOUBLE_EQ(gyro_tc_bias_dph(&b, -60, -2), gyro_tc_bias_dph(&b, -40, -0.5));
-  EXPECT_DOUBLE_EQ(gyro_tc_correct(&b, 1.0, 10, 0.4), 1.0 - gyro_tc_bias_dph(&b, 10, 0.4));
-  // A block whose span is reversed never verifies, whatever its checksum.
-  b.t_min_c = 80;
-  EXPECT_EQ(gyro_tc_verify(&b), 0);
+// Issue 36: a block with a scale factor carries it in JSON and CSV (read back, the block
+// verifies: the checksum covers it) and the PX4 file, which has no parameter for it, says so
+// with the value; the short cycle has no rate ladder, so its own block says "not measured".
+TEST_F(ExportRoundTrip, TheScaleFactorTravelsInJsonAndCsvAndPx4SaysItCannotHoldIt) {
+  const json none = station::block_json(block_);
+  EXPECT_EQ(none["scale_factor"]["measured"], false);
+  EXPECT_NE(none["scale_factor"]["note"].get<std::string>().find("not measured"),
+            std::string::npos);
+  EXPECT_EQ(none["checksum"]["canonical"].get<std::string>().rfind("gyro_tc/2;", 0), 0u);
+  const auto sf = station::testing_support::with_scale_factor(block_);
+  EXPECT_EQ(sf.canonical.rfind("gyro_tc/4;", 0), 0u) << sf.canonical;
+  EXPECT_EQ(sf.canonical.substr(0, block_.canonical.size()).substr(9),
+            block_.canonical.substr(9));  // the bias part unchanged, the scale factor after it
+  const json j = json::parse(station::block_json(sf).dump(2));
+  EXPECT_EQ(j["scale_factor"]["tc_se_ppm_per_c"], 0.4);
+  EXPECT_EQ(j["scale_factor"]["runs"], json({1}));
+  std::string sn, pn;
+  gyro_tc_block b = block_from_json(j, sn, pn);
+  EXPECT_EQ(gyro_tc_verify(&b), 1);
+  b.sf_tc_ppm_per_c = std::nextafter(b.sf_tc_ppm_per_c, 0.0);
+  EXPECT_EQ(gyro_tc_verify(&b), 0) << "the checksum covers the scale factor";
+  const auto rows = csv_rows(station::blocks_csv({sf, block_}));
+  ASSERT_EQ(rows.size(), 6u);
+  EXPECT_EQ(rows[0].at("scale_factor"), "measured");
+  EXPECT_EQ(std::stod(rows[0].at("sf_k0_pulse_per_arcsec")), (1.0 + 37e-6) / 1.5);
+  EXPECT_EQ(std::stod(rows[0].at("sf_tc_ppm_per_c")), 3.25);
+  EXPECT_EQ(std::stod(rows[0].at("earth_rate_dph")), 12.3);
+  EXPECT_EQ(rows[3].at("scale_factor"), "not measured");
+  EXPECT_EQ(rows[3].at("sf_k0_pulse_per_arcsec"), "");
+  auto cubic = sf;
+  cubic.names = {"B0", "k1"};
+  cubic.coefficients = {0.1, 1e-3};
+  cubic.std_errors = {0.01, 1e-4};
+  const std::string px4 = station::block_px4(cubic, {0, 2});
+  EXPECT_NE(px4.find("\n# SCALE FACTOR NOT IN THIS FILE: PX4's TC_G parameters hold no scale "
+                     "factor"),
+            std::string::npos)
+      << px4;
+  EXPECT_NE(px4.find("K0 0.666691333"), std::string::npos) << px4;
+  cubic.scale_factor = block_.scale_factor;
+  EXPECT_NE(station::block_px4(cubic, {0, 2}).find("\n# scale factor: not measured"),
+            std::string::npos);
 }
 
 }  // namespace
