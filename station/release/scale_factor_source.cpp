@@ -6,7 +6,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "station/acceptance/acceptance_json.hpp"
 #include "station/acceptance/acceptance_run.hpp"
+#include "station/store/acceptance_results.hpp"
 
 namespace station {
 namespace {
@@ -34,40 +36,44 @@ std::optional<std::pair<double, double>> fit_slot_scale(Store& store, const FitR
   return we;
 }
 
-/// From two or more plateaus: K0 and TC of the fit across them.
-ScaleFactorModel from_plateaus(const SerialAcceptance& a,
-                               const comp::ScaleFactorTemperatureFit& t) {
-  ScaleFactorModel m;
-  m.k0_pulse_per_arcsec = t.sf_ref_pulse_per_arcsec;
-  m.k0_se_pulse_per_arcsec = t.sf_ref_se_pulse_per_arcsec;
-  m.tc_ppm_per_c = t.tc_ppm_per_c;
-  m.tc_se_ppm_per_c = t.tc_se_ppm_per_c;
-  m.t_ref_c = t.ref_temp_c;
-  m.plateaus = t.plateaus;
+/// The span of plateau temperatures: the ladders that gave a scale factor.
+void set_ladder_span(const SerialAcceptance& a, ScaleFactorModel& m) {
   m.t_min_c = HUGE_VAL;
   m.t_max_c = -HUGE_VAL;
   for (const auto& l : a.ladders)
-    if (l.fit && std::isfinite(l.temp_c)) {  // the plateaus run_acceptance fitted
+    if (l.fit && std::isfinite(l.temp_c)) {
       m.t_min_c = std::min(m.t_min_c, l.temp_c);
       m.t_max_c = std::max(m.t_max_c, l.temp_c);
+      ++m.plateaus;
     }
-  return m;
 }
 
-/// From one usable ladder (the one nearest T_ref when several lie at one temperature): its K,
-/// TC 0, the span its one temperature.
-std::optional<ScaleFactorModel> from_one_ladder(const SerialAcceptance& a, double t_ref_c) {
-  const LadderFigures* best = nullptr;
-  for (const auto& l : a.ladders)
-    if (l.fit && std::isfinite(l.temp_c) &&
-        (!best || std::abs(l.temp_c - t_ref_c) < std::abs(best->temp_c - t_ref_c)))
-      best = &l;
-  if (!best) return std::nullopt;
+/// The model of one serial's figures of run `run`. K0 is the K the serial is held to
+/// (held_scale_factor, the verdict's and history's rule): K at T_ref of the fit across its
+/// plateaus, with its TC; else its one ladder's K at that ladder's temperature, TC 0 (noted).
+std::optional<ScaleFactorModel> model_of(const SerialAcceptance& a, std::int64_t run,
+                                         double t_ref_c, std::string& note) {
+  const auto held = held_scale_factor(acceptance_json({a}).at(0));
+  if (!held) return std::nullopt;
   ScaleFactorModel m;
-  m.k0_pulse_per_arcsec = best->fit->sf_pulse_per_arcsec;
-  m.k0_se_pulse_per_arcsec = best->fit->sf_se_pulse_per_arcsec;
-  m.t_ref_c = m.t_min_c = m.t_max_c = best->temp_c;
+  m.k0_pulse_per_arcsec = held->k_pulse_per_arcsec;
+  m.k0_se_pulse_per_arcsec = held->se_pulse_per_arcsec;
+  m.runs = {run};
+  set_ladder_span(a, m);
+  if (a.sf_vs_temp && a.sf_vs_temp->ok()) {
+    const comp::ScaleFactorTemperatureFit& t = a.sf_vs_temp->value();
+    m.tc_ppm_per_c = t.tc_ppm_per_c;
+    m.tc_se_ppm_per_c = t.tc_se_ppm_per_c;
+    m.t_ref_c = t.ref_temp_c;
+    note = fmt::format("from the rate ladders of run {} ({} plateaus)", run, m.plateaus);
+    return m;
+  }
+  // One ladder: K holds at its temperature (or, when it had none, K is all there is).
+  m.t_ref_c = held->temp_c.value_or(t_ref_c);
+  m.t_min_c = m.t_max_c = m.t_ref_c;
   m.plateaus = 1;
+  note = fmt::format(
+      "from the one rate ladder of run {}: no temperature coefficient measured, taken as 0", run);
   return m;
 }
 
@@ -77,20 +83,8 @@ std::optional<ScaleFactorModel> model_of_run(Store& store, std::int64_t run, con
   // Only a protocol with a ladder can give one: the others are not analysed at all.
   const auto rec = store.find_run(run);
   if (!rec || rec->protocol_text.find("rate_ladder") == std::string::npos) return std::nullopt;
-  for (const auto& a : run_acceptance(store, run, fit.fit.spec.ref_temp_c)) {
-    if (a.serial != fit.serial) continue;
-    std::optional<ScaleFactorModel> m;
-    if (a.sf_vs_temp && a.sf_vs_temp->ok()) {
-      m = from_plateaus(a, a.sf_vs_temp->value());
-      note = fmt::format("from the rate ladders of run {} ({} plateaus)", run, m->plateaus);
-    } else if ((m = from_one_ladder(a, fit.fit.spec.ref_temp_c))) {
-      note = fmt::format(
-          "from one plateau of run {} ({}): no temperature coefficient measured, taken as 0", run,
-          a.sf_vs_temp ? "the fit across plateaus: " + a.sf_vs_temp->error() : "one usable ladder");
-    }
-    if (m) m->runs = {run};
-    return m;
-  }
+  for (const auto& a : run_acceptance(store, run, fit.fit.spec.ref_temp_c))
+    if (a.serial == fit.serial) return model_of(a, run, fit.fit.spec.ref_temp_c, note);
   return std::nullopt;
 }
 

@@ -35,11 +35,12 @@ struct ScaleFactorSource {
 
 /// The scale factor for the block of `fit`. Rule: the runs of the fit, newest first, then the
 /// serial's other runs, newest first; the first whose acceptance figures (run_acceptance, at the
-/// fit's T_ref) give the serial a scale factor against temperature (two or more plateaus) gives
-/// K0 and TC; a run with one usable ladder gives that ladder's K with TC 0 (noted), K0 at the
-/// ladder's temperature. None: "scale factor: not measured" and the block leaves the scale
-/// alone. Also none (noted) when the fit's runs differ in the serial's pulse weight or Earth
-/// rate, which the bias model would need to be put in input units.
+/// fit's T_ref) hold the serial to a scale factor (held_scale_factor, the rule of its verdict
+/// and history) gives it: K0 at T_ref with TC from the fit across the plateaus; or its one
+/// ladder's K, TC 0 (noted), K0 at that ladder's temperature. None: "scale factor: not
+/// measured" and the block leaves the scale alone. Also none (noted) when the fit's runs differ
+/// in the serial's pulse weight or Earth rate, which the bias model needs to be put in input
+/// units.
 ScaleFactorSource find_scale_factor(Store& store, const FitRecord& fit);
 
 /// "K0 0.6667 +- 1e-05 pulse/arcsec at 25.0 C, TC +2.10 +- 0.3 ppm/C over 5..45 C (run 3)" or
