@@ -227,3 +227,25 @@ TEST(AcceptanceStore, AFailureToStoreTheFiguresDoesNotLoseTheRun) {
   EXPECT_EQ(count(s, "SELECT count(*) FROM acceptance_results"), 0);
   EXPECT_EQ(count(s, "SELECT count(*) FROM events WHERE kind = 'run_end'"), 1);
 }
+
+// A run whose figures were never stored (run before migration 12, or its end failed to store
+// them): `station fit --all --run ID --acceptance` computes them by the run's end's code path,
+// judged against the part its slots named (the snapshot stored with the run).
+TEST(AcceptanceStore, FitAcceptanceComputesAnOlderRunsFiguresAgain) {
+  const auto o = short_acceptance(station::testing_support::fresh_db("acceptance_refit"), 1);
+  const std::int64_t run = station::run_simulated(o)["run_id"];
+  {
+    station::Store s(o.db_path);
+    s.db().exec("DELETE FROM acceptance_results");
+  }
+  // No thermal record in this protocol: every serial's fit is skipped (exit 1), the figures are
+  // computed all the same.
+  const auto out = run_station("fit --db " + o.db_path + " --all --run " + std::to_string(run) +
+                               " --acceptance");
+  EXPECT_EQ(out.status, 1) << out.out;
+  station::Store s(o.db_path);
+  const json stored = station::stored_acceptance_json(s, run);
+  ASSERT_EQ(stored.size(), 2u);
+  EXPECT_EQ(stored, station::judged_acceptance(s, run, gx200(s, run)));
+  EXPECT_EQ(stored[0]["verdict"]["part"], "GX-200");
+}
