@@ -124,6 +124,11 @@ ReportFiles write_report(const ReportOptions& o) {
     write_file(dir / names.back(), serial_html(r, s, assets));
     files.pages.push_back((dir / names.back()).string());
   }
+  for (const auto p : acceptance_pages(r.acceptance)) {
+    const auto path = dir / acceptance_page_name(r.run.id, p);
+    write_file(path, acceptance_html(r, p, assets));
+    files.pages.push_back(path.string());
+  }
   files.index = (dir / index_page_name(r.run.id)).string();
   write_file(files.index, index_html(r, assets, names));
   if (o.pdf) {

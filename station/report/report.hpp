@@ -16,14 +16,16 @@ struct ReportOptions {
   std::string chromium = "chromium";  ///< the browser for --pdf, looked up on PATH
 };
 
-/// The files written: the index first, then one page per serial with a fit, then PDFs.
+/// The files written: the index first, then one page per serial with a fit and the acceptance
+/// pages (report_acceptance.hpp), then PDFs.
 struct ReportFiles {
   std::string index;
   std::vector<std::string> pages, pdfs;
 };
 
-/// Opens `db` read-only, writes run-ID.html and run-ID-slotN-SERIAL.html into out_dir
-/// (created when missing). Throws InputError (no run, no fit, no dygraphs, no chromium) and
+/// Opens `db` read-only, writes run-ID.html, run-ID-slotN-SERIAL.html and run-ID-KIND.html (an
+/// acceptance test's) into out_dir (created when missing). Throws InputError (no run, no fit
+/// and no acceptance step, no dygraphs, no chromium) and
 /// SqliteError (not a station database). Blocks while Chromium prints.
 ReportFiles write_report(const ReportOptions& o);
 

@@ -19,6 +19,9 @@ struct Series {
   std::vector<double> x, y, y_low, y_high;
   bool line = false;      ///< drawn as a line (else points only)
   bool second_y = false;  ///< on the right-hand axis
+  /// y_low/y_high drawn as each point's error bar (whiskers), not as a band between points.
+  bool whiskers = false;
+  bool large_points = false;  ///< points drawn larger (a few measured points on a curve)
 };
 
 /// One figure: its id ("2a".."5b"), axes and series; `note` is shown under it (e.g. why it is

@@ -41,6 +41,8 @@ json series_options(const Series& s) {
   json o = s.line ? json{{"strokeWidth", 1.5}, {"drawPoints", false}}
                   : json{{"strokeWidth", 0.0}, {"drawPoints", true}, {"pointSize", 2}};
   if (s.second_y) o["axis"] = "y2";
+  if (s.whiskers) o["whiskers"] = true;  // the page's script (report_script.cpp) draws them
+  if (s.large_points) o["pointSize"] = 4;
   return o;
 }
 

@@ -40,6 +40,13 @@ nlohmann::json figure_json(const Figure& f);
 /// the file name of serial i's page (empty: none).
 std::string index_html(const RunReport& r, const Assets& a, const std::vector<std::string>& pages);
 
+/// The index's section linking the run's acceptance pages; empty without acceptance steps.
+std::string acceptance_index_html(const RunReport& r);
+
+/// An acceptance page of the run (report_acceptance.hpp): per serial its figures' table and
+/// figures, then the run record.
+std::string acceptance_html(const RunReport& r, AcceptancePage p, const Assets& a);
+
 /// One serial's page: verdict, coefficient table, noise terms, Figs. 2a-5b, run record, events.
 std::string serial_html(const RunReport& r, const SerialReport& s, const Assets& a);
 

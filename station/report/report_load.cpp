@@ -137,7 +137,8 @@ RunReport load_report(Store& store, std::int64_t run_id) {
     rr.serials.push_back(load_serial(store, rr, slot));
     any_fit = any_fit || rr.serials.back().fit.has_value();
   }
-  if (!any_fit)
+  rr.acceptance = load_acceptance(store, rr.run);
+  if (!any_fit && rr.acceptance.empty())
     throw InputError(fmt::format("{}: run {} has no stored fit (run `station fit --all --run {}`)",
                                  store.db().path(), run_id, run_id));
   return rr;

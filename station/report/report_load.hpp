@@ -11,6 +11,7 @@
 #include "compensation/binning.hpp"
 #include "station/release/releases.hpp"
 #include "station/release/verification.hpp"
+#include "station/report/report_acceptance.hpp"
 #include "station/report/report_allan.hpp"
 #include "station/report/report_data.hpp"
 #include "station/report/report_model.hpp"
@@ -56,10 +57,12 @@ struct RunReport {
   double bin_s = compensation::kPaperBinS;  ///< the run's bin width (run_bin_s)
   std::vector<EventRow> events;
   std::vector<SerialReport> serials;
+  /// Each serial's acceptance figures (issue 36); empty when the protocol has no acceptance step.
+  std::vector<SerialAcceptanceReport> acceptance;
 };
 
 /// Reads run `run_id` and prepares every figure. Throws InputError naming the database when the
-/// run does not exist or none of its serials has a fit.
+/// run does not exist, or none of its serials has a fit and it has no acceptance step.
 RunReport load_report(Store& store, std::int64_t run_id);
 
 /// SHA-256 of `text` as 64 lowercase hex digits (FIPS 180-4, through OpenSSL).

@@ -40,6 +40,9 @@ std::optional<std::string> report_page(Store& store, const std::string& name,
   bool known = name == index_page_name(*run_id);
   for (const auto& s : store.run_slots(*run_id))
     known = known || name == serial_page_name(*run_id, s.slot, s.serial);
+  for (const auto p :
+       {AcceptancePage::scale_factor, AcceptancePage::turn_on, AcceptancePage::positions})
+    known = known || name == acceptance_page_name(*run_id, p);
   if (!known) return std::nullopt;
   const RunReport r = load_report(store, *run_id);
   std::vector<std::string> names;
@@ -50,6 +53,8 @@ std::optional<std::string> report_page(Store& store, const std::string& name,
   if (name == index_page_name(r.run.id)) return index_html(r, assets, names);
   for (std::size_t i = 0; i < r.serials.size(); ++i)
     if (!names[i].empty() && name == names[i]) return serial_html(r, r.serials[i], assets);
+  for (const auto p : acceptance_pages(r.acceptance))
+    if (name == acceptance_page_name(r.run.id, p)) return acceptance_html(r, p, assets);
   return std::nullopt;
 }
 

@@ -16,6 +16,7 @@ std::string index_page_name(std::int64_t run_id);
 /// The file name of a serial's page: run-ID-slotN-SERIAL.html (SERIAL through file_safe).
 std::string serial_page_name(std::int64_t run_id, int slot, const std::string& serial);
 
+/// (An acceptance page's name: report_acceptance.hpp, acceptance_page_name.)
 /// The page named `name` (as write_report names its files) rendered from `store` with
 /// libjs-dygraphs from `dygraphs_dir`; empty when `name` is no page of a run in the store.
 /// Throws InputError as write_report does (the run has no fit, dygraphs not installed).

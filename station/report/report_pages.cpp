@@ -16,12 +16,10 @@ namespace station::report {
 using nlohmann::json;
 namespace sc = station::compensation;
 
-namespace {
-
-std::string num(double v, const char* spec = "{:.5g}") {
+std::string num(double v, const char* spec) {
   return std::isfinite(v) ? fmt::format(fmt::runtime(spec), v) : "-";
 }
-std::string num(const std::optional<double>& v, const char* spec = "{:.5g}") {
+std::string num(const std::optional<double>& v, const char* spec) {
   return v ? num(*v, spec) : "-";
 }
 
@@ -31,12 +29,13 @@ std::string row(std::initializer_list<std::string> cells) {
   return out + "</tr>\n";
 }
 
-/// A row whose first cell heads it (names the quantity and its unit).
 std::string kv(const std::string& head, std::initializer_list<std::string> cells) {
   std::string out = "<tr><th scope=\"row\">" + head + "</th>";
   for (const auto& c : cells) out += "<td>" + c + "</td>";
   return out + "</tr>\n";
 }
+
+namespace {
 
 /// A coefficient's unit as people write it: "deg/h/C^2" -> "°/h/°C²" (compensation::
 /// coefficient_unit spells units in ASCII for files and JSON).
@@ -316,7 +315,8 @@ std::string index_html(const RunReport& r, const Assets& a, const std::vector<st
       "before)</th><th>bins (count)</th><th>release</th></tr>\n";
   for (std::size_t i = 0; i < r.serials.size(); ++i)
     body += serial_summary_row(r, i, i < pages.size() ? pages[i] : "", columns);
-  body += "</table>\n</section>\n" + verification_index(r) + run_record_html(r) + events_html(r);
+  body += "</table>\n</section>\n" + acceptance_index_html(r) + verification_index(r) +
+          run_record_html(r) + events_html(r);
   return page_html(title, body, json::array(), a);
 }
 

@@ -1,7 +1,9 @@
 // Inside the report room: the page shell and the sections the index and serial pages share.
 #pragma once
 
+#include <initializer_list>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -15,6 +17,14 @@ extern const std::string_view kReportCss;
 /// to Dygraph with round ticks; marks its element data-drawn="true" once drawn with room for its
 /// labels. No data is ever written into it.
 extern const std::string_view kRenderJs;
+
+/// `v` formatted by `spec`, "-" when not finite (or empty).
+std::string num(double v, const char* spec = "{:.5g}");
+std::string num(const std::optional<double>& v, const char* spec = "{:.5g}");
+/// A table row of cells (already escaped HTML).
+std::string row(std::initializer_list<std::string> cells);
+/// A row whose first cell heads it (names the quantity and its unit).
+std::string kv(const std::string& head, std::initializer_list<std::string> cells);
 
 /// A whole page: `body` (already escaped HTML), the figures as JSON, dygraphs inlined.
 std::string page_html(std::string_view title, std::string_view body, const nlohmann::json& figures,

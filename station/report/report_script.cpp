@@ -19,6 +19,7 @@ td.num { text-align: right; font-family: monospace; }
 .figure .legend { font-size: 0.8em; min-height: 1.2em; }
 .figure .legend .dygraph-legend { position: static; width: auto; background: none; }
 .note { font-style: italic; color: #8a5a00; }
+.figure[data-points="0"] .chart { display: none; }  /* not drawn: its note says why */
 .dygraph-axis-label { white-space: nowrap; }
 )css";
 
@@ -73,6 +74,30 @@ const std::string_view kRenderJs = R"js(
         opts.axes[a].valueRange = T.padded(ex[a][0], ex[a][1], logY);
     });
   }
+  // A point's own error bar (a series marked "whiskers"): dygraphs' custom bars fill a band
+  // between neighbouring points, which reads as a curve's interval, not a point's.
+  function whiskers(e) {
+    var ctx = e.drawingContext, a = e.plotArea, cap = 3;
+    ctx.save();
+    ctx.strokeStyle = e.color;
+    ctx.fillStyle = e.color;
+    ctx.lineWidth = 1;
+    e.points.forEach(function (p) {
+      if (typeof p.yval !== "number" || !isFinite(p.yval)) return;
+      var lo = a.y + a.h * p.y_bottom, hi = a.y + a.h * p.y_top, x = p.canvasx;
+      ctx.beginPath();
+      if (isFinite(lo) && isFinite(hi)) {
+        ctx.moveTo(x, lo); ctx.lineTo(x, hi);
+        ctx.moveTo(x - cap, lo); ctx.lineTo(x + cap, lo);
+        ctx.moveTo(x - cap, hi); ctx.lineTo(x + cap, hi);
+        ctx.stroke();
+      }
+      ctx.beginPath();
+      ctx.arc(x, p.canvasy, 2.5, 0, 2 * Math.PI);
+      ctx.fill();
+    });
+    ctx.restore();
+  }
   var figures = JSON.parse(document.getElementById("report-figures").textContent);
   figures.forEach(function (f) {
     var box = document.querySelector('[data-figure="' + f.id + '"]');
@@ -85,6 +110,11 @@ const std::string_view kRenderJs = R"js(
       opts.axes[a].ticker = T.numeric(a === "x");
     });
     opts.axes.y2.independentTicks = true;  // its own round values, not y's positions
+    Object.keys(opts.series || {}).forEach(function (name) {
+      var s = opts.series[name];
+      if (s.whiskers) s.plotter = whiskers;
+      delete s.whiskers;  // not a dygraphs option
+    });
     pad(f, opts);
     draw(box, f.rows, opts, 0);
   });

@@ -58,15 +58,16 @@ def station(bin_path, *args):
     return r.stdout
 
 
-def make_db(bin_path, db, gyros, ramps, verify=False):
+def make_db(bin_path, db, gyros, ramps, verify=False, protocol=None):
     for ext in ("", "-wal", "-shm", ".lock"):
         if os.path.exists(db + ext):
             os.remove(db + ext)
-    for protocol in RAMPS if ramps else []:
-        station(bin_path, "run", "--sim", "--gyros", str(gyros), "--protocol", protocol, "--new",
+    for ramp in RAMPS if ramps else []:
+        station(bin_path, "run", "--sim", "--gyros", str(gyros), "--protocol", ramp, "--new",
                 "--db", db, "--json")
     out = station(bin_path, "run", "--sim", "--gyros", str(gyros), "--new", "--db", db, "--json",
-                  *(["--verify"] if verify else []))
+                  *(["--verify"] if verify else []),
+                  *(["--protocol", protocol] if protocol else []))
     return json.loads(out)
 
 
@@ -379,6 +380,120 @@ def check_pdf(bin_path, db, run_id, out_dir, gyros):
     print(f"--pdf: {len(pdfs)} PDFs")
 
 
+# The acceptance pages (issue 36): page name part -> per serial its figures, each drawn when the
+# run's JSON says its figure was computed, else a visible note saying why.
+ACCEPTANCE_PROTOCOL = os.path.join(os.path.dirname(os.path.abspath(__file__)),
+                                   "acceptance_two_plateaus.toml")
+ACCEPTANCE_PAGES = {"scale-factor": ["S1", "S2"], "turn-on": ["T1", "T2"], "positions": ["P1"]}
+
+
+def expected_acceptance(serial):
+    """Per figure of a serial (S1.. P1): the reason it cannot be drawn, or None when it is drawn
+    (the run's own JSON: acceptance_json)."""
+    def why(items):
+        ok = [i for i in items if i.get("ok")]
+        return None if ok else "; ".join(i.get("error", "?") for i in items) or "none"
+    sf = serial.get("sf_vs_temp")
+    turn_on = serial.get("turn_on") or {"ok": False, "error": "no power cycles"}
+    return {"S1": why(serial["ladders"]),
+            "S2": None if sf and sf.get("ok") else (sf or {}).get("error", "plateaus"),
+            "T1": None if turn_on.get("ok") else turn_on["error"],
+            "T2": None if turn_on.get("ok") else turn_on["error"],
+            "P1": why(serial["positions"])}
+
+
+FIGURE_TEXT_JS = """
+var out = {}, figs = JSON.parse(document.getElementById('report-figures').textContent);
+figs.forEach(function (f) { out[f.id] = {x: f.options.xlabel, y: f.options.ylabel}; });
+document.querySelectorAll('[data-figure]').forEach(function (el) {
+  var o = out[el.getAttribute('data-figure')] || {};
+  o.drawnx = Array.prototype.map.call(el.querySelectorAll('.dygraph-xlabel'),
+                                      function (e) { return e.textContent; }).join('');
+  o.drawny = Array.prototype.map.call(el.querySelectorAll('.dygraph-ylabel'),
+                                      function (e) { return e.textContent; }).join('');
+  out[el.getAttribute('data-figure')] = o;
+});
+return out;
+"""
+UNIT = re.compile(r"\(.+\)")
+NOT_A_NUMBER = re.compile(r"\b(nan|NaN|inf|Infinity|undefined)\b")
+
+
+def check_acceptance_page(drv, path, slug, report, artifacts, name):
+    """One acceptance page: each serial's figures drawn with unit-labelled axes and round ticks
+    where the run computed them, the reason shown where it did not; no NaN anywhere."""
+    from selenium.webdriver.common.by import By
+    load(drv, path)
+    check_clean(drv, path)
+    check_units(drv, path)
+    text = drv.find_element(By.TAG_NAME, "body").text
+    if NOT_A_NUMBER.search(text):
+        fail(f"{path}: the page shows {NOT_A_NUMBER.search(text).group(0)!r}")
+    labels = drv.execute_script(FIGURE_TEXT_JS)
+    drawn = []
+    for k, serial in enumerate(report["acceptance"]):
+        expect = expected_acceptance(serial)
+        for fig in ACCEPTANCE_PAGES[slug]:
+            fid = f"{fig}.{k + 1}"
+            els = drv.find_elements(By.CSS_SELECTOR, f'[data-figure="{fid}"]')
+            if len(els) != 1:
+                fail(f"{path}: {len(els)} elements with data-figure={fid}")
+            el, points = els[0], int(els[0].get_attribute("data-points"))
+            note = el.find_elements(By.CSS_SELECTOR, ".note")
+            if expect[fig] is not None:
+                shown = note[0].text if note and note[0].is_displayed() else ""
+                if points != 0 or expect[fig] not in shown:
+                    fail(f"{path}: fig {fid} of {serial['serial']}: {points} points, note "
+                         f"{shown!r}; expected no points and the reason {expect[fig]!r}")
+                if el.find_element(By.CSS_SELECTOR, ".chart").is_displayed():
+                    fail(f"{path}: fig {fid} is not computed but shows an empty chart")
+                print(f"fig {fid}: not computed, says {shown!r}")
+                continue
+            deadline = time.time() + 10
+            while el.get_attribute("data-drawn") != "true" and time.time() < deadline:
+                time.sleep(0.1)
+            if points <= 0 or el.get_attribute("data-drawn") != "true" or \
+                    not el.find_elements(By.CSS_SELECTOR, ".chart canvas"):
+                fail(f"{path}: fig {fid} ({points} points) was not drawn")
+            lab = labels.get(fid, {})
+            for axis in ("x", "y"):
+                if not UNIT.search(lab.get(axis) or "") or lab.get(axis) != lab.get("drawn" + axis):
+                    fail(f"{path}: fig {fid} {axis} axis title {lab.get('drawn' + axis)!r} "
+                         f"(figure's {lab.get(axis)!r}) does not name a unit")
+            drawn.append(fid)
+            print(f"fig {fid}: {points} points drawn, axes {lab['x']!r} / {lab['y']!r}")
+    shot = os.path.join(artifacts, f"{name}-{slug}.png")
+    drv.save_screenshot(shot)
+    shoot_figures(drv, artifacts, f"{name}-{slug}")
+    print(f"screenshot {shot}")
+    check_ticks(drv, path, drawn)
+    check_drawn(drv, path, fitted_curves=False)
+    return drawn
+
+
+def check_acceptance(drv, index, pages, report, artifacts, name):
+    """The index links a page per acceptance kind; every page checked; every kind of figure
+    drawn for at least one serial."""
+    from selenium.webdriver.common.by import By
+    load(drv, index)
+    links = [a.get_attribute("href").rsplit("/", 1)[-1]
+             for a in drv.find_elements(By.CSS_SELECTOR, "section.acceptance a")]
+    run_id = report["run_id"]
+    want = [f"run-{run_id}-{slug}.html" for slug in ACCEPTANCE_PAGES]
+    if links != want:
+        fail(f"{index}: acceptance links {links}, expected {want}")
+    drawn = []
+    for slug in ACCEPTANCE_PAGES:
+        path = [p for p in pages if p.endswith(f"-{slug}.html")]
+        if len(path) != 1:
+            fail(f"report wrote {path} for the {slug} page")
+        drawn += check_acceptance_page(drv, path[0], slug, report, artifacts, name)
+    kinds = {d.split(".")[0] for d in drawn}
+    missing = [f for figs in ACCEPTANCE_PAGES.values() for f in figs if f not in kinds]
+    if missing:
+        fail(f"figures {missing} drawn for no serial: the run does not exercise them")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--station", required=True)
@@ -388,29 +503,38 @@ def main():
     ap.add_argument("--ramps", action="store_true", help="also ramp_00/10/20 runs (Fig. 3)")
     ap.add_argument("--verify", action="store_true",
                     help="run --sim --verify: report the verification run (release, Fig. 6)")
+    ap.add_argument("--acceptance", action="store_true",
+                    help="a short acceptance protocol (acceptance_two_plateaus.toml): its pages")
     a = ap.parse_args()
     drv = browser()
     try:
         os.makedirs(a.work, exist_ok=True)
         os.makedirs(a.artifacts, exist_ok=True)
-        name = "report-ramps" if a.ramps else "report-verify" if a.verify else "report"
+        name = ("report-ramps" if a.ramps else "report-verify" if a.verify else
+                "report-acceptance" if a.acceptance else "report")
         db = os.path.join(a.work, name + ".db")
         t0 = time.time()
-        report = make_db(a.station, db, a.gyros, a.ramps, a.verify)
+        report = make_db(a.station, db, a.gyros, a.ramps, a.verify,
+                         ACCEPTANCE_PROTOCOL if a.acceptance else None)
         run_id = report["run_id"]
         print(f"database {db}: run {run_id} in {time.time() - t0:.1f} s")
         out_dir = os.path.join(a.work, name)
         shutil.rmtree(out_dir, ignore_errors=True)
         files = station(a.station, "report", "--db", db, "--run", str(run_id), "--out",
                         out_dir).split()
-        index, pages = files[0], files[1:]
-        if len(pages) != a.gyros:
-            fail(f"expected {a.gyros} serial pages, got {pages}")
+        index, pages = files[0], files[1:1 + a.gyros]
+        if len(files) != 1 + a.gyros + (len(ACCEPTANCE_PAGES) if a.acceptance else 0):
+            fail(f"expected {a.gyros} serial pages (and the acceptance pages), got {files[1:]}")
         load(drv, index)
         from selenium.webdriver.common.by import By
         links = drv.find_elements(By.CSS_SELECTOR, ".serials a")
         if len(links) != a.gyros:
             fail(f"{index}: {len(links)} serial links, expected {a.gyros}")
+        if a.acceptance:
+            check_acceptance(drv, index, files[1 + a.gyros:], report, a.artifacts, name)
+            load(drv, index)
+        elif drv.find_elements(By.CSS_SELECTOR, "section.acceptance"):
+            fail(f"{index}: a run without acceptance steps links acceptance pages")
         check_clean(drv, index)
         check_units(drv, index)
         load(drv, pages[0])
@@ -444,7 +568,7 @@ def main():
             rel = drv.find_element(By.CSS_SELECTOR, "p.release").text
             if not rel.startswith("RELEASED"):
                 fail(f"{cal[1]}: the calibration run's fit is not shown released: {rel!r}")
-        if not a.ramps:
+        if not a.ramps and not a.acceptance:
             check_pdf(a.station, db, run_id, out_dir + "-pdf", a.gyros)
     finally:
         drv.quit()
