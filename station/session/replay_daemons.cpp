@@ -37,13 +37,13 @@ struct SessionLogs {
   std::optional<SessionLogStream> ascii;  // absent before issue 20
   std::int64_t can_records = 0;           // records taken from `can`
 
-  explicit SessionLogs(const std::string& dir)
-      : can((fs::path(dir) / "can.log").string()),
-        modbus((fs::path(dir) / "modbus.log").string()),
-        gpio((fs::path(dir) / "gpio.log").string()) {
+  SessionLogs(const std::string& dir, SessionReads& reads)
+      : can(reads.reader("can.log")),
+        modbus(reads.reader("modbus.log")),
+        gpio(reads.reader("gpio.log")) {
     const auto ascii_log = fs::path(dir) / "ascii.log";
     if (fs::exists(ascii_log) || fs::exists(ascii_log.string() + ".gz"))
-      ascii.emplace(ascii_log.string());
+      ascii.emplace(reads.reader("ascii.log"));
   }
 };
 
@@ -213,15 +213,15 @@ std::vector<SessionResume> replayable_resumes(const std::string& dir,
 /// The session's daemons replayed one after the other into one store.
 class DaemonReplay {
  public:
-  DaemonReplay(const std::string& dir, const RecordedSession& session, Store& store,
-               ReplayReport& report, std::function<void(double)> on_tick)
+  DaemonReplay(const std::string& dir, SessionReads& reads, const RecordedSession& session,
+               Store& store, ReplayReport& report, std::function<void(double)> on_tick)
       : dir_(dir),
         session_(session),
         store_(store),
         report_(report),
         on_tick_(std::move(on_tick)),
         resumes_(replayable_resumes(dir, session)),
-        logs_(dir) {}
+        logs_(dir, reads) {}
 
   /// The run's id, 0 when a divergence ended it (reported in the report).
   std::int64_t run() {
@@ -372,9 +372,10 @@ class DaemonReplay {
 
 }  // namespace
 
-std::int64_t replay_daemons(const std::string& dir, const RecordedSession& session, Store& store,
-                            ReplayReport& report, const std::function<void(double t_s)>& on_tick) {
-  return DaemonReplay(dir, session, store, report, on_tick).run();
+std::int64_t replay_daemons(const std::string& dir, SessionReads& reads,
+                            const RecordedSession& session, Store& store, ReplayReport& report,
+                            const std::function<void(double t_s)>& on_tick) {
+  return DaemonReplay(dir, reads, session, store, report, on_tick).run();
 }
 
 }  // namespace station

@@ -10,6 +10,7 @@
 
 #include "station/config/config.hpp"
 #include "station/config/protocol.hpp"
+#include "station/session/session_digest.hpp"
 #include "station/session/session_files.hpp"
 #include "station/session/session_replay.hpp"
 #include "station/store/store.hpp"
@@ -30,8 +31,9 @@ struct RecordedSession {
 /// InputError when the recording cannot be replayed (a resume without its keys, a recording
 /// that starts mid-run, a run that ended before its recorded kill).
 /// `on_tick` (optional) is told each tick's t_s before it is replayed.
-std::int64_t replay_daemons(const std::string& dir, const RecordedSession& session, Store& store,
-                            ReplayReport& report,
+/// The logs are read once each through `reads` (verified as they are read).
+std::int64_t replay_daemons(const std::string& dir, SessionReads& reads,
+                            const RecordedSession& session, Store& store, ReplayReport& report,
                             const std::function<void(double t_s)>& on_tick = {});
 
 }  // namespace station

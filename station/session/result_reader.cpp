@@ -82,7 +82,7 @@ class TickStreamingSax final : public nlohmann::json_sax<json> {
 /// (the text the parser sees, and so a "byte N" it names, is that of read_session_log's lines).
 class LineStreamBuf final : public std::streambuf {
  public:
-  explicit LineStreamBuf(const std::string& path) : reader_(path) {}
+  explicit LineStreamBuf(LogLineReader& reader) : reader_(reader) {}
   const std::string& file() const { return reader_.file(); }
 
  protected:
@@ -97,14 +97,19 @@ class LineStreamBuf final : public std::streambuf {
   }
 
  private:
-  LogLineReader reader_;
+  LogLineReader& reader_;
   std::string line_;
 };
 
 }  // namespace
 
 json read_result_file(const std::string& path, const std::function<void(json&&)>& on_tick) {
-  LineStreamBuf text(path);
+  LogLineReader reader(path);
+  return read_result_file(reader, on_tick);
+}
+
+json read_result_file(LogLineReader& reader, const std::function<void(json&&)>& on_tick) {
+  LineStreamBuf text(reader);
   std::istream in(&text);
   const std::string file = text.file();
   TickStreamingSax sax(file, on_tick);

@@ -16,4 +16,10 @@ namespace station {
 nlohmann::json read_result_file(const std::string& path,
                                 const std::function<void(nlohmann::json&&)>& on_tick);
 
+class LogLineReader;
+
+/// The same, from `reader` (SessionReads: verified as it is read).
+nlohmann::json read_result_file(LogLineReader& reader,
+                                const std::function<void(nlohmann::json&&)>& on_tick);
+
 }  // namespace station

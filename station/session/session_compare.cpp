@@ -10,6 +10,7 @@
 #include "station/common/input_error.hpp"
 #include "station/session/result_reader.hpp"
 #include "station/session/session_files.hpp"
+#include "station/session/session_log.hpp"
 #include "station/session/session_replay.hpp"
 
 namespace station {
@@ -251,14 +252,13 @@ nlohmann::json ReplayReport::json() const {
            max_abs_difference.is_null() ? nlohmann::json::object() : max_abs_difference}};
 }
 
-ReplayReport compare_with_store(const std::string& result_path, Store& store, std::int64_t run_id,
-                                double rtol, double atol) {
+ReplayReport compare_with_store(const std::string& result_path, LogLineReader& result, Store& store,
+                                std::int64_t run_id, double rtol, double atol) {
   ReplayReport r;
   Comparer c{rtol, atol, r};
   TickComparer ticks(c, store, run_id);
   // Each recorded tick compared as it is read, with the replayed store's, then forgotten.
-  const json recorded =
-      read_result_file(result_path, [&ticks](json&& tick) { ticks.recorded(tick); });
+  const json recorded = read_result_file(result, [&ticks](json&& tick) { ticks.recorded(tick); });
   r.ticks = ticks.finish();
   const auto version = recorded.value("format_version", json());
   if (version != kSessionFormatVersion)

@@ -6,6 +6,8 @@
 #include <charconv>
 #include <filesystem>
 #include <map>
+#include <memory>
+#include <string_view>
 
 #include "station/common/input_error.hpp"
 #include "station/session/session_digest.hpp"
@@ -46,16 +48,24 @@ bool append_tags(std::string_view hex, std::vector<std::uint16_t>& tags) {
 /// Per file, the digest.txt line each "tags" line is on, by the first file line it covers.
 using TagLines = std::map<std::string, std::map<std::int64_t, int>>;
 
-/// digest.txt as written: the files in order of their "file" lines. Throws InputError FILE:LINE.
-std::map<std::string, FileDigest> read_digest(const std::string& path, std::string& read_as,
+/// digest.txt as written (`text`, its bytes as read from `read_as`): the files in order of their
+/// "file" lines. Lines as LogLineReader gives them (a CR before the newline and empty lines left
+/// out): not_canonical names what that forgives. Throws InputError FILE:LINE.
+std::map<std::string, FileDigest> read_digest(const std::string& read_as, std::string_view text,
                                               TagLines& tag_lines) {
   std::map<std::string, FileDigest> out;
-  read_as = for_each_line(path, [&](std::string_view line, int line_no) {
-    if (line.front() == '#') return;
+  int line_no = 0;
+  for (std::size_t begin = 0; begin < text.size();) {
+    const auto nl = std::min(text.find('\n', begin), text.size());
+    std::string_view line = text.substr(begin, nl - begin);
+    begin = nl + 1;
+    ++line_no;
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    if (line.empty() || line.front() == '#') continue;
     std::string_view rest = line;
     const auto kind = field(rest), name = field(rest), number = field(rest), value = field(rest);
     const auto bad = [&](const char* what) {
-      return InputError(fmt::format("{}:{}: {}", read_as.empty() ? path : read_as, line_no, what));
+      return InputError(fmt::format("{}:{}: {}", read_as, line_no, what));
     };
     std::int64_t n = 0;
     if (!parse_number(number, n) || n < 0 || value.empty() || !field(rest).empty())
@@ -72,7 +82,7 @@ std::map<std::string, FileDigest> read_digest(const std::string& path, std::stri
     } else {
       throw bad("unknown line kind");
     }
-  });
+  }
   for (const auto& [name, d] : out)
     if (static_cast<std::int64_t>(d.tags.size()) != d.lines)
       throw InputError(
@@ -107,7 +117,7 @@ std::optional<DigestMismatch> compare(const std::string& file, const FileDigest&
 /// digest.txt in its one form (digest_text of what it says, the files in digested_files()'s
 /// order, hex in lower case): any other byte (a space, a comment, a case, a CR, an empty line,
 /// an unknown file) is named at its line, so that no edit of the digest replays silently.
-std::optional<DigestMismatch> not_canonical(const std::string& read_as,
+std::optional<DigestMismatch> not_canonical(const std::string& read_as, const std::string& have,
                                             const std::map<std::string, FileDigest>& recorded) {
   std::vector<FileDigest> files;
   for (const auto& name : digested_files()) {
@@ -116,14 +126,6 @@ std::optional<DigestMismatch> not_canonical(const std::string& read_as,
   for (auto& f : files)
     std::transform(f.sha256_hex.begin(), f.sha256_hex.end(), f.sha256_hex.begin(),
                    [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  std::string have;
-  try {
-    have = decompressed_bytes(read_as);
-  } catch (const InputError& e) {  // bytes after its compressed end: "FILE: what"
-    const std::string_view what(e.what());
-    return DigestMismatch{read_as, std::nullopt,
-                          std::string(what.substr(std::min(what.size(), read_as.size() + 2)))};
-  }
   const std::string want = digest_text(files);
   if (want == have) return std::nullopt;
   const auto at = std::mismatch(want.begin(), want.end(), have.begin(), have.end());
@@ -133,46 +135,120 @@ std::optional<DigestMismatch> not_canonical(const std::string& read_as,
                         "an edited digest proves nothing"};
 }
 
+/// `file` (digest.txt calls it `name`) against what digest.txt says: the first line that is not
+/// the run's, or nothing. `corrupt`: what stopped the read early, if anything.
+std::optional<DigestMismatch> file_mismatch(const std::string& file, const std::string& name,
+                                            const FileDigest& recorded, const FileDigest& actual,
+                                            const std::string& corrupt, const std::string& read_as,
+                                            const TagLines& tag_lines) {
+  if (auto m = compare(file, recorded, actual); m && (corrupt.empty() || m->line <= actual.lines)) {
+    if (actual.sha256_hex != recorded.sha256_hex || !m->line) return m;
+    // The file is byte for byte the one whose SHA-256 the digest holds: the tag is what changed.
+    const auto lines = tag_lines.find(name);
+    if (lines == tag_lines.end()) return m;
+    const int at = std::prev(lines->second.upper_bound(*m->line))->second;
+    return DigestMismatch{read_as, at,
+                          fmt::format("the tag of {} line {} is not the one of the bytes its "
+                                      "SHA-256 proves",
+                                      name, *m->line)};
+  }
+  if (!corrupt.empty()) return DigestMismatch{file, actual.lines + 1, corrupt};
+  return std::nullopt;
+}
+
 }  // namespace
 
-std::optional<DigestMismatch> verify_session_digest(const std::string& dir) {
-  const std::string path = (fs::path(dir) / "digest.txt").string();
+struct SessionReads::Recorded {
+  std::string read_as;  // digest.txt as read (or digest.txt.gz)
+  std::map<std::string, FileDigest> files;
+  TagLines tag_lines;
+};
+
+SessionReads::SessionReads(std::string dir, bool verify) : dir_(std::move(dir)) {
+  if (verify) recorded_ = std::make_unique<Recorded>();
+}
+
+SessionReads::~SessionReads() = default;
+
+LogLineReader& SessionReads::reader(const std::string& name) {
+  for (auto& [n, r] : readers_)
+    if (n == name) return *r;
+  auto r = std::make_unique<LogLineReader>((fs::path(dir_) / name).string());
+  if (recorded_ && recorded_->files.contains(name)) {
+    digests_.emplace_back(name, std::make_unique<DigestBuilder>(name));
+    r->digest_into(digests_.back().second.get());
+  }
+  readers_.emplace_back(name, std::move(r));
+  return *readers_.back().second;
+}
+
+std::optional<DigestMismatch> SessionReads::check_up_front() {
+  if (!recorded_) return std::nullopt;
+  const std::string path = (fs::path(dir_) / "digest.txt").string();
   if (!fs::exists(path) && !fs::exists(path + ".gz"))
     return DigestMismatch{path, std::nullopt,
                           "missing: nothing proves the logs are the ones the run wrote"};
-  std::string read_as;
-  TagLines tag_lines;
-  const auto recorded = read_digest(path, read_as, tag_lines);
-  if (auto m = not_canonical(read_as, recorded)) return m;
-  for (const auto& name : digested_files()) {
-    const auto it = recorded.find(name);
-    const fs::path maybe = fs::path(dir) / name;
-    if (it == recorded.end() && name == "ascii.log" && !fs::exists(maybe) &&
-        !fs::exists(maybe.string() + ".gz"))
-      continue;  // a session from before issue 20: no line devices, no ascii.log
-    if (it == recorded.end())
-      return DigestMismatch{read_as, std::nullopt, fmt::format("no entry for {}", name)};
-    const fs::path plain = fs::path(dir) / name;
-    if (!fs::exists(plain) && !fs::exists(plain.string() + ".gz"))
-      return DigestMismatch{plain.string(), std::nullopt, "missing (digest.txt lists it)"};
-    const std::string file =
-        fs::exists(plain) ? plain.string() : plain.string() + ".gz";  // as the readers take it
-    std::string corrupt;
-    const FileDigest actual = digest_file(dir, name, &corrupt);
-    if (auto m = compare(file, it->second, actual);
-        m && (corrupt.empty() || m->line <= actual.lines)) {
-      if (actual.sha256_hex != it->second.sha256_hex || !m->line) return m;
-      // The file is byte for byte the one whose SHA-256 the digest holds: the tag is what changed.
-      const auto& lines = tag_lines[name];
-      const int at = std::prev(lines.upper_bound(*m->line))->second;
-      return DigestMismatch{read_as, at,
-                            fmt::format("the tag of {} line {} is not the one of the bytes its "
-                                        "SHA-256 proves",
-                                        name, *m->line)};
-    }
-    if (!corrupt.empty()) return DigestMismatch{file, actual.lines + 1, corrupt};
+  auto& rec = *recorded_;
+  rec.read_as = fs::exists(path) ? path : path + ".gz";
+  std::string have;
+  std::optional<std::string> after_end;  // bytes after its compressed end: "FILE: what"
+  try {
+    have = decompressed_bytes(rec.read_as);
+  } catch (const InputError& e) {
+    // Bytes after its compressed end are a mismatch (below); corrupt data is no digest at all.
+    const std::string_view what(e.what());
+    if (what.find("after the end") == std::string_view::npos) throw;
+    after_end = what.substr(std::min(what.size(), rec.read_as.size() + 2));
   }
+  rec.files = read_digest(rec.read_as, have, rec.tag_lines);
+  if (after_end) return DigestMismatch{rec.read_as, std::nullopt, *after_end};
+  if (auto m = not_canonical(rec.read_as, have, rec.files)) return m;
+  return check_file(digested_files().front());  // session.toml: read for its meaning first
+}
+
+std::optional<DigestMismatch> SessionReads::check_file(const std::string& name) {
+  const auto& rec = *recorded_;
+  const auto it = rec.files.find(name);
+  const fs::path plain = fs::path(dir_) / name;
+  const bool exists = fs::exists(plain) || fs::exists(plain.string() + ".gz");
+  if (it == rec.files.end() && name == "ascii.log" && !exists)
+    return std::nullopt;  // a session from before issue 20: no line devices, no ascii.log
+  if (it == rec.files.end())
+    return DigestMismatch{rec.read_as, std::nullopt, fmt::format("no entry for {}", name)};
+  if (!exists) return DigestMismatch{plain.string(), std::nullopt, "missing (digest.txt lists it)"};
+  // What the replay did not read of the file, read now: the digest takes every byte.
+  LogLineReader& r = reader(name);
+  std::string_view line;
+  int line_no = 0;
+  try {
+    while (r.next(line, line_no)) {
+    }
+  } catch (const InputError&) {  // corrupt compressed data: the digest was told
+  }
+  DigestBuilder* d = nullptr;
+  for (auto& [n, b] : digests_)
+    if (n == name) d = b.get();
+  std::string corrupt;
+  if (d == nullptr) {  // opened before digest.txt was read: digested on its own
+    const FileDigest actual = digest_file(dir_, name, &corrupt);
+    return file_mismatch(r.file(), name, it->second, actual, corrupt, rec.read_as, rec.tag_lines);
+  }
+  corrupt = d->corrupt_what();
+  return file_mismatch(r.file(), name, it->second, d->finish(), corrupt, rec.read_as,
+                       rec.tag_lines);
+}
+
+std::optional<DigestMismatch> SessionReads::check_rest() {
+  if (!recorded_) return std::nullopt;
+  for (std::size_t i = 1; i < digested_files().size(); ++i)
+    if (auto m = check_file(digested_files()[i])) return m;
   return std::nullopt;
+}
+
+std::optional<DigestMismatch> verify_session_digest(const std::string& dir) {
+  SessionReads reads(dir, true);
+  if (auto m = reads.check_up_front()) return m;
+  return reads.check_rest();
 }
 
 }  // namespace station

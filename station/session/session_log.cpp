@@ -1,8 +1,7 @@
-// Session log lines: split, hex-decode; files read through zlib (plain or .gz alike).
+// Session log lines: split, hex-decode; files read plain or gzip'd alike (DecompressedReader).
 #include "station/session/session_log.hpp"
 
 #include <fmt/format.h>
-#include <zlib.h>
 
 #include <algorithm>
 #include <charconv>
@@ -46,11 +45,6 @@ bool decode_hex(std::string_view hex, std::vector<std::uint8_t>& out) {
   return true;
 }
 
-struct GzClose {
-  void operator()(gzFile f) const noexcept { gzclose(f); }
-};
-using GzHandle = std::unique_ptr<std::remove_pointer_t<gzFile>, GzClose>;
-
 }  // namespace
 
 dr::Result<SessionLogLine> parse_session_line(std::string_view line) {
@@ -74,42 +68,33 @@ dr::Result<SessionLogLine> parse_session_line(std::string_view line) {
   return out;
 }
 
-struct LogLineReader::Gz {
-  GzHandle handle;
-};
-
 LogLineReader::LogLineReader(const std::string& path) : file_(path) {
   if (!std::filesystem::exists(file_) && std::filesystem::exists(path + ".gz"))
     file_ = path + ".gz";
-  // zlib reads a file that is not gzip-compressed as it is.
-  in_ = std::make_unique<Gz>(Gz{GzHandle(gzopen(file_.c_str(), "rb"))});
-  if (!in_->handle) throw InputError(fmt::format("{}: cannot open the session log", file_));
-  // Large reads, lines split in place: a session log has millions of lines (a small file gets a
-  // small buffer).
-  std::error_code ec;
-  const auto size = std::filesystem::file_size(file_, ec);
-  chunk_ =
-      ec ? std::size_t{1} << 20 : std::clamp<std::size_t>(size + 1, 4096, std::size_t{1} << 20);
-  gzbuffer(in_->handle.get(), static_cast<unsigned>(chunk_));
+  try {
+    in_ = std::make_unique<DecompressedReader>(file_);
+  } catch (const InputError&) {
+    throw InputError(fmt::format("{}: cannot open the session log", file_));
+  }
 }
 
 LogLineReader::~LogLineReader() = default;
-LogLineReader::LogLineReader(LogLineReader&&) noexcept = default;
 
 bool LogLineReader::refill() {
   buf_.erase(0, begin_);
   begin_ = 0;
-  const std::size_t had = buf_.size();
-  buf_.resize(had + chunk_);
-  const int n = gzread(in_->handle.get(), buf_.data() + had, static_cast<unsigned>(chunk_));
-  buf_.resize(had + static_cast<std::size_t>(std::max(n, 0)));
-  if (n > 0) return true;
-  eof_ = true;
-  int err = Z_OK;
-  gzerror(in_->handle.get(), &err);
-  if (err != Z_OK && err != Z_STREAM_END)
-    throw InputError(fmt::format("{}:{}: corrupt compressed data", file_, line_no_ + 1));
-  return false;
+  std::string_view bytes;
+  try {
+    bytes = in_->next();
+  } catch (const CompressedDataError& e) {
+    eof_ = true;
+    if (digest_ != nullptr) digest_->corrupt(e.what());
+    throw InputError(fmt::format("{}:{}: {}", file_, line_no_ + 1, e.what()));
+  }
+  if (digest_ != nullptr) digest_->add(bytes);
+  buf_.append(bytes);
+  eof_ = bytes.empty();
+  return !eof_;
 }
 
 bool LogLineReader::next(std::string_view& line, int& line_no) {

@@ -12,6 +12,7 @@
 
 #include "drivers/can/candump_log.hpp"
 #include "drivers/common/result.hpp"
+#include "station/session/session_digest.hpp"
 
 namespace station {
 
@@ -28,27 +29,27 @@ struct SessionLogLine {
 /// malformed.
 drivers::Result<SessionLogLine> parse_session_line(std::string_view line);
 
-/// A log file (`path`, or `path`.gz when only that exists) read a line at a time through zlib (a
-/// plain file reads as it is), in chunks of up to 1 MiB: nothing held but the chunk.
+/// A log file (`path`, or `path`.gz when only that exists) read a line at a time, decompressed as
+/// it is read (DecompressedReader: a plain file as it is): nothing held but a chunk.
 class LogLineReader {
  public:
   /// Throws InputError naming the file when it cannot be opened.
   explicit LogLineReader(const std::string& path);
   ~LogLineReader();
-  LogLineReader(LogLineReader&&) noexcept;
+  /// Hands every byte read from now on to `digest` (whose file this is), before it is split.
+  void digest_into(DigestBuilder* digest) { digest_ = digest; }
   /// The next non-empty line (without its newline or a CR before it; valid until the next call)
-  /// and its 1-based number; false at the end. Throws InputError "FILE:LINE: corrupt compressed
-  /// data".
+  /// and its 1-based number; false at the end. Throws InputError "FILE:LINE: what" for corrupt
+  /// compressed data (the digest is told).
   bool next(std::string_view& line, int& line_no);
   /// The file actually read.
   const std::string& file() const { return file_; }
 
  private:
   bool refill();
-  struct Gz;
   std::string file_;
-  std::unique_ptr<Gz> in_;
-  std::size_t chunk_ = 0;
+  std::unique_ptr<DecompressedReader> in_;
+  DigestBuilder* digest_ = nullptr;
   std::string buf_;
   std::size_t begin_ = 0;  // first byte of buf_ not yet handed out
   int line_no_ = 0;
@@ -64,26 +65,34 @@ std::string for_each_line(const std::string& path,
 /// A session log (modbus.log, gpio.log, ascii.log) parsed a line at a time, one line ahead.
 class SessionLogStream {
  public:
-  explicit SessionLogStream(const std::string& path) : reader_(path) {}
+  explicit SessionLogStream(const std::string& path)
+      : own_(std::make_unique<LogLineReader>(path)), reader_(*own_) {}
+  /// Over `reader` (SessionReads: verified as it is read).
+  explicit SessionLogStream(LogLineReader& reader) : reader_(reader) {}
   /// The next line, nullptr at the end; throws InputError "FILE:LINE: what" for a malformed one.
   const SessionLogLine* peek();
   /// Takes the line peek() gave.
   SessionLogLine take();
 
  private:
-  LogLineReader reader_;
+  std::unique_ptr<LogLineReader> own_;
+  LogLineReader& reader_;
   std::optional<SessionLogLine> next_;
 };
 
 /// A session's can.log (or can.log.gz) parsed a record at a time (blank lines skipped).
 class CanLogStream {
  public:
-  explicit CanLogStream(const std::string& path) : reader_(path) {}
+  explicit CanLogStream(const std::string& path)
+      : own_(std::make_unique<LogLineReader>(path)), reader_(*own_) {}
+  /// Over `reader` (SessionReads: verified as it is read).
+  explicit CanLogStream(LogLineReader& reader) : reader_(reader) {}
   /// The next record; false at the end. Throws InputError "FILE:LINE: what".
   bool next(drivers::can::CandumpRecord& record);
 
  private:
-  LogLineReader reader_;
+  std::unique_ptr<LogLineReader> own_;
+  LogLineReader& reader_;
 };
 
 /// Every CAN frame of a session's can.log (or can.log.gz); throws InputError "path:line: what".

@@ -116,26 +116,48 @@ ReplayReport header_differs(const std::string& header_path, const nlohmann::json
 }
 
 ReplayReport replay_and_compare(const ReplayOptions& o, const RecordedSession& session,
-                                const std::string& result_path) {
+                                const std::string& result_path, SessionReads& reads) {
   const std::string db = fresh_db_path(o);
   ReplayReport report;
   {
     Store store(db);
     store.set_ticks_per_commit(600);  // nothing to lose: the recording is the record
+    // A thrown-away database needs no write-ahead log and no syncs (the store's WAL writes each
+    // page twice); its rollback journal stays (in memory), as a killed daemon's lost batch is
+    // rolled back (Store::discard). The daemon's statements are the production ones.
+    if (o.db.empty()) store.db().exec("PRAGMA journal_mode=MEMORY; PRAGMA synchronous=OFF;");
     std::optional<ReplayNarration> narration;
     if (o.narrate) narration.emplace(session.started_utc, session.end.last_tick_s);
-    const std::int64_t run_id = replay_daemons(o.dir, session, store, report, [&](double t_s) {
-      if (narration) narration->at(t_s);
-    });
+    const std::int64_t run_id =
+        replay_daemons(o.dir, reads, session, store, report, [&](double t_s) {
+          if (narration) narration->at(t_s);
+        });
     if (run_id != 0) {
       store.flush();
-      report = compare_with_store(result_path, store, run_id, o.rtol, o.atol);
+      report = compare_with_store(result_path, reads.reader("result.json"), store, run_id, o.rtol,
+                                  o.atol);
     }
   }
   if (o.db.empty()) {
     std::error_code ec;
     for (const char* suffix : {"", "-wal", "-shm"}) fs::remove(db + suffix, ec);
   }
+  return report;
+}
+
+/// The replay, then what it did not read of each file: a file that is not what its digest says
+/// is the finding, whatever the replay made of it (a changed line may have diverged it, or been
+/// malformed), as when every file was checked before the replay.
+ReplayReport replay_verified(const ReplayOptions& o, const RecordedSession& session,
+                             const std::string& result_path, SessionReads& reads) {
+  ReplayReport report;
+  try {
+    report = replay_and_compare(o, session, result_path, reads);
+  } catch (const std::exception&) {
+    if (auto m = reads.check_rest()) return not_the_recording(*m);
+    throw;
+  }
+  if (auto m = reads.check_rest()) return not_the_recording(*m);
   return report;
 }
 
@@ -153,21 +175,23 @@ ReplayReport replay_session(const ReplayOptions& o) {
   if (!fs::exists(result_path) && !fs::exists(result_path + ".gz"))
     throw InputError(fmt::format("{}: cannot open (the run did not end?)", result_path));
   // The recording is the one the run made before anything in it is read for its meaning: a
-  // changed byte anywhere, session.toml included, is a difference naming file and line. Without
-  // a digest, the version says first why (version 2 wrote none).
+  // changed byte anywhere, session.toml included, is a difference naming file and line: digest.txt
+  // and session.toml first, every other file as the replay reads it (one read of each). Without a
+  // digest, the version says first why (version 2 wrote none).
   const bool has_digest = fs::exists(dir / "digest.txt") || fs::exists(dir / "digest.txt.gz");
-  if (o.verify && has_digest) {
-    if (auto m = verify_session_digest(o.dir)) return not_the_recording(*m);
-  }
+  SessionReads reads(o.dir, o.verify && has_digest);
+  if (auto m = reads.check_up_front()) return not_the_recording(*m);
   const toml::table header = parse_header(header_path);
   check_version(header_path, header);
   if (o.verify && !has_digest) {
     if (auto m = verify_session_digest(o.dir)) return not_the_recording(*m);
   }
   const RecordedSession session = read_session(header_path, header);
-  if (auto d = header_difference(header_path, session.config, session.protocol))
+  if (auto d = header_difference(header_path, session.config, session.protocol)) {
+    if (auto m = reads.check_rest()) return not_the_recording(*m);
     return header_differs(header_path, *d);
-  return replay_and_compare(o, session, result_path);
+  }
+  return replay_verified(o, session, result_path, reads);
 }
 
 }  // namespace station

@@ -44,10 +44,12 @@ struct ReplayReport {
 /// not hold) is a difference, reported with the tick, the device and both requests.
 ReplayReport replay_session(const ReplayOptions& o);
 
-/// Compares the recorded result.json at `result_path` (or its .gz), read as it is compared, with
-/// run `run_id` of `store` (the replayed run): tick by tick, then bins, events and fits. Throws
-/// InputError naming the file when it is not a result.json of this format version.
-ReplayReport compare_with_store(const std::string& result_path, Store& store, std::int64_t run_id,
-                                double rtol, double atol);
+class LogLineReader;
+
+/// Compares the recorded result.json at `result_path` (or its .gz), read by `result` as it is
+/// compared, with run `run_id` of `store` (the replayed run): tick by tick, then bins, events and
+/// fits. Throws InputError naming the file when it is not a result.json of this format version.
+ReplayReport compare_with_store(const std::string& result_path, LogLineReader& result, Store& store,
+                                std::int64_t run_id, double rtol, double atol);
 
 }  // namespace station
