@@ -118,11 +118,11 @@ std::string scale_factor_text(const ScaleFactorSource& s) {
   if (!s.model) return "scale factor: " + s.note;
   const ScaleFactorModel& m = *s.model;
   return fmt::format(
-      "scale factor: K0 {:.9g} +- {:.2g} pulse/arcsec at {:.2f} C, TC {:+.3f}{} ppm/C over "
-      "{:.2f}..{:.2f} C; {}",
-      m.k0_pulse_per_arcsec, m.k0_se_pulse_per_arcsec, m.t_ref_c, m.tc_ppm_per_c,
-      m.tc_se_ppm_per_c ? fmt::format(" +- {:.2g}", *m.tc_se_ppm_per_c)
-                        : std::string(" (not measured)"),
+      "scale factor: K0 {:.9g} +- {:.2g} pulse/arcsec at {:.2f} C, {} over {:.2f}..{:.2f} C; {}",
+      m.k0_pulse_per_arcsec, m.k0_se_pulse_per_arcsec, m.t_ref_c,
+      m.tc_se_ppm_per_c
+          ? fmt::format("TC {:+.3f} +- {:.2g} ppm/C", m.tc_ppm_per_c, *m.tc_se_ppm_per_c)
+          : std::string("TC not measured (0)"),
       m.t_min_c, m.t_max_c, s.note);
 }
 

@@ -43,8 +43,9 @@ struct ScaleFactorSource {
 /// units.
 ScaleFactorSource find_scale_factor(Store& store, const FitRecord& fit);
 
-/// "K0 0.6667 +- 1e-05 pulse/arcsec at 25.0 C, TC +2.10 +- 0.3 ppm/C over 5..45 C (run 3)" or
-/// "not measured (…)": one line for people.
+/// "scale factor: K0 0.666668189 +- 4e-06 pulse/arcsec at 25.00 C, TC +2.477 +- 0.16 ppm/C over
+/// -39.85..69.85 C; from the rate ladders of run 1 (3 plateaus)" (TC without an error: "TC not
+/// measured (0)"), or "scale factor: not measured (…)": one line for people.
 std::string scale_factor_text(const ScaleFactorSource& s);
 
 }  // namespace station

@@ -331,4 +331,45 @@ TEST(ScaleFactorBlock, AnAcceptanceRunsLaddersGiveTheBlocksScaleFactor) {
       << rel.out;
 }
 
+// Issue 36: a run with one rate ladder holds the serial to that ladder's K at its temperature:
+// the block gets it with TC 0 and says so.
+TEST(ScaleFactorBlock, OneLadderGivesItsKWithNoTemperatureCoefficientNoted) {
+  const std::string path = station::testing_support::fresh_db("one_ladder") + ".toml";
+  std::ofstream(path) << "name = \"one_ladder\"\n[[step]]\ntype = \"lock_turntable\"\n"
+                         "[[step]]\ntype = \"rate_ladder\"\nrates_dps = [10, 50, 100]\n"
+                         "dwell_s = 60\n[[step]]\ntype = \"lock_turntable\"\n";
+  station::SimRunOptions o;
+  o.db_path = station::testing_support::fresh_db("one_ladder");
+  o.protocol = path;
+  o.progress = false;
+  o.fresh = true;
+  o.gyros = 1;
+  const auto r = station::run_simulated(o);
+  ASSERT_EQ(r["state"], "completed") << r.dump();
+  const std::int64_t run = r["run_id"].get<std::int64_t>();
+  station::Store store(o.db_path, station::OpenMode::read_only);
+  station::FitRecord fit;  // what find_scale_factor reads of a fit: serial, runs, T_ref
+  fit.serial = r["gyros"][0]["serial"].get<std::string>();
+  fit.runs = {run};
+  fit.fit.spec.ref_temp_c = 25.0;
+  const auto acc = station::run_acceptance(store, run, 25.0);
+  ASSERT_EQ(acc.size(), 1u);
+  ASSERT_EQ(acc[0].ladders.size(), 1u);
+  const auto& ladder = acc[0].ladders[0];
+  ASSERT_TRUE(ladder.fit.ok()) << ladder.fit.error();
+  const auto sf = station::find_scale_factor(store, fit);
+  ASSERT_TRUE(sf.model) << sf.note;
+  EXPECT_EQ(sf.model->k0_pulse_per_arcsec, ladder.fit->sf_pulse_per_arcsec);
+  EXPECT_EQ(sf.model->k0_se_pulse_per_arcsec, ladder.fit->sf_se_pulse_per_arcsec);
+  EXPECT_EQ(sf.model->tc_ppm_per_c, 0.0);
+  EXPECT_FALSE(sf.model->tc_se_ppm_per_c);
+  EXPECT_EQ(sf.model->t_ref_c, ladder.temp_c);
+  EXPECT_EQ(sf.model->t_min_c, ladder.temp_c);
+  EXPECT_EQ(sf.model->t_max_c, ladder.temp_c);
+  EXPECT_NE(sf.note.find("no temperature coefficient measured, taken as 0"), std::string::npos)
+      << sf.note;
+  EXPECT_NE(station::scale_factor_text(sf).find("TC not measured (0)"), std::string::npos)
+      << station::scale_factor_text(sf);
+}
+
 }  // namespace
