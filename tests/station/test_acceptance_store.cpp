@@ -12,6 +12,7 @@
 #include <string>
 
 #include "schemas/migrations.hpp"
+#include "station/acceptance/acceptance_history.hpp"
 #include "station/acceptance/acceptance_record.hpp"
 #include "station/parts/part_file.hpp"
 #include "station/sim/sim_run.hpp"
@@ -248,4 +249,39 @@ TEST(AcceptanceStore, FitAcceptanceComputesAnOlderRunsFiguresAgain) {
   ASSERT_EQ(stored.size(), 2u);
   EXPECT_EQ(stored, station::judged_acceptance(s, run, gx200(s, run)));
   EXPECT_EQ(stored[0]["verdict"]["part"], "GX-200");
+}
+
+// The drift between runs: each run with a K against the previous one with a K (a run without
+// one skipped); zeta = dK / sqrt(u1^2 + u2^2), flagged beyond 3 (ISO 13528); K held more than
+// 1 C apart named; TC's change where both runs have one.
+TEST(AcceptanceHistory, DriftIsFlaggedBeyondThreeCombinedErrors) {
+  const auto row = [](std::int64_t run, std::optional<double> k, double temp_c,
+                      std::optional<double> tc) {
+    station::AcceptanceRow r;
+    r.run_id = run;
+    r.sf_pulse_per_arcsec = k;
+    r.sf_se_pulse_per_arcsec = 1e-6;
+    r.sf_temp_c = temp_c;
+    r.tc_ppm_per_c = tc;
+    r.tc_se_ppm_per_c = 0.1;
+    return r;
+  };
+  const double k = 0.6667;
+  const auto d =
+      station::scale_factor_drift({row(1, k, 25, 4.0), row(2, std::nullopt, 25, {}),
+                                   row(3, k + 5e-6, 25, 4.2), row(4, k + 8e-6, 40, std::nullopt)});
+  ASSERT_EQ(d.size(), 2u);
+  EXPECT_EQ(d[0].run_id, 3);
+  EXPECT_EQ(d[0].previous_run_id, 1);
+  EXPECT_NEAR(d[0].delta_ppm, 5e-6 / k * 1e6, 1e-9);
+  EXPECT_NEAR(d[0].se_ppm, std::sqrt(2.0) * 1e-6 / k * 1e6, 1e-9);
+  EXPECT_NEAR(*d[0].zeta, 5.0 / std::sqrt(2.0), 1e-6);  // 3.54: beyond 3
+  EXPECT_TRUE(d[0].drift);
+  EXPECT_NEAR(*d[0].tc_delta_ppm_per_c, 0.2, 1e-12);
+  EXPECT_NEAR(*d[0].tc_se_ppm_per_c, 0.1 * std::sqrt(2.0), 1e-12);
+  EXPECT_FALSE(d[0].temp_gap_c.has_value());
+  EXPECT_NEAR(*d[1].zeta, 3.0 / std::sqrt(2.0), 1e-6);  // 2.12: within
+  EXPECT_FALSE(d[1].drift);
+  EXPECT_FALSE(d[1].tc_delta_ppm_per_c.has_value());
+  EXPECT_EQ(d[1].temp_gap_c, 15.0);
 }
