@@ -6,7 +6,7 @@
 namespace station::compensation {
 
 Computed<WeightedFit> weighted_least_squares(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
-                                             const Eigen::VectorXd& se) {
+                                             const Eigen::VectorXd& se, bool chi2_rule) {
   const Eigen::Index n = x.rows(), p = x.cols();
   if (n < p)
     return NotComputed{std::to_string(n) + " points for " + std::to_string(p) + " unknowns"};
@@ -39,7 +39,7 @@ Computed<WeightedFit> weighted_least_squares(const Eigen::MatrixXd& x, const Eig
   fit.chi2 = w.cwiseProduct(fit.residuals).squaredNorm();
   fit.dof = static_cast<std::size_t>(n - p);
   // The PDG rule (acceptance.hpp): inflate by chi2/dof only when it exceeds 1.
-  if (fit.dof > 0 && fit.chi2 / fit.dof > 1.0) {
+  if (chi2_rule && fit.dof > 0 && fit.chi2 / fit.dof > 1.0) {
     fit.covariance *= fit.chi2 / fit.dof;
     fit.se_scale = std::sqrt(fit.chi2 / fit.dof);
   }

@@ -65,7 +65,8 @@ void add_asymmetry(const UsedPoints& u, LadderResult& r) {
   design.col(0).setOnes();
   design.col(1) = x.cwiseMax(0.0);
   design.col(2) = x.cwiseMin(0.0);
-  const auto fit = weighted_least_squares(design, u.y_pps, u.se_pps);
+  // K+ and K- are each sign's least-squares line: no chi2/dof rule (acceptance.hpp).
+  const auto fit = weighted_least_squares(design, u.y_pps, u.se_pps, false);
   if (!fit) {
     r.asymmetry_note = fit.error();
     return;
@@ -92,7 +93,8 @@ void add_nonlinearity(const UsedPoints& u, const WeightedFit& fit, LadderResult&
   const Eigen::VectorXd ppm = fit.residuals / fs_output_pps * kPpm;
   r.nonlinearity_max_ppm_fs = ppm.cwiseAbs().maxCoeff();
   r.nonlinearity_rms_ppm_fs = std::sqrt(ppm.squaredNorm() / static_cast<double>(ppm.size()));
-  for (Eigen::Index k = 0; k < x.size(); ++k) r.residuals.push_back({x(k) / 3600.0, ppm(k)});
+  for (Eigen::Index k = 0; k < x.size(); ++k)
+    r.residuals.push_back({x(k) / 3600.0, ppm(k), u.se_pps(k)});
 }
 
 }  // namespace
@@ -108,7 +110,9 @@ Computed<LadderResult> analyze_rate_ladder(std::span<const LadderPoint> points) 
   Eigen::MatrixXd design(u->x_arcsec_per_s.size(), 2);
   design.col(0).setOnes();
   design.col(1) = u->x_arcsec_per_s;
-  const auto fit = weighted_least_squares(design, u->y_pps, u->se_pps);
+  // K is the least-squares line, its residuals the nonlinearity: no chi2/dof rule
+  // (acceptance.hpp).
+  const auto fit = weighted_least_squares(design, u->y_pps, u->se_pps, false);
   if (!fit) return NotComputed{"ladder: " + fit.error()};
   const double a = fit->coefficients(0), k = fit->coefficients(1);
   if (!(k != 0.0)) return NotComputed{"ladder: the fitted scale factor is zero"};

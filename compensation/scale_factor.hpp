@@ -10,9 +10,10 @@
 //   Input rate of dwell i:  x_i = 3600 * table_rate_dps_i + earth_rate_dph_i   [arcsec/s]
 //     (the table's read-back rate plus the Earth rate along the input axis, earth_rate.hpp).
 //   Scale factor and bias:  y_i = a + K x_i + e_i, fitted by weighted least squares, weights
-//     1/se_i^2 (acceptance.hpp, with its chi2/dof covariance rule). K is the scale factor
-//     (pulses/arcsec); the bias is the input-equivalent intercept B = a / K [deg/h], its SE by
-//     the delta method with gradient (1/K, -a/K^2).
+//     1/se_i^2 (acceptance.hpp; its chi2/dof rule NOT applied: the line is the definition and
+//     its residuals are the nonlinearity below, so K's SE is the noise's alone). K is the scale
+//     factor (pulses/arcsec); the bias is the input-equivalent intercept B = a / K [deg/h], its SE
+//     by the delta method with gradient (1/K, -a/K^2).
 //   Full scale:  FS = max_i |x_i| over the points used (the ladder's largest input rate);
 //     full-scale output K * FS.
 //   Nonlinearity: the residual r_i = y_i - a - K x_i in ppm of full-scale output,
@@ -77,6 +78,7 @@ double ladder_input_arcsec_per_s(const LadderPoint& p);
 struct LadderResidual {
   double input_rate_dps = 0;   ///< x_i / 3600, deg/s
   double residual_ppm_fs = 0;  ///< r_i / (|K| FS) * 1e6, signed (output above the line > 0)
+  double output_se_pps = 0;    ///< the point's standard error: its weight in the fit
 };
 
 /// Positive-rate and negative-rate scale factors with one common bias.
@@ -87,7 +89,7 @@ struct ScaleFactorAsymmetry {
   double sf_negative_se_pulse_per_arcsec = 0;
   double asymmetry_ppm = 0;     ///< (K+ - K-) / mean(K+, K-) * 1e6
   double asymmetry_se_ppm = 0;  ///< delta method on the joint fit's covariance
-  double se_scale = 1;          ///< the joint fit's chi2/dof factor (acceptance.hpp)
+  double se_scale = 1;          ///< 1: the chi2/dof rule is not applied to a ladder
 };
 
 /// The figures of one ladder at one plateau.
@@ -108,7 +110,7 @@ struct LadderResult {
   std::size_t points_excluded = 0;  ///< rate_in_tolerance == false
   std::size_t dof = 0;              ///< points_used - 2
   double chi2 = 0;                  ///< weighted residual sum of squares of the line
-  double se_scale = 1;              ///< sqrt(chi2/dof) when applied (> 1), else 1
+  double se_scale = 1;              ///< 1: the chi2/dof rule is not applied to a ladder
 };
 
 /// The least number of used points a ladder needs (a line and one degree of freedom).

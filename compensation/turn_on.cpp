@@ -101,9 +101,12 @@ Computed<TurnOnFigures> analyze_turn_on(const TurnOnSeries& series, const TurnOn
 }
 
 Computed<TurnOnRepeatability> turn_on_repeatability(std::span<const double> biases_dph,
-                                                    double confidence) {
+                                                    double confidence, double quantization_dph) {
   if (!(confidence > 0 && confidence < 1))
     return NotComputed{"confidence " + number_text(confidence) + " is not within (0, 1)"};
+  if (!(quantization_dph >= 0 && std::isfinite(quantization_dph)))
+    return NotComputed{"quantization " + number_text(quantization_dph) +
+                       " deg/h is not a number >= 0"};
   if (biases_dph.size() < 2)
     return NotComputed{std::to_string(biases_dph.size()) + " turn-ons; at least 2 needed"};
   for (std::size_t k = 0; k < biases_dph.size(); ++k)
@@ -125,7 +128,7 @@ Computed<TurnOnRepeatability> turn_on_repeatability(std::span<const double> bias
   const double q_hi = chi_squared_quantile(0.5 * (1 + confidence), dof);
   const double q_lo = chi_squared_quantile(0.5 * (1 - confidence), dof);
   r.repeatability_lower_dph = std::sqrt(ss / q_hi);
-  r.repeatability_upper_dph = std::sqrt(ss / q_lo);
+  r.repeatability_upper_dph = std::sqrt((ss + dof * quantization_dph * quantization_dph) / q_lo);
   return r;
 }
 
@@ -145,7 +148,7 @@ Computed<TurnOnResult> analyze_turn_ons(std::span<const TurnOnSeries> turn_ons,
       out.max_warmup_s = std::max(out.max_warmup_s.value_or(*f->warmup_s), *f->warmup_s);
     out.turn_ons.push_back(*f);
   }
-  const auto rep = turn_on_repeatability(biases, w.confidence);
+  const auto rep = turn_on_repeatability(biases, w.confidence, w.bias_quantization_dph);
   if (!rep) return NotComputed{rep.error()};
   out.repeatability = *rep;
   out.mean_bias_se_dph = std::sqrt(se2 / static_cast<double>(turn_ons.size()));

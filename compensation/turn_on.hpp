@@ -51,6 +51,9 @@ struct TurnOnWindows {
   double final_end_s = 0;
   double band_dph = 0;       ///< half-width of the warm-up band, deg/h (> 0)
   double confidence = 0.95;  ///< level of the repeatability's interval, in (0, 1)
+  /// The sd of one turn-on bias's pulse quantization, deg/h (0: none); widens the interval's
+  /// upper end (turn_on_repeatability).
+  double bias_quantization_dph = 0;
 };
 
 /// One turn-on's figures.
@@ -94,9 +97,17 @@ Computed<std::optional<double>> warmup_time_s(const TurnOnSeries& series, double
 Computed<TurnOnFigures> analyze_turn_on(const TurnOnSeries& series, const TurnOnWindows& w);
 
 /// Repeatability of given turn-on biases. NotComputed for fewer than 2, a value not finite,
-/// or a confidence outside (0, 1).
+/// a confidence outside (0, 1) or a negative quantization.
+///
+/// Quantized biases: a counter's bias over a window is a whole number of pulses, so two
+/// turn-ons can read exactly the same bias (s = 0) far more often than normal data would, and
+/// the chi-square interval would then be [0, 0]. Each bias carries a rounding error of sd u =
+/// `quantization_dph` (independent between turn-ons; GUM 4.3.7) that s may have hidden: the
+/// upper end is computed from s_u = sqrt(s^2 + u^2) instead of s (the lower end, and s itself,
+/// stay as measured). The station-level Monte Carlo (tests/station/test_acceptance_coverage.cpp)
+/// measured the interval's coverage without it at 0.85 for a nominal 0.95.
 Computed<TurnOnRepeatability> turn_on_repeatability(std::span<const double> biases_dph,
-                                                    double confidence);
+                                                    double confidence, double quantization_dph = 0);
 
 /// Every turn-on, then the repeatability of their biases. NotComputed names the first turn-on
 /// that could not be analyzed.

@@ -39,6 +39,13 @@ json ladder_json(const LadderFigures& l) {
             {"full_scale_dps", f.full_scale_dps},
             {"points_used", f.points_used},
             {"points_excluded", f.points_excluded}});
+  // Each used point: its input, its residual and the error it was weighted by (a reader can
+  // redo the fit's line, as the simulator's truth does: sim_acceptance_truth.cpp).
+  auto& used = j["used_points"] = json::array();
+  for (const auto& r : f.residuals)
+    used.push_back({{"input_rate_dps", r.input_rate_dps},
+                    {"residual_ppm_fs", r.residual_ppm_fs},
+                    {"output_se_pps", r.output_se_pps}});
   if (f.asymmetry) {
     j["asymmetry_ppm"] = f.asymmetry->asymmetry_ppm;
     j["asymmetry_se_ppm"] = f.asymmetry->asymmetry_se_ppm;

@@ -73,11 +73,17 @@ struct Window {
 /// The mean of a window's series and its standard error by batch means (Schmeiser, "Batch size
 /// effects in the analysis of simulation output", Oper. Res. 30(3):556, 1982): the series in
 /// up to kBatches consecutive batches of equal count, the error from the spread of the batch
-/// means, never below `floor` (the window's quantization). Not sd/sqrt(n) of the 1 Hz values: their
-/// pulse quantization (one pulse is 1.5 deg/h in a second) is anticorrelated from second to second
-/// and would make the error of a 300 s mean four times what it is; the batch means keep what is
-/// left of it and the gyro's own correlated noise (conservative where quantization dominates a
-/// batch).
+/// means. Not sd/sqrt(n) of the 1 Hz values: their pulse quantization (one pulse is 1.5 deg/h in
+/// a second) is anticorrelated from second to second. The batch means still carry it: batch b's
+/// count is exact to the phases e_b, e_(b+1) of its first and last pulse, so its mean errs by
+/// (e_(b+1) - e_b) / D (D its span), variance 2 var(e) / D^2 with var(e) = 1/12 pulse^2 (GUM
+/// 4.3.7, rectangular), while the whole window's mean errs only by (e_k - e_0) / T, the sum
+/// telescoping. With `floor` = that least error of the window's mean (sd sqrt(2/12)/T) and k
+/// batches (D = T/k), a batch mean's quantization variance is k^2 floor^2; the rest of the
+/// spread (the gyro's own noise, correlated or not within a batch) is s_b^2 - k^2 floor^2
+/// (clipped at 0), which the window's mean carries divided by k. So SE^2 = max(s_b^2 - k^2
+/// floor^2, 0) / k + floor^2: the station-level Monte Carlo (tests/station/
+/// test_acceptance_coverage.cpp) measured the plain batch-means error 1.6 times too wide.
 MeanSe batch_mean_se(const std::vector<double>& v, double floor) {
   constexpr std::size_t kBatches = 10, kMinPerBatch = 5;
   const std::size_t k = std::min(kBatches, v.size() / kMinPerBatch);
@@ -94,7 +100,10 @@ MeanSe batch_mean_se(const std::vector<double>& v, double floor) {
     means.push_back(sum / static_cast<double>(per));
   }
   MeanSe m = mean_se(v);
-  m.se = std::max(mean_se(means).se.value_or(0.0), floor);
+  const double kd = static_cast<double>(k);
+  const double se_b = mean_se(means).se.value_or(0.0);  // s_b / sqrt(k)
+  const double noise_var = std::max(se_b * se_b * kd - kd * kd * floor * floor, 0.0) / kd;
+  m.se = std::sqrt(noise_var + floor * floor);
   return m;
 }
 Window window_of(const std::vector<SampleRow>& rows, double from_s, double to_s) {
@@ -214,8 +223,11 @@ TurnOnBins turn_on_bins(const std::vector<SampleRow>& rows, const PointEvent& e,
 }
 
 /// The warm-up band: three times the sd of the bins in the final windows (pooled over the
-/// turn-ons, about each one's final mean), so noise alone leaves a settled gyro inside it.
-double noise_band_dph(const std::vector<TurnOnBins>& all, const comp::TurnOnWindows& w) {
+/// turn-ons, about each one's final mean), so noise alone leaves a settled gyro inside it; never
+/// narrower than three times a bin's own quantization sd (`bin_quantization_dph`: a quiet gyro's
+/// bins can all read the same count, an sd of 0 and no band at all).
+double noise_band_dph(const std::vector<TurnOnBins>& all, const comp::TurnOnWindows& w,
+                      double bin_quantization_dph) {
   double ss = 0;
   std::size_t n = 0, groups = 0;
   for (const auto& b : all) {
@@ -227,7 +239,8 @@ double noise_band_dph(const std::vector<TurnOnBins>& all, const comp::TurnOnWind
     n += v.size();
     groups += v.empty() ? 0 : 1;
   }
-  return n > groups ? 3.0 * std::sqrt(ss / static_cast<double>(n - groups)) : 0.0;
+  const double sd = n > groups ? std::sqrt(ss / static_cast<double>(n - groups)) : 0.0;
+  return 3.0 * std::max(sd, bin_quantization_dph);
 }
 
 void turn_ons_of(const Step& s, const std::map<int, PointEvent>& events,
@@ -242,7 +255,13 @@ void turn_ons_of(const Step& s, const std::map<int, PointEvent>& events,
   w.bias_end_s = s.dwell_s;
   w.final_start_s = s.dwell_s * 2 / 3;
   w.final_end_s = s.dwell_s;
-  w.band_dph = noise_band_dph(bins, w);
+  // One pulse in a window of W seconds is pulse_weight_arcsec / W deg/h (arcsec/s = deg/h); a
+  // mean's count is exact to two uniform phases: sd 1/sqrt(6) of that (GUM 4.3.7).
+  const auto quantization_dph = [&](double window_s) {
+    return slot.pulse_weight_arcsec / window_s / std::sqrt(6.0);
+  };
+  w.band_dph = noise_band_dph(bins, w, quantization_dph(kTurnOnBinS));
+  w.bias_quantization_dph = quantization_dph(w.bias_end_s - w.bias_start_s);
   out.turn_on_band_dph = w.band_dph;
   std::vector<comp::TurnOnSeries> series;
   for (const auto& b : bins) series.push_back({b.t_s, b.bias_dph});

@@ -25,15 +25,24 @@ nlohmann::json serial_truth(const sim::SimGyro& g) {
 
 /// The ladder's figures on the gyro's noise-free output: pulses/s = (3600 w_in (1 + e(w, dT))
 /// + Earth) / pulse weight, w_in the table rate along the input axis (gyro_acceptance.hpp).
+/// A nonlinear response's least-squares line depends on the points and their weights, so the
+/// truth is fitted over the points the station used, each with the error it was weighted by
+/// (`used`: the ladder's used_points); without them, over the schedule with equal weights.
 nlohmann::json ladder_truth(const sim::SimGyro& g, const Step& step, double temp_c,
-                            double earth_dph) {
+                            double earth_dph, const nlohmann::json& used) {
   std::vector<comp::LadderPoint> points;
   const double dt_c = temp_c - g.truth.ref_temp_c, c = sim::table_coupling(g.acceptance);
-  for (const auto& p : acceptance_schedule(step)) {
-    const double in_dps = p.demand * c;
+  const auto add = [&](double table_dps, double se_pps) {
+    const double in_dps = table_dps * c;
     const double e = 1e-6 * sim::scale_factor_error_ppm(g.acceptance, in_dps, dt_c);
     const double out = (3600.0 * in_dps * (1.0 + e) + earth_dph) / g.pulse_weight_arcsec;
-    points.push_back({p.demand, earth_dph, out, 1.0, true});
+    points.push_back({table_dps, earth_dph, out, se_pps, true});
+  };
+  if (used.is_array() && !used.empty()) {
+    for (const auto& p : used)  // input_rate_dps = table + Earth / 3600 (scale_factor.hpp)
+      add(p.value("input_rate_dps", 0.0) - earth_dph / 3600.0, p.value("output_se_pps", 1.0));
+  } else {
+    for (const auto& p : acceptance_schedule(step)) add(p.demand, 1.0);
   }
   const auto fit = comp::analyze_rate_ladder(points);
   if (!fit) return nullptr;
@@ -55,9 +64,9 @@ nlohmann::json with_acceptance_truth(nlohmann::json serials, const sim::SimWorld
       for (auto& l : s["ladders"]) {
         const int i = l.value("step_index", -1);
         if (i < 0 || i >= static_cast<int>(protocol.steps.size())) continue;
-        l["true"] = ladder_truth(g, protocol.steps[static_cast<std::size_t>(i)],
-                                 l.value("temp_c", g.truth.ref_temp_c),
-                                 s.value("earth_rate_dph", 0.0));
+        l["true"] = ladder_truth(
+            g, protocol.steps[static_cast<std::size_t>(i)], l.value("temp_c", g.truth.ref_temp_c),
+            s.value("earth_rate_dph", 0.0), l.value("used_points", nlohmann::json()));
         if (l["true"].is_object())
           plateaus.push_back({l.value("temp_c", 0.0), l["true"]["sf_pulse_per_arcsec"], 1.0});
       }
@@ -75,10 +84,10 @@ nlohmann::json with_acceptance_truth(nlohmann::json serials, const sim::SimWorld
         // The sd of the turn-on biases holds each one's estimation noise (its window's SE) beside
         // the turn-on spread: what the figure should show is their root sum of squares.
         const double se = s["turn_on"].value("mean_bias_se_dph", 0.0);
-        s["turn_on"]["true"] = {{"sigma_dph", g.acceptance.turn_on_sigma_dph},
-                                {"sigma_with_noise_dph",
-                                 std::hypot(g.acceptance.turn_on_sigma_dph, se)},
-                                {"warmup_s", a > band ? g.acceptance.warmup_tau_s * std::log(a / band) : 0.0}};
+        s["turn_on"]["true"] = {
+            {"sigma_dph", g.acceptance.turn_on_sigma_dph},
+            {"sigma_with_noise_dph", std::hypot(g.acceptance.turn_on_sigma_dph, se)},
+            {"warmup_s", a > band ? g.acceptance.warmup_tau_s * std::log(a / band) : 0.0}};
       }
     }
   }

@@ -140,6 +140,36 @@ TEST(ScaleFactor, NonlinearityIsTheLargestDeviationFromTheLeastSquaresLine) {
   EXPECT_GT(worst, 1.0);  // a visible nonlinearity, ppm of full scale
 }
 
+// The scale factor is the least-squares line by definition; the nonlinearity is its residual,
+// reported as a figure, not as the scale factor's error: the same points with and without a
+// cubic term give the same SE for K (the noise's: sqrt of (X' W X)^-1's K element, closed form
+// sum w / (sum w sum w x^2 - (sum w x)^2)), however large chi2/dof grows.
+TEST(ScaleFactor, NonlinearityDoesNotInflateTheScaleFactorsError) {
+  TrueGyro g;
+  const auto linear = ladder(g, nullptr);
+  g.cubic_per_arcsec2 = 1e-17;
+  const auto cubic = ladder(g, nullptr);
+  const auto a = sc::analyze_rate_ladder(linear), b = sc::analyze_rate_ladder(cubic);
+  ASSERT_TRUE(a.ok() && b.ok());
+  const auto se_k = [](const std::vector<sc::LadderPoint>& pts) {
+    double sw = 0, swx = 0, swxx = 0;
+    for (const auto& p : pts) {
+      const double x = sc::ladder_input_arcsec_per_s(p);
+      const double w = 1 / (p.output_se_pps * p.output_se_pps);
+      sw += w, swx += w * x, swxx += w * x * x;
+    }
+    return std::sqrt(sw / (sw * swxx - swx * swx));
+  };
+  EXPECT_GT(b->chi2 / static_cast<double>(b->dof), 100.0);  // the residuals far beyond the noise
+  EXPECT_NEAR(b->sf_se_pulse_per_arcsec, se_k(cubic), 1e-9 * se_k(cubic));
+  EXPECT_NEAR(a->sf_se_pulse_per_arcsec, se_k(linear), 1e-9 * se_k(linear));
+  EXPECT_DOUBLE_EQ(b->se_scale, 1.0);
+  ASSERT_TRUE(b->asymmetry.has_value());
+  // The asymmetry's SE moves only with the points' errors (1e-5 apart here), not with chi2.
+  EXPECT_NEAR(b->asymmetry->asymmetry_se_ppm, a->asymmetry->asymmetry_se_ppm,
+              1e-3 * a->asymmetry->asymmetry_se_ppm);
+}
+
 TEST(ScaleFactor, ExcludedPointIsCountedAndNotRead) {
   TrueGyro g;
   auto pts = ladder(g, nullptr);

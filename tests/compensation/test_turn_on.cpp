@@ -156,3 +156,55 @@ TEST(TurnOn, MonteCarloRepeatabilityIntervalCoverage) {
   // Equal tails: each side misses 2.5 % (sd 0.0025 at M = 4000; +-4 sd).
   EXPECT_NEAR(lower_miss / double(m), 0.025, 4 * std::sqrt(0.025 * 0.975 / m));
 }
+
+// Quantized biases: two turn-ons that read the same count (s = 0) get the upper end from the
+// rounding's own sd u, sqrt(u^2 / q_lo) with q_lo the 2.5 % quantile of chi^2(1) (0.000982069,
+// NIST/SEMATECH table 1.3.6.7.4), and a lower end of 0.
+TEST(TurnOn, QuantizedEqualBiasesKeepAnUpperEnd) {
+  const std::vector<double> b = {0.0819, 0.0819};
+  const double u = 0.002;
+  const auto r = sc::turn_on_repeatability(b, 0.95, u);
+  ASSERT_TRUE(r.ok()) << r.error();
+  EXPECT_EQ(r->repeatability_dph, 0.0);
+  EXPECT_EQ(r->repeatability_lower_dph, 0.0);
+  EXPECT_NEAR(r->repeatability_upper_dph, u / std::sqrt(0.000982069), 1e-5);
+  EXPECT_FALSE(sc::turn_on_repeatability(b, 0.95, -1e-3).ok());
+  EXPECT_FALSE(sc::turn_on_repeatability(b, 0.95, std::nan("")).ok());
+}
+
+// The same coverage check as above with the biases rounded to a counter's grid (step q = 2
+// sigma, a fresh grid phase per realization: the rounding uniform, sd u = q / sqrt(12), GUM
+// 4.3.7), N = 2 as the shipped sessions' power cycles. The spread the repeatability measures is
+// then sqrt(sigma^2 + u^2). Rounding makes s = 0 about a third of the time, where the plain
+// chi-square interval is [0, 0]: its coverage falls well below 0.95 (printed); with u given the
+// upper end holds and the coverage is at least nominal (binomial sd 0.0034 at M = 4000, 4 sd).
+TEST(TurnOn, MonteCarloCoverageWithQuantizedBiases) {
+  std::mt19937_64 rng(3636);
+  std::normal_distribution<double> unit(0.0, 1.0);
+  std::uniform_real_distribution<double> phase(0.0, 1.0);
+  const double sigma = 0.005, q = 2 * sigma, u = q / std::sqrt(12.0);
+  const double sigma_true = std::hypot(sigma, u);
+  const int m = 4000;
+  int covered = 0, covered_plain = 0, zero = 0;
+  for (int i = 0; i < m; ++i) {
+    const double offset = q * phase(rng);
+    std::vector<double> b;
+    for (int k = 0; k < 2; ++k)
+      b.push_back(std::round((0.08 + sigma * unit(rng) - offset) / q) * q + offset);
+    const auto with = sc::turn_on_repeatability(b, 0.95, u);
+    const auto plain = sc::turn_on_repeatability(b, 0.95);
+    ASSERT_TRUE(with.ok() && plain.ok());
+    zero += with->repeatability_dph < 1e-12;
+    covered +=
+        with->repeatability_lower_dph <= sigma_true && sigma_true <= with->repeatability_upper_dph;
+    covered_plain += plain->repeatability_lower_dph <= sigma_true &&
+                     sigma_true <= plain->repeatability_upper_dph;
+  }
+  std::printf(
+      "[coverage] quantized, N = 2: %.4f with the rounding's sd, %.4f without; s = 0 in "
+      "%.3f\n",
+      covered / double(m), covered_plain / double(m), zero / double(m));
+  EXPECT_GT(zero / double(m), 0.2);  // the case this guards is there
+  EXPECT_GE(covered / double(m), 0.95 - 4 * std::sqrt(0.95 * 0.05 / m));
+  EXPECT_LT(covered_plain / double(m), 0.90);  // and the plain interval fails it
+}
