@@ -6,7 +6,7 @@
 namespace station::compensation {
 
 Computed<WeightedFit> weighted_least_squares(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
-                                             const Eigen::VectorXd& se, bool chi2_rule) {
+                                             const Eigen::VectorXd& se) {
   const Eigen::Index n = x.rows(), p = x.cols();
   if (n < p)
     return NotComputed{std::to_string(n) + " points for " + std::to_string(p) + " unknowns"};
@@ -39,10 +39,24 @@ Computed<WeightedFit> weighted_least_squares(const Eigen::MatrixXd& x, const Eig
   fit.chi2 = w.cwiseProduct(fit.residuals).squaredNorm();
   fit.dof = static_cast<std::size_t>(n - p);
   // The PDG rule (acceptance.hpp): inflate by chi2/dof only when it exceeds 1.
-  if (chi2_rule && fit.dof > 0 && fit.chi2 / fit.dof > 1.0) {
+  if (fit.dof > 0 && fit.chi2 / fit.dof > 1.0) {
     fit.covariance *= fit.chi2 / fit.dof;
     fit.se_scale = std::sqrt(fit.chi2 / fit.dof);
   }
+  return fit;
+}
+
+Computed<WeightedFit> ordinary_least_squares(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
+                                             const Eigen::VectorXd& se) {
+  // Equal weights: the same QR with se = 1 gives b and (X'X)^-1 (its chi2/dof rule undone).
+  const auto ols = weighted_least_squares(x, y, Eigen::VectorXd::Ones(y.size()));
+  if (!ols) return ols;
+  WeightedFit fit = *ols;
+  const Eigen::MatrixXd xtx_inv = fit.covariance / (fit.se_scale * fit.se_scale);
+  const Eigen::MatrixXd l = xtx_inv * x.transpose();  // b = L y
+  fit.covariance = l * se.cwiseAbs2().asDiagonal() * l.transpose();
+  fit.chi2 = fit.residuals.cwiseQuotient(se).squaredNorm();
+  fit.se_scale = 1;
   return fit;
 }
 

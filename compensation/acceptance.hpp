@@ -12,13 +12,15 @@
 // applied only when S > 1 (Review of Particle Physics, "Introduction", section on averaging and
 // fitting; the "Birge ratio"): errors the data show to be larger than stated inflate the
 // standard errors; data that scatter less than stated never shrink them.
-// Except a rate ladder's line and its asymmetry fit (scale_factor.hpp): their scale factors are
-// *defined* as the least-squares line over the ladder, and its residuals are the gyro's
-// nonlinearity, a figure of its own, not a sign of understated errors. There chi2/dof is large
-// whenever the nonlinearity exceeds the noise (ppm of a 300 deg/s full scale against a window's
-// 0.01 deg/h), and the rule would report the nonlinearity as the scale factor's error: the
-// station-level Monte Carlo (tests/station/test_acceptance_coverage.cpp) measured the scaled
-// SE covering the line's K in 100 % at +-1 SE, the unscaled one in 0.69 (+-2 SE: 0.93).
+// Except a rate ladder's line and its asymmetry fit (scale_factor.hpp): ordinary_least_squares
+// below. Their scale factors are *defined* as the least-squares straight line over the ladder
+// (equal weights: every dwell is as long), its residuals are the gyro's nonlinearity, a figure
+// of its own and not a sign of understated errors, and the fit's errors are those of that
+// estimator under the points' stated errors. The station-level Monte Carlo (tests/station/
+// test_acceptance_coverage.cpp) found both alternatives wrong: the chi2/dof rule let the
+// nonlinearity pass for K's error (K within 1 SE in 100 %), and weights 1/se^2 from the points'
+// own noise estimates (9 dof each, a factor 6 apart by chance) moved the line wherever the
+// luckiest points pulled it (an asymmetry of -104 ppm for a gyro's +26 over the same points).
 #pragma once
 
 #include <Eigen/Dense>
@@ -64,7 +66,7 @@ class [[nodiscard]] Computed {
 /// A weighted least-squares fit y = X b (see the covariance rule above).
 struct WeightedFit {
   Eigen::VectorXd coefficients;  ///< b
-  Eigen::MatrixXd covariance;    ///< of b, after the chi2/dof rule (when applied)
+  Eigen::MatrixXd covariance;    ///< of b, after the chi2/dof rule
   Eigen::VectorXd residuals;     ///< y - X b, in y's unit (unweighted)
   double chi2 = 0;               ///< sum of (residual / se)^2
   std::size_t dof = 0;           ///< rows - columns
@@ -74,10 +76,17 @@ struct WeightedFit {
 /// Weighted least squares by Householder QR of the weighted, column-scaled design (no normal
 /// equations). `se` holds each row's standard error (> 0, finite; checked by the caller).
 /// NotComputed when rows < columns or the columns are linearly dependent (|R_jj| below 1e-12
-/// of the largest after scaling each column to unit norm). `chi2_rule`: apply the PDG rule
-/// above (false: C = (X' W X)^-1 as stated, for a fit that defines its figure; see above).
+/// of the largest after scaling each column to unit norm).
 Computed<WeightedFit> weighted_least_squares(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
-                                             const Eigen::VectorXd& se, bool chi2_rule = true);
+                                             const Eigen::VectorXd& se);
+
+/// Ordinary (equal-weight) least squares with the estimator's exact covariance under the rows'
+/// stated errors: b = L y with L = (X'X)^-1 X', so Cov(b) = L diag(se^2) L' (the covariance of
+/// a linear function of independent y: Seber & Lee, Linear Regression Analysis, 2nd ed.,
+/// theorem 1.3). No chi2/dof rule; chi2 = sum (r_i / se_i)^2 and se_scale = 1 for the record.
+/// NotComputed as weighted_least_squares.
+Computed<WeightedFit> ordinary_least_squares(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
+                                             const Eigen::VectorXd& se);
 
 /// Variance of g(b) by the delta method: grad' C grad (Casella & Berger, Statistical
 /// Inference, 2nd ed., Theorem 5.5.24 and its multivariate form).

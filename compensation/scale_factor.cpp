@@ -65,8 +65,8 @@ void add_asymmetry(const UsedPoints& u, LadderResult& r) {
   design.col(0).setOnes();
   design.col(1) = x.cwiseMax(0.0);
   design.col(2) = x.cwiseMin(0.0);
-  // K+ and K- are each sign's least-squares line: no chi2/dof rule (acceptance.hpp).
-  const auto fit = weighted_least_squares(design, u.y_pps, u.se_pps, false);
+  // K+ and K- of each sign's least-squares line (ordinary least squares: acceptance.hpp).
+  const auto fit = ordinary_least_squares(design, u.y_pps, u.se_pps);
   if (!fit) {
     r.asymmetry_note = fit.error();
     return;
@@ -110,9 +110,8 @@ Computed<LadderResult> analyze_rate_ladder(std::span<const LadderPoint> points) 
   Eigen::MatrixXd design(u->x_arcsec_per_s.size(), 2);
   design.col(0).setOnes();
   design.col(1) = u->x_arcsec_per_s;
-  // K is the least-squares line, its residuals the nonlinearity: no chi2/dof rule
-  // (acceptance.hpp).
-  const auto fit = weighted_least_squares(design, u->y_pps, u->se_pps, false);
+  // K is the least-squares straight line, its residuals the nonlinearity (acceptance.hpp).
+  const auto fit = ordinary_least_squares(design, u->y_pps, u->se_pps);
   if (!fit) return NotComputed{"ladder: " + fit.error()};
   const double a = fit->coefficients(0), k = fit->coefficients(1);
   if (!(k != 0.0)) return NotComputed{"ladder: the fitted scale factor is zero"};

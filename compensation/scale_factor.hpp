@@ -9,11 +9,12 @@
 // "Sources" for what could be checked):
 //   Input rate of dwell i:  x_i = 3600 * table_rate_dps_i + earth_rate_dph_i   [arcsec/s]
 //     (the table's read-back rate plus the Earth rate along the input axis, earth_rate.hpp).
-//   Scale factor and bias:  y_i = a + K x_i + e_i, fitted by weighted least squares, weights
-//     1/se_i^2 (acceptance.hpp; its chi2/dof rule NOT applied: the line is the definition and
-//     its residuals are the nonlinearity below, so K's SE is the noise's alone). K is the scale
-//     factor (pulses/arcsec); the bias is the input-equivalent intercept B = a / K [deg/h], its SE
-//     by the delta method with gradient (1/K, -a/K^2).
+//   Scale factor and bias:  y_i = a + K x_i + e_i, the least-squares straight line: ordinary
+//     (equal-weight) least squares, its covariance L diag(se_i^2) L' from the points' standard
+//     errors (acceptance.hpp, ordinary_least_squares: no chi2/dof rule, no weights from the
+//     points' noisy errors). K is the scale factor (pulses/arcsec); the bias is the
+//     input-equivalent intercept B = a / K [deg/h], its SE by the delta method with gradient
+//     (1/K, -a/K^2).
 //   Full scale:  FS = max_i |x_i| over the points used (the ladder's largest input rate);
 //     full-scale output K * FS.
 //   Nonlinearity: the residual r_i = y_i - a - K x_i in ppm of full-scale output,

@@ -150,13 +150,36 @@ double mean_temp_c(const std::vector<double>& temps) {
   return temps.empty() ? std::nan("") : mean_se(temps).mean;
 }
 
+/// The temperature a ladder's scale factor belongs to: the slope K = sum (x_i - xm) y_i / Sxx
+/// of a gyro whose K drifts with its temperature T_i over the ladder (the later, faster points
+/// warmer or colder) is, to first order in the drift, K(T_eff) with T_eff = sum (x_i - xm)^2 T_i
+/// / Sxx: the fast points' temperature, not the mean over the windows (which put the plateaus'
+/// K off their temperature by 0.15 ppm, 9 SE, on the shipped protocol's cold and hot ladders).
+/// `points`/`temps_c`: the points the fit takes (in tolerance) and each one's mean sensor A.
+double slope_temp_c(const std::vector<comp::LadderPoint>& points,
+                    const std::vector<double>& temps_c) {
+  double xm = 0, n = 0;
+  for (std::size_t i = 0; i < points.size(); ++i)
+    if (points[i].rate_in_tolerance && std::isfinite(temps_c[i]))
+      xm += comp::ladder_input_arcsec_per_s(points[i]), n += 1;
+  if (n < 2) return std::nan("");
+  xm /= n;
+  double sxx = 0, sxt = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (!points[i].rate_in_tolerance || !std::isfinite(temps_c[i])) continue;
+    const double d = comp::ladder_input_arcsec_per_s(points[i]) - xm;
+    sxx += d * d, sxt += d * d * temps_c[i];
+  }
+  return sxx > 0 ? sxt / sxx : std::nan("");
+}
+
 LadderFigures ladder_of(const Step& s, int index, const std::map<int, PointEvent>& events,
                         const std::vector<SampleRow>& rows, const RunSlot& slot) {
   LadderFigures f;
   f.step_index = index;
   f.label = s.label;
   std::vector<comp::LadderPoint> points;
-  std::vector<double> temps;
+  std::vector<double> point_temps_c;
   for (const auto& w : walk_schedule(s, events, rows)) {
     ++f.points;
     if (w.event == nullptr) {
@@ -174,9 +197,9 @@ LadderFigures ladder_of(const Step& s, int index, const std::map<int, PointEvent
     p.output_se_pps = out.se.value_or(0.0);
     p.rate_in_tolerance = w.event->held && out.se && *out.se > 0;
     points.push_back(p);
-    temps.insert(temps.end(), w.window.temp_c.begin(), w.window.temp_c.end());
+    point_temps_c.push_back(mean_temp_c(w.window.temp_c));
   }
-  f.temp_c = mean_temp_c(temps);
+  f.temp_c = slope_temp_c(points, point_temps_c);
   f.fit = comp::analyze_rate_ladder(points);
   return f;
 }
@@ -197,6 +220,7 @@ PositionFigures positions_of(const Step& s, int index, const std::map<int, Point
       continue;
     }
     points.push_back({w.event->table_mean.value_or(w.scheduled.demand), out.mean, *out.se});
+    f.angles_deg.push_back(points.back().table_angle_deg);
     temps.insert(temps.end(), w.window.temp_c.begin(), w.window.temp_c.end());
   }
   f.temp_c = mean_temp_c(temps);
@@ -208,11 +232,9 @@ PositionFigures positions_of(const Step& s, int index, const std::map<int, Point
 }
 
 /// One turn-on's bias in kTurnOnBinS bins from its power-on, deg/h (rate - Earth rate).
-struct TurnOnBins {
-  std::vector<double> t_s, bias_dph;
-};
-TurnOnBins turn_on_bins(const std::vector<SampleRow>& rows, const PointEvent& e, double earth_dph) {
-  TurnOnBins b;
+TurnOnCurve turn_on_bins(const std::vector<SampleRow>& rows, const PointEvent& e,
+                         double earth_dph) {
+  TurnOnCurve b;
   for (double from = e.measure_s; from + kTurnOnBinS <= e.end_s + 1e-9; from += kTurnOnBinS) {
     const MeanSe m = mean_se(window_of(rows, from, from + kTurnOnBinS).rate_dph);
     if (m.n * 2 < kTurnOnBinS) continue;  // a bin with under half its samples is no bin
@@ -226,7 +248,7 @@ TurnOnBins turn_on_bins(const std::vector<SampleRow>& rows, const PointEvent& e,
 /// turn-ons, about each one's final mean), so noise alone leaves a settled gyro inside it; never
 /// narrower than three times a bin's own quantization sd (`bin_quantization_dph`: a quiet gyro's
 /// bins can all read the same count, an sd of 0 and no band at all).
-double noise_band_dph(const std::vector<TurnOnBins>& all, const comp::TurnOnWindows& w,
+double noise_band_dph(const std::vector<TurnOnCurve>& all, const comp::TurnOnWindows& w,
                       double bin_quantization_dph) {
   double ss = 0;
   std::size_t n = 0, groups = 0;
@@ -245,7 +267,7 @@ double noise_band_dph(const std::vector<TurnOnBins>& all, const comp::TurnOnWind
 
 void turn_ons_of(const Step& s, const std::map<int, PointEvent>& events,
                  const std::vector<SampleRow>& rows, const RunSlot& slot, SerialAcceptance& out) {
-  std::vector<TurnOnBins> bins;
+  std::vector<TurnOnCurve> bins;
   for (const auto& [point, e] : events)  // a turn-on a hold or a kill cut short is left out
     if (e.held) bins.push_back(turn_on_bins(rows, e, slot.earth_rate_dph));
   // After warm-up: the bias over the second half of the powered time, the final value over
@@ -266,6 +288,7 @@ void turn_ons_of(const Step& s, const std::map<int, PointEvent>& events,
   std::vector<comp::TurnOnSeries> series;
   for (const auto& b : bins) series.push_back({b.t_s, b.bias_dph});
   out.turn_on = comp::analyze_turn_ons(series, w);
+  out.turn_on_curves = std::move(bins);
 }
 
 void analyze_step(const Protocol& p, int index, const StepPoints& events,

@@ -20,7 +20,7 @@ namespace station {
 struct LadderFigures {
   int step_index = 0;
   std::string label;
-  double temp_c = 0;  ///< mean of sensor A over the ladder's windows, C
+  double temp_c = 0;  ///< sensor A where the slope was taken (slope_temp_c: the fast points'), C
   int points = 0;     ///< points the schedule has
   int missing = 0;    ///< points without a measured window (a kill or a hold across it)
   compensation::Computed<compensation::LadderResult> fit{compensation::NotComputed{"not analysed"}};
@@ -32,8 +32,15 @@ struct PositionFigures {
   std::string label;
   double temp_c = 0;
   int points = 0, excluded = 0;
+  std::vector<double> angles_deg;  ///< the table angle of each point the fit took, in its order
   compensation::Computed<compensation::VerticalAxisResult> fit{
       compensation::NotComputed{"not analysed"}};
+};
+
+/// One turn-on's bias in kTurnOnBinS bins from its power-up: what its warm-up was judged on.
+struct TurnOnCurve {
+  std::vector<double> t_s;       ///< bin centre, s since power-up
+  std::vector<double> bias_dph;  ///< bin mean rate minus the Earth rate along the axis, deg/h
 };
 
 /// Everything one serial's acceptance steps gave.
@@ -45,8 +52,9 @@ struct SerialAcceptance {
   std::optional<compensation::Computed<compensation::ScaleFactorTemperatureFit>> sf_vs_temp;
   std::vector<PositionFigures> positions;
   std::optional<compensation::Computed<compensation::TurnOnResult>> turn_on;
-  double turn_on_band_dph = 0;  ///< the warm-up band used
-  std::string positions_note;   ///< why positions were not analysed (an axis not up or down)
+  std::vector<TurnOnCurve> turn_on_curves;  ///< the analysed turn-ons' bins, in turn_on's order
+  double turn_on_band_dph = 0;              ///< the warm-up band used
+  std::string positions_note;  ///< why positions were not analysed (an axis not up or down)
 };
 
 /// Bin width of a turn-on's bias series, s: long enough that a bin's white noise (ARW 0.003

@@ -15,10 +15,7 @@
 namespace station::report {
 
 /// One turn-on's bias against the time since its power-up, in acceptance_run's kTurnOnBinS bins.
-struct WarmupCurve {
-  std::vector<double> t_s;       ///< bin centre, s since power-up
-  std::vector<double> bias_dph;  ///< bin mean rate minus the Earth rate along the axis, deg/h
-};
+using WarmupCurve = TurnOnCurve;  ///< a turn-on's bins (acceptance_run.hpp)
 
 /// One serial's acceptance figures with what the report draws them from beyond the structs.
 struct SerialAcceptanceReport {
