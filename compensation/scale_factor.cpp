@@ -162,8 +162,12 @@ Computed<ScaleFactorTemperatureFit> fit_scale_factor_vs_temperature(
     sf(i) = p.sf_pulse_per_arcsec;
     se(i) = p.sf_se_pulse_per_arcsec;
   }
+  const double span_c = design.col(1).maxCoeff() - design.col(1).minCoeff();
+  if (!(span_c >= kMinPlateauSpanC))
+    return NotComputed{"the plateaus span " + number_text(span_c) + " C; at least " +
+                       number_text(kMinPlateauSpanC) + " C needed for a temperature coefficient"};
   const auto fit = weighted_least_squares(design, sf, se);
-  if (!fit) return NotComputed{"scale factor vs temperature: " + fit.error()};
+  if (!fit) return NotComputed{fit.error()};
   const double k0 = fit->coefficients(0), s = fit->coefficients(1);
   if (!(k0 != 0.0)) return NotComputed{"the scale factor at T_ref is zero"};
   ScaleFactorTemperatureFit t;

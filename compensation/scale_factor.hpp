@@ -117,6 +117,16 @@ struct LadderResult {
 /// The least number of used points a ladder needs (a line and one degree of freedom).
 inline constexpr std::size_t kMinLadderPoints = 3;
 
+/// The largest |K w - 1| a ladder's scale factor may have against the gyro's nominal pulse
+/// weight w: an RLG's scale factor lies within a few hundred ppm of its nominal; beyond 1 % the
+/// ladder did not measure the gyro (its output did not follow the table: unpowered, another
+/// axis, a counter not counting). gyro_tc.h's GYRO_TC_MAX_SF_DEVIATION is the same bound.
+inline constexpr double kMaxScaleFactorDeviation = 0.01;
+
+/// The least span of plateau temperatures a temperature coefficient is fitted over, C (two
+/// ladders at one temperature give none).
+inline constexpr double kMinPlateauSpanC = 1.0;
+
 /// Fits a ladder. NotComputed with one line when fewer than kMinLadderPoints points are in
 /// tolerance, a used point has a value that is not finite (or a rate beyond
 /// limits.hpp's kMaxAbsRateDph, or se <= 0), or the input rates do not span a line.

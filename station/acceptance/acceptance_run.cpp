@@ -1,6 +1,8 @@
 // A run's acceptance figures from its acceptance_point events and its samples.
 #include "station/acceptance/acceptance_run.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -201,6 +203,16 @@ LadderFigures ladder_of(const Step& s, int index, const std::map<int, PointEvent
   }
   f.temp_c = slope_temp_c(points, point_temps_c);
   f.fit = comp::analyze_rate_ladder(points);
+  // A gyro that did not follow the table gives a "scale factor" that is none (its K w far
+  // from 1): not computed, never released.
+  if (f.fit && slot.pulse_weight_arcsec > 0) {
+    const double kw = f.fit->sf_pulse_per_arcsec * slot.pulse_weight_arcsec;
+    if (!(std::abs(kw - 1.0) <= comp::kMaxScaleFactorDeviation))
+      f.fit = comp::NotComputed{fmt::format(
+          "K w = {:.6g} is not 1 within {:g} %: the gyro's output did not follow the table "
+          "(nominal pulse weight w = {:g} arcsec)",
+          kw, 100 * comp::kMaxScaleFactorDeviation, slot.pulse_weight_arcsec)};
+  }
   return f;
 }
 

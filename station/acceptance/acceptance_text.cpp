@@ -37,7 +37,7 @@ std::string ladder_line(const json& l) {
       l["bias_se_dph"].get<double>(), l["nonlinearity_max_ppm_fs"].get<double>(),
       truth(l, "nonlinearity_max_ppm_fs", "{:.1f}"), l["nonlinearity_rms_ppm_fs"].get<double>());
   if (l.contains("asymmetry_ppm"))
-    out += fmt::format(", asymmetry {:+.1f} +- {:.1f} ppm{}", l["asymmetry_ppm"].get<double>(),
+    out += fmt::format(", asymmetry {:+.1f} +- {:.2g} ppm{}", l["asymmetry_ppm"].get<double>(),
                        l["asymmetry_se_ppm"].get<double>(), truth(l, "asymmetry_ppm", "{:+.1f}"));
   const int excluded = l.value("points_excluded", 0) + l.value("missing", 0);
   out += fmt::format("; {} of {} points", l.value("points_used", 0), l.value("points", 0));
@@ -54,7 +54,7 @@ std::string tc_line(const json& s) {
   if (!t.value("ok", false)) return "  scale factor vs temperature: " + t.value("error", "") + "\n";
   return fmt::format(
       "  scale factor vs temperature: K({:g} C) {:.7f} +- {:.1e} pulse/arcsec{}, "
-      "temperature coefficient {:+.2f} +- {:.2f} ppm/C{} over {} plateaus\n",
+      "temperature coefficient {:+.3f} +- {:.2g} ppm/C{} over {} plateaus\n",
       t["ref_temp_c"].get<double>(), t["sf_ref_pulse_per_arcsec"].get<double>(),
       t["sf_ref_se_pulse_per_arcsec"].get<double>(), truth(t, "sf_ref_pulse_per_arcsec", "{:.7f}"),
       t["tc_ppm_per_c"].get<double>(), t["tc_se_ppm_per_c"].get<double>(),

@@ -10,6 +10,7 @@
 #include "compensation/model_selection.hpp"
 #include "station/acceptance/acceptance_json.hpp"
 #include "station/acceptance/acceptance_record.hpp"
+#include "station/cli/acceptance_beside.hpp"
 #include "station/cli/commands.hpp"
 #include "station/cli/exit_status.hpp"
 #include "station/common/input_error.hpp"
@@ -120,28 +121,6 @@ void recompute_acceptance(Store& store, const std::vector<JudgedFit>& fits,
   }
 }
 
-/// The serial's acceptance beside its thermal verdict: the stored figures of the newest of the
-/// fit's runs that has them; null when none has.
-nlohmann::json fit_acceptance_json(Store& store, const SerialFit& f) {
-  const auto row = newest_acceptance_row(store, f.serial, f.runs);
-  if (!row) return nullptr;
-  return {{"run_id", row->run_id},
-          {"part_number", row->part_number ? nlohmann::json(*row->part_number) : nullptr},
-          {"verdict", row->figures.value("verdict", nlohmann::json())},
-          {"sf_pulse_per_arcsec",
-           row->sf_pulse_per_arcsec ? nlohmann::json(*row->sf_pulse_per_arcsec) : nullptr}};
-}
-
-std::string fit_acceptance_text(const nlohmann::json& a) {
-  if (a.is_null()) return "";
-  const std::string verdict = a["verdict"].is_null()
-                                  ? std::string("not judged (no acceptance limits)")
-                                  : acceptance_verdict_text(a["verdict"]);
-  return fmt::format("  acceptance verdict (run {}{}): {}\n", a["run_id"].get<std::int64_t>(),
-                     a["part_number"].is_null() ? "" : ", " + a["part_number"].get<std::string>(),
-                     verdict);
-}
-
 void print_fit(const JudgedFit& jf) {
   const SerialFit& f = jf.fit;
   fmt::print("{}: fit {} over runs {} ({} bins)\n", f.serial, f.fit_id, fmt::join(f.runs, ","),
@@ -230,7 +209,7 @@ int run_fit(const FitOptions& o) {
       arr.push_back(fit_json(f));
       const auto choice = load_fit_model_choice(store, f.fit.fit_id);
       arr.back()["model_choice"] = choice ? *choice : nlohmann::json();
-      arr.back()["acceptance"] = fit_acceptance_json(store, f.fit);
+      arr.back()["acceptance"] = acceptance_beside_json(store, f.fit.serial, f.fit.runs);
       if (o.cv) arr.back()["cross_validation"] = cv_json(cross_validate(store, f.fit), f.fit.runs);
     }
     std::cout << (o.all ? arr : arr[0]).dump(2) << '\n';
@@ -238,7 +217,8 @@ int run_fit(const FitOptions& o) {
   }
   for (const auto& f : fits) {
     print_fit(f);
-    fmt::print("{}", fit_acceptance_text(fit_acceptance_json(store, f.fit)));
+    fmt::print("{}",
+               acceptance_beside_text(acceptance_beside_json(store, f.fit.serial, f.fit.runs)));
     if (o.cv) print_cv(cross_validate(store, f.fit), f.fit.runs);
   }
   return status;

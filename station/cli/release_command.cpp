@@ -7,6 +7,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
+#include "station/cli/acceptance_beside.hpp"
 #include "station/cli/commands.hpp"
 #include "station/cli/exit_status.hpp"
 #include "station/cli/text_options.hpp"
@@ -162,16 +163,20 @@ FitRecord fit_to_verify(Store& store, const VerifyOptions& o) {
   return *store.find_fit(rel->fit_id);
 }
 
-void print_verify(const VerifyOptions& o, const VerificationResult& v, bool reused) {
+void print_verify(Store& store, const VerifyOptions& o, const VerificationResult& v, bool reused) {
+  // The verification run's acceptance figures, judged when it ended (issue 36).
+  const auto acceptance = acceptance_beside_json(store, v.serial, {v.run_id});
   if (o.json) {
     auto j = verification_json(v);
     j["verification_id"] = v.id;
     j["created_utc"] = v.created_utc;
     j["stored_before"] = reused;
+    j["acceptance"] = acceptance;
     std::cout << j.dump(2) << '\n';
     return;
   }
   print_verification(v);
+  fmt::print("{}", acceptance_beside_text(acceptance));
   if (reused)
     fmt::print("  (stored {}: the same fit on the same run; --redo verifies it again)\n",
                v.created_utc);
@@ -194,7 +199,7 @@ int run_verify(const VerifyOptions& o) {
   const bool reused = stored.has_value();
   VerificationResult v = reused ? std::move(*stored) : verify_fit(store, fit, o.run_id, limits);
   if (!reused) save_verification(store, v);
-  print_verify(o, v, reused);
+  print_verify(store, o, v, reused);
   return v.verdict && !v.verdict->pass ? 1 : 0;
 }
 

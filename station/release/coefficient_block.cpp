@@ -8,11 +8,15 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 
+#include "compensation/scale_factor.hpp"
 #include "station/common/text_rule.hpp"
 #include "station/parts/deliverable_terms.hpp"
 #include "station/store/calibration.hpp"
 #include "station/store/fit_model_choice.hpp"
 #include "station/store/fit_verdicts.hpp"
+
+// One bound for a usable scale factor, in the station and in the shipped header.
+static_assert(GYRO_TC_MAX_SF_DEVIATION == station::compensation::kMaxScaleFactorDeviation);
 
 namespace station {
 namespace {

@@ -36,6 +36,11 @@ extern "C" {
 
 /* The longest canonical text a block may have (the station refuses to export a longer one). */
 #define GYRO_TC_CANONICAL_MAX 1024
+/* The largest |K(T) w - 1| a scale-factor model may have: a gyro's scale factor lies within a
+ * few hundred ppm of its nominal pulse weight w; beyond 1 % the ladder did not measure the gyro
+ * (one that did not follow the table). The station refuses such a ladder by the same bound
+ * (compensation/scale_factor.hpp, kMaxScaleFactorDeviation; equal by a static_assert). */
+#define GYRO_TC_MAX_SF_DEVIATION 0.01
 
 typedef struct gyro_tc_block {
   const char *serial;      /* gyro serial number */
@@ -214,14 +219,21 @@ static inline uint32_t gyro_tc_crc32(const char *s, size_t n) {
   return crc ^ 0xFFFFFFFFu;
 }
 
-/* 1 when a scale-factor model is absent, or present and usable: its span ordered, w > 0, and
- * K(T) > 0 over the span (a scale factor that reaches 0 cannot be divided by); else 0. */
+/* 1 when K(T) w is within GYRO_TC_MAX_SF_DEVIATION of 1 (false for NaN). */
+static inline int gyro_tc_sf_near_nominal(const gyro_tc_block *b, double temp_c) {
+  const double kw = gyro_tc_scale_factor_pulse_per_arcsec(b, temp_c) * b->pulse_weight_arcsec;
+  return kw >= 1.0 - GYRO_TC_MAX_SF_DEVIATION && kw <= 1.0 + GYRO_TC_MAX_SF_DEVIATION;
+}
+
+/* 1 when a scale-factor model is absent, or present and usable: its span ordered, w finite and
+ * > 0, the Earth rate finite, and K(T) w within GYRO_TC_MAX_SF_DEVIATION of 1 over the span (K
+ * is linear in T: its ends bound it); else 0. */
 static inline int gyro_tc_scale_factor_ok(const gyro_tc_block *b) {
   if (b->sf_measured == 0) return 1;
   return b->sf_measured == 1 && b->sf_t_min_c <= b->sf_t_max_c && b->pulse_weight_arcsec > 0 &&
-         b->sf_k0_pulse_per_arcsec > 0 &&
-         gyro_tc_scale_factor_pulse_per_arcsec(b, b->sf_t_min_c) > 0 &&
-         gyro_tc_scale_factor_pulse_per_arcsec(b, b->sf_t_max_c) > 0;
+         b->pulse_weight_arcsec < 1e300 && b->earth_rate_dph == b->earth_rate_dph &&
+         b->earth_rate_dph > -1e300 && b->earth_rate_dph < 1e300 &&
+         gyro_tc_sf_near_nominal(b, b->sf_t_min_c) && gyro_tc_sf_near_nominal(b, b->sf_t_max_c);
 }
 
 /* 1 when the block's checksum matches its contents, its spans are ordered and its scale-factor

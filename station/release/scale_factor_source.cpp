@@ -68,12 +68,13 @@ std::optional<ScaleFactorModel> model_of(const SerialAcceptance& a, std::int64_t
     note = fmt::format("from the rate ladders of run {} ({} plateaus)", run, m.plateaus);
     return m;
   }
-  // One ladder: K holds at its temperature (or, when it had none, K is all there is).
+  // One ladder (or plateaus too close for a temperature model: the one nearest 25 C): K holds
+  // at its temperature (or, when it had none, K is all there is).
   m.t_ref_c = held->temp_c.value_or(t_ref_c);
   m.t_min_c = m.t_max_c = m.t_ref_c;
   m.plateaus = 1;
   note = fmt::format(
-      "from the one rate ladder of run {}: no temperature coefficient measured, taken as 0", run);
+      "from one rate ladder of run {}: no temperature coefficient measured, taken as 0", run);
   return m;
 }
 

@@ -52,16 +52,19 @@ Figure ladder_residuals_figure(std::string id, const SerialAcceptance& a) {
     }
     Series s;
     s.label = step_label(l.label, l.step_index, l.temp_c);
+    // Each point's error in the residual's unit: se / (|K| FS), FS in arcsec/s (scale_factor.hpp).
+    const double fs_pps = std::abs(l.fit->sf_pulse_per_arcsec) * l.fit->full_scale_dps * 3600.0;
     for (const auto& r : l.fit->residuals) {
+      const double se_ppm = fs_pps > 0 ? r.output_se_pps / fs_pps * 1e6 : 0.0;
       s.x.push_back(r.input_rate_dps);
       s.y.push_back(r.residual_ppm_fs);
+      s.y_low.push_back(r.residual_ppm_fs - se_ppm);
+      s.y_high.push_back(r.residual_ppm_fs + se_ppm);
     }
+    s.whiskers = true;
     f.series.push_back(std::move(s));
   }
   f.note = why.empty() ? "" : "Not computed: " + joined(why) + ".";
-  if (!f.series.empty())
-    f.note += std::string(f.note.empty() ? "" : " ") +
-              "No error bars: the ladder's result keeps no standard error per point.";
   return f;
 }
 

@@ -6,6 +6,7 @@ namespace station::report {
 
 std::vector<SerialAcceptanceReport> load_acceptance(Store& store, const RunRecord& run) {
   std::vector<SerialAcceptanceReport> out;
+  if (run.protocol_text.empty()) return out;  // a run stored without its protocol
   for (auto& f : run_acceptance(store, run.id)) {
     SerialAcceptanceReport s;
     // The bins the analysis judged each turn-on's warm-up on, and the angles its positions fit

@@ -18,10 +18,6 @@ std::string pm(double v, double se, const char* spec = "{:.5g}") {
   return num(v, spec) + " &plusmn; " + num(se, "{:.2g}");
 }
 
-std::string note_html(const std::string& text) {
-  return "<p class=\"note\">" + html_escape(text) + "</p>\n";
-}
-
 /// The figures' boxes, each also added to the page's figure data.
 std::string figures_html(const std::vector<Figure>& figs, json& data) {
   std::string t = "<div class=\"figures\">\n";
@@ -149,7 +145,8 @@ std::string serial_section(const SerialAcceptanceReport& s, std::size_t k, Accep
 std::string method_note(AcceptancePage p) {
   switch (p) {
     case AcceptancePage::scale_factor:
-      return "<p class=\"method\">Each ladder fitted by weighted least squares, output against "
+      return "<p class=\"method\">Each ladder's least-squares straight line (equal weights, the "
+             "error bars each point's standard error), output against "
              "input rate (the table's read-back rate plus the Earth rate along the input axis); "
              "nonlinearity is the residual in ppm of full-scale output, asymmetry the positive "
              "against the negative scale factor with one bias; the temperature coefficient from "

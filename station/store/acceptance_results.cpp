@@ -79,18 +79,28 @@ std::vector<AcceptanceRow> read_rows(StatementLease& st) {
 std::optional<HeldScaleFactor> held_scale_factor(const json& serial) {
   if (serial.contains("sf_vs_temp")) {
     const json& t = serial["sf_vs_temp"];
-    const auto k = figure(t, "sf_ref_pulse_per_arcsec");
-    if (!k) return std::nullopt;
-    return HeldScaleFactor{*k, figure(t, "sf_ref_se_pulse_per_arcsec").value_or(0.0),
-                           figure(t, "ref_temp_c")};
+    if (const auto k = figure(t, "sf_ref_pulse_per_arcsec"))
+      return HeldScaleFactor{*k, figure(t, "sf_ref_se_pulse_per_arcsec").value_or(0.0),
+                             figure(t, "ref_temp_c")};
   }
-  if (!serial.contains("ladders") || serial["ladders"].size() != 1) return std::nullopt;
-  const json& l = serial["ladders"][0];
-  const auto k = figure(l, "sf_pulse_per_arcsec");
-  if (!k) return std::nullopt;
+  // No temperature model (one ladder, or plateaus too close to give one): the computed ladder
+  // nearest kHeldScaleFactorTempC holds at its own temperature.
+  if (!serial.contains("ladders")) return std::nullopt;
+  const json* best = nullptr;
+  double best_gap = 0;
+  for (const json& l : serial["ladders"]) {
+    if (!figure(l, "sf_pulse_per_arcsec")) continue;
+    const double gap = l.contains("temp_c") && l["temp_c"].is_number()
+                           ? std::abs(l["temp_c"].get<double>() - kHeldScaleFactorTempC)
+                           : 1e300;
+    if (best == nullptr || gap < best_gap) best = &l, best_gap = gap;
+  }
+  if (best == nullptr) return std::nullopt;
+  const json& l = *best;
   return HeldScaleFactor{
-      *k, figure(l, "sf_se_pulse_per_arcsec").value_or(0.0),
-      l.contains("temp_c") ? std::optional(l["temp_c"].get<double>()) : std::nullopt};
+      *figure(l, "sf_pulse_per_arcsec"), figure(l, "sf_se_pulse_per_arcsec").value_or(0.0),
+      l.contains("temp_c") && l["temp_c"].is_number() ? std::optional(l["temp_c"].get<double>())
+                                                      : std::nullopt};
 }
 
 AcceptanceRow acceptance_row(std::int64_t run_id, const json& serial) {

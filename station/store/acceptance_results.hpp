@@ -21,8 +21,11 @@ struct HeldScaleFactor {
   double k_pulse_per_arcsec = 0, se_pulse_per_arcsec = 0;
   std::optional<double> temp_c;  ///< where K holds, C; empty when its ladder had no temperature
 };
-/// HeldScaleFactor of one serial's object (acceptance_json); empty when it was not computed, or
-/// the serial has several ladders and no temperature model over them.
+/// Where a scale factor without a temperature model is taken: the ladder nearest this, C.
+inline constexpr double kHeldScaleFactorTempC = 25.0;
+/// HeldScaleFactor of one serial's object (acceptance_json): K at T_ref of the fit across the
+/// plateaus; without one (a single ladder, or plateaus too close), the computed ladder nearest
+/// kHeldScaleFactorTempC at its temperature; empty when no ladder was computed.
 std::optional<HeldScaleFactor> held_scale_factor(const nlohmann::json& serial);
 
 /// One stored row.

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "station/acceptance/acceptance_run.hpp"
 #include "station/acceptance/acceptance_verdict.hpp"
 #include "station/common/input_error.hpp"
 #include "station/config/acceptance_steps.hpp"
@@ -361,6 +362,29 @@ TEST(AcceptanceRun, ADriveFaultMidLadderHoldsSafeAndLeavesItsPointsOut) {
   const auto& ladders = r["acceptance"][0]["ladders"];
   ASSERT_EQ(ladders.size(), 1u) << r["acceptance"].dump();
   EXPECT_TRUE(ladders[0]["ok"].get<bool>()) << ladders[0].dump();
+}
+
+// The hostile review's case: a ladder the gyro's output did not follow (here its counts
+// overwritten with a constant 6 pulses a second over the ladder) is no scale factor: K w far from
+// 1 is not computed, so it is neither judged nor released; the rest still is.
+TEST(AcceptanceRun, ALadderTheGyroDidNotFollowIsNotComputed) {
+  station::SimRunOptions o;
+  o.db_path = station::testing_support::fresh_db("ladder_not_followed");
+  o.protocol = std::string(STATION_SOURCE_DIR) + "/tests/sessions/session_acceptance.toml";
+  o.progress = false;
+  o.fresh = true;
+  o.gyros = 1;
+  ASSERT_EQ(station::run_simulated(o)["state"], "completed");
+  station::Store store(o.db_path, station::OpenMode::existing);
+  store.db().exec("UPDATE samples SET net_pulses = 6 * interval_s WHERE t_s BETWEEN 1322 AND 1797");
+  const auto a = station::run_acceptance(store, 1);
+  ASSERT_EQ(a.size(), 1u);
+  ASSERT_EQ(a[0].ladders.size(), 1u);
+  ASSERT_FALSE(a[0].ladders[0].fit.ok());
+  EXPECT_NE(a[0].ladders[0].fit.error().find("did not follow the table"), std::string::npos)
+      << a[0].ladders[0].fit.error();
+  ASSERT_EQ(a[0].positions.size(), 1u);
+  EXPECT_TRUE(a[0].positions[0].fit.ok());
 }
 
 // A figure beyond its limit fails named; a limit whose figure the run did not measure fails too.

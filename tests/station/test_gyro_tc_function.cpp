@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -149,6 +150,21 @@ TEST(GyroTc, TheRateIsTheOutputOverKMinusTheBiasInInputUnits) {
   EXPECT_NEAR(gyro_tc_rate_dph(&b, at_rest_dph, 40, 0.4), 10.5, 1e-12 * 10.5);
   // A scale factor that reaches zero over its span cannot be divided by: never verifies.
   b.sf_tc_ppm_per_c = -4e4;
+  EXPECT_EQ(gyro_tc_scale_factor_ok(&b), 0);
+  // Nor one that is no gyro's (K w beyond 1 +- GYRO_TC_MAX_SF_DEVIATION anywhere on its span: a
+  // ladder the gyro did not follow), nor a w or an Earth rate that is not a number.
+  b.sf_tc_ppm_per_c = 3.0;
+  EXPECT_EQ(gyro_tc_scale_factor_ok(&b), 1);
+  b.sf_tc_ppm_per_c = 500.0;  // K w = 1.0125 at 50 C
+  EXPECT_EQ(gyro_tc_scale_factor_ok(&b), 0);
+  b.sf_tc_ppm_per_c = 3.0;
+  b.sf_k0_pulse_per_arcsec = 1.96e-8;
+  EXPECT_EQ(gyro_tc_scale_factor_ok(&b), 0);
+  b.sf_k0_pulse_per_arcsec = (1 + 40e-6) / 1.5;
+  b.earth_rate_dph = std::nan("");
+  EXPECT_EQ(gyro_tc_scale_factor_ok(&b), 0);
+  b.earth_rate_dph = 10.5;
+  b.pulse_weight_arcsec = std::numeric_limits<double>::infinity();
   EXPECT_EQ(gyro_tc_scale_factor_ok(&b), 0);
 }
 
