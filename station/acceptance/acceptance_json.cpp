@@ -39,8 +39,8 @@ json ladder_json(const LadderFigures& l) {
             {"full_scale_dps", f.full_scale_dps},
             {"points_used", f.points_used},
             {"points_excluded", f.points_excluded}});
-  // Each used point: its input, its residual and the error it was weighted by (a reader can
-  // redo the fit's line, as the simulator's truth does: sim_acceptance_truth.cpp).
+  // Each used point: its input, its residual and its standard error (a reader can redo the
+  // line over the same points, as the simulator's truth does: sim_acceptance_truth.cpp).
   auto& used = j["used_points"] = json::array();
   for (const auto& r : f.residuals)
     used.push_back({{"input_rate_dps", r.input_rate_dps},

@@ -62,14 +62,20 @@ MeanSe mean_se(const std::vector<double>& v) {
   return m;
 }
 
+/// The least error of a mean count rate over `window_s`, in pulses/s: the count is exact to the
+/// phase of the first and last pulse, two uniform errors of one pulse, sd 1/sqrt(6) pulse (GUM
+/// 4.3.7, the rectangular distribution, for their difference's triangle). Times the pulse weight
+/// (arcsec) it is deg/h (arcsec/s = deg/h).
+double mean_quantization_pps(double window_s) {
+  return window_s > 0 ? 1.0 / (window_s * std::sqrt(6.0)) : 0.0;
+}
+
 /// The samples of [from_s, to_s) with a rate: pulses per second, rate deg/h and sensor A.
 struct Window {
   std::vector<double> pps, rate_dph, temp_c;
   double span_s = 0;  ///< the time the samples cover (their intervals), s
-  /// The least error of a mean over the window: its count of pulses is exact to the phase of
-  /// the first and last pulse, two uniform errors of one pulse, sd 1/sqrt(6) pulse (GUM 4.3.7,
-  /// the rectangular distribution, for their difference's triangle): pulses/s.
-  double quantization_pps() const { return span_s > 0 ? 1.0 / (span_s * std::sqrt(6.0)) : 0.0; }
+  /// The least error of a mean over the window, pulses/s (mean_quantization_pps).
+  double quantization_pps() const { return mean_quantization_pps(span_s); }
 };
 
 /// The mean of a window's series and its standard error by batch means (Schmeiser, "Batch size
@@ -84,8 +90,8 @@ struct Window {
 /// batches (D = T/k), a batch mean's quantization variance is k^2 floor^2; the rest of the
 /// spread (the gyro's own noise, correlated or not within a batch) is s_b^2 - k^2 floor^2
 /// (clipped at 0), which the window's mean carries divided by k. So SE^2 = max(s_b^2 - k^2
-/// floor^2, 0) / k + floor^2: the station-level Monte Carlo (tests/station/
-/// test_acceptance_coverage.cpp) measured the plain batch-means error 1.6 times too wide.
+/// floor^2, 0) / k + floor^2 (tests/station/test_acceptance_coverage.cpp checks the errors end
+/// to end).
 MeanSe batch_mean_se(const std::vector<double>& v, double floor) {
   constexpr std::size_t kBatches = 10, kMinPerBatch = 5;
   const std::size_t k = std::min(kBatches, v.size() / kMinPerBatch);
@@ -289,10 +295,8 @@ void turn_ons_of(const Step& s, const std::map<int, PointEvent>& events,
   w.bias_end_s = s.dwell_s;
   w.final_start_s = s.dwell_s * 2 / 3;
   w.final_end_s = s.dwell_s;
-  // One pulse in a window of W seconds is pulse_weight_arcsec / W deg/h (arcsec/s = deg/h); a
-  // mean's count is exact to two uniform phases: sd 1/sqrt(6) of that (GUM 4.3.7).
   const auto quantization_dph = [&](double window_s) {
-    return slot.pulse_weight_arcsec / window_s / std::sqrt(6.0);
+    return slot.pulse_weight_arcsec * mean_quantization_pps(window_s);
   };
   w.band_dph = noise_band_dph(bins, w, quantization_dph(kTurnOnBinS));
   w.bias_quantization_dph = quantization_dph(w.bias_end_s - w.bias_start_s);

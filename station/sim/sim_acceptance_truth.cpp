@@ -25,24 +25,24 @@ nlohmann::json serial_truth(const sim::SimGyro& g) {
 
 /// The ladder's figures on the gyro's noise-free output: pulses/s = (3600 w_in (1 + e(w, dT))
 /// + Earth) / pulse weight, w_in the table rate along the input axis (gyro_acceptance.hpp).
-/// A nonlinear response's least-squares line depends on the points and their weights, so the
-/// truth is fitted over the points the station used, each with the error it was weighted by
-/// (`used`: the ladder's used_points); without them, over the schedule with equal weights.
+/// A nonlinear response's least-squares line depends on the points, so the truth is fitted over
+/// the points the station used (`used`: the ladder's used_points); without them, over the
+/// schedule. The line has equal weights (scale_factor.hpp): the errors given are only checked.
 nlohmann::json ladder_truth(const sim::SimGyro& g, const Step& step, double temp_c,
                             double earth_dph, const nlohmann::json& used) {
   std::vector<comp::LadderPoint> points;
   const double dt_c = temp_c - g.truth.ref_temp_c, c = sim::table_coupling(g.acceptance);
-  const auto add = [&](double table_dps, double se_pps) {
+  const auto add = [&](double table_dps) {
     const double in_dps = table_dps * c;
     const double e = 1e-6 * sim::scale_factor_error_ppm(g.acceptance, in_dps, dt_c);
     const double out = (3600.0 * in_dps * (1.0 + e) + earth_dph) / g.pulse_weight_arcsec;
-    points.push_back({table_dps, earth_dph, out, se_pps, true});
+    points.push_back({table_dps, earth_dph, out, 1.0, true});
   };
   if (used.is_array() && !used.empty()) {
     for (const auto& p : used)  // input_rate_dps = table + Earth / 3600 (scale_factor.hpp)
-      add(p.value("input_rate_dps", 0.0) - earth_dph / 3600.0, p.value("output_se_pps", 1.0));
+      add(p.value("input_rate_dps", 0.0) - earth_dph / 3600.0);
   } else {
-    for (const auto& p : acceptance_schedule(step)) add(p.demand, 1.0);
+    for (const auto& p : acceptance_schedule(step)) add(p.demand);
   }
   const auto fit = comp::analyze_rate_ladder(points);
   if (!fit) return nullptr;
