@@ -9,6 +9,11 @@
 // The walk starts at 0 in each run (its level there is the constant's, and runs are independent).
 #include "compensation/reml_filter.hpp"
 
+// No product fused into a sum anywhere in this file: the AVX-512 copy of the pass (whose
+// instruction set has FMA) then does the same IEEE operations on each lane as the SSE2 and AVX2
+// copies, so a model's likelihood is the same bits whichever pass the CPU runs.
+#pragma GCC optimize("fp-contract=off")
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -18,12 +23,14 @@
 namespace station::compensation::reml {
 namespace {
 
-constexpr int L = kLanes;
+/// The AVX-512 pass's lanes: eight models, one 512-bit register a step.
+constexpr int kWideLanes = 8;
 using SmallMatrix =
     Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxColumns, kMaxColumns>;
 using SmallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxColumns, 1>;
 
 /// What a pass gathers per lane: [y X]' F^-1 [y X] (upper triangle) and sum log f.
+template <int L>
 struct Gathered {
   std::array<SmallMatrix, L> m;
   std::array<double, L> sum_log_f{};
@@ -33,6 +40,7 @@ struct Gathered {
 #define STATION_INLINE inline __attribute__((always_inline))
 
 /// The lanes' covariance of the two states (units of s^2) and their gains at one bin.
+template <int L>
 struct Riccati {
   double pgg[L], pgr[L], prr[L], f[L], inv_f[L], kg[L], kr[L];
 
@@ -66,12 +74,12 @@ struct Riccati {
 
 /// One pass over the bins for L models at once, K columns fixed at compile time. Every loop's
 /// innermost index is the lane, so the compiler vectorizes across models.
-template <int K>
-STATION_INLINE Gathered pass(const double* z, Eigen::Index stride, Eigen::Index n,
-                             const std::vector<double>& dt_h, const std::array<Model, L>& md) {
+template <int K, int L>
+STATION_INLINE Gathered<L> pass(const double* z, Eigen::Index stride, Eigen::Index n,
+                                const std::vector<double>& dt_h, const std::array<Model, L>& md) {
   double m[K * K][L] = {}, g[K][L] = {}, r[K][L] = {}, v[K][L];
   double q[L], w[L], ph[L], sum_log_f[L] = {}, prod_f[L];
-  Riccati p{};
+  Riccati<L> p{};
   for (int l = 0; l < L; ++l) q[l] = md[l].q, w[l] = md[l].w_per_h, prod_f[l] = 1;
   for (Eigen::Index i = 0; i < n; ++i, z += stride) {
     const auto iu = static_cast<std::size_t>(i);
@@ -106,7 +114,7 @@ STATION_INLINE Gathered pass(const double* z, Eigen::Index stride, Eigen::Index 
         for (int l = 0; l < L; ++l) m[a * K + b][l] += va[l] * v[b][l];
     }
   }
-  Gathered out;
+  Gathered<L> out;
   for (int l = 0; l < L; ++l) {
     out.sum_log_f[l] = sum_log_f[l] + std::log(prod_f[l]);
     out.m[l].resize(K, K);
@@ -117,41 +125,60 @@ STATION_INLINE Gathered pass(const double* z, Eigen::Index stride, Eigen::Index 
 }
 
 /// The pass for k columns, the copy compiled for the instruction set the caller was compiled for.
-template <int... Ks>
-STATION_INLINE Gathered pass_for(int k, const double* z, Eigen::Index stride, Eigen::Index n,
-                                 const std::vector<double>& dt_h, const std::array<Model, L>& md,
-                                 std::integer_sequence<int, Ks...>) {
-  Gathered out;
-  ((k == Ks + 2 ? (out = pass<Ks + 2>(z, stride, n, dt_h, md), true) : false) || ...);
+template <int L, int... Ks>
+STATION_INLINE Gathered<L> pass_for(int k, const double* z, Eigen::Index stride, Eigen::Index n,
+                                    const std::vector<double>& dt_h, const std::array<Model, L>& md,
+                                    std::integer_sequence<int, Ks...>) {
+  Gathered<L> out;
+  ((k == Ks + 2 ? (out = pass<Ks + 2, L>(z, stride, n, dt_h, md), true) : false) || ...);
   return out;
 }
 
 using Columns2To10 = std::make_integer_sequence<int, kMaxColumns - 1>;
 
-// The same pass for SSE2 (every x86-64) and for AVX2, whose 256-bit registers hold all L = 4
-// lanes of a step: twice the work per instruction. Both copies do the same IEEE operations on
-// each lane in the same order (no FMA: target "avx2" does not enable contraction into fused
-// multiply-adds), so the likelihoods are the same bits whichever runs.
-Gathered pass_default(int k, const double* z, Eigen::Index stride, Eigen::Index n,
-                      const std::vector<double>& dt_h, const std::array<Model, L>& md) {
-  return pass_for(k, z, stride, n, dt_h, md, Columns2To10{});
+// The same pass for SSE2 (every x86-64), for AVX2, whose 256-bit registers hold all kLanes = 4
+// lanes of a step (twice the work per instruction), and for AVX-512, eight lanes a 512-bit
+// register (issue 37: the error model's passes were most of a fit). Each copy does the same IEEE
+// operations on each lane in the same order (no FMA: contraction is off in this file), so the
+// likelihoods are the same bits whichever runs.
+Gathered<kLanes> pass_default(int k, const double* z, Eigen::Index stride, Eigen::Index n,
+                              const std::vector<double>& dt_h,
+                              const std::array<Model, kLanes>& md) {
+  return pass_for<kLanes>(k, z, stride, n, dt_h, md, Columns2To10{});
 }
 
 #if defined(__x86_64__) && defined(__GNUC__)
-__attribute__((target("avx2"))) Gathered pass_avx2(int k, const double* z, Eigen::Index stride,
-                                                   Eigen::Index n, const std::vector<double>& dt_h,
-                                                   const std::array<Model, L>& md) {
-  return pass_for(k, z, stride, n, dt_h, md, Columns2To10{});
+__attribute__((target("avx2"))) Gathered<kLanes> pass_avx2(int k, const double* z,
+                                                           Eigen::Index stride, Eigen::Index n,
+                                                           const std::vector<double>& dt_h,
+                                                           const std::array<Model, kLanes>& md) {
+  return pass_for<kLanes>(k, z, stride, n, dt_h, md, Columns2To10{});
+}
+__attribute__((target("avx512f"))) Gathered<kWideLanes> pass_avx512(
+    int k, const double* z, Eigen::Index stride, Eigen::Index n, const std::vector<double>& dt_h,
+    const std::array<Model, kWideLanes>& md) {
+  return pass_for<kWideLanes>(k, z, stride, n, dt_h, md, Columns2To10{});
 }
 #endif
 
-/// One pass, on the widest of the two the CPU has (asked once).
-/// The first k columns of z's rows (`stride` apart).
-Gathered pass_on_cpu(int k, const double* z, Eigen::Index stride, Eigen::Index n,
-                     const std::vector<double>& dt_h, const std::array<Model, L>& md) {
+/// The widest pass the CPU has (asked once).
+enum class Width { sse2, avx2, avx512 };
+Width cpu_width() {
 #if defined(__x86_64__) && defined(__GNUC__)
-  static const bool avx2 = __builtin_cpu_supports("avx2");
-  if (avx2) return pass_avx2(k, z, stride, n, dt_h, md);
+  static const Width width = __builtin_cpu_supports("avx512f") ? Width::avx512
+                             : __builtin_cpu_supports("avx2")  ? Width::avx2
+                                                               : Width::sse2;
+  return width;
+#else
+  return Width::sse2;
+#endif
+}
+
+/// One pass of kLanes models over the first k columns of z's rows (`stride` apart).
+Gathered<kLanes> pass_narrow(int k, const double* z, Eigen::Index stride, Eigen::Index n,
+                             const std::vector<double>& dt_h, const std::array<Model, kLanes>& md) {
+#if defined(__x86_64__) && defined(__GNUC__)
+  if (cpu_width() != Width::sse2) return pass_avx2(k, z, stride, n, dt_h, md);
 #endif
   return pass_default(k, z, stride, n, dt_h, md);
 }
@@ -191,18 +218,30 @@ Profile finish(const SmallMatrix& g, Eigen::Index p, double sum_log_f, Eigen::In
 
 namespace {
 
-/// Every model's pass over z's first `cols` columns, kLanes at a time; `take(model index,
+/// Every model's pass over z's first `cols` columns, L at a time by `run`; `take(model index,
 /// gathered, lane)` for each.
-template <typename Take>
-void each_pass(const RowMajor& z, Eigen::Index cols, const std::vector<double>& dt_h,
-               std::span<const Model> models, Take take) {
+template <int L, typename Run, typename Take>
+void passes_of(const RowMajor& z, Eigen::Index cols, const std::vector<double>& dt_h,
+               std::span<const Model> models, Run run, Take take) {
   for (std::size_t first = 0; first < models.size(); first += L) {
     const std::size_t lanes = std::min<std::size_t>(L, models.size() - first);
     std::array<Model, L> md;
     for (std::size_t l = 0; l < L; ++l) md[l] = models[first + std::min(l, lanes - 1)];
-    const Gathered g = pass_on_cpu(static_cast<int>(cols), z.data(), z.cols(), z.rows(), dt_h, md);
+    const Gathered<L> g = run(static_cast<int>(cols), z.data(), z.cols(), z.rows(), dt_h, md);
     for (std::size_t l = 0; l < lanes; ++l) take(first + l, g, l);
   }
+}
+
+/// The same, eight models a pass where the CPU has AVX-512 and more than four models are asked
+/// (fewer would leave lanes idle), else four.
+template <typename Take>
+void each_pass(const RowMajor& z, Eigen::Index cols, const std::vector<double>& dt_h,
+               std::span<const Model> models, Take take) {
+#if defined(__x86_64__) && defined(__GNUC__)
+  if (cpu_width() == Width::avx512 && models.size() > static_cast<std::size_t>(kLanes))
+    return passes_of<kWideLanes>(z, cols, dt_h, models, pass_avx512, take);
+#endif
+  passes_of<kLanes>(z, cols, dt_h, models, pass_narrow, take);
 }
 
 }  // namespace
@@ -215,7 +254,7 @@ void profiles(const RowMajor& z, const std::vector<double>& dt_h, std::span<cons
 void evaluate(const RowMajor& z, Eigen::Index base, const std::vector<double>& dt_h,
               std::span<const Model> models, std::span<Profile> out, std::span<Deviances> ml) {
   const Eigen::Index cols = ml.empty() ? base + 1 : z.cols();
-  each_pass(z, cols, dt_h, models, [&](std::size_t i, const Gathered& g, std::size_t l) {
+  each_pass(z, cols, dt_h, models, [&](std::size_t i, const auto& g, std::size_t l) {
     out[i] = finish(g.m[l], base, g.sum_log_f[l], z.rows(), ml.empty() ? nullptr : &ml[i]);
   });
 }

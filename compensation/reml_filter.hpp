@@ -12,7 +12,9 @@
 namespace station::compensation::reml {
 
 /// Error models evaluated in one pass over the bins: their filters run side by side, so the
-/// per-bin work vectorizes and one model's division waits on no other's.
+/// per-bin work vectorizes and one model's division waits on no other's. Eight to a pass where
+/// the CPU has AVX-512 and more than four are asked; a model's likelihood is the same bits in
+/// either.
 inline constexpr int kLanes = 4;
 /// The filter's columns: y and up to 9 regressors (B0 and the eight terms of fit.hpp).
 inline constexpr int kMaxColumns = 10;

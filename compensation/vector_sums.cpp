@@ -1,5 +1,6 @@
 // The ADEV curve's long sums with vector arithmetic: squared differences of the angle for every
-// tau in one tiled sweep, and the lag-1 noise identification's sums of a tau-averaged series.
+// tau (a tiled sweep for the near lags, chains for the far ones), and the lag-1 noise
+// identification's sums of a tau-averaged series.
 #include "compensation/vector_sums.hpp"
 
 #include <algorithm>
@@ -22,6 +23,14 @@ constexpr std::size_t kSeriesLanes = 16;  // partial sums of a series' sum
 // Terms per tile (a multiple of kLanes): 3 x 16 KiB per factor, every factor's share of the
 // angle taken while the tile's neighbourhood is still in the core's cache.
 constexpr std::size_t kTile = 2048;
+// The chained factors (vector_sums.hpp): from 2^13 up, a level's stride M a multiple of the
+// block, its factors up to 16 M. A window of 64 blocks of one chain plus the 48 blocks a factor of
+// the level reaches beyond it (3 x 16, Hadamard) are 112 x 2 KiB, well inside the core's cache:
+// every angle value comes from memory once a level, not once for every lag that reads it.
+constexpr std::size_t kChainFrom = 8192;
+constexpr std::size_t kChainBlock = 256;  // a multiple of kLanes: block k0 starts in lane 0
+constexpr std::size_t kChainSpan = 16;
+constexpr std::size_t kChainWindow = 64;
 
 // The kernels are templates on the vector type, always inlined into one entry point per
 // instruction set (target attribute), picked once by what the CPU has. The file is compiled with
@@ -87,6 +96,35 @@ STATION_INLINE void add_terms(const double* theta, std::size_t m, std::size_t k0
   }
   for (std::size_t v = 0; v < nv; ++v) store(partial + w * v, s[v]);
   for (; k < k1; ++k) {  // the last terms of the sum, each into its own partial
+    const double d = diff1<Diff>(theta + k, m);
+    partial[k % kLanes] += d * d;
+  }
+}
+
+// Adds the terms of one chain (vector_sums.hpp) at lag m: the blocks k = k_first + b stride +
+// [0, kChainBlock) for b < blocks, each cut at `terms`, the partial sums kept in registers from
+// block to block. A block cut short is the chain's last: its tail goes lane by lane.
+template <class V, class Diff>
+STATION_INLINE void add_chain_terms(const double* theta, std::size_t m, std::size_t k_first,
+                                    std::size_t stride, std::size_t blocks, std::size_t terms,
+                                    double* partial) {
+  constexpr std::size_t w = kWidth<V>, nv = kLanes / w;
+  V s[nv];
+  for (std::size_t v = 0; v < nv; ++v) s[v] = load<V>(partial + w * v);
+  std::size_t k = k_first, end = k_first;
+  for (std::size_t b = 0; b < blocks && k < terms; ++b, k = k_first + b * stride) {
+    end = std::min(k + kChainBlock, terms);
+    for (; k + kLanes <= end; k += kLanes) {
+#pragma GCC unroll 16
+      for (std::size_t v = 0; v < nv; ++v) {
+        const V d = Diff::template diff<V>(theta + k + w * v, m);
+        s[v] += d * d;
+      }
+    }
+    if (k < end) break;  // the chain's last block, cut short: its tail below
+  }
+  for (std::size_t v = 0; v < nv; ++v) store(partial + w * v, s[v]);
+  for (; k < end; ++k) {
     const double d = diff1<Diff>(theta + k, m);
     partial[k % kLanes] += d * d;
   }
@@ -211,28 +249,41 @@ struct Kernels {
   void (*line)(const double*, std::size_t, double*);
   void (*sequential_line)(const double*, std::size_t, double*);
   void (*lag)(const double*, std::size_t, double, double, double*);
+  void (*chain_second)(const double*, std::size_t, std::size_t, std::size_t, std::size_t,
+                       std::size_t, double*);
+  void (*chain_third)(const double*, std::size_t, std::size_t, std::size_t, std::size_t,
+                      std::size_t, double*);
 };
 
-#define STATION_KERNELS(name, V, attr)                                                     \
-  attr void name##_second(const double* t, std::size_t m, std::size_t a, std::size_t b,    \
-                          double* p) {                                                     \
-    add_terms<V, Second>(t, m, a, b, p);                                                   \
-  }                                                                                        \
-  attr void name##_third(const double* t, std::size_t m, std::size_t a, std::size_t b,     \
-                         double* p) {                                                      \
-    add_terms<V, Third>(t, m, a, b, p);                                                    \
-  }                                                                                        \
-  attr void name##_line(const double* y, std::size_t n, double* s) {                       \
-    line_sums_into<V>(y, n, s);                                                            \
-  }                                                                                        \
-  attr void name##_sequential_line(const double* y, std::size_t n, double* s) {            \
-    sequential_line_sums_into<V>(y, n, s);                                                 \
-  }                                                                                        \
-  attr void name##_lag(const double* y, std::size_t n, double i, double sl, double* s) {   \
-    lag_sums_into<V>(y, n, i, sl, s);                                                      \
-  }                                                                                        \
-  constexpr Kernels name{name##_second, name##_third, name##_line, name##_sequential_line, \
-                         name##_lag};
+#define STATION_KERNELS(name, V, attr)                                                         \
+  attr void name##_second(const double* t, std::size_t m, std::size_t a, std::size_t b,        \
+                          double* p) {                                                         \
+    add_terms<V, Second>(t, m, a, b, p);                                                       \
+  }                                                                                            \
+  attr void name##_third(const double* t, std::size_t m, std::size_t a, std::size_t b,         \
+                         double* p) {                                                          \
+    add_terms<V, Third>(t, m, a, b, p);                                                        \
+  }                                                                                            \
+  attr void name##_line(const double* y, std::size_t n, double* s) {                           \
+    line_sums_into<V>(y, n, s);                                                                \
+  }                                                                                            \
+  attr void name##_sequential_line(const double* y, std::size_t n, double* s) {                \
+    sequential_line_sums_into<V>(y, n, s);                                                     \
+  }                                                                                            \
+  attr void name##_lag(const double* y, std::size_t n, double i, double sl, double* s) {       \
+    lag_sums_into<V>(y, n, i, sl, s);                                                          \
+  }                                                                                            \
+  attr void name##_chain_second(const double* t, std::size_t m, std::size_t k, std::size_t st, \
+                                std::size_t nb, std::size_t te, double* p) {                   \
+    add_chain_terms<V, Second>(t, m, k, st, nb, te, p);                                        \
+  }                                                                                            \
+  attr void name##_chain_third(const double* t, std::size_t m, std::size_t k, std::size_t st,  \
+                               std::size_t nb, std::size_t te, double* p) {                    \
+    add_chain_terms<V, Third>(t, m, k, st, nb, te, p);                                         \
+  }                                                                                            \
+  constexpr Kernels name{name##_second,          name##_third, name##_line,                    \
+                         name##_sequential_line, name##_lag,   name##_chain_second,            \
+                         name##_chain_third};
 
 STATION_KERNELS(kBaseline, V2, )  // SSE2 on x86-64; what the compiler makes of it elsewhere
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
@@ -274,18 +325,51 @@ LagSums residual_lag_sums(std::span<const double> y, double icpt, double slope) 
   return {s[0], s[1], s[2]};
 }
 
+std::vector<std::size_t> difference_sum_strides(std::span<const std::size_t> m_list) {
+  std::vector<std::size_t> stride(m_list.size(), 0);
+  for (std::size_t i = 0; i < m_list.size(); ++i) {
+    const std::size_t m = m_list[i];
+    if (stride[i] != 0 || m < kChainFrom || m % kChainBlock != 0) continue;
+    for (std::size_t j = i; j < m_list.size(); ++j) {
+      if (stride[j] == 0 && m_list[j] % m == 0 && m_list[j] <= kChainSpan * m) stride[j] = m;
+    }
+  }
+  return stride;
+}
+
 std::vector<double> difference_sums(std::span<const double> theta,
                                     std::span<const std::size_t> m_list, int order) {
-  const auto add = order == 3 ? kernels().third : kernels().second;
+  const Kernels& kernel = kernels();
+  const auto add = order == 3 ? kernel.third : kernel.second;
+  const auto add_chain = order == 3 ? kernel.chain_third : kernel.chain_second;
+  const std::vector<std::size_t> stride = difference_sum_strides(m_list);
   std::vector<std::size_t> terms(m_list.size());
-  for (std::size_t i = 0; i < m_list.size(); ++i)
+  std::size_t most = 0;  // the tiled sweep's longest sum
+  for (std::size_t i = 0; i < m_list.size(); ++i) {
     terms[i] = theta.size() - static_cast<std::size_t>(order) * m_list[i];
-  const std::size_t most = terms.empty() ? 0 : *std::max_element(terms.begin(), terms.end());
+    if (stride[i] == 0) most = std::max(most, terms[i]);
+  }
   std::vector<double> partial(m_list.size() * kLanes, 0.0);
   for (std::size_t k0 = 0; k0 < most; k0 += kTile) {
     for (std::size_t i = 0; i < m_list.size(); ++i) {
-      if (k0 >= terms[i]) continue;
+      if (stride[i] != 0 || k0 >= terms[i]) continue;
       add(theta.data(), m_list[i], k0, std::min(k0 + kTile, terms[i]), &partial[i * kLanes]);
+    }
+  }
+  // Each level's chains: for each block of residues c0 + [0, kChainBlock) modulo the stride, its
+  // chain's blocks a window at a time, every factor of the level through the window in turn.
+  for (std::size_t i = 0; i < m_list.size(); ++i) {
+    const std::size_t level = stride[i];
+    if (level == 0 || level != m_list[i]) continue;  // a level starts at its stride
+    const std::size_t blocks = theta.size() / level + 1;
+    for (std::size_t c0 = 0; c0 < level; c0 += kChainBlock) {
+      for (std::size_t b0 = 0; b0 < blocks; b0 += kChainWindow) {
+        for (std::size_t j = i; j < m_list.size(); ++j) {
+          if (stride[j] != level) continue;
+          add_chain(theta.data(), m_list[j], c0 + b0 * level, level, kChainWindow, terms[j],
+                    &partial[j * kLanes]);
+        }
+      }
     }
   }
   std::vector<double> sums(m_list.size());

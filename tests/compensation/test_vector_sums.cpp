@@ -41,13 +41,21 @@ double third_diff(const std::vector<double>& t, std::size_t k, std::size_t m) {
 }
 
 // The order vector_sums.hpp documents, in scalar code: term k into partial k mod 32, the 32
-// partials added pairwise.
-double documented_sum(const std::vector<double>& t, std::size_t m, int order) {
+// partials added pairwise; the terms in increasing k, or for a factor with chain stride M, k = c +
+// b M by blocks of 256 residues c, within a block by b, then c.
+double documented_sum(const std::vector<double>& t, std::size_t m, int order, std::size_t stride) {
   double p[32] = {};
   const std::size_t terms = t.size() - static_cast<std::size_t>(order) * m;
-  for (std::size_t k = 0; k < terms; ++k) {
+  const auto add = [&](std::size_t k) {
     const double d = order == 3 ? third_diff(t, k, m) : second_diff(t, k, m);
     p[k % 32] += d * d;
+  };
+  if (stride == 0) {
+    for (std::size_t k = 0; k < terms; ++k) add(k);
+  } else {
+    for (std::size_t c0 = 0; c0 < stride; c0 += 256)
+      for (std::size_t b = 0; c0 + b * stride < terms; ++b)
+        for (std::size_t c = c0; c < c0 + 256 && c + b * stride < terms; ++c) add(c + b * stride);
   }
   for (std::size_t n = 32; n > 1; n /= 2) {
     for (std::size_t i = 0; i < n / 2; ++i) p[i] = p[2 * i] + p[2 * i + 1];
@@ -72,9 +80,50 @@ TEST(VectorSums, DifferenceSumsAreTheDocumentedOrderBitForBit) {
       const std::vector<double> sums = difference_sums(theta, ms, order);
       ASSERT_EQ(sums.size(), ms.size());
       for (std::size_t i = 0; i < ms.size(); ++i)
-        EXPECT_EQ(sums[i], documented_sum(theta, ms[i], order)) << n << " m " << ms[i];
+        EXPECT_EQ(sums[i], documented_sum(theta, ms[i], order, 0)) << n << " m " << ms[i];
     }
   }
+}
+
+// The chained factors too (issue 37): octave factors up to 2^18 and a list with factors of no
+// level (not multiples of 256), lengths that cut a chain's last block within a lane, at a lane
+// boundary and at a block boundary, both orders.
+TEST(VectorSums, ChainedDifferenceSumsAreTheDocumentedOrderBitForBit) {
+  for (const std::size_t n : {std::size_t{16'390}, std::size_t{3 * 16'384 + 17},
+                              std::size_t{(1u << 19) + 777}, std::size_t{(1u << 19) + 255}}) {
+    const std::vector<double> theta = integrated_angle(walk_plus_white(n, n));
+    for (const int order : {2, 3}) {
+      std::vector<std::size_t> ms = tau_factors(n, TauSpacing::octave);
+      std::erase_if(ms, [&](std::size_t m) { return order * m >= theta.size(); });
+      // A factor of no level after the levels (not a multiple of 256).
+      if (order * (ms.back() + 1) < theta.size()) ms.push_back(ms.back() + 1);
+      const std::vector<std::size_t> strides = difference_sum_strides(ms);
+      const std::vector<double> sums = difference_sums(theta, ms, order);
+      for (std::size_t i = 0; i < ms.size(); ++i)
+        EXPECT_EQ(sums[i], documented_sum(theta, ms[i], order, strides[i])) << n << " m " << ms[i];
+    }
+  }
+}
+
+// The levels as vector_sums.hpp states them: octave 2^13 .. 2^17 at stride 2^13, 2^18 .. 2^22 at
+// 2^18, nothing below 2^13; of a decade list only 4 x 10^6 (2^8 x 15625, a level of its own:
+// 10^4 .. 2 x 10^6 are no multiples of 256); a level takes only
+// multiples of its stride up to 16 times it (17 x 2^13 starts a level of its own).
+TEST(VectorSums, ChainStridesAreTheDocumentedLevels) {
+  const std::vector<std::size_t> octave = tau_factors(10'000'000, TauSpacing::octave);
+  const std::vector<std::size_t> strides = difference_sum_strides(octave);
+  for (std::size_t i = 0; i < octave.size(); ++i) {
+    const std::size_t m = octave[i];
+    const std::size_t want = m < 8192 ? 0 : m <= 131'072 ? 8192 : 262'144;
+    EXPECT_EQ(strides[i], want) << m;
+  }
+  const std::vector<std::size_t> decade = tau_factors(10'000'000, TauSpacing::decade);
+  const std::vector<std::size_t> decade_strides = difference_sum_strides(decade);
+  for (std::size_t i = 0; i < decade.size(); ++i)
+    EXPECT_EQ(decade_strides[i], decade[i] == 4'000'000 ? decade[i] : 0) << decade[i];
+  const std::vector<std::size_t> mixed{8192, 8192 + 256, 3 * 8192, 16 * 8192, 17 * 8192};
+  EXPECT_EQ(difference_sum_strides(mixed),
+            (std::vector<std::size_t>{8192, 8448, 8192, 8192, 17 * 8192}));
 }
 
 // Against the plain sequential sum of the same terms: both sum n positive terms, each with a
