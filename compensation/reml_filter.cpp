@@ -12,7 +12,11 @@
 // No product fused into a sum anywhere in this file: the AVX-512 copy of the pass (whose
 // instruction set has FMA) then does the same IEEE operations on each lane as the SSE2 and AVX2
 // copies, so a model's likelihood is the same bits whichever pass the CPU runs.
+#if defined(__clang__)
+#pragma STDC FP_CONTRACT OFF
+#elif defined(__GNUC__)
 #pragma GCC optimize("fp-contract=off")
+#endif
 
 #include <algorithm>
 #include <array>
