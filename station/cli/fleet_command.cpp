@@ -1,7 +1,9 @@
 // `station fleet --pg URL [--part PN] [--since DATE] [--out DIR] [--json] [--propose-noise]`:
-// control charts of the calibrations every station forwarded (station/fleet/fleet_charts.hpp), as
-// JSON and as a self-contained page DIR/fleet.html; the points beyond a limit are listed. With
-// --propose-noise, each part's noise from its runs (station/fleet/noise_proposal.hpp) as a
+// control charts of the calibrations every station forwarded (station/fleet/fleet_charts.hpp) and
+// of the acceptance scale factor and its temperature coefficient per part
+// (station/fleet/fleet_acceptance.hpp: JSON "acceptance"), as JSON and as a self-contained page
+// DIR/fleet.html; the points beyond a limit, and the results without K or TC and why, are listed.
+// With --propose-noise, each part's noise from its runs (station/fleet/noise_proposal.hpp) as a
 // ready-to-paste [part."PN".noise] block, in the JSON ("noise") and on the page. Read-only.
 #include <fmt/format.h>
 
@@ -14,6 +16,7 @@
 #include "station/cli/exit_status.hpp"
 #include "station/common/input_error.hpp"
 #include "station/config/fleet_config.hpp"
+#include "station/fleet/fleet_acceptance.hpp"
 #include "station/fleet/fleet_charts.hpp"
 #include "station/fleet/fleet_noise.hpp"
 #include "station/fleet/fleet_page.hpp"
@@ -61,6 +64,7 @@ void run_fleet(const FleetOptions& o) {
       o.out.empty() ? report::Assets{} : report::read_dygraphs(std::string(report::kDygraphsDir));
   fleet::PgConnection pg({o.pg, {}});
   auto charts = fleet::fleet_charts_json(fleet::fleet_points(pg, f));
+  charts["acceptance"] = fleet::fleet_acceptance_json(fleet::fleet_acceptance_points(pg, f));
   std::vector<fleet::NoiseProposal> noise;
   if (o.propose_noise) {
     noise = fleet::propose_noise(fleet::fleet_run_noise(pg, f));
@@ -78,6 +82,7 @@ void run_fleet(const FleetOptions& o) {
     return;
   }
   print_outside(charts);
+  fmt::print("{}", fleet::fleet_acceptance_text(charts["acceptance"]));
   for (const auto& p : noise) fmt::print("\n{}", fleet::noise_toml(p));
   if (o.propose_noise && noise.empty())
     fmt::print("\nno part's noise to propose: no fit with a part number used a run\n");
@@ -88,11 +93,14 @@ void run_fleet(const FleetOptions& o) {
 void add_fleet_command(CLI::App& app, CommandStatus& status) {
   auto o = std::make_shared<FleetOptions>();
   auto* cmd = app.add_subcommand(
-      "fleet", "Control charts of k1, k0, B0 and the std ratio across the fleet's stations");
+      "fleet",
+      "Control charts of k1, k0, B0 and the std ratio, and of the acceptance scale "
+      "factor K and its temperature coefficient, across the fleet's stations");
   cmd->footer(exit_status_footer({{kExitOk, "the charts were written"}}));
   cmd->add_option("--pg", o->pg, "the fleet's PostgreSQL (libpq URL)")->required();
   cmd->add_option("--part", o->part, "only this part number");
-  cmd->add_option("--since", o->since, "only calibrations created at or after (ISO-8601)");
+  cmd->add_option("--since", o->since,
+                  "only calibrations created, and acceptance runs started, at or after (ISO-8601)");
   cmd->add_option("--out", o->out, "write DIR/fleet.html");
   cmd->add_flag("--json", o->json, "print the charts as JSON");
   cmd->add_flag("--propose-noise", o->propose_noise,

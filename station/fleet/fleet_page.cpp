@@ -4,6 +4,7 @@
 
 #include <map>
 
+#include "station/fleet/fleet_acceptance.hpp"
 #include "station/fleet/fleet_charts.hpp"
 #include "station/report/report_pages.hpp"
 
@@ -162,6 +163,7 @@ std::string fleet_html(const json& charts, const std::string& filter_text,
     ++i;
   }
   if (charts["parts"].empty()) body += "<p class=\"empty\">No calibration matches.</p>\n";
+  if (charts.contains("acceptance")) body += fleet_acceptance_html(charts["acceptance"], figures);
   if (charts.contains("noise")) body += noise_section(charts["noise"]);
   return report::page_html("Fleet control charts", body, figures, assets);
 }

@@ -49,6 +49,21 @@ const std::vector<FleetTable> kTables = {
      "FROM bins AS b JOIN runs AS r ON r.id = b.run_id "
      "WHERE b.run_id = :id",
      Merge::replace_set},
+    // Issue 36: the run's acceptance figures (station migrations 12 and 13, fleet version 6); a
+    // recomputation replaces them, a serial no longer computed is deleted.
+    {"acceptance_results", Item::run,
+     "run_uuid,serial,computed_utc,part_number,pass,sf_pulse_per_arcsec,sf_se_pulse_per_arcsec,"
+     "sf_temp_c,tc_ppm_per_c,tc_se_ppm_per_c,nonlinearity_max_ppm_fs,asymmetry_ppm,"
+     "asymmetry_se_ppm,tilt_mrad,tilt_se_mrad,turn_on_repeatability_dph,"
+     "turn_on_repeatability_lower_dph,turn_on_repeatability_upper_dph,max_warmup_s,figures_json",
+     "run_uuid,serial",
+     "SELECT r.uuid, a.serial, a.computed_utc, a.part_number, a.pass, a.sf_pulse_per_arcsec, "
+     "a.sf_se_pulse_per_arcsec, a.sf_temp_c, a.tc_ppm_per_c, a.tc_se_ppm_per_c, "
+     "a.nonlinearity_max_ppm_fs, a.asymmetry_ppm, a.asymmetry_se_ppm, a.tilt_mrad, a.tilt_se_mrad, "
+     "a.turn_on_repeatability_dph, a.turn_on_repeatability_lower_dph, "
+     "a.turn_on_repeatability_upper_dph, a.max_warmup_s, a.figures_json FROM acceptance_results "
+     "AS a JOIN runs AS r ON r.id = a.run_id WHERE a.run_id = :id",
+     Merge::replace_set},
     {"events", Item::run, "run_uuid,local_id,t_s,wall_utc,severity,source,kind,message,data_json",
      "run_uuid,local_id",
      "SELECT r.uuid, e.id, e.t_s, e.wall_utc, e.severity, e.source, e.kind, e.message, "

@@ -14,6 +14,7 @@
 #include "station/fleet/fleet_schema.hpp"
 #include "station/fleet/forwarder.hpp"
 #include "station/sim/sim_run.hpp"
+#include "station/store/sqlite.hpp"
 #include "tests/fleet/pg_server.hpp"
 #include "tests/station/sim_options.hpp"
 #include "tests/station/temp_db.hpp"
@@ -105,6 +106,62 @@ inline std::vector<std::string> normalized_rows(const std::string& copy_text) {
   }
   std::sort(rows.begin(), rows.end());
   return rows;
+}
+
+/// The ids of `sql`'s first column.
+inline std::vector<std::int64_t> ids(Database& db, const std::string& sql) {
+  std::vector<std::int64_t> out;
+  auto st = db.prepare(sql);
+  while (st.step()) out.push_back(st.column_int(0));
+  return out;
+}
+
+inline void bind_if(Statement& st, const char* name, auto v) {
+  if (int i = st.parameter_index(name); i > 0) st.bind(i, v);
+}
+
+/// Every row the station holds for central table `t`, through the table's own SELECT.
+inline std::vector<std::string> station_rows(const std::string& path, const fleet::FleetTable& t) {
+  Database db(path, OpenMode::read_only);
+  std::string text;
+  const char* items[] = {"SELECT id FROM runs", "SELECT id FROM fits", "SELECT id FROM releases",
+                         "SELECT id FROM verifications"};
+  for (std::int64_t id : ids(db, items[static_cast<int>(t.item)])) {
+    std::vector<std::string> serials = {""};
+    if (t.name == "samples") {
+      serials.clear();
+      auto s = db.prepare("SELECT serial FROM run_slots WHERE run_id = ?");
+      s.bind(1, id);
+      while (s.step()) serials.push_back(s.column_text(0));
+    }
+    for (const auto& serial : serials) {
+      auto st = db.prepare(t.select);
+      bind_if(st, ":id", id);
+      bind_if(st, ":after", -1e300);
+      bind_if(st, ":limit", std::int64_t{-1});
+      bind_if(st, ":serial", std::string_view(serial));
+      bind_if(st, ":station", std::string_view("test"));
+      text += fleet::encode_rows(st).data;
+    }
+  }
+  return normalized_rows(text);
+}
+
+/// Every row the server holds in `t` (those `where` selects, when given).
+inline std::vector<std::string> server_rows(const fleet::FleetTable& t,
+                                            const std::string& where = "") {
+  fleet::PgConnection pg(FleetTest::target());
+  auto r = pg.exec(fmt::format("SELECT {} FROM {} {}", t.columns, t.name, where));
+  std::string text;
+  for (int i = 0; i < r.rows(); ++i) {
+    for (int c = 0; c < r.columns(); ++c) {
+      if (c > 0) text += '\t';
+      const auto v = r.opt_text(i, c);
+      fleet::append_copy_field(text, v ? std::optional<std::string_view>(*v) : std::nullopt);
+    }
+    text += '\n';
+  }
+  return normalized_rows(text);
 }
 
 }  // namespace station::testing_support
