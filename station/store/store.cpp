@@ -155,17 +155,19 @@ void Store::append_tick(std::int64_t run_id, double t_s, const std::vector<Sampl
   }
   if (!batch_) batch_.emplace(db_);
   try {
-    write_tick(run_id, t_s, rows, p);
+    insert_samples(run_id, rows);
   } catch (...) {
-    batch_.reset();  // rolls back the whole batch: no half tick is ever committed
-    batch_ticks_ = 0;
+    discard();  // rolls back the whole batch: no half tick is ever committed
     throw;
   }
+  // The run's progress is written once, by the batch's commit (flush), in the same transaction
+  // as the samples: what a resume reads is the last committed tick's, as when every tick wrote
+  // it, for one UPDATE (and one outbox trigger) per batch instead of one per tick.
+  pending_progress_ = PendingProgress{run_id, t_s, p};
   if (++batch_ticks_ >= ticks_per_commit_) flush();
 }
 
-void Store::write_tick(std::int64_t run_id, double t_s, const std::vector<SampleRow>& rows,
-                       const RunProgress& p) {
+void Store::insert_samples(std::int64_t run_id, const std::vector<SampleRow>& rows) {
   auto& ins = *insert_sample_;
   for (const auto& r : rows) {
     ins.reset();
@@ -179,26 +181,36 @@ void Store::write_tick(std::int64_t run_id, double t_s, const std::vector<Sample
     ins.step();
   }
   ins.reset();
+}
+
+void Store::write_progress(const PendingProgress& w) {
+  const auto& p = w.progress;
   auto& up = *update_progress_;
   up.reset();
-  up.bind(1, p.step_index).bind(2, p.step_started_s).bind(3, t_s).bind(4, p.recording ? 1 : 0);
-  up.bind(5, p.record_start_s).bind(6, p.start_temp_c).bind(7, run_id);
+  up.bind(1, p.step_index).bind(2, p.step_started_s).bind(3, w.t_s).bind(4, p.recording ? 1 : 0);
+  up.bind(5, p.record_start_s).bind(6, p.start_temp_c).bind(7, w.run_id);
   up.step();
   up.reset();
+}
+
+void Store::discard() {
+  batch_.reset();
+  batch_ticks_ = 0;
+  pending_progress_.reset();
 }
 
 void Store::flush() {
   if (!batch_) return;
   try {
+    if (pending_progress_) write_progress(*pending_progress_);
     batch_->commit();
   } catch (...) {
-    // The batch's ticks are lost (never committed); the next tick starts a new transaction.
-    batch_.reset();
-    batch_ticks_ = 0;
+    discard();  // the batch's ticks are lost (never committed); the next tick starts anew
     throw;
   }
   batch_.reset();
   batch_ticks_ = 0;
+  pending_progress_.reset();
 }
 
 Store::~Store() {

@@ -147,7 +147,9 @@ class Store {
 
   /// Tick `t_s`: its samples, the run's progress and t_s as the run's last tick, committed
   /// together with the ticks of its batch (see set_ticks_per_commit); a kill loses only ticks
-  /// not yet committed. Samples are plain INSERTs: a tick stored twice throws, never replaces.
+  /// not yet committed. The progress row is written once per batch, by its commit: the last
+  /// tick's, in the transaction of its samples, so the two never disagree. Samples are plain
+  /// INSERTs: a tick stored twice throws, never replaces.
   void append_tick(std::int64_t run_id, double t_s, const std::vector<SampleRow>& rows,
                    const RunProgress& p);
   /// Ticks per transaction: 1 (default) on real hardware, where a tick is a second; the
@@ -156,10 +158,7 @@ class Store {
   /// Commits an open batch of ticks.
   void flush();
   /// Rolls an open batch of ticks back, as a kill before its commit loses it (replay).
-  void discard() {
-    batch_.reset();
-    batch_ticks_ = 0;
-  }
+  void discard();
   ~Store();
   /// Samples of one serial in a run, by time (recording window only when asked).
   /// (SampleReader: the same, a row at a time.)
@@ -209,13 +208,20 @@ class Store {
   StatementLease cached(const std::string& sql);
 
  private:
-  void write_tick(std::int64_t run_id, double t_s, const std::vector<SampleRow>& rows,
-                  const RunProgress& p);
+  /// The progress of a batch's last tick, written by its commit (flush).
+  struct PendingProgress {
+    std::int64_t run_id = 0;
+    double t_s = 0;
+    RunProgress progress;
+  };
+  void insert_samples(std::int64_t run_id, const std::vector<SampleRow>& rows);
+  void write_progress(const PendingProgress& w);
 
   Database db_;
   // The 1 Hz path's statements, prepared once (preparing costs more than the inserts).
   std::optional<Statement> insert_sample_, update_progress_;
   std::optional<Transaction> batch_;
+  std::optional<PendingProgress> pending_progress_;
   std::unordered_map<std::string, Statement> cache_;  // by SQL text; nodes never move
   int ticks_per_commit_ = 1, batch_ticks_ = 0;
 };
