@@ -286,7 +286,11 @@ namespace station::sim {
 std::string SimWorld::devices_toml() const {
   return device_toml("chamber", config_.chamber_model, chamber_endpoint(), &config_.panel,
                      config_.chamber_gateway) +
-         "\n" + device_toml("turntable", config_.turntable_model, turntable_endpoint(), nullptr);
+         "\n" + device_toml("turntable", config_.turntable_model, turntable_endpoint(), nullptr) +
+         // The simulated table's own limits (TurntableSimConfig): the start checks a protocol's
+         // ladders against them as against a real table's rating.
+         fmt::format("max_rate_dps = {}\nmax_accel_dps2 = {}\n", config_.table.max_rate_mode_dps,
+                     config_.table.max_accel_dps2);
 }
 
 }  // namespace station::sim

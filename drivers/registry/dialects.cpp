@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <stdexcept>
 #include <variant>
 
@@ -112,6 +113,8 @@ WatlowInputs watlow_inputs(const DeviceSpec& s) {
 const auto kF4pMap = with_overrides([](const DeviceSpec& s) { return watlow_f4p::map(s.unit_id); });
 const auto kPlcChamberMap =
     with_overrides([](const DeviceSpec& s) { return chamber_map::generic_plc(s.unit_id); });
+// The station's own table map: its driver's bound on a rate demand (docs/DEVICES.md).
+constexpr double kPlcRateLimitDps = TurntableLimits{}.max_rate_dps;
 const auto kPlcTableMap =
     with_overrides([](const DeviceSpec& s) { return turntable_map::generic_plc(s.unit_id); });
 
@@ -177,12 +180,14 @@ const std::vector<TurntableDialect> kTables{
      "the station's own Modbus map for a PLC-fronted table (docs/DEVICES.md)", "default", false,
      kPlcTableMap,
      [](const DeviceSpec& s, const LinkOptions& o) -> std::unique_ptr<Turntable> {
-       return hooked(
-           std::make_unique<ModbusTurntable>(s.name, modbus_ep(s), kPlcTableMap(s),
-                                             TurntableLimits{}, s.timeout_s, modbus_wire(s, o)),
-           s, o);
+       const double limit_dps =
+           std::min(s.max_rate_dps.value_or(kPlcRateLimitDps), kPlcRateLimitDps);
+       return hooked(std::make_unique<ModbusTurntable>(s.name, modbus_ep(s), kPlcTableMap(s),
+                                                       TurntableLimits{limit_dps}, s.timeout_s,
+                                                       modbus_wire(s, o)),
+                     s, o);
      },
-     0, kStationTiming},  // the station's own map: no maker's timing
+     0, kStationTiming, {}, kPlcRateLimitDps},  // the station's own map: no maker's timing
     {"acutrol3000", Transport::ascii, "Acutronic ACUTROL3000, ASCII over TCP 9878 or serial", "",
      false, nullptr,
      [](const DeviceSpec& s, const LinkOptions& o) -> std::unique_ptr<Turntable> {

@@ -65,6 +65,10 @@ struct DeviceSpec {
   std::optional<double> setpoint_low_c, setpoint_high_c;
   /// ASCII dialects with a choice of reply framing (the row's `framings`): "" is the default.
   std::string framing;
+  /// [turntable]: the table's rate and acceleration limits (its maker's rating, or the unit's
+  /// setting), deg/s and deg/s^2; unset: the dialect's (`Dialect::rate_limit_dps`) or none. The
+  /// start refuses a protocol asking beyond them (station/daemon/acceptance_runner.hpp).
+  std::optional<double> max_rate_dps, max_accel_dps2;
 };
 
 /// Makes the link under a device's client (replay passes recorded ones); empty: the real link.
@@ -102,6 +106,9 @@ struct Dialect {
   /// The reply framings `framing` may name, comma-separated, the first the default (empty: the
   /// key is not taken).
   std::string_view framings = {};
+  /// A turntable dialect's fixed rate limit, deg/s, where it has one (the station's own map:
+  /// its driver refuses a demand beyond it); unset: the unit's own (read at connect) or none.
+  std::optional<double> rate_limit_dps = {};
 };
 
 using ChamberDialect = Dialect<Chamber>;

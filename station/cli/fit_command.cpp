@@ -2,7 +2,9 @@
 // errors beside the in-sample std.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <iostream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <set>
 
@@ -106,19 +108,40 @@ nlohmann::json fit_json(const JudgedFit& jf) {
 }
 
 /// `--acceptance`: the acceptance figures of every run the fits used (and of --run, fitted or
-/// not) computed again and stored (record_acceptance, the run's end's code path), judged against
-/// the part the fit is judged against.
-void recompute_acceptance(Store& store, const std::vector<JudgedFit>& fits,
-                          std::optional<std::int64_t> run_id, const PartChoice& choice) {
-  std::set<std::int64_t> runs;
+/// not; and of --serial's runs when it had nothing to fit) computed again and stored
+/// (record_acceptance, the run's end's code path), judged against the part the fit is judged
+/// against. Returns each run's figures.
+std::map<std::int64_t, nlohmann::json> recompute_acceptance(Store& store,
+                                                            const std::vector<JudgedFit>& fits,
+                                                            std::set<std::int64_t> runs,
+                                                            const PartChoice& choice) {
   for (const auto& f : fits) runs.insert(f.fit.runs.begin(), f.fit.runs.end());
-  if (run_id) runs.insert(*run_id);
+  std::map<std::int64_t, nlohmann::json> out;
   for (const auto run : runs) {
     std::map<std::string, PartLimits> limits;
     for (const auto& slot : store.run_slots(run))
       if (auto l = limits_for(store, slot.serial, {run}, choice)) limits[slot.serial] = *l;
-    record_acceptance(store, run, limits);
+    out[run] = record_acceptance(store, run, limits);
   }
+  return out;
+}
+
+/// The recomputed figures of the serials no thermal fit was printed for (a run of acceptance
+/// steps only has no bins): an array of their objects per run, for the text or the JSON.
+std::map<std::int64_t, nlohmann::json> unfitted_acceptance(
+    const std::map<std::int64_t, nlohmann::json>& figures, const std::vector<JudgedFit>& fits,
+    const std::string& only_serial) {
+  std::set<std::string> fitted;
+  for (const auto& f : fits) fitted.insert(f.fit.serial);
+  std::map<std::int64_t, nlohmann::json> out;
+  for (const auto& [run, serials] : figures)
+    for (const auto& s : serials) {
+      const std::string serial = s.value("serial", "");
+      if (fitted.contains(serial) || (!only_serial.empty() && serial != only_serial)) continue;
+      if (!out.contains(run)) out[run] = nlohmann::json::array();
+      out[run].push_back(s);
+    }
+  return out;
 }
 
 void print_fit(const JudgedFit& jf) {
@@ -191,19 +214,37 @@ int run_fit(const FitOptions& o) {
   Store store(o.db, OpenMode::existing);  // stores the fit; never creates a database
   const sc::ModelSpec spec{sc::parse_terms(o.terms), o.ref_temp_c};
   FitAllResult result;
+  std::set<std::int64_t> acceptance_runs;  // --acceptance: runs computed whether fitted or not
+  if (o.run) acceptance_runs.insert(*o.run);
   if (o.all) {
     if (o.run && !store.find_run(*o.run))
       throw InputError(fmt::format("{}: no run {}", o.db, *o.run));
     result = fit_all(store, o.run, spec, choice, o.terms_given);
+  } else if (o.acceptance) {
+    // A serial whose runs hold acceptance steps only has no bins: its figures are still shown.
+    try {
+      result.fits.push_back(fit_one(store, o, spec, choice));
+    } catch (const InputError& e) {
+      // Nothing to fit in runs that are there; an unknown serial or run stays the error it is.
+      const auto runs = o.runs.empty() ? store.runs_of_serial(o.serial) : o.runs;
+      if (runs.empty() ||
+          std::any_of(runs.begin(), runs.end(), [&](auto id) { return !store.find_run(id); }))
+        throw;
+      result.skipped.push_back(e.what());
+      acceptance_runs.insert(runs.begin(), runs.end());
+    }
   } else {
     result.fits.push_back(fit_one(store, o, spec, choice));
   }
   // Serials with nothing to fit: one line each on stderr, and exit status 1 (the others stored).
   for (const auto& s : result.skipped) fmt::print(stderr, "station: fit skipped: {}\n", s);
   const auto& fits = result.fits;
-  if (o.acceptance) recompute_acceptance(store, fits, o.run, choice);
+  std::map<std::int64_t, nlohmann::json> unfitted;
+  if (o.acceptance)
+    unfitted = unfitted_acceptance(recompute_acceptance(store, fits, acceptance_runs, choice), fits,
+                                   o.all ? std::string() : o.serial);
   const int status = result.skipped.empty() ? 0 : 1;
-  if (o.json) {
+  if (o.json && (o.all || !fits.empty())) {
     nlohmann::json arr = nlohmann::json::array();
     for (const auto& f : fits) {
       arr.push_back(fit_json(f));
@@ -212,7 +253,24 @@ int run_fit(const FitOptions& o) {
       arr.back()["acceptance"] = acceptance_beside_json(store, f.fit.serial, f.fit.runs);
       if (o.cv) arr.back()["cross_validation"] = cv_json(cross_validate(store, f.fit), f.fit.runs);
     }
+    // Serials without a thermal fit whose acceptance figures were computed: one object each.
+    for (const auto& [run, serials] : unfitted)
+      for (const auto& a : serials)
+        arr.push_back({{"serial", a.value("serial", "")},
+                       {"fit_id", nullptr},
+                       {"acceptance_run_id", run},
+                       {"acceptance_figures", a}});
     std::cout << (o.all ? arr : arr[0]).dump(2) << '\n';
+    return status;
+  }
+  if (o.json) {  // --serial --acceptance without a fit: its figures alone
+    nlohmann::json figures = nlohmann::json::array();
+    for (const auto& [run, serials] : unfitted)
+      for (const auto& a : serials)
+        figures.push_back({{"acceptance_run_id", run}, {"acceptance_figures", a}});
+    std::cout << nlohmann::json{{"serial", o.serial}, {"fit_id", nullptr}, {"acceptance", figures}}
+                     .dump(2)
+              << '\n';
     return status;
   }
   for (const auto& f : fits) {
@@ -221,6 +279,13 @@ int run_fit(const FitOptions& o) {
                acceptance_beside_text(acceptance_beside_json(store, f.fit.serial, f.fit.runs)));
     if (o.cv) print_cv(cross_validate(store, f.fit), f.fit.runs);
   }
+  for (const auto& [run, serials] : unfitted) {
+    fmt::print("run {}: no thermal fit for {} (no complete bins); its acceptance figures:", run,
+               serials.size() == 1 ? "this serial" : "these serials");
+    fmt::print("{}", acceptance_text(serials));
+  }
+  if (o.acceptance && fits.empty() && unfitted.empty())
+    fmt::print("no thermal fit and no acceptance figures: the runs hold no acceptance step\n");
   return status;
 }
 
@@ -231,7 +296,9 @@ void add_fit_commands(CLI::App& app, CommandStatus& status) {
   auto* fit = app.add_subcommand("fit", "Fit the thermal model per serial number from stored runs");
   fit->footer(exit_status_footer(
       {{0, "every serial was fitted and stored"},
-       {1, "a serial had nothing to fit (one line each on stderr; the others are stored)"}}));
+       {1,
+        "a serial had nothing to fit (one line each on stderr; the others are stored; with "
+        "--acceptance its acceptance figures are still computed, stored and printed)"}}));
   fit->add_option("--db", o->db, "SQLite database")->required();
   auto* serial = fit->add_option("--serial", o->serial, "gyro serial number");
   fit->add_option("--runs", o->runs, "run ids (default: every run of the serial)")->delimiter(',');

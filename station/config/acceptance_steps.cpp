@@ -25,6 +25,20 @@ double time_in(const TomlView& v, const char* key, double fallback, double lo) {
   return t;
 }
 
+// The first pair of entries closer than `resolution` by `distance`, as "entries I and J: A and B
+// UNIT are one ...": a repeated point measures nothing new and is counted twice in the fit.
+template <typename Distance>
+void refuse_repeats(const TomlView& v, const char* key, const std::vector<double>& values,
+                    double resolution, Distance distance, const char* what) {
+  for (std::size_t j = 1; j < values.size(); ++j) {
+    for (std::size_t i = 0; i < j; ++i) {
+      if (distance(values[i], values[j]) < resolution)
+        throw v.error(key, fmt::format("entries {} and {}: {:g} and {:g} are one {}", i, j,
+                                       values[i], values[j], what));
+    }
+  }
+}
+
 void read_ladder(const TomlView& v, Step& s) {
   v.allow_only({"type", "label", "rates_dps", "settle_s", "dwell_s", "accel_dps2",
                 "rate_tolerance_dps", "timeout_s"});
@@ -41,8 +55,14 @@ void read_ladder(const TomlView& v, Step& s) {
   s.settle_s = time_in(v, "settle_s", 10.0, 2.0);
   s.dwell_s = time_in(v, "dwell_s", 60.0, 10.0);
   s.accel_dps2 = v.opt_number_in("accel_dps2", 0.01, 1e4, "deg/s^2").value_or(10.0);
-  s.rate_tolerance_dps =
-      v.opt_number_in("rate_tolerance_dps", 1e-6, 100.0, "deg/s").value_or(0.05);
+  s.rate_tolerance_dps = v.opt_number_in("rate_tolerance_dps", 1e-6, 100.0, "deg/s").value_or(0.05);
+  refuse_repeats(
+      v, "rates_dps", s.rates_dps, s.rate_tolerance_dps,
+      [](double a, double b) { return std::abs(a - b); },
+      fmt::format("rate (closer than rate_tolerance_dps {:g} deg/s: the table's read-back cannot "
+                  "tell them apart)",
+                  s.rate_tolerance_dps)
+          .c_str());
 }
 
 void read_positions(const TomlView& v, Step& s) {
@@ -50,16 +70,12 @@ void read_positions(const TomlView& v, Step& s) {
   s.angles_deg = v.number_array_in("angles_deg", -kMaxAngleDeg, kMaxAngleDeg, "deg", kMaxPoints);
   if (s.angles_deg.size() < 3)
     throw v.error("angles_deg", "needs at least 3 angles (a cosine has 3 unknowns)");
-  std::vector<double> distinct;
-  for (double a : s.angles_deg) {
-    const bool seen = std::any_of(distinct.begin(), distinct.end(), [a](double d) {
-      return std::abs(std::remainder(a - d, 360.0)) < 1e-9;
-    });
-    if (!seen) distinct.push_back(a);
-  }
-  if (distinct.size() < 3)
-    throw v.error("angles_deg", fmt::format("{} distinct angles (mod 360), needs at least 3",
-                                            distinct.size()));
+  refuse_repeats(
+      v, "angles_deg", s.angles_deg, kAngleToleranceDeg,
+      [](double a, double b) { return std::abs(std::remainder(a - b, 360.0)); },
+      fmt::format("angle (mod 360 deg, closer than the table's {:g} deg in-position tolerance)",
+                  kAngleToleranceDeg)
+          .c_str());
   s.settle_s = time_in(v, "settle_s", 30.0, 2.0);
   s.dwell_s = time_in(v, "dwell_s", 300.0, 10.0);
 }
@@ -96,7 +112,8 @@ void read_acceptance_step(const TomlView& v, Step& s) {
   }
   if (const double d = acceptance_duration_s(s); d > kMaxTimeS)
     throw v.error("type", fmt::format("the step takes {:g} days, longer than the longest step "
-                                      "(7 days)", d / 86400.0));
+                                      "(7 days)",
+                                      d / 86400.0));
 }
 
 void check_tables_locked(const std::vector<Step>& steps, const std::string& path) {
@@ -150,7 +167,8 @@ double acceptance_duration_s(const Step& s) {
   const auto points = acceptance_schedule(s);
   if (points.empty()) return 0;
   double end = points.back().end_s;
-  if (s.kind == StepKind::rate_ladder) end += std::abs(points.back().demand) / s.accel_dps2 + s.settle_s;
+  if (s.kind == StepKind::rate_ladder)
+    end += std::abs(points.back().demand) / s.accel_dps2 + s.settle_s;
   return end;
 }
 

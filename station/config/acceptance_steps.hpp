@@ -15,6 +15,10 @@ namespace station {
 /// rate_ladder, positions or power_cycles.
 bool is_acceptance_step(StepKind k);
 
+/// positions: the table is at its angle within this, deg (the runner's check over a window); two
+/// angles of one step closer than this (mod 360) are one angle and refused at parse.
+inline constexpr double kAngleToleranceDeg = 0.1;
+
 /// One point of an acceptance step; times from the step's start, s.
 struct AcceptancePoint {
   int index = 0;
@@ -37,6 +41,8 @@ double acceptance_duration_s(const Step& s);
 
 /// Reads the keys of an acceptance step into `s` (its kind already set); throws InputError
 /// naming the key ("FILE:LINE: key 'step[4].rates_dps': entry 2: 4000 is outside 0..1000 deg/s").
+/// Two ladder rates closer than the step's rate_tolerance_dps (the table's read-back cannot tell
+/// them apart), or two angles closer than kAngleToleranceDeg mod 360, are refused, naming both.
 void read_acceptance_step(const TomlView& v, Step& s);
 /// A rate_ladder or positions step leaves the table turning or unlocked at an angle: a
 /// lock_turntable step must follow it before the record window opens or the protocol ends.

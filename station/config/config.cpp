@@ -85,9 +85,12 @@ void link_defaults(const TomlView& v, const Dialect& dialect, DeviceConfig& d) {
 DeviceConfig read_device(const TomlView& v, bool is_chamber) {
   v.allow_only({"endpoint", "model", "preset", "unit_id", "timeout_s", "readback_every", "point",
                 "run_event", "product_input", "humidity_event", "setpoint_low_c", "setpoint_high_c",
-                "request_gap_s", "word_order", "gateway", "framing", "on_foreign_setpoint"});
+                "request_gap_s", "word_order", "gateway", "framing", "on_foreign_setpoint",
+                "max_rate_dps", "max_accel_dps2"});
   if (!is_chamber && v.table().contains("on_foreign_setpoint"))
     throw v.error("on_foreign_setpoint", "is a [chamber] key");
+  for (const char* key : {"max_rate_dps", "max_accel_dps2"})
+    if (is_chamber && v.table().contains(key)) throw v.error(key, "is a [turntable] key");
   DeviceConfig d;
   d.name = is_chamber ? "chamber" : "turntable";
   if (v.opt_string("model") && v.opt_string("preset"))
@@ -104,6 +107,10 @@ DeviceConfig read_device(const TomlView& v, bool is_chamber) {
   d.setpoint_low_c = v.opt_number("setpoint_low_c");
   d.setpoint_high_c = v.opt_number("setpoint_high_c");
   d.framing = v.opt_string("framing").value_or("");
+  // The table's limits as its maker rates it (or the unit is set): the start checks a protocol's
+  // rate ladders against them (daemon/acceptance_runner.hpp, check_acceptance_rig).
+  d.max_rate_dps = v.opt_number_in("max_rate_dps", 1e-3, 1e5, "deg/s");
+  d.max_accel_dps2 = v.opt_number_in("max_accel_dps2", 1e-3, 1e6, "deg/s^2");
   for (const auto& p : v.table_array("point")) d.overrides.push_back(read_override(p));
   const auto check = [&](const auto* dialect) {
     d.model = std::string(dialect->model);

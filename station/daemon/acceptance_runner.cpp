@@ -4,6 +4,10 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <optional>
+#include <string>
+
+#include "drivers/registry/dialects.hpp"
 
 namespace station {
 namespace {
@@ -13,8 +17,36 @@ namespace dr = station::drivers;
 // A point is measured over the whole window when the ticks it saw span all of it but the first
 // and last tick (a run killed or held in the window measured less: left out).
 constexpr double kWindowEdgeS = 2.0;
-// positions: the table is at its angle within this (as lock_turntable's check).
-constexpr double kAngleToleranceDeg = 0.1;
+
+// A rate_ladder's demands against the table's limits: the configured ones, the dialect's own
+// rate limit where it is lower (drivers/registry). Throws naming the step, the figure and the
+// limit.
+void check_table_limits(const Step& s, const std::string& where, const StationConfig& config) {
+  if (s.kind != StepKind::rate_ladder || !config.turntable) return;
+  const auto& spec = *config.turntable;
+  std::optional<double> rate_limit = spec.max_rate_dps;
+  const char* rate_source = "[turntable] max_rate_dps";
+  if (const auto own = dr::turntable_dialect(spec.model).rate_limit_dps;
+      own && (!rate_limit || *own < *rate_limit)) {
+    rate_limit = own;
+    rate_source = "its dialect's own limit";
+  }
+  if (rate_limit) {
+    for (std::size_t i = 0; i < s.rates_dps.size(); ++i) {
+      if (s.rates_dps[i] > *rate_limit)
+        throw InputError(
+            fmt::format("{}: rates_dps entry {}: {:g} deg/s is beyond the "
+                        "turntable's rate limit {:g} deg/s ({}, model {})",
+                        where, i, s.rates_dps[i], *rate_limit, rate_source, spec.model));
+    }
+  }
+  if (spec.max_accel_dps2 && s.accel_dps2 > *spec.max_accel_dps2)
+    throw InputError(
+        fmt::format("{}: accel_dps2 {:g} deg/s^2 is beyond the turntable's "
+                    "acceleration limit {:g} deg/s^2 ([turntable] max_accel_dps2): "
+                    "the schedule would measure before the table reached its rate",
+                    where, s.accel_dps2, *spec.max_accel_dps2));
+}
 
 }  // namespace
 
@@ -22,15 +54,18 @@ void check_acceptance_rig(const Protocol& protocol, const StationConfig& config,
                           bool has_turntable) {
   for (std::size_t i = 0; i < protocol.steps.size(); ++i) {
     const Step& s = protocol.steps[i];
-    const auto where = fmt::format("{}:{}: step[{}] {}", protocol.path, s.line, i, to_string(s.kind));
+    const auto where =
+        fmt::format("{}:{}: step[{}] {}", protocol.path, s.line, i, to_string(s.kind));
     if ((s.kind == StepKind::rate_ladder || s.kind == StepKind::positions) && !has_turntable)
       throw InputError(where + ": this rig has no turntable");
+    check_table_limits(s, where, config);
     if (s.kind != StepKind::power_cycles) continue;
     for (std::size_t k = 0; k < config.slots.size(); ++k) {
       if (config.slots[k].relay.empty())
-        throw InputError(fmt::format("{}: slot {} has no relay (its [[slot]] relay = \"LINE\"): "
-                                     "its gyro could not be switched off",
-                                     where, k + 1));
+        throw InputError(
+            fmt::format("{}: slot {} has no relay (its [[slot]] relay = \"LINE\"): "
+                        "its gyro could not be switched off",
+                        where, k + 1));
     }
   }
 }
@@ -104,14 +139,14 @@ void AcceptanceRunner::measure(const AcceptancePoint& p, double t_s,
 
 void AcceptanceRunner::close(const AcceptancePoint& p, AcceptanceActions& a) {
   const double window_s = p.end_s - p.measure_s;
-  const bool spanned =
-      stats_.first_s && stats_.last_s && *stats_.last_s - *stats_.first_s >= window_s - kWindowEdgeS;
+  const bool spanned = stats_.first_s && stats_.last_s &&
+                       *stats_.last_s - *stats_.first_s >= window_s - kWindowEdgeS;
   const bool power = step_->kind == StepKind::power_cycles;
   const double tolerance =
       step_->kind == StepKind::rate_ladder ? step_->rate_tolerance_dps : kAngleToleranceDeg;
-  const bool held = spanned && !cut_ &&
-                    (power || (stats_.readings > 0 && stats_.all_in_position &&
-                               stats_.max_dev <= tolerance));
+  const bool held =
+      spanned && !cut_ &&
+      (power || (stats_.readings > 0 && stats_.all_in_position && stats_.max_dev <= tolerance));
   nlohmann::json data{{"step_index", step_index_},
                       {"point", p.index},
                       {"demand", p.demand},
@@ -172,7 +207,8 @@ AcceptanceActions AcceptanceRunner::tick(double t_s, const TableObservation& tab
     return a;
   }
   const auto& p = points_[static_cast<std::size_t>(now)];
-  const bool power_edge = step_->kind == StepKind::power_cycles && power_on_ != (in_s >= p.measure_s);
+  const bool power_edge =
+      step_->kind == StepKind::power_cycles && power_on_ != (in_s >= p.measure_s);
   if (now != current_ || resend_ || power_edge) send(p, t_s, a);
   current_ = now;
   resend_ = false;

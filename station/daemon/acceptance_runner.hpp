@@ -15,7 +15,10 @@ namespace station {
 
 /// Refuses (InputError, before the run exists) a protocol whose acceptance steps this rig cannot
 /// carry out: a rate_ladder or positions step without a turntable, a power_cycles step while a
-/// slot has no relay (its gyro would never be switched off, and its turn-ons would be made up).
+/// slot has no relay (its gyro would never be switched off, and its turn-ons would be made up),
+/// a rate_ladder asking a rate or an acceleration beyond the table's limits ([turntable]
+/// max_rate_dps and max_accel_dps2, the dialect's own rate limit where lower). Called once for a
+/// new run, before it is stored (Sequencer::create_run: run --config, serve, run --sim alike).
 void check_acceptance_rig(const Protocol& protocol, const StationConfig& config,
                           bool has_turntable);
 
@@ -64,9 +67,9 @@ class AcceptanceRunner {
   double started_s_ = 0;
   std::vector<AcceptancePoint> points_;
   double duration_s_ = 0;  ///< acceptance_duration_s of the step, taken at enter, s
-  int current_ = -1;    ///< point whose demand was sent
-  bool resend_ = false;  ///< entered again: send the current demand at the next tick
-  bool rested_ = false;  ///< the end-of-step demand was sent
+  int current_ = -1;       ///< point whose demand was sent
+  bool resend_ = false;    ///< entered again: send the current demand at the next tick
+  bool rested_ = false;    ///< the end-of-step demand was sent
   bool power_on_ = true;
   bool cut_ = false;  ///< the current point's window was interrupted (a safe hold): left out
   PointStats stats_;

@@ -18,6 +18,7 @@
 #include <utility>
 
 #include "station/common/input_error.hpp"
+#include "station/session/session_files.hpp"
 #include "station/session/session_log.hpp"
 
 namespace station {
@@ -50,11 +51,10 @@ std::array<unsigned char, EVP_MAX_MD_SIZE> finish_md(EVP_MD_CTX* c) {
   return md;
 }
 
-/// `dir`/`name`, or `dir`/`name`.gz when only that exists (as the replay's readers resolve it).
+/// `dir`/`name`, or `dir`/`name`.gz when only that exists (session_file: the replay's readers'
+/// one rule; both refused).
 std::string resolved(const std::string& dir, const std::string& name) {
-  const fs::path plain = fs::path(dir) / name;
-  if (!fs::exists(plain) && fs::exists(plain.string() + ".gz")) return plain.string() + ".gz";
-  return plain.string();
+  return session_file((fs::path(dir) / name).string());
 }
 
 /// Calls `each` with the decompressed bytes of `file` (DecompressedReader). Throws

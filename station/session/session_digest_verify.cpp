@@ -11,6 +11,7 @@
 
 #include "station/common/input_error.hpp"
 #include "station/session/session_digest.hpp"
+#include "station/session/session_files.hpp"
 #include "station/session/session_log.hpp"
 
 namespace station {
@@ -54,6 +55,7 @@ using TagLines = std::map<std::string, std::map<std::int64_t, int>>;
 std::map<std::string, FileDigest> read_digest(const std::string& read_as, std::string_view text,
                                               TagLines& tag_lines) {
   std::map<std::string, FileDigest> out;
+  std::map<std::string, int> file_line;  // the line of each file's `file` entry
   int line_no = 0;
   for (std::size_t begin = 0; begin < text.size();) {
     const auto nl = std::min(text.find('\n', begin), text.size());
@@ -73,6 +75,7 @@ std::map<std::string, FileDigest> read_digest(const std::string& read_as, std::s
     if (kind == "file") {
       if (value.size() != 64 || out.contains(std::string(name))) throw bad("bad file line");
       out[std::string(name)] = {std::string(name), n, std::string(value), {}};
+      file_line[std::string(name)] = line_no;
     } else if (kind == "tags") {
       auto it = out.find(std::string(name));
       if (it == out.end() || static_cast<std::int64_t>(it->second.tags.size()) + 1 != n ||
@@ -83,10 +86,12 @@ std::map<std::string, FileDigest> read_digest(const std::string& read_as, std::s
       throw bad("unknown line kind");
     }
   }
+  // The count on a `file` line and its tags lines disagree: the file line is named (its count
+  // is the one field the tags do not spell out).
   for (const auto& [name, d] : out)
     if (static_cast<std::int64_t>(d.tags.size()) != d.lines)
-      throw InputError(
-          fmt::format("{}: {} has {} lines but {} tags", read_as, name, d.lines, d.tags.size()));
+      throw InputError(fmt::format("{}:{}: {} has {} lines but {} tags", read_as, file_line[name],
+                                   name, d.lines, d.tags.size()));
   return out;
 }
 
@@ -165,6 +170,9 @@ struct SessionReads::Recorded {
 };
 
 SessionReads::SessionReads(std::string dir, bool verify) : dir_(std::move(dir)) {
+  // A file there plain and as .gz is refused before anything is read (session_file).
+  for (const auto& name : digested_files()) (void)session_file((fs::path(dir_) / name).string());
+  (void)session_file((fs::path(dir_) / "digest.txt").string());
   if (verify) recorded_ = std::make_unique<Recorded>();
 }
 
@@ -185,11 +193,11 @@ LogLineReader& SessionReads::reader(const std::string& name) {
 std::optional<DigestMismatch> SessionReads::check_up_front() {
   if (!recorded_) return std::nullopt;
   const std::string path = (fs::path(dir_) / "digest.txt").string();
-  if (!fs::exists(path) && !fs::exists(path + ".gz"))
+  if (!session_file_exists(path))
     return DigestMismatch{path, std::nullopt,
                           "missing: nothing proves the logs are the ones the run wrote"};
   auto& rec = *recorded_;
-  rec.read_as = fs::exists(path) ? path : path + ".gz";
+  rec.read_as = session_file(path);
   std::string have;
   std::optional<std::string> after_end;  // bytes after its compressed end: "FILE: what"
   try {

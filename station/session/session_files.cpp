@@ -24,6 +24,24 @@ json or_null(const std::optional<T>& v) {
 
 }  // namespace
 
+std::string session_file(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const std::string gz = path + ".gz";
+  const bool plain = fs::exists(path, ec), packed = fs::exists(gz, ec);
+  if (plain && packed)
+    throw InputError(
+        fmt::format("{} and {} both exist: which one the run wrote cannot be told "
+                    "(compressing a session replaces each file by its .gz); keep one",
+                    path, gz));
+  return packed ? gz : path;
+}
+
+bool session_file_exists(const std::string& path) {
+  std::error_code ec;
+  return std::filesystem::exists(path, ec) || std::filesystem::exists(path + ".gz", ec);
+}
+
 const std::vector<std::string>& sample_columns() {
   static const std::vector<std::string> columns{"serial", "net_pulses", "interval_s", "rate_dph",
                                                 "temp_c", "temp2_c",    "air_c",      "setpoint_c",

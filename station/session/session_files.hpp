@@ -28,6 +28,15 @@ struct SessionHeader {
   std::vector<RunSlot> slots;
 };
 
+/// The file a session's `path` is read from: `path`, or `path`.gz when only that exists (`path`
+/// when neither does: the caller says it is missing). Both at once is refused (InputError naming
+/// both): which one the run wrote cannot be told, and a check of one would vouch for the other.
+/// The one rule of every reader of a session (logs, result.json, digest.txt).
+std::string session_file(const std::string& path);
+
+/// Whether `path` or `path`.gz exists.
+bool session_file_exists(const std::string& path);
+
 /// Writes `dir`/session.toml unless it exists (a resumed run keeps the header of its start).
 /// Throws InputError naming the path when it cannot be written.
 void write_session_header(const std::string& dir, const SessionHeader& header);

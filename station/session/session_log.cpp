@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "station/common/input_error.hpp"
+#include "station/session/session_files.hpp"
 
 namespace station {
 namespace {
@@ -68,9 +69,7 @@ dr::Result<SessionLogLine> parse_session_line(std::string_view line) {
   return out;
 }
 
-LogLineReader::LogLineReader(const std::string& path) : file_(path) {
-  if (!std::filesystem::exists(file_) && std::filesystem::exists(path + ".gz"))
-    file_ = path + ".gz";
+LogLineReader::LogLineReader(const std::string& path) : file_(session_file(path)) {
   try {
     in_ = std::make_unique<DecompressedReader>(file_);
   } catch (const InputError&) {

@@ -105,7 +105,8 @@ InputError fault_error(double at_s, const std::string& command, const std::strin
 constexpr double kUntimedWaitS = 7 * 86400.0;
 
 /// The protocol's longest run from `start_c`, s: each step's timeout where it has one; else a
-/// step that waits counts its nominal duration plus kUntimedWaitS, any other its nominal
+/// step that waits (for the air, a soak, the table's lock) counts its nominal duration plus
+/// kUntimedWaitS, any other its nominal
 /// duration (a ramp at its rate, a hold's time). A --fault past it is refused: it would never
 /// run (one within it that the run does not reach is reported when the run ends).
 double protocol_span_s(const Protocol& p, double start_c) {
@@ -113,7 +114,10 @@ double protocol_span_s(const Protocol& p, double start_c) {
   double span_s = 0;
   for (std::size_t i = 0; i < p.steps.size(); ++i) {
     const Step& s = p.steps[i];
-    const bool waits = s.kind == StepKind::soak || (s.kind == StepKind::set_temperature && s.wait);
+    // lock_turntable waits for the table to be at its angle and locked: nominally 0 s, it takes
+    // the table's travel (a --fault in the final lock's last seconds is within the run).
+    const bool waits = s.kind == StepKind::soak || s.kind == StepKind::lock_turntable ||
+                       (s.kind == StepKind::set_temperature && s.wait);
     const double d = nominal[i].value_or(0.0);
     span_s += s.timeout_s > 0 ? std::max(s.timeout_s, d) : waits ? d + kUntimedWaitS : d;
   }
