@@ -24,7 +24,7 @@ std::string point_problem(std::size_t i, const LadderPoint& p) {
 }
 
 struct UsedPoints {
-  Eigen::VectorXd x_arcsec_per_s, y_pps, se_pps;
+  Eigen::VectorXd x_arcsec_per_s, y_pps, se_pps, temp_c;  // temp_c: NaN where not given
   std::size_t excluded = 0;
 };
 
@@ -44,12 +44,13 @@ Computed<UsedPoints> used_points(std::span<const LadderPoint> points) {
                        std::to_string(u.excluded) + " excluded); at least " +
                        std::to_string(kMinLadderPoints) + " needed"};
   const auto n = static_cast<Eigen::Index>(used.size());
-  u.x_arcsec_per_s.resize(n), u.y_pps.resize(n), u.se_pps.resize(n);
+  u.x_arcsec_per_s.resize(n), u.y_pps.resize(n), u.se_pps.resize(n), u.temp_c.resize(n);
   for (Eigen::Index k = 0; k < n; ++k) {
     const LadderPoint& p = points[used[k]];
     u.x_arcsec_per_s(k) = ladder_input_arcsec_per_s(p);
     u.y_pps(k) = p.output_pps;
     u.se_pps(k) = p.output_se_pps;
+    u.temp_c(k) = p.temp_c;
   }
   return u;
 }
@@ -104,14 +105,15 @@ double ladder_input_arcsec_per_s(const LadderPoint& p) {
   return 3600.0 * p.table_rate_dps + p.earth_rate_dph;
 }
 
-Computed<LadderResult> analyze_rate_ladder(std::span<const LadderPoint> points) {
-  const auto u = used_points(points);
-  if (!u) return NotComputed{u.error()};
-  Eigen::MatrixXd design(u->x_arcsec_per_s.size(), 2);
+namespace {
+
+// The line, its nonlinearity and its asymmetry over the used points (scale_factor.hpp).
+Computed<LadderResult> fit_ladder(const UsedPoints& u) {
+  Eigen::MatrixXd design(u.x_arcsec_per_s.size(), 2);
   design.col(0).setOnes();
-  design.col(1) = u->x_arcsec_per_s;
+  design.col(1) = u.x_arcsec_per_s;
   // K is the least-squares straight line, its residuals the nonlinearity (acceptance.hpp).
-  const auto fit = ordinary_least_squares(design, u->y_pps, u->se_pps);
+  const auto fit = ordinary_least_squares(design, u.y_pps, u.se_pps);
   if (!fit) return NotComputed{"ladder: " + fit.error()};
   const double a = fit->coefficients(0), k = fit->coefficients(1);
   if (!(k != 0.0)) return NotComputed{"ladder: the fitted scale factor is zero"};
@@ -121,14 +123,84 @@ Computed<LadderResult> analyze_rate_ladder(std::span<const LadderPoint> points) 
   r.bias_dph = a / k;  // arcsec/s = deg/h
   r.bias_se_dph =
       std::sqrt(delta_method_variance(Eigen::Vector2d(1.0 / k, -a / (k * k)), fit->covariance));
-  add_nonlinearity(*u, *fit, r);
-  add_asymmetry(*u, r);
-  r.points_used = static_cast<std::size_t>(u->x_arcsec_per_s.size());
-  r.points_excluded = u->excluded;
+  add_nonlinearity(u, *fit, r);
+  add_asymmetry(u, r);
+  r.points_used = static_cast<std::size_t>(u.x_arcsec_per_s.size());
+  r.points_excluded = u.excluded;
   r.dof = fit->dof;
   r.chi2 = fit->chi2;
   r.se_scale = fit->se_scale;
   return r;
+}
+
+// The points brought to Tc with `tc_ppm_per_c`: y_i - K x_i TC (T_i - Tc) 1e-6.
+UsedPoints at_slope_temp(UsedPoints u, double k, double tc_c, double tc_ppm_per_c) {
+  for (Eigen::Index i = 0; i < u.y_pps.size(); ++i)
+    u.y_pps(i) -= k * u.x_arcsec_per_s(i) * tc_ppm_per_c * 1e-6 * (u.temp_c(i) - tc_c);
+  return u;
+}
+
+// The drift-corrected figures, TC's error carried by their sensitivity to TC (linear in TC:
+// one more fit at TC + 1 ppm/C gives it exactly).
+Computed<LadderResult> corrected(const UsedPoints& u, const LadderResult& plain,
+                                 const LadderTemperatureModel& tc) {
+  const double k = plain.sf_pulse_per_arcsec, t = plain.temp_c;
+  auto r = fit_ladder(at_slope_temp(u, k, t, tc.tc_ppm_per_c));
+  const auto moved = fit_ladder(at_slope_temp(u, k, t, tc.tc_ppm_per_c + 1.0));
+  if (!r || !moved) return r;
+  LadderResult out = *r;
+  const double dk = (moved->sf_pulse_per_arcsec - out.sf_pulse_per_arcsec) * tc.tc_se_ppm_per_c;
+  out.sf_se_pulse_per_arcsec = std::hypot(out.sf_se_pulse_per_arcsec, dk);
+  if (out.asymmetry && moved->asymmetry) {
+    const double da =
+        (moved->asymmetry->asymmetry_ppm - out.asymmetry->asymmetry_ppm) * tc.tc_se_ppm_per_c;
+    out.asymmetry->asymmetry_se_ppm = std::hypot(out.asymmetry->asymmetry_se_ppm, da);
+  }
+  out.temp_c = plain.temp_c;
+  out.drift_c = plain.drift_c;
+  out.drift_corrected = true;
+  return out;
+}
+
+}  // namespace
+
+double ladder_slope_temp_c(std::span<const LadderPoint> points) {
+  double xm = 0, n = 0;
+  for (const auto& p : points) {
+    if (!p.rate_in_tolerance) continue;
+    if (!std::isfinite(p.temp_c)) return std::nan("");
+    xm += ladder_input_arcsec_per_s(p), n += 1;
+  }
+  if (n < 2) return std::nan("");
+  xm /= n;
+  double sxx = 0, sxt = 0;
+  for (const auto& p : points) {
+    if (!p.rate_in_tolerance) continue;
+    const double d = ladder_input_arcsec_per_s(p) - xm;
+    sxx += d * d, sxt += d * d * p.temp_c;
+  }
+  return sxx > 0 ? sxt / sxx : std::nan("");
+}
+
+Computed<LadderResult> analyze_rate_ladder(std::span<const LadderPoint> points,
+                                           std::optional<LadderTemperatureModel> tc) {
+  const auto u = used_points(points);
+  if (!u) return NotComputed{u.error()};
+  auto r = fit_ladder(*u);
+  if (!r) return r;
+  LadderResult plain = *r;
+  plain.temp_c = ladder_slope_temp_c(points);
+  if (std::isfinite(plain.temp_c)) plain.drift_c = u->temp_c.maxCoeff() - u->temp_c.minCoeff();
+  if (tc && std::isfinite(plain.temp_c) && std::isfinite(tc->tc_ppm_per_c) &&
+      std::isfinite(tc->tc_se_ppm_per_c))
+    return corrected(*u, plain, *tc);
+  if (plain.asymmetry && plain.drift_c > kMaxUncorrectedDriftC) {
+    plain.asymmetry->judged = false;
+    plain.asymmetry_note = "the plateau drifted " + number_text(plain.drift_c) +
+                           " C during the ladder and no temperature coefficient corrects it: "
+                           "the asymmetry holds TC x drift, not judged";
+  }
+  return plain;
 }
 
 namespace {

@@ -26,6 +26,17 @@
 //     ppm, its SE by the delta method (gradient 4 K- / S^2, -4 K+ / S^2 times 1e6, S = K+ + K-).
 //     The common intercept is the gyro's one bias: fitting each sign's line with its own
 //     intercept would let a bias difference pass for asymmetry.
+//   A drifting plateau: the scale factor changes with the gyro's temperature, K(T) = K(Tc) (1 +
+//     TC (T - Tc) 1e-6), so a point at T_i reads K(Tc) x_i (1 + TC (T_i - Tc) 1e-6). To first
+//     order the slope of the line is K at Tc = sum (x_i - xm)^2 T_i / Sxx (the fast points'
+//     temperature, ladder_slope_temp_c), but the asymmetry is not: a ladder runs each rate one
+//     way then the other, so +x and -x are read at temperatures apart by the drift dT between
+//     them, and the asymmetry fit takes TC dT ppm for asymmetry; it is the same column |x| dT/2,
+//     so a ladder alone cannot tell them apart. Given TC (the run's own fit across plateaus),
+//     each point is brought to Tc first, y_i - K x_i TC (T_i - Tc) 1e-6 (K from the uncorrected
+//     line: the error is second order), and TC's standard error is carried into K's and the
+//     asymmetry's by the figures' (linear) sensitivity to TC. Without TC, a ladder whose points'
+//     temperatures spread beyond kMaxUncorrectedDriftC has its asymmetry stated but not judged.
 //   Temperature coefficient: K(T) = K0 + s (T - T_ref) fitted to the plateaus' scale factors by
 //     weighted least squares (weights 1/SE(K)^2); TC = s / K0 * 1e6 ppm/degC, its SE by the
 //     delta method (gradient (-s/K0^2, 1/K0) * 1e6). K0 is the scale factor at T_ref.
@@ -50,6 +61,7 @@
 #pragma once
 
 #include <cstddef>
+#include <limits>
 #include <optional>
 #include <span>
 #include <string>
@@ -70,6 +82,19 @@ struct LadderPoint {
   /// False when the table did not hold the rate within its tolerance: the point is excluded
   /// and counted, and none of its values are read (they may be NaN).
   bool rate_in_tolerance = true;
+  /// The gyro's temperature over the dwell, deg C; NaN (any used point's): the ladder's drift
+  /// is not known and not corrected.
+  double temp_c = std::numeric_limits<double>::quiet_NaN();
+};
+
+/// The temperature of a ladder's slope: sum (x_i - xm)^2 T_i / Sxx over the used points (the
+/// fast points'; see "A drifting plateau"), deg C; NaN without a temperature for each.
+double ladder_slope_temp_c(std::span<const LadderPoint> points);
+
+/// The scale factor's temperature coefficient a drifting ladder is corrected with.
+struct LadderTemperatureModel {
+  double tc_ppm_per_c = 0;
+  double tc_se_ppm_per_c = 0;  ///< carried into K's and the asymmetry's errors
 };
 
 /// The input rate of a dwell, arcsec/s (= deg/h): 3600 * table_rate_dps + earth_rate_dph.
@@ -91,6 +116,9 @@ struct ScaleFactorAsymmetry {
   double asymmetry_ppm = 0;     ///< (K+ - K-) / mean(K+, K-) * 1e6
   double asymmetry_se_ppm = 0;  ///< delta method on the joint fit's covariance
   double se_scale = 1;          ///< 1: the chi2/dof rule is not applied to a ladder
+  /// False: the plateau drifted beyond kMaxUncorrectedDriftC with no TC to correct it; the
+  /// figure is stated, not judged (asymmetry_note says why).
+  bool judged = true;
 };
 
 /// The figures of one ladder at one plateau.
@@ -112,7 +140,15 @@ struct LadderResult {
   std::size_t dof = 0;              ///< points_used - 2
   double chi2 = 0;                  ///< weighted residual sum of squares of the line
   double se_scale = 1;              ///< 1: the chi2/dof rule is not applied to a ladder
+  double temp_c = std::numeric_limits<double>::quiet_NaN();  ///< Tc: ladder_slope_temp_c
+  double drift_c = 0;            ///< the used points' temperature spread, max - min, C
+  bool drift_corrected = false;  ///< the points were brought to Tc with a given TC
 };
+
+/// The largest spread of a ladder's point temperatures, C, whose asymmetry is judged without a
+/// TC to correct it: at 5 ppm/C (the simulator's largest TC) it moves the asymmetry by 0.1 ppm,
+/// under the simulated ladders' asymmetry SE (about 0.12 ppm).
+inline constexpr double kMaxUncorrectedDriftC = 0.02;
 
 /// The least number of used points a ladder needs (a line and one degree of freedom).
 inline constexpr std::size_t kMinLadderPoints = 3;
@@ -127,10 +163,12 @@ inline constexpr double kMaxScaleFactorDeviation = 0.01;
 /// ladders at one temperature give none).
 inline constexpr double kMinPlateauSpanC = 1.0;
 
-/// Fits a ladder. NotComputed with one line when fewer than kMinLadderPoints points are in
-/// tolerance, a used point has a value that is not finite (or a rate beyond
-/// limits.hpp's kMaxAbsRateDph, or se <= 0), or the input rates do not span a line.
-Computed<LadderResult> analyze_rate_ladder(std::span<const LadderPoint> points);
+/// Fits a ladder; with `tc`, the points brought to Tc first ("A drifting plateau"). NotComputed
+/// with one line when fewer than kMinLadderPoints points are in tolerance, a used point has a
+/// value that is not finite (or a rate beyond limits.hpp's kMaxAbsRateDph, or se <= 0), or the
+/// input rates do not span a line.
+Computed<LadderResult> analyze_rate_ladder(std::span<const LadderPoint> points,
+                                           std::optional<LadderTemperatureModel> tc = {});
 
 /// One plateau's scale factor (from analyze_rate_ladder) at its temperature.
 struct PlateauScaleFactor {

@@ -46,9 +46,15 @@ json ladder_json(const LadderFigures& l) {
     used.push_back({{"input_rate_dps", r.input_rate_dps},
                     {"residual_ppm_fs", r.residual_ppm_fs},
                     {"output_se_pps", r.output_se_pps}});
+  // The points' temperature spread, and whether the run's TC brought them to temp_c
+  // (scale_factor.hpp, "A drifting plateau").
+  if (std::isfinite(f.temp_c)) j["drift_c"] = f.drift_c;
+  j["drift_corrected"] = f.drift_corrected;
   if (f.asymmetry) {
     j["asymmetry_ppm"] = f.asymmetry->asymmetry_ppm;
     j["asymmetry_se_ppm"] = f.asymmetry->asymmetry_se_ppm;
+    j["asymmetry_judged"] = f.asymmetry->judged;
+    if (!f.asymmetry->judged) j["asymmetry_note"] = f.asymmetry_note;
   } else {
     j["asymmetry_note"] = f.asymmetry_note;
   }
@@ -117,6 +123,16 @@ json acceptance_json(const std::vector<SerialAcceptance>& serials) {
     for (const auto& p : s.positions) j["positions"].push_back(positions_json(p));
     if (s.sf_vs_temp) j["sf_vs_temp"] = sf_vs_temp_json(*s.sf_vs_temp);
     if (s.turn_on) j["turn_on"] = turn_on_json(*s.turn_on, s.turn_on_band_dph);
+    // Two or more power_cycles steps: each one's figures ("turn_on" is the first's).
+    if (s.turn_on_steps.size() > 1) {
+      auto& steps = j["turn_on_steps"] = json::array();
+      for (const auto& t : s.turn_on_steps) {
+        json one = turn_on_json(t.result, t.band_dph);
+        one.update({{"step_index", t.step_index}, {"label", t.label}});
+        if (std::isfinite(t.temp_c)) one["temp_c"] = t.temp_c;
+        steps.push_back(std::move(one));
+      }
+    }
     if (!s.positions_note.empty()) j["positions_note"] = s.positions_note;
     out.push_back(std::move(j));
   }

@@ -8,6 +8,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
+#include "compensation/acceptance_windows.hpp"
 #include "compensation/earth_rate.hpp"
 #include "station/config/acceptance_steps.hpp"
 #include "station/config/protocol.hpp"
@@ -62,58 +63,15 @@ MeanSe mean_se(const std::vector<double>& v) {
   return m;
 }
 
-/// The least error of a mean count rate over `window_s`, in pulses/s: the count is exact to the
-/// phase of the first and last pulse, two uniform errors of one pulse, sd 1/sqrt(6) pulse (GUM
-/// 4.3.7, the rectangular distribution, for their difference's triangle). Times the pulse weight
-/// (arcsec) it is deg/h (arcsec/s = deg/h).
-double mean_quantization_pps(double window_s) {
-  return window_s > 0 ? 1.0 / (window_s * std::sqrt(6.0)) : 0.0;
-}
-
-/// The samples of [from_s, to_s) with a rate: pulses per second, rate deg/h and sensor A.
+/// The samples of [from_s, to_s) with a rate: pulses per second, rate deg/h, sensor A and each
+/// sample's span.
 struct Window {
-  std::vector<double> pps, rate_dph, temp_c;
+  std::vector<double> pps, rate_dph, temp_c, spans_s;
   double span_s = 0;  ///< the time the samples cover (their intervals), s
-  /// The least error of a mean over the window, pulses/s (mean_quantization_pps).
-  double quantization_pps() const { return mean_quantization_pps(span_s); }
+  /// The series in pulses/s (`in_dph` false) or deg/h, for the window statistics.
+  comp::WindowSeries series(bool in_dph) const { return {in_dph ? rate_dph : pps, spans_s}; }
 };
 
-/// The mean of a window's series and its standard error by batch means (Schmeiser, "Batch size
-/// effects in the analysis of simulation output", Oper. Res. 30(3):556, 1982): the series in
-/// up to kBatches consecutive batches of equal count, the error from the spread of the batch
-/// means. Not sd/sqrt(n) of the 1 Hz values: their pulse quantization (one pulse is 1.5 deg/h in
-/// a second) is anticorrelated from second to second. The batch means still carry it: batch b's
-/// count is exact to the phases e_b, e_(b+1) of its first and last pulse, so its mean errs by
-/// (e_(b+1) - e_b) / D (D its span), variance 2 var(e) / D^2 with var(e) = 1/12 pulse^2 (GUM
-/// 4.3.7, rectangular), while the whole window's mean errs only by (e_k - e_0) / T, the sum
-/// telescoping. With `floor` = that least error of the window's mean (sd sqrt(2/12)/T) and k
-/// batches (D = T/k), a batch mean's quantization variance is k^2 floor^2; the rest of the
-/// spread (the gyro's own noise, correlated or not within a batch) is s_b^2 - k^2 floor^2
-/// (clipped at 0), which the window's mean carries divided by k. So SE^2 = max(s_b^2 - k^2
-/// floor^2, 0) / k + floor^2 (tests/station/test_acceptance_coverage.cpp checks the errors end
-/// to end).
-MeanSe batch_mean_se(const std::vector<double>& v, double floor) {
-  constexpr std::size_t kBatches = 10, kMinPerBatch = 5;
-  const std::size_t k = std::min(kBatches, v.size() / kMinPerBatch);
-  if (k < 3) {
-    MeanSe m = mean_se(v);
-    if (m.se) m.se = std::max(*m.se, floor);
-    return m;
-  }
-  const std::size_t per = v.size() / k;
-  std::vector<double> means;
-  for (std::size_t b = 0; b < k; ++b) {
-    double sum = 0;
-    for (std::size_t i = b * per; i < (b + 1) * per; ++i) sum += v[i];
-    means.push_back(sum / static_cast<double>(per));
-  }
-  MeanSe m = mean_se(v);
-  const double kd = static_cast<double>(k);
-  const double se_b = mean_se(means).se.value_or(0.0);  // s_b / sqrt(k)
-  const double noise_var = std::max(se_b * se_b * kd - kd * kd * floor * floor, 0.0) / kd;
-  m.se = std::sqrt(noise_var + floor * floor);
-  return m;
-}
 Window window_of(const std::vector<SampleRow>& rows, double from_s, double to_s) {
   Window w;
   for (const auto& r : rows) {
@@ -123,6 +81,7 @@ Window window_of(const std::vector<SampleRow>& rows, double from_s, double to_s)
         (r.flags & kSafeHold) != 0)
       continue;
     w.pps.push_back(static_cast<double>(*r.net_pulses) / *r.interval_s);
+    w.spans_s.push_back(*r.interval_s);
     w.span_s += *r.interval_s;
     w.rate_dph.push_back(*r.rate_dph);
     if (r.temp_c) w.temp_c.push_back(*r.temp_c);
@@ -158,59 +117,100 @@ double mean_temp_c(const std::vector<double>& temps) {
   return temps.empty() ? std::nan("") : mean_se(temps).mean;
 }
 
-/// The temperature a ladder's scale factor belongs to: the slope K = sum (x_i - xm) y_i / Sxx
-/// of a gyro whose K drifts with its temperature T_i over the ladder (the later, faster points
-/// warmer or colder) is, to first order in the drift, K(T_eff) with T_eff = sum (x_i - xm)^2 T_i
-/// / Sxx: the fast points' temperature, not the mean over the windows (which put the plateaus'
-/// K off their temperature by 0.15 ppm, 9 SE, on the shipped protocol's cold and hot ladders).
-/// `points`/`temps_c`: the points the fit takes (in tolerance) and each one's mean sensor A.
-double slope_temp_c(const std::vector<comp::LadderPoint>& points,
-                    const std::vector<double>& temps_c) {
-  double xm = 0, n = 0;
-  for (std::size_t i = 0; i < points.size(); ++i)
-    if (points[i].rate_in_tolerance && std::isfinite(temps_c[i]))
-      xm += comp::ladder_input_arcsec_per_s(points[i]), n += 1;
-  if (n < 2) return std::nan("");
-  xm /= n;
-  double sxx = 0, sxt = 0;
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    if (!points[i].rate_in_tolerance || !std::isfinite(temps_c[i])) continue;
-    const double d = comp::ladder_input_arcsec_per_s(points[i]) - xm;
-    sxx += d * d, sxt += d * d * temps_c[i];
-  }
-  return sxx > 0 ? sxt / sxx : std::nan("");
+/// A measuring window's mean and its error from the serial's white noise density (in the
+/// series' unit squared times s) and its two ends' rounding (acceptance_windows.hpp); empty
+/// without a density or with fewer than 2 samples.
+std::optional<comp::WindowMean> point_mean(const Window& w, bool in_dph,
+                                           std::optional<double> white, double pulse_unit) {
+  if (!white || w.spans_s.size() < 2) return std::nullopt;
+  return comp::window_mean(w.series(in_dph), *white, pulse_unit);
 }
 
+/// A power_cycles step's windows after warm-up: the bias over the second half of the powered
+/// time, the final value over its last third (s since power-on).
+comp::TurnOnWindows turn_on_windows(const Step& s) {
+  comp::TurnOnWindows w;
+  w.bias_start_s = s.dwell_s / 2;
+  w.bias_end_s = s.dwell_s;
+  w.final_start_s = s.dwell_s * 2 / 3;
+  w.final_end_s = s.dwell_s;
+  return w;
+}
+
+/// The windows of step `s` that estimate the gyro's white noise: each point the table held
+/// (ladders, positions), each whole turn-on's final-value window (power cycles).
+std::vector<Window> noise_windows(const Step& s, const std::map<int, PointEvent>& events,
+                                  const std::vector<SampleRow>& rows) {
+  std::vector<Window> out;
+  if (s.kind == StepKind::power_cycles) {
+    const auto w = turn_on_windows(s);
+    for (const auto& [point, e] : events)
+      if (e.held) out.push_back(window_of(rows, e.measure_s + w.final_start_s, e.end_s));
+    return out;
+  }
+  for (auto& w : walk_schedule(s, events, rows))
+    if (w.event != nullptr && w.event->held) out.push_back(std::move(w.window));
+  return out;
+}
+
+/// The serial's white rate noise density, pulses^2/s: pooled over the measuring windows of all
+/// its acceptance steps (noise_windows; acceptance_windows.hpp: the gyro's N is one number, and
+/// one window alone estimates it poorly).
+std::optional<double> serial_white_density(const Protocol& p, const std::vector<int>& steps,
+                                           const StepPoints& events,
+                                           const std::vector<SampleRow>& rows) {
+  std::vector<Window> windows;
+  for (int i : steps) {
+    const auto it = events.find(i);
+    if (it == events.end()) continue;
+    for (auto& w : noise_windows(p.steps[static_cast<std::size_t>(i)], it->second, rows))
+      windows.push_back(std::move(w));
+  }
+  std::vector<comp::WindowSeries> series;
+  for (const auto& w : windows) series.push_back(w.series(false));
+  return comp::pooled_white_density(series, 1.0);
+}
+
+void hold_to_nominal(LadderFigures& f, const RunSlot& slot);
+
 LadderFigures ladder_of(const Step& s, int index, const std::map<int, PointEvent>& events,
-                        const std::vector<SampleRow>& rows, const RunSlot& slot) {
+                        const std::vector<SampleRow>& rows, const RunSlot& slot,
+                        std::optional<double> white_pps2_s) {
   LadderFigures f;
   f.step_index = index;
   f.label = s.label;
   std::vector<comp::LadderPoint> points;
-  std::vector<double> point_temps_c;
   for (const auto& w : walk_schedule(s, events, rows)) {
     ++f.points;
     if (w.event == nullptr) {
       ++f.missing;
       continue;
     }
-    const MeanSe out = batch_mean_se(w.window.pps, w.window.quantization_pps());
+    const auto out = point_mean(w.window, false, white_pps2_s, 1.0);
     comp::LadderPoint p;
     // The table turns about up: an input axis down senses it negated (its Earth rate is the
     // slot's, already signed).
     p.table_rate_dps =
         (slot.axis == "down" ? -1.0 : 1.0) * w.event->table_mean.value_or(w.scheduled.demand);
     p.earth_rate_dph = slot.earth_rate_dph;
-    p.output_pps = out.mean;
-    p.output_se_pps = out.se.value_or(0.0);
-    p.rate_in_tolerance = w.event->held && out.se && *out.se > 0;
+    p.output_pps = out ? out->mean : std::nan("");
+    p.output_se_pps = out ? out->se : 0.0;
+    p.rate_in_tolerance = w.event->held && out;
+    p.temp_c = mean_temp_c(w.window.temp_c);
     points.push_back(p);
-    point_temps_c.push_back(mean_temp_c(w.window.temp_c));
   }
-  f.temp_c = slope_temp_c(points, point_temps_c);
+  // K's temperature is the fast points' (scale_factor.hpp: the windows' mean put the shipped
+  // protocol's cold and hot K off their temperature by 0.15 ppm, 9 SE, on drifting plateaus).
+  f.temp_c = comp::ladder_slope_temp_c(points);
   f.fit = comp::analyze_rate_ladder(points);
-  // A gyro that did not follow the table gives a "scale factor" that is none (its K w far
-  // from 1): not computed, never released.
+  f.measured = std::move(points);
+  hold_to_nominal(f, slot);
+  return f;
+}
+
+/// A gyro that did not follow the table gives a "scale factor" that is none (its K w far from
+/// 1): not computed, never released.
+void hold_to_nominal(LadderFigures& f, const RunSlot& slot) {
   if (f.fit && slot.pulse_weight_arcsec > 0) {
     const double kw = f.fit->sf_pulse_per_arcsec * slot.pulse_weight_arcsec;
     if (!(std::abs(kw - 1.0) <= comp::kMaxScaleFactorDeviation))
@@ -219,11 +219,11 @@ LadderFigures ladder_of(const Step& s, int index, const std::map<int, PointEvent
           "(nominal pulse weight w = {:g} arcsec)",
           kw, 100 * comp::kMaxScaleFactorDeviation, slot.pulse_weight_arcsec)};
   }
-  return f;
 }
 
 PositionFigures positions_of(const Step& s, int index, const std::map<int, PointEvent>& events,
-                             const std::vector<SampleRow>& rows, const RunSlot& slot) {
+                             const std::vector<SampleRow>& rows, const RunSlot& slot,
+                             std::optional<double> white_pps2_s) {
   PositionFigures f;
   f.step_index = index;
   f.label = s.label;
@@ -231,13 +231,16 @@ PositionFigures positions_of(const Step& s, int index, const std::map<int, Point
   std::vector<double> temps;
   for (const auto& w : walk_schedule(s, events, rows)) {
     ++f.points;
-    const MeanSe out =
-        batch_mean_se(w.window.rate_dph, w.window.quantization_pps() * slot.pulse_weight_arcsec);
-    if (w.event == nullptr || !w.event->held || !out.se || !(*out.se > 0)) {
+    // In deg/h: one pulse per second is the pulse weight (arcsec/s = deg/h).
+    const double w_arcsec = slot.pulse_weight_arcsec;
+    const auto out = white_pps2_s
+                         ? point_mean(w.window, true, *white_pps2_s * w_arcsec * w_arcsec, w_arcsec)
+                         : std::nullopt;
+    if (w.event == nullptr || !w.event->held || !out) {
       ++f.excluded;
       continue;
     }
-    points.push_back({w.event->table_mean.value_or(w.scheduled.demand), out.mean, *out.se});
+    points.push_back({w.event->table_mean.value_or(w.scheduled.demand), out->mean, out->se});
     f.angles_deg.push_back(points.back().table_angle_deg);
     temps.insert(temps.end(), w.window.temp_c.begin(), w.window.temp_c.end());
   }
@@ -262,59 +265,68 @@ TurnOnCurve turn_on_bins(const std::vector<SampleRow>& rows, const PointEvent& e
   return b;
 }
 
-/// The warm-up band: three times the sd of the bins in the final windows (pooled over the
-/// turn-ons, about each one's final mean), so noise alone leaves a settled gyro inside it; never
-/// narrower than three times a bin's own quantization sd (`bin_quantization_dph`: a quiet gyro's
-/// bins can all read the same count, an sd of 0 and no band at all).
-double noise_band_dph(const std::vector<TurnOnCurve>& all, const comp::TurnOnWindows& w,
-                      double bin_quantization_dph) {
-  double ss = 0;
-  std::size_t n = 0, groups = 0;
-  for (const auto& b : all) {
-    std::vector<double> v;
-    for (std::size_t i = 0; i < b.t_s.size(); ++i)
-      if (b.t_s[i] >= w.final_start_s && b.t_s[i] <= w.final_end_s) v.push_back(b.bias_dph[i]);
-    const MeanSe m = mean_se(v);
-    for (double x : v) ss += (x - m.mean) * (x - m.mean);
-    n += v.size();
-    groups += v.empty() ? 0 : 1;
-  }
-  const double sd = n > groups ? std::sqrt(ss / static_cast<double>(n - groups)) : 0.0;
-  return 3.0 * std::max(sd, bin_quantization_dph);
+/// The warm-up band, deg/h: three times the sd of a bin's deviation from its turn-on's final
+/// value, sqrt((S / bin + q(bin)^2) (1 + 1/m)), S the serial's white noise density in deg/h
+/// (acceptance_windows.hpp: pooled over all its measuring windows, so noise alone leaves a
+/// settled gyro inside it with probability 0.997 per bin), q(bin) the bin's two ends' rounding
+/// and m the bins of the final value's mean. Not the sd of the final bins themselves: three
+/// bins a turn-on (4 dof with two turn-ons) put the band anywhere, and a quantized bin two
+/// pulses off (0.05 deg/h) then read "outside" by noise (warm-ups of 270..410 s for a true 0
+/// in 6 of 48 simulated gyros of tests/sessions/session_acceptance.toml, seeds 1..6).
+double noise_band_dph(std::optional<double> white_dph2_s, double bin_quantization_dph,
+                      double final_bins) {
+  const double bin_var =
+      white_dph2_s.value_or(0.0) / kTurnOnBinS + bin_quantization_dph * bin_quantization_dph;
+  return 3.0 * std::sqrt(bin_var * (1.0 + 1.0 / std::max(final_bins, 1.0)));
 }
 
-void turn_ons_of(const Step& s, const std::map<int, PointEvent>& events,
-                 const std::vector<SampleRow>& rows, const RunSlot& slot, SerialAcceptance& out) {
-  std::vector<TurnOnCurve> bins;
-  for (const auto& [point, e] : events)  // a turn-on a hold or a kill cut short is left out
-    if (e.held) bins.push_back(turn_on_bins(rows, e, slot.earth_rate_dph));
-  // After warm-up: the bias over the second half of the powered time, the final value over
-  // its last third.
-  comp::TurnOnWindows w;
-  w.bias_start_s = s.dwell_s / 2;
-  w.bias_end_s = s.dwell_s;
-  w.final_start_s = s.dwell_s * 2 / 3;
-  w.final_end_s = s.dwell_s;
+void turn_ons_of(const Step& s, int index, const std::map<int, PointEvent>& events,
+                 const std::vector<SampleRow>& rows, const RunSlot& slot,
+                 std::optional<double> white_pps2_s, SerialAcceptance& out) {
+  TurnOnStep t;
+  t.step_index = index;
+  t.label = s.label;
+  std::vector<double> temps;
+  for (const auto& [point, e] : events) {  // a turn-on a hold or a kill cut short is left out
+    if (!e.held) continue;
+    t.curves.push_back(turn_on_bins(rows, e, slot.earth_rate_dph));
+    const auto w = window_of(rows, e.measure_s, e.end_s).temp_c;
+    temps.insert(temps.end(), w.begin(), w.end());
+  }
+  t.temp_c = mean_temp_c(temps);
+  comp::TurnOnWindows w = turn_on_windows(s);
+  const double w_arcsec = slot.pulse_weight_arcsec;
   const auto quantization_dph = [&](double window_s) {
-    return slot.pulse_weight_arcsec * mean_quantization_pps(window_s);
+    return w_arcsec * comp::mean_quantization_pps(window_s);
   };
-  w.band_dph = noise_band_dph(bins, w, quantization_dph(kTurnOnBinS));
+  std::optional<double> white_dph2_s;
+  if (white_pps2_s) white_dph2_s = *white_pps2_s * w_arcsec * w_arcsec;
+  w.band_dph = noise_band_dph(white_dph2_s, quantization_dph(kTurnOnBinS),
+                              (w.final_end_s - w.final_start_s) / kTurnOnBinS);
   w.bias_quantization_dph = quantization_dph(w.bias_end_s - w.bias_start_s);
-  out.turn_on_band_dph = w.band_dph;
+  t.band_dph = w.band_dph;
   std::vector<comp::TurnOnSeries> series;
-  for (const auto& b : bins) series.push_back({b.t_s, b.bias_dph});
-  out.turn_on = comp::analyze_turn_ons(series, w);
-  out.turn_on_curves = std::move(bins);
+  for (const auto& b : t.curves) series.push_back({b.t_s, b.bias_dph});
+  t.result = comp::analyze_turn_ons(series, w);
+  // The serial's headline turn-on figures are its first power_cycles step's (the report, the
+  // store and the fleet carry them); every step's are in turn_on_steps and judged.
+  if (!out.turn_on) {
+    out.turn_on = t.result;
+    out.turn_on_curves = t.curves;
+    out.turn_on_band_dph = t.band_dph;
+  }
+  out.turn_on_steps.push_back(std::move(t));
 }
 
 void analyze_step(const Protocol& p, int index, const StepPoints& events,
-                  const std::vector<SampleRow>& rows, const RunSlot& slot, SerialAcceptance& out) {
+                  const std::vector<SampleRow>& rows, const RunSlot& slot,
+                  std::optional<double> white_pps2_s, SerialAcceptance& out) {
   const Step& s = p.steps[static_cast<std::size_t>(index)];
   static const std::map<int, PointEvent> kNone;
   const auto it = events.find(index);
   const auto& mine = it == events.end() ? kNone : it->second;
   if (s.kind == StepKind::rate_ladder) {
-    LadderFigures f = ladder_of(s, index, mine, rows, slot);
+    LadderFigures f = ladder_of(s, index, mine, rows, slot, white_pps2_s);
     if (slot.axis != "up" && slot.axis != "down")
       f.fit = comp::NotComputed{
           "a ladder is analysed for an input axis along the table's (up or "
@@ -323,13 +335,24 @@ void analyze_step(const Protocol& p, int index, const StepPoints& events,
     out.ladders.push_back(std::move(f));
   } else if (s.kind == StepKind::positions) {
     if (slot.axis == "up")
-      out.positions.push_back(positions_of(s, index, mine, rows, slot));
+      out.positions.push_back(positions_of(s, index, mine, rows, slot, white_pps2_s));
     else
       out.positions_note =
           "positions are analysed for an input axis up only (this one: " + slot.axis + ")";
   } else if (s.kind == StepKind::power_cycles) {
-    turn_ons_of(s, mine, rows, slot, out);
+    turn_ons_of(s, index, mine, rows, slot, white_pps2_s, out);
   }
+}
+
+/// The scale factor against temperature over the serial's ladders (two or more).
+void fit_across_plateaus(SerialAcceptance& a, double ref_temp_c) {
+  std::vector<comp::PlateauScaleFactor> plateaus;
+  for (const auto& l : a.ladders)
+    if (l.fit && std::isfinite(l.temp_c))
+      plateaus.push_back({l.temp_c, l.fit->sf_pulse_per_arcsec, l.fit->sf_se_pulse_per_arcsec});
+  a.sf_vs_temp.reset();
+  if (plateaus.size() >= 2)
+    a.sf_vs_temp = comp::fit_scale_factor_vs_temperature(plateaus, ref_temp_c);
 }
 
 }  // namespace
@@ -349,13 +372,21 @@ std::vector<SerialAcceptance> run_acceptance(Store& store, std::int64_t run_id, 
     a.serial = slot.serial;
     a.earth_rate_dph = slot.earth_rate_dph;
     const auto rows = store.samples(run_id, slot.serial, false);
-    for (int i : steps) analyze_step(p, i, events, rows, slot, a);
-    std::vector<comp::PlateauScaleFactor> plateaus;
-    for (const auto& l : a.ladders)
-      if (l.fit && std::isfinite(l.temp_c))
-        plateaus.push_back({l.temp_c, l.fit->sf_pulse_per_arcsec, l.fit->sf_se_pulse_per_arcsec});
-    if (plateaus.size() >= 2)
-      a.sf_vs_temp = comp::fit_scale_factor_vs_temperature(plateaus, ref_temp_c);
+    const auto white_pps2_s = serial_white_density(p, steps, events, rows);
+    for (int i : steps) analyze_step(p, i, events, rows, slot, white_pps2_s, a);
+    fit_across_plateaus(a, ref_temp_c);
+    // A drifting plateau's ladder brought to its slope's temperature with the run's own TC
+    // (scale_factor.hpp, "A drifting plateau"), then K against temperature again.
+    if (a.sf_vs_temp && *a.sf_vs_temp) {
+      const comp::LadderTemperatureModel tc{(*a.sf_vs_temp)->tc_ppm_per_c,
+                                            (*a.sf_vs_temp)->tc_se_ppm_per_c};
+      for (auto& l : a.ladders) {
+        if (!l.fit) continue;
+        l.fit = comp::analyze_rate_ladder(l.measured, tc);
+        hold_to_nominal(l, slot);
+      }
+      fit_across_plateaus(a, ref_temp_c);
+    }
     out.push_back(std::move(a));
   }
   return out;

@@ -24,6 +24,8 @@ struct LadderFigures {
   int points = 0;     ///< points the schedule has
   int missing = 0;    ///< points without a measured window (a kill or a hold across it)
   compensation::Computed<compensation::LadderResult> fit{compensation::NotComputed{"not analysed"}};
+  /// The measured points the fit took (with each one's temperature), in the schedule's order.
+  std::vector<compensation::LadderPoint> measured;
 };
 
 /// One set of positions of one serial.
@@ -43,6 +45,17 @@ struct TurnOnCurve {
   std::vector<double> bias_dph;  ///< bin mean rate minus the Earth rate along the axis, deg/h
 };
 
+/// One power_cycles step of one serial.
+struct TurnOnStep {
+  int step_index = 0;
+  std::string label;
+  double temp_c = 0;  ///< sensor A's mean over the powered windows, C (NaN: none)
+  compensation::Computed<compensation::TurnOnResult> result{
+      compensation::NotComputed{"not analysed"}};
+  std::vector<TurnOnCurve> curves;  ///< the analysed turn-ons' bins, in result's order
+  double band_dph = 0;              ///< the warm-up band used
+};
+
 /// Everything one serial's acceptance steps gave.
 struct SerialAcceptance {
   std::string serial;
@@ -51,9 +64,14 @@ struct SerialAcceptance {
   /// The scale factor against temperature over the ladders (two or more plateaus).
   std::optional<compensation::Computed<compensation::ScaleFactorTemperatureFit>> sf_vs_temp;
   std::vector<PositionFigures> positions;
+  /// The first power_cycles step's figures (what the report, the store and the fleet carry).
   std::optional<compensation::Computed<compensation::TurnOnResult>> turn_on;
   std::vector<TurnOnCurve> turn_on_curves;  ///< the analysed turn-ons' bins, in turn_on's order
   double turn_on_band_dph = 0;              ///< the warm-up band used
+  /// Every power_cycles step's figures, in the protocol's order: each step on its own (a second
+  /// block is often at another temperature: pooling its biases would add a temperature effect
+  /// to the repeatability); every one is judged.
+  std::vector<TurnOnStep> turn_on_steps;
   std::string positions_note;  ///< why positions were not analysed (an axis not up or down)
 };
 

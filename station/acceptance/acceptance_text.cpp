@@ -39,6 +39,11 @@ std::string ladder_line(const json& l) {
   if (l.contains("asymmetry_ppm"))
     out += fmt::format(", asymmetry {:+.1f} +- {:.2g} ppm{}", l["asymmetry_ppm"].get<double>(),
                        l["asymmetry_se_ppm"].get<double>(), truth(l, "asymmetry_ppm", "{:+.1f}"));
+  if (!l.value("asymmetry_judged", true))
+    out += " (not judged: " + l.value("asymmetry_note", "") + ")";
+  if (l.value("drift_corrected", false) && l.value("drift_c", 0.0) > 0)
+    out += fmt::format(" [points {:.2g} C apart, brought to {:.2f} C by the run's TC]",
+                       l["drift_c"].get<double>(), l["temp_c"].get<double>());
   const int excluded = l.value("points_excluded", 0) + l.value("missing", 0);
   out += fmt::format("; {} of {} points", l.value("points_used", 0), l.value("points", 0));
   if (excluded > 0)
@@ -93,19 +98,19 @@ std::string warmup_truth(const json& t) {
                : std::string(" (true: the simulated transient stays inside the band)");
 }
 
-std::string turn_on_line(const json& s) {
-  const json& t = s["turn_on"];
-  if (!t.value("ok", false)) return "  turn-on: not computed: " + t.value("error", "") + "\n";
+std::string turn_on_line(const json& t, const std::string& head) {
+  if (!t.value("ok", false)) return head + "not computed: " + t.value("error", "") + "\n";
   std::string warm = t["max_warmup_s"].is_number()
                          ? fmt::format("longest warm-up {:.0f} s", t["max_warmup_s"].get<double>())
                          : std::string("no turn-on settled");
-  return fmt::format(
-      "  turn-on: {} turn-ons, repeatability {:.4f} deg/h ({:.0f} % interval {:.4f}..{:.4f}){}, "
-      "mean bias {:+.4f} deg/h; {}{} within +-{:.4f} deg/h of the final value\n",
-      t["turn_ons"].get<int>(), t["repeatability_dph"].get<double>(),
-      100 * t["confidence"].get<double>(), t["repeatability_lower_dph"].get<double>(),
-      t["repeatability_upper_dph"].get<double>(), sigma_truth(t), t["mean_bias_dph"].get<double>(),
-      warm, warmup_truth(t), t["band_dph"].get<double>());
+  return head + fmt::format(
+                    "{} turn-ons, repeatability {:.4f} deg/h ({:.0f} % interval {:.4f}..{:.4f}){}, "
+                    "mean bias {:+.4f} deg/h; {}{} within +-{:.4f} deg/h of the final value\n",
+                    t["turn_ons"].get<int>(), t["repeatability_dph"].get<double>(),
+                    100 * t["confidence"].get<double>(), t["repeatability_lower_dph"].get<double>(),
+                    t["repeatability_upper_dph"].get<double>(), sigma_truth(t),
+                    t["mean_bias_dph"].get<double>(), warm, warmup_truth(t),
+                    t["band_dph"].get<double>());
 }
 
 std::string verdict_line(const json& v) {
@@ -116,13 +121,15 @@ std::string verdict_line(const json& v) {
 }  // namespace
 
 std::string acceptance_verdict_text(const json& v) {
-  if (v.value("pass", false)) return fmt::format("PASS, {} limits", v.value("checked", 0));
-  std::string out = "FAIL";
+  std::string out = v.value("pass", false) ? fmt::format("PASS, {} limits", v.value("checked", 0))
+                                           : std::string("FAIL");
   const char* sep = ": ";
   for (const auto& f : v.value("failed", json::array())) {
     out += sep + f.get<std::string>();
     sep = "; ";
   }
+  for (const auto& f : v.value("not_judged", json::array()))
+    out += "; not judged: " + f.get<std::string>();
   return out;
 }
 
@@ -138,7 +145,12 @@ std::string acceptance_text(const json& serials) {
     for (const auto& p : s["positions"]) out += positions_line(s, p);
     if (s.contains("positions_note"))
       out += "  positions: " + s["positions_note"].get<std::string>() + "\n";
-    if (s.contains("turn_on")) out += turn_on_line(s);
+    if (s.contains("turn_on_steps")) {
+      for (const auto& t : s["turn_on_steps"])
+        out += turn_on_line(t, fmt::format("  turn-on {:<33} {}  ", t.value("label", ""), temp(t)));
+    } else if (s.contains("turn_on")) {
+      out += turn_on_line(s["turn_on"], "  turn-on: ");
+    }
     if (s.contains("verdict")) out += verdict_line(s["verdict"]);
   }
   return out;

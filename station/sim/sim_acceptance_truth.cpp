@@ -52,6 +52,20 @@ nlohmann::json ladder_truth(const sim::SimGyro& g, const Step& step, double temp
   return j;
 }
 
+/// A power_cycles step's truth under its own band.
+void add_turn_on_truth(nlohmann::json& t, const sim::SimGyro& g) {
+  if (t.value("band_dph", 0.0) <= 0) return;
+  // The warm-up time the band gives a noise-free transient A exp(-t/tau): tau ln(|A|/band).
+  const double a = std::abs(g.acceptance.warmup_amplitude_dph);
+  const double band = t["band_dph"];
+  // The sd of the turn-on biases holds each one's estimation noise (its window's SE) beside
+  // the turn-on spread: what the figure should show is their root sum of squares.
+  const double se = t.value("mean_bias_se_dph", 0.0);
+  t["true"] = {{"sigma_dph", g.acceptance.turn_on_sigma_dph},
+               {"sigma_with_noise_dph", std::hypot(g.acceptance.turn_on_sigma_dph, se)},
+               {"warmup_s", a > band ? g.acceptance.warmup_tau_s * std::log(a / band) : 0.0}};
+}
+
 }  // namespace
 
 nlohmann::json with_acceptance_truth(nlohmann::json serials, const sim::SimWorld& world,
@@ -77,18 +91,9 @@ nlohmann::json with_acceptance_truth(nlohmann::json serials, const sim::SimWorld
           s["sf_vs_temp"]["true"] = {{"sf_ref_pulse_per_arcsec", fit->sf_ref_pulse_per_arcsec},
                                      {"tc_ppm_per_c", fit->tc_ppm_per_c}};
       }
-      if (s.contains("turn_on") && s["turn_on"].value("band_dph", 0.0) > 0) {
-        // The warm-up time the band gives a noise-free transient A exp(-t/tau): tau ln(|A|/band).
-        const double a = std::abs(g.acceptance.warmup_amplitude_dph);
-        const double band = s["turn_on"]["band_dph"];
-        // The sd of the turn-on biases holds each one's estimation noise (its window's SE) beside
-        // the turn-on spread: what the figure should show is their root sum of squares.
-        const double se = s["turn_on"].value("mean_bias_se_dph", 0.0);
-        s["turn_on"]["true"] = {
-            {"sigma_dph", g.acceptance.turn_on_sigma_dph},
-            {"sigma_with_noise_dph", std::hypot(g.acceptance.turn_on_sigma_dph, se)},
-            {"warmup_s", a > band ? g.acceptance.warmup_tau_s * std::log(a / band) : 0.0}};
-      }
+      if (s.contains("turn_on")) add_turn_on_truth(s["turn_on"], g);
+      if (s.contains("turn_on_steps"))
+        for (auto& t : s["turn_on_steps"]) add_turn_on_truth(t, g);
     }
   }
   return serials;

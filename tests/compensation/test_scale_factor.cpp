@@ -296,3 +296,66 @@ TEST(ScaleFactor, MonteCarloTemperatureCoefficientWithinItsError) {
   expect_coverage(tcc, "temperature coefficient");
   expect_coverage(k_ref, "scale factor at T_ref");
 }
+
+// A ladder read while the gyro warms: each rate one way then the other (+1 -1 +10 -10 +100
+// -100, the station's order), the temperature rising 0.5 C from point to point, and K
+// changing by TC = 4 ppm/C with it. The pair +-100 deg/s is read 0.5 C apart: the plain fit
+// takes TC x 0.5 C = 2 ppm for asymmetry; brought to Tc with the TC, the points give the truth
+// (an exact ladder: K to 1e-12 of K(Tc), the asymmetry to 1e-4 ppm: the correction takes K(Tc)
+// for K(25 C), an error of TC (Tc - 25) x TC dT = 2e-11 of K, 2e-5 ppm).
+TEST(ScaleFactor, ADriftingLadderIsBroughtToItsSlopesTemperature) {
+  constexpr double kK = 0.95, kTc = 4.0, kStepC = 0.5, kT0 = 20.0;
+  std::vector<sc::LadderPoint> pts;
+  int i = 0;
+  for (double r : {1.0, -1.0, 10.0, -10.0, 100.0, -100.0}) {
+    sc::LadderPoint p;
+    p.table_rate_dps = r;
+    p.earth_rate_dph = 0;
+    p.temp_c = kT0 + kStepC * i++;
+    p.output_pps = kK * (1 + kTc * 1e-6 * (p.temp_c - 25.0)) * 3600 * r;
+    p.output_se_pps = 0.02;
+    pts.push_back(p);
+  }
+  const double tc_c = sc::ladder_slope_temp_c(pts);
+  // Sxx-weighted: the +-100 points (22.0 and 22.5 C) carry nearly all of it.
+  EXPECT_NEAR(tc_c, 22.24, 0.01);
+  const auto plain = sc::analyze_rate_ladder(pts);
+  ASSERT_TRUE(plain) << plain.error();
+  ASSERT_TRUE(plain->asymmetry);
+  EXPECT_NEAR(plain->drift_c, 2.5, 1e-12);
+  EXPECT_FALSE(plain->drift_corrected);
+  EXPECT_NEAR(plain->asymmetry->asymmetry_ppm, -kTc * kStepC, 0.05);  // -2 ppm, not 0
+  EXPECT_FALSE(plain->asymmetry->judged);  // 2.5 C > kMaxUncorrectedDriftC, no TC given
+  EXPECT_NE(plain->asymmetry_note.find("not judged"), std::string::npos);
+
+  const auto fixed = sc::analyze_rate_ladder(pts, sc::LadderTemperatureModel{kTc, 0.0});
+  ASSERT_TRUE(fixed) << fixed.error();
+  EXPECT_TRUE(fixed->drift_corrected);
+  EXPECT_NEAR(fixed->asymmetry->asymmetry_ppm, 0.0, 1e-4);
+  EXPECT_TRUE(fixed->asymmetry->judged);
+  const double k_at_tc = kK * (1 + kTc * 1e-6 * (tc_c - 25.0));
+  EXPECT_NEAR(fixed->sf_pulse_per_arcsec / k_at_tc - 1, 0.0, 1e-12);
+
+  // TC's own error is carried: d(asymmetry)/d(TC) is -0.5 C here, so an SE of 1 ppm/C adds
+  // 0.5 ppm in quadrature to the points' share.
+  const auto carried = sc::analyze_rate_ladder(pts, sc::LadderTemperatureModel{kTc, 1.0});
+  ASSERT_TRUE(carried);
+  const double points_share = fixed->asymmetry->asymmetry_se_ppm;
+  EXPECT_NEAR(carried->asymmetry->asymmetry_se_ppm, std::hypot(points_share, 0.5), 0.02);
+}
+
+TEST(ScaleFactor, ASteadyLadderIsJudgedWithoutATemperatureCoefficient) {
+  auto pts = ladder(TrueGyro{}, nullptr);
+  for (auto& p : pts) p.temp_c = 25.0 + 0.01 * (&p - pts.data()) / 11.0;  // 0.01 C spread
+  const auto r = sc::analyze_rate_ladder(pts);
+  ASSERT_TRUE(r);
+  EXPECT_LE(r->drift_c, sc::kMaxUncorrectedDriftC);
+  EXPECT_TRUE(r->asymmetry->judged);
+  // A point without a temperature: the drift is not known, nothing is flagged or corrected.
+  pts[3].temp_c = std::numeric_limits<double>::quiet_NaN();
+  const auto unknown = sc::analyze_rate_ladder(pts, sc::LadderTemperatureModel{4.0, 0.1});
+  ASSERT_TRUE(unknown);
+  EXPECT_TRUE(std::isnan(unknown->temp_c));
+  EXPECT_FALSE(unknown->drift_corrected);
+  EXPECT_TRUE(unknown->asymmetry->judged);
+}
