@@ -146,8 +146,10 @@ std::string acceptance_text(const json& serials) {
     if (s.contains("positions_note"))
       out += "  positions: " + s["positions_note"].get<std::string>() + "\n";
     if (s.contains("turn_on_steps")) {
-      for (const auto& t : s["turn_on_steps"])
-        out += turn_on_line(t, fmt::format("  turn-on {:<33} {}  ", t.value("label", ""), temp(t)));
+      for (const auto& t : s["turn_on_steps"])  // the step's number: labels may repeat
+        out += turn_on_line(
+            t, fmt::format("  turn-on step {:<2} {:<28} {}  ", t.value("step_index", 0) + 1,
+                           t.value("label", ""), temp(t)));
     } else if (s.contains("turn_on")) {
       out += turn_on_line(s["turn_on"], "  turn-on: ");
     }
