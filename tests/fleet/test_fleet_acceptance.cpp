@@ -113,9 +113,12 @@ TEST_F(FleetAcceptance, ARunsFiguresArriveEqualToTheStationsRowsAndAreCharted) {
   EXPECT_NEAR(k["overall"]["centre"].get<double>(),
               (*rows[0].sf_pulse_per_arcsec + *rows[1].sf_pulse_per_arcsec) / 2, 1e-15);
   // The part filter and --since select them, or none.
-  EXPECT_EQ(fleet::fleet_acceptance_points(pg, {.part = "GX-200"}).size(), 2u);
-  EXPECT_TRUE(fleet::fleet_acceptance_points(pg, {.part = "GX-200-A"}).empty());
-  EXPECT_TRUE(fleet::fleet_acceptance_points(pg, {.since = "2999-01-01"}).empty());
+  EXPECT_EQ(fleet::fleet_acceptance_points(pg, {.part = "GX-200", .since = std::nullopt}).size(),
+            2u);
+  EXPECT_TRUE(
+      fleet::fleet_acceptance_points(pg, {.part = "GX-200-A", .since = std::nullopt}).empty());
+  EXPECT_TRUE(
+      fleet::fleet_acceptance_points(pg, {.part = std::nullopt, .since = "2999-01-01"}).empty());
 }
 
 // `station fit --acceptance` computes a run's figures again (record_acceptance, its code path):
@@ -139,7 +142,7 @@ TEST_F(FleetAcceptance, ARecomputationReplacesTheCentralRows) {
             2);
   // Without a verdict the part is the slot's: still charted under GX-200, judged by none.
   fleet::PgConnection pg(target());
-  const auto points = fleet::fleet_acceptance_points(pg, {.part = "GX-200"});
+  const auto points = fleet::fleet_acceptance_points(pg, {.part = "GX-200", .since = std::nullopt});
   ASSERT_EQ(points.size(), 2u);
   EXPECT_FALSE(points[0].pass.has_value());
   {
