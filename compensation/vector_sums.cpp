@@ -330,8 +330,8 @@ std::vector<std::size_t> difference_sum_strides(std::span<const std::size_t> m_l
   for (std::size_t i = 0; i < m_list.size(); ++i) {
     const std::size_t m = m_list[i];
     if (stride[i] != 0 || m < kChainFrom || m % kChainBlock != 0) continue;
-    for (std::size_t j = i; j < m_list.size(); ++j) {
-      if (stride[j] == 0 && m_list[j] % m == 0 && m_list[j] <= kChainSpan * m) stride[j] = m;
+    for (std::size_t j = i; j < m_list.size() && m_list[j] <= kChainSpan * m; ++j) {
+      if (stride[j] == 0 && m_list[j] % m == 0) stride[j] = m;
     }
   }
   return stride;
@@ -361,11 +361,13 @@ std::vector<double> difference_sums(std::span<const double> theta,
   for (std::size_t i = 0; i < m_list.size(); ++i) {
     const std::size_t level = stride[i];
     if (level == 0 || level != m_list[i]) continue;  // a level starts at its stride
+    std::vector<std::size_t> members;                // its factors (a long `all` list: few)
+    for (std::size_t j = i; j < m_list.size() && m_list[j] <= kChainSpan * level; ++j)
+      if (stride[j] == level) members.push_back(j);
     const std::size_t blocks = theta.size() / level + 1;
     for (std::size_t c0 = 0; c0 < level; c0 += kChainBlock) {
       for (std::size_t b0 = 0; b0 < blocks; b0 += kChainWindow) {
-        for (std::size_t j = i; j < m_list.size(); ++j) {
-          if (stride[j] != level) continue;
+        for (const std::size_t j : members) {
           add_chain(theta.data(), m_list[j], c0 + b0 * level, level, kChainWindow, terms[j],
                     &partial[j * kLanes]);
         }
