@@ -19,6 +19,13 @@ running daemon. Checked:
     |k_victim - k_reference| <= 5 * sqrt(se_victim^2 + se_reference^2) (two independent
     estimates of the same gyro; 5 sigma because OLS errors are optimistic for correlated bins).
 
+Before the faults, the protocol runs a short rate ladder (issue 36) on both rigs, and the victim's
+turntable drive faults in the middle of it (simrig `table fault on`, cleared 3 s later), at a
+point's window found from the run's own events. Checked: the run holds safe (a safe_hold naming
+the drive fault, and its end), how fast; the point whose window the hold cut is left out
+(acceptance_point held = 0) and every other point kept; the stored figures (acceptance_results)
+count exactly that point as excluded where the reference's count none; no committed sample lost.
+
 Usage: scripts/fault_campaign.py --build build [--duration-s 150] [--seed 1] [--faults N]
 (N: by default one fault of every kind the rig's dialects take)
                                  [--json OUT] [--keep DIR]
@@ -192,18 +199,101 @@ def wall(utc):
 
 # The campaign's protocol heats 25 -> 31 C at 3 C/min: the step lasts until the air is there.
 RAMP_S = 120
+# Issue 36: a short rate ladder first (+2, -2, +4, -4 deg/s; 2 s settle, 10 s windows at the
+# shipped 10 deg/s^2: its schedule is 52.4 s, config/acceptance_steps.hpp), then the table locked.
+# The random faults start after it (LADDER_S), so only the drive fault below touches the ladder.
+LADDER_TOML = ('[[step]]\ntype = "rate_ladder"\nlabel = "campaign ladder"\nrates_dps = [2, 4]\n'
+               'settle_s = 2\ndwell_s = 10\naccel_dps2 = 10\n\n[[step]]\n'
+               'type = "lock_turntable"\n\n')
+LADDER_S = 56
+# The point the drive fault cuts: its index (the -2 deg/s point, window 14.6-24.6 s of the step),
+# injected this long after the point before it reported (its end, 12.2 s: the next tick), and
+# cleared FAULT_S later, so the hold ends before the next point's demand (24.6 s).
+LADDER_CUT_POINT = 1
+LADDER_FAULT_AFTER_S = 3.0
+LADDER_FAULT_S = 3.0
 
 
-def write_protocol(work, name, duration_s):
-    """A protocol of about duration_s: the ramp (RAMP_S), then a hold for the rest. (The campaign
-    asks for 30 s more than its faults' window: injections run late by the faults' own waits.)"""
+def write_protocol(work, name, duration_s, ladder=False):
+    """A protocol of about duration_s: the ramp (RAMP_S), then a hold for the rest, after the
+    ladder when asked. (The campaign asks for 30 s more than its faults' window: injections run
+    late by the faults' own waits.)"""
     path = os.path.join(work, name + ".protocol.toml")
     open(path, "w").write(
         "# Fault campaign: record while the chamber heats 25 -> 31 C at 3 C/min, then hold.\n"
-        'name = "campaign"\n\n[[step]]\ntype = "record_start"\n\n[[step]]\n'
+        'name = "campaign"\n\n' + (LADDER_TOML if ladder else "") +
+        '[[step]]\ntype = "record_start"\n\n[[step]]\n'
         'type = "set_temperature"\nsetpoint_c = 31.0\nramp_c_per_h = 180.0\nwait = false\n\n'
         '[[step]]\ntype = "hold"\nduration_s = %d\n' % max(10, duration_s - RAMP_S))
     return path
+
+
+def ladder_points(db):
+    """The ladder's acceptance_point events: {point: held} (step 0)."""
+    out = {}
+    for e in events(db):
+        if e[4] == "acceptance_point":
+            d = json.loads(e[6] or "{}")
+            if d.get("step_index") == 0:
+                out[d["point"]] = bool(d.get("held"))
+    return out
+
+
+def ladder_figures(db):
+    """Each serial's stored ladder figures (acceptance_results): (ok, points used, excluded)."""
+    out = {}
+    with ro(db) as c:
+        for serial, figures in c.execute(
+                "SELECT serial, figures_json FROM acceptance_results WHERE run_id = 1"):
+            ladders = json.loads(figures).get("ladders", [])
+            out[serial] = [(lad.get("ok"), lad.get("points_used"), lad.get("points_excluded"))
+                           for lad in ladders]
+    return out
+
+
+def ladder_fault(rig, db, log, begin):
+    """The turntable's drive fault in the middle of the ladder: injected once the point before
+    LADDER_CUT_POINT has reported, cleared LADDER_FAULT_S later. Returns its row and the snapshot
+    taken just before it."""
+    deadline = time.time() + LADDER_S + 30
+    while time.time() < deadline:
+        if os.path.exists(db) and LADDER_CUT_POINT - 1 in ladder_points(db):
+            break
+        time.sleep(0.2)
+    else:
+        return {"fault": "ladder_drive_fault", "error": "the ladder's first point never reported"}, None
+    time.sleep(LADDER_FAULT_AFTER_S)
+    n_events = len(events(db))
+    snap = snapshot(db)
+    t0 = time.time()
+    log.append("table fault on -> %s" % rig.send("table fault on"))
+    time.sleep(LADDER_FAULT_S)
+    log.append("table fault off -> %s" % rig.send("table fault off"))
+    time.sleep(3)
+    new = events(db)[n_events:]
+    holds = [wall(e[1]) - t0 for e in new
+             if e[4] in ("safe_hold", "safe_hold_changed") and "drive fault" in e[5]]
+    seen = {e[4] for e in new}
+    row = {"fault": "ladder_drive_fault", "at_s": round(t0 - begin, 1), "events": sorted(seen),
+           "time_to_safe_s": round(min(holds), 3) if holds else None,
+           "event_expected": bool(holds) and "safe_hold_cleared" in seen}
+    return row, snap
+
+
+def check_ladder(row, db, ref_db):
+    """After the run: exactly the cut point left out (the reference kept every one), and the
+    stored figures counting it excluded."""
+    victim, reference = ladder_points(db), ladder_points(ref_db)
+    row["points_held"] = {str(k): v for k, v in sorted(victim.items())}
+    row["figures"] = ladder_figures(db)
+    row["reference_figures"] = ladder_figures(ref_db)
+    cut_only = (len(victim) == 4 and not victim.get(LADDER_CUT_POINT) and
+                all(v for k, v in victim.items() if k != LADDER_CUT_POINT))
+    figures_ok = bool(row["figures"]) and all(
+        ls == [(True, 3, 1)] for ls in row["figures"].values()) and all(
+        ls == [(True, 4, 0)] for ls in row["reference_figures"].values())
+    row["point_excluded"] = cut_only and figures_ok and all(reference.get(k) for k in range(4))
+    row["event_expected"] = row["event_expected"] and row["point_excluded"]
 
 
 def inject(kind, rig, daemon, db, rng, log):
@@ -271,7 +361,7 @@ def compare_fits(victim, reference):
 
 def campaign(args, work):
     rng = random.Random(args.seed)
-    protocol = write_protocol(work, "campaign", args.duration_s + 30)
+    protocol = write_protocol(work, "campaign", args.duration_s + 30, ladder=True)
     ref_rig, rig = Rig(args.build, work, "reference", 7), Rig(args.build, work, "victim", 7)
     ref_rig.start()
     rig.start()
@@ -293,8 +383,12 @@ def campaign(args, work):
     n = args.faults or len(faults)  # by default one of every kind this rig takes
     kinds = (faults * (n // len(faults) + 1))[:n]
     rng.shuffle(kinds)
-    slots = sorted(rng.uniform(8, args.duration_s - 15) for _ in kinds)
+    slots = sorted(LADDER_S + rng.uniform(8, args.duration_s - 15) for _ in kinds)
     log, rows, snaps = [], [], []
+    ladder_row, snap = ladder_fault(rig, db, log, begin)
+    rows.append(ladder_row)
+    if snap is not None:
+        snaps.append(snap)
     for kind, at in zip(kinds, slots):
         time.sleep(max(0, begin + at - time.time()))
         if victim.proc.poll() is not None:
@@ -348,7 +442,10 @@ def campaign(args, work):
         if kind in HOLD_FAULTS:
             row["time_to_safe_s"] = round(min(holds), 3) if holds else None
         rows.append(row)
-    rc_v, rc_r = victim.wait(args.duration_s + 120), ref.wait(args.duration_s + 120)
+    rc_v = victim.wait(args.duration_s + LADDER_S + 120)
+    rc_r = ref.wait(args.duration_s + LADDER_S + 120)
+    if "error" not in ladder_row:
+        check_ladder(ladder_row, db, ref_db)
     final = snapshot(db)
     lost = changed = 0
     for s in snaps:
@@ -400,7 +497,11 @@ def verdict(result, restart):
     for r in result["faults"]:
         if "error" in r or not r["event_expected"]:
             problems.append("fault %s left no expected event" % r["fault"])
-        if r["fault"] in HOLD_FAULTS and r.get("time_to_safe_s") is None:
+        if r["fault"] == "ladder_drive_fault" and not r.get("point_excluded"):
+            problems.append("ladder drive fault: not exactly the cut point left out (held %s, "
+                            "figures %s, reference %s)" % (r.get("points_held"), r.get("figures"),
+                                                           r.get("reference_figures")))
+        if r["fault"] in HOLD_FAULTS + ("ladder_drive_fault",) and r.get("time_to_safe_s") is None:
             problems.append("fault %s: no safe hold" % r["fault"])
     for serial, w in result["fit_max_diff_in_combined_se"].items():
         if not w <= 5:
