@@ -101,7 +101,7 @@ TEST(AcceptanceSteps, BadKeysAreNamedWithFileLineAndKey) {
   EXPECT_NE(parse_error(l + "rates_dps = [1, 2]\nsettle_s = 0\n").find("step[0].settle_s"),
             std::string::npos);
   EXPECT_NE(
-      parse_error("type = \"positions\"\nangles_deg = [0, 360, -360]\n").find("1 distinct angles"),
+      parse_error("type = \"positions\"\nangles_deg = [0, 360, -360]\n").find("0 and 360 are one angle"),
       std::string::npos);
   EXPECT_NE(parse_error("type = \"power_cycles\"\non_s = 100\n").find("step[0].on_s"),
             std::string::npos);
