@@ -18,7 +18,8 @@ ScaleFactorDrift drift_of(const AcceptanceRow& now, const AcceptanceRow& prev) {
   d.delta_ppm = (k - k_prev) / k_prev * 1e6;
   d.se_ppm = std::sqrt(se * se + se_prev * se_prev) / std::abs(k_prev) * 1e6;
   d.zeta = zeta_score(k, se, k_prev, se_prev);
-  if (now.sf_temp_c && prev.sf_temp_c && std::abs(*now.sf_temp_c - *prev.sf_temp_c) > 1.0)
+  if (now.sf_temp_c && prev.sf_temp_c &&
+      std::abs(*now.sf_temp_c - *prev.sf_temp_c) > kHeldTempToleranceC)
     d.temp_gap_c = *now.sf_temp_c - *prev.sf_temp_c;
   if (now.tc_ppm_per_c && prev.tc_ppm_per_c) {
     const double u = now.tc_se_ppm_per_c.value_or(0.0), u_prev = prev.tc_se_ppm_per_c.value_or(0.0);

@@ -102,7 +102,7 @@ std::vector<WalkedPoint> walk_schedule(const Step& s, const std::map<int, PointE
                                        const std::vector<SampleRow>& rows) {
   std::vector<WalkedPoint> out;
   for (const auto& sp : acceptance_schedule(s)) {
-    WalkedPoint w{sp};
+    WalkedPoint w{sp, nullptr, {}};
     if (const auto it = events.find(sp.index); it != events.end()) {
       w.event = &it->second;
       w.window = window_of(rows, it->second.measure_s, it->second.end_s);
@@ -127,12 +127,17 @@ std::optional<comp::WindowMean> point_mean(const Window& w, bool in_dph,
 }
 
 /// A power_cycles step's windows after warm-up: the bias over the second half of the powered
-/// time, the final value over its last third (s since power-on).
+/// time, the final value over its last third and at least its last two whole bins (s since
+/// power-on). A third can hold one bin's centre: on_s = 330 s has bins to 300 s, centres at 210
+/// and 270 s, its third 220..330 s. The bins' centres are kTurnOnBinS apart from kTurnOnBinS/2,
+/// so from the second-last whole bin's start both last centres are inside; with the parser's
+/// shortest powered time (four bins) the second half holds two as well.
 comp::TurnOnWindows turn_on_windows(const Step& s) {
   comp::TurnOnWindows w;
   w.bias_start_s = s.dwell_s / 2;
   w.bias_end_s = s.dwell_s;
-  w.final_start_s = s.dwell_s * 2 / 3;
+  const double whole_bins = std::floor(s.dwell_s / kTurnOnBinS);
+  w.final_start_s = std::min(s.dwell_s * 2 / 3, (whole_bins - 2) * kTurnOnBinS);
   w.final_end_s = s.dwell_s;
   return w;
 }

@@ -64,7 +64,7 @@ void run_fleet(const FleetOptions& o) {
       o.out.empty() ? report::Assets{} : report::read_dygraphs(std::string(report::kDygraphsDir));
   fleet::PgConnection pg({o.pg, {}});
   auto charts = fleet::fleet_charts_json(fleet::fleet_points(pg, f));
-  charts["acceptance"] = fleet::fleet_acceptance_json(fleet::fleet_acceptance_points(pg, f));
+  charts["acceptance"] = fleet::fleet_acceptance_charts(pg, f);
   std::vector<fleet::NoiseProposal> noise;
   if (o.propose_noise) {
     noise = fleet::propose_noise(fleet::fleet_run_noise(pg, f));

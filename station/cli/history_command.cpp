@@ -14,6 +14,7 @@
 #include "station/cli/exit_status.hpp"
 #include "station/common/input_error.hpp"
 #include "station/config/fleet_config.hpp"
+#include "station/fleet/fleet_acceptance.hpp"
 #include "station/fleet/fleet_history.hpp"
 #include "station/parts/history.hpp"
 #include "station/parts/verdict.hpp"
@@ -188,7 +189,7 @@ json acceptance_row_json(const AcceptanceRow& r) {
 }
 
 /// "acceptance": each run's stored figures; "scale_factor_drift": K's (and TC's) change from
-/// run to run with its combined SE. Both null with --pg (not in the fleet yet).
+/// run to run with its combined SE. Both null with --pg on a fleet server older than schema 6.
 json acceptance_history_json(const std::optional<std::vector<AcceptanceRow>>& rows) {
   if (!rows) return {{"acceptance", nullptr}, {"scale_factor_drift", nullptr}};
   json runs = json::array(), drift = json::array();
@@ -235,7 +236,9 @@ void print_drift(const ScaleFactorDrift& d) {
 
 void print_acceptance_history(const std::optional<std::vector<AcceptanceRow>>& rows) {
   if (!rows) {
-    fmt::print("  acceptance figures: not in the fleet database yet (give --db)\n");
+    fmt::print(
+        "  acceptance figures: the fleet database has no acceptance table yet (migrate it with "
+        "`station sync --init`)\n");
     return;
   }
   if (rows->empty()) return;
@@ -250,7 +253,7 @@ void print_acceptance_history(const std::optional<std::vector<AcceptanceRow>>& r
 }
 
 /// What history reads: the runs, fits and releases, and the acceptance figures (empty with
-/// --pg: the fleet does not hold them yet).
+/// --pg on a fleet server older than schema 6).
 struct HistoryRead {
   fleet::FleetSerialHistory h;
   std::optional<std::vector<AcceptanceRow>> acceptance;
@@ -260,7 +263,8 @@ HistoryRead read_history(const HistoryOptions& o) {
   if (!o.pg.empty()) {
     if (auto why = pg_url_problem(o.pg)) throw InputError(fmt::format("--pg: {}", *why));
     fleet::PgConnection pg({o.pg, {}});
-    return {fleet::fleet_serial_history(pg, o.serial), std::nullopt};
+    return {fleet::fleet_serial_history(pg, o.serial),
+            fleet::fleet_acceptance_rows_of_serial(pg, o.serial)};
   }
   Store store(o.db, OpenMode::read_only);
   HistoryRead r{

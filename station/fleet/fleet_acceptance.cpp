@@ -8,6 +8,7 @@
 #include <map>
 
 #include "compensation/control_chart.hpp"
+#include "station/fleet/fleet_schema.hpp"
 #include "station/store/acceptance_results.hpp"
 
 namespace station::fleet {
@@ -15,10 +16,6 @@ namespace {
 
 using nlohmann::json;
 namespace sc = station::compensation;
-
-// K held further than this from kHeldScaleFactorTempC is another quantity (it carries TC times
-// the gap): charted apart. The same 1 C as `history`'s scale-factor drift (acceptance_history).
-constexpr double kHeldTempToleranceC = 1.0;
 
 json opt(const std::optional<double>& v) {
   return v ? json(*v) : json(nullptr);
@@ -217,8 +214,45 @@ json fleet_acceptance_json(const std::vector<AcceptancePoint>& points) {
   return {{"parts", parts}};
 }
 
+bool has_acceptance_table(PgConnection& pg) {
+  return pg.exec("SELECT to_regclass('acceptance_results') IS NOT NULL").text(0, 0) == "t";
+}
+
+std::optional<std::vector<AcceptanceRow>> fleet_acceptance_rows_of_serial(
+    PgConnection& pg, const std::string& serial) {
+  if (!has_acceptance_table(pg)) return std::nullopt;
+  auto r = pg.exec(
+      "SELECT r.fleet_id, a.computed_utc, a.figures_json FROM acceptance_results AS a JOIN runs "
+      "AS r ON r.uuid = a.run_uuid WHERE a.serial = $1 ORDER BY r.started_utc, r.fleet_id",
+      {serial});
+  std::vector<AcceptanceRow> rows;
+  for (int i = 0; i < r.rows(); ++i) {
+    const json figures = json::parse(r.text(i, 2), nullptr, false);
+    if (figures.is_discarded() || !figures.is_object())
+      throw PgError(
+          fmt::format("PostgreSQL {}: acceptance_results of run {} serial '{}': the "
+                      "stored figures are not readable JSON",
+                      pg.where(), r.integer(i, 0), serial));
+    rows.push_back(acceptance_row(r.integer(i, 0), figures));
+    rows.back().computed_utc = r.text(i, 1);
+  }
+  return rows;
+}
+
+json fleet_acceptance_charts(PgConnection& pg, const ChartFilter& filter) {
+  if (!has_acceptance_table(pg))
+    return {{"parts", json::array()},
+            {"unavailable",
+             fmt::format("the fleet database (schema version {}) has no acceptance table yet: "
+                         "migrate it with `station sync --init`",
+                         server_schema_version(pg))}};
+  return fleet_acceptance_json(fleet_acceptance_points(pg, filter));
+}
+
 std::string fleet_acceptance_text(const json& acceptance) {
   std::string out;
+  if (acceptance.contains("unavailable"))
+    out += fmt::format("acceptance figures: {}\n", acceptance["unavailable"].get<std::string>());
   for (const auto& part : acceptance["parts"]) {
     const auto& charts = part["charts"];
     out += fmt::format(

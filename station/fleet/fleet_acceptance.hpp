@@ -14,6 +14,7 @@
 
 #include "station/fleet/fleet_charts.hpp"
 #include "station/fleet/pg.hpp"
+#include "station/store/acceptance_results.hpp"
 
 namespace station::fleet {
 
@@ -46,6 +47,18 @@ std::vector<AcceptancePoint> fleet_acceptance_points(PgConnection& pg, const Cha
 /// the chart's limits over the K held within 1 C of 25 C only (another temperature is another
 /// quantity; such points are drawn apart and named).
 nlohmann::json fleet_acceptance_json(const std::vector<AcceptancePoint>& points);
+
+/// The acceptance part of `station fleet`'s charts: fleet_acceptance_json of the server's
+/// results, or, on a server whose schema predates the acceptance table (fleet schema < 6: a
+/// fleet not migrated since), {"parts": [], "unavailable": why} — the thermal charts stay
+/// drawable on such a server.
+nlohmann::json fleet_acceptance_charts(PgConnection& pg, const ChartFilter& filter);
+
+/// One serial's acceptance rows on the server (`station history --pg`), oldest run first, each
+/// row's run_id the fleet's id of its run and its columns read from its figures as the station
+/// read them (acceptance_row); empty when the server has no acceptance table (schema < 6).
+std::optional<std::vector<AcceptanceRow>> fleet_acceptance_rows_of_serial(
+    PgConnection& pg, const std::string& serial);
 
 /// The page's acceptance sections: per part the K and TC figures (report::figure_html, error
 /// bars of one standard error) and the table of results; appends the figures' JSON to `figures`.

@@ -119,6 +119,9 @@ std::string results_table(const json& part) {
 
 std::string fleet_acceptance_html(const json& acceptance, json& figures) {
   std::string body;
+  if (acceptance.contains("unavailable"))
+    body += "<p class=\"acceptance-unavailable\">acceptance figures: " +
+            html_escape(acceptance["unavailable"].get<std::string>()) + "</p>\n";
   std::size_t i = 0;
   for (const auto& part : acceptance["parts"]) {
     body += fmt::format(

@@ -23,6 +23,9 @@ struct HeldScaleFactor {
 };
 /// Where a scale factor without a temperature model is taken: the ladder nearest this, C.
 inline constexpr double kHeldScaleFactorTempC = 25.0;
+/// Two K held further apart than this are two quantities (each carries TC times the gap): history
+/// names the gap instead of a drift, the fleet charts such a K apart from the limits' K, C.
+inline constexpr double kHeldTempToleranceC = 1.0;
 /// HeldScaleFactor of one serial's object (acceptance_json): K at T_ref of the fit across the
 /// plateaus; without one (a single ladder, or plateaus too close), the computed ladder nearest
 /// kHeldScaleFactorTempC at its temperature; empty when no ladder was computed.

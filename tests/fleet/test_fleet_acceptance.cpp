@@ -119,6 +119,17 @@ TEST_F(FleetAcceptance, ARunsFiguresArriveEqualToTheStationsRowsAndAreCharted) {
       fleet::fleet_acceptance_points(pg, {.part = "GX-200-A", .since = std::nullopt}).empty());
   EXPECT_TRUE(
       fleet::fleet_acceptance_points(pg, {.part = std::nullopt, .since = "2999-01-01"}).empty());
+  // What `station history --pg` reads: the same row as the station's, under the fleet's run id.
+  const auto central = fleet::fleet_acceptance_rows_of_serial(pg, rows[1].serial);
+  ASSERT_TRUE(central.has_value());
+  ASSERT_EQ(central->size(), 1u);
+  const auto& c = central->front();
+  EXPECT_EQ(c.run_id, k["points"][1]["run_fleet_id"].get<long long>());
+  EXPECT_EQ(c.computed_utc, rows[1].computed_utc);
+  EXPECT_EQ(c.sf_pulse_per_arcsec, rows[1].sf_pulse_per_arcsec);
+  EXPECT_EQ(c.tc_se_ppm_per_c, rows[1].tc_se_ppm_per_c);
+  EXPECT_EQ(c.pass, rows[1].pass);
+  EXPECT_TRUE(fleet::fleet_acceptance_rows_of_serial(pg, "no-such-serial")->empty());
 }
 
 // `station fit --acceptance` computes a run's figures again (record_acceptance, its code path):
@@ -208,6 +219,32 @@ TEST_F(FleetAcceptance, FiguresStoredBeforeMigration13TravelOnce) {
   EXPECT_EQ(f.backlog().runs, 1);
   forward_all(db, false);
   EXPECT_EQ(count("SELECT count(*) FROM acceptance_results"), 2);
+}
+
+// A fleet server not migrated since schema 5 (no acceptance table): `station fleet` still draws
+// its thermal charts and says, in its JSON, text and page, why no acceptance figure is there
+// (it failed with the server's "relation does not exist" before).
+TEST_F(FleetAcceptance, AServerAtSchema5SaysWhyItHasNoAcceptanceFigures) {
+  {
+    fleet::PgConnection pg(target());
+    pg.exec("DROP TABLE acceptance_results");
+    pg.exec("DELETE FROM fleet_schema WHERE version = 6");
+  }
+  fleet::PgConnection pg(target());
+  const json j = fleet::fleet_acceptance_charts(pg, {});
+  EXPECT_TRUE(j["parts"].empty());
+  EXPECT_EQ(j["unavailable"],
+            "the fleet database (schema version 5) has no acceptance table yet: migrate it with "
+            "`station sync --init`");
+  EXPECT_NE(fleet::fleet_acceptance_text(j).find("acceptance figures: the fleet database"),
+            std::string::npos);
+  json charts{{"parts", json::array()}, {"acceptance", j}};
+  EXPECT_NE(
+      fleet::fleet_html(charts, "all", station::report::Assets{}).find("acceptance-unavailable"),
+      std::string::npos);
+  EXPECT_FALSE(fleet::fleet_acceptance_rows_of_serial(pg, "any").has_value());
+  fleet::init_fleet_schema(pg);  // migrated: the table is back and the reason gone
+  EXPECT_FALSE(fleet::fleet_acceptance_charts(pg, {}).contains("unavailable"));
 }
 
 // A serial whose ladder was not computed: no K point and no zero, the ladder's own error said

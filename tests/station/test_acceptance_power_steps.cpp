@@ -51,6 +51,35 @@ TEST(AcceptancePowerSteps, EachPowerCyclesStepHasItsOwnFigures) {
   }
 }
 
+// The shortest powered times the parser takes, and ones whose last third holds one bin's centre
+// (250 s: bins to 240 s, centres 150 and 210 s, third 167..250 s; 330 s: third 220..330 s, centres
+// 210 and 270 s): each turn-on analysed from at least its last two whole bins (they were refused:
+// "final window 220..330 s holds 1 bins").
+TEST(AcceptancePowerSteps, AShortPoweredTimeStillHasAFinalValue) {
+  for (const int on_s : {240, 250, 330}) {
+    SCOPED_TRACE(on_s);
+    const std::string text =
+        "name = \"short_on\"\ndescription = \"short turn-ons\"\n[[step]]\ntype = "
+        "\"lock_turntable\"\nposition_deg = 0.0\n[[step]]\ntype = \"power_cycles\"\ncycles = "
+        "2\noff_s = 60\non_s = " +
+        std::to_string(on_s) + "\n";
+    const std::string path = ::testing::TempDir() + "short-on-" + std::to_string(on_s) + "-" +
+                             std::to_string(getpid()) + ".toml";
+    std::ofstream(path) << text;
+    station::SimRunOptions o;
+    o.db_path = station::testing_support::fresh_db("acceptance_short_on_" + std::to_string(on_s));
+    o.protocol = path;
+    o.progress = false;
+    o.fresh = true;
+    o.gyros = 1;
+    const auto r = station::run_simulated(o);
+    ASSERT_EQ(r["state"], "completed") << r.dump();
+    const auto& t = r["acceptance"][0]["turn_on"];
+    ASSERT_TRUE(t["ok"].get<bool>()) << t.dump();
+    EXPECT_EQ(t["turn_ons"], 2);
+  }
+}
+
 // Every power_cycles step is judged; a drifting ladder's asymmetry without a TC is stated, not
 // judged, and said so.
 TEST(AcceptanceVerdict, EveryTurnOnStepIsJudgedAndAnUnjudgedAsymmetryIsNamed) {
