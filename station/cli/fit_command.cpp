@@ -16,6 +16,8 @@
 #include "station/cli/commands.hpp"
 #include "station/cli/exit_status.hpp"
 #include "station/common/input_error.hpp"
+#include "station/config/acceptance_steps.hpp"
+#include "station/config/protocol.hpp"
 #include "station/parts/deliverable_terms.hpp"
 #include "station/parts/judged_fit.hpp"
 #include "station/store/acceptance_results.hpp"
@@ -126,6 +128,28 @@ std::map<std::int64_t, nlohmann::json> recompute_acceptance(Store& store,
   return out;
 }
 
+/// `fit --all --acceptance` without --run: the runs whose stored protocol holds an acceptance
+/// step (a run stored without its protocol text has none to compute; an unreadable one is said).
+std::set<std::int64_t> runs_with_acceptance_steps(Store& store) {
+  std::vector<std::int64_t> ids;
+  auto st = store.db().prepare("SELECT DISTINCT run_id FROM run_slots ORDER BY run_id");
+  while (st.step()) ids.push_back(st.column_int(0));
+  std::set<std::int64_t> out;
+  for (const auto id : ids) {
+    const auto run = store.find_run(id);
+    if (!run || run->protocol_text.empty()) continue;
+    try {
+      const auto p = parse_protocol(run->protocol_text, "run " + std::to_string(id));
+      if (std::any_of(p.steps.begin(), p.steps.end(),
+                      [](const Step& s) { return is_acceptance_step(s.kind); }))
+        out.insert(id);
+    } catch (const InputError& e) {
+      fmt::print(stderr, "station: fit --acceptance: run {} skipped: {}\n", id, e.what());
+    }
+  }
+  return out;
+}
+
 /// The recomputed figures of the serials no thermal fit was printed for (a run of acceptance
 /// steps only has no bins): an array of their objects per run, for the text or the JSON.
 std::map<std::int64_t, nlohmann::json> unfitted_acceptance(
@@ -220,6 +244,8 @@ int run_fit(const FitOptions& o) {
     if (o.run && !store.find_run(*o.run))
       throw InputError(fmt::format("{}: no run {}", o.db, *o.run));
     result = fit_all(store, o.run, spec, choice, o.terms_given);
+    // Every run with acceptance steps: one of acceptance steps only has no fit to bring it.
+    if (o.acceptance && !o.run) acceptance_runs.merge(runs_with_acceptance_steps(store));
   } else if (o.acceptance) {
     // A serial whose runs hold acceptance steps only has no bins: its figures are still shown.
     try {

@@ -81,6 +81,9 @@ void run_fleet(const FleetOptions& o) {
     std::cout << charts.dump(2) << '\n';
     return;
   }
+  if (f.part && charts["parts"].empty() && charts["acceptance"]["parts"].empty())
+    fmt::print("no calibration and no acceptance result of part '{}'{} in the fleet database\n",
+               *f.part, f.since ? " since " + *f.since : "");
   print_outside(charts);
   fmt::print("{}", fleet::fleet_acceptance_text(charts["acceptance"]));
   for (const auto& p : noise) fmt::print("\n{}", fleet::noise_toml(p));

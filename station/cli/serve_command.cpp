@@ -100,11 +100,14 @@ bool close_failed_run(Service& s, const UnclosedRun& u) {
 /// A run's failure (the store or a bug; the sequencer does not throw for device faults): the
 /// run is closed with the reason, at once or as soon as the store writes again, so the next
 /// start does not resume into the same wall; an API start that never got its run is answered.
-void run_failed(Service& s, std::optional<std::int64_t> id, const std::string& why) {
+/// `refused`: the request was refused before its run was created (an InputError: the protocol
+/// is beyond what the rig can do), answered 400; otherwise the station could not record, 503.
+void run_failed(Service& s, std::optional<std::int64_t> id, const std::string& why,
+                bool refused = false) {
   log("serve")->error("run {} failed: {}", id.value_or(0), why);
   s.live.hub().run_ended(id.value_or(0), fmt::format("failed: {}", why));
   if (!id) {
-    s.control.start_failed(why);
+    s.control.start_failed(why, refused ? 400 : 503);
     return;
   }
   UnclosedRun u{*id, why};
@@ -152,6 +155,8 @@ void run_one(Service& s, const StartPlan& plan, const std::string& operator_name
     notify_status(fmt::format("idle; run {} {}", out.run_id, to_string(out.state)));
     log("serve")->info("run {} {} at t = {:.0f} s after {} ticks", out.run_id, to_string(out.state),
                        out.t_s, out.ticks);
+  } catch (const InputError& e) {
+    run_failed(s, run_id, e.what(), !run_id.has_value());
   } catch (const std::exception& e) {
     run_failed(s, run_id, e.what());
   }

@@ -68,7 +68,7 @@ http::ControlReply ServeControl::start(const std::string& protocol,
   cv_.wait_for(lock, std::chrono::seconds(5), [&] { return answered_ >= mine; });
   const std::int64_t id = answered_ >= mine ? started_id_ : 0;
   if (answered_ >= mine && id == 0)
-    return {503, fmt::format("the run could not be started: {}", start_error_)};
+    return {start_status_, fmt::format("the run could not be started: {}", start_error_)};
   return {202, fmt::format("starting protocol '{}'", protocol), id};
 }
 
@@ -108,10 +108,11 @@ void ServeControl::started(std::int64_t run_id) {
   cv_.notify_all();
 }
 
-void ServeControl::start_failed(const std::string& why) {
+void ServeControl::start_failed(const std::string& why, int status) {
   std::lock_guard lock(mu_);
   started_id_ = 0;
   start_error_ = why;
+  start_status_ = status;
   answered_ = requests_;
   cv_.notify_all();
 }

@@ -48,8 +48,10 @@ class ServeControl final : public http::RunControl {
   void set_fault(const std::string& fault, bool storage = false);
   /// The serve loop: the run of the last request was created with this id (start() answers it).
   void started(std::int64_t run_id);
-  /// The serve loop: the run of the last request could not be created (start() answers 503).
-  void start_failed(const std::string& why);
+  /// The serve loop: the run of the last request could not be created; start() answers
+  /// `status`: 503 when the station could not record it, 400 when the request itself was
+  /// refused (a protocol the rig cannot run: beyond the table's limits, no relay).
+  void start_failed(const std::string& why, int status = 503);
   /// Wakes next() (shutdown).
   void wake();
 
@@ -68,6 +70,7 @@ class ServeControl final : public http::RunControl {
   std::uint64_t requests_ = 0, answered_ = 0;  ///< start requests taken / whose run exists
   std::int64_t started_id_ = 0;
   std::string start_error_;  ///< why the last request's run was not created
+  int start_status_ = 503;   ///< and the answer it gets
   std::string fault_;
   bool storage_fault_ = false;
 };
