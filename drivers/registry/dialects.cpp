@@ -16,6 +16,7 @@
 #include "drivers/chamber/watlow_f4p/watlow_f4p_chamber.hpp"
 #include "drivers/chamber/watlow_f4t/f4t_map.hpp"
 #include "drivers/chamber/watlow_f4t/watlow_f4t_chamber.hpp"
+#include "drivers/registry/rate_limit.hpp"
 #include "drivers/turntable/acutrol3000/acutrol3000_table.hpp"
 #include "drivers/turntable/acutrol3000/acutrol_wire.hpp"
 #include "drivers/turntable/generic_plc/generic_plc_map.hpp"
@@ -176,18 +177,23 @@ const std::vector<ChamberDialect> kChambers{
 };
 
 const std::vector<TurntableDialect> kTables{
-    {"generic_plc", Transport::modbus,
-     "the station's own Modbus map for a PLC-fronted table (docs/DEVICES.md)", "default", false,
+    {"generic_plc",
+     Transport::modbus,
+     "the station's own Modbus map for a PLC-fronted table (docs/DEVICES.md)",
+     "default",
+     false,
      kPlcTableMap,
      [](const DeviceSpec& s, const LinkOptions& o) -> std::unique_ptr<Turntable> {
-       const double limit_dps =
-           std::min(s.max_rate_dps.value_or(kPlcRateLimitDps), kPlcRateLimitDps);
+       const double limit_dps = turntable_rate_limit(s)->dps;  // the dialect has its own
        return hooked(std::make_unique<ModbusTurntable>(s.name, modbus_ep(s), kPlcTableMap(s),
                                                        TurntableLimits{limit_dps}, s.timeout_s,
                                                        modbus_wire(s, o)),
                      s, o);
      },
-     0, kStationTiming, {}, kPlcRateLimitDps},  // the station's own map: no maker's timing
+     0,
+     kStationTiming,
+     {},
+     kPlcRateLimitDps},  // the station's own map: no maker's timing
     {"acutrol3000", Transport::ascii, "Acutronic ACUTROL3000, ASCII over TCP 9878 or serial", "",
      false, nullptr,
      [](const DeviceSpec& s, const LinkOptions& o) -> std::unique_ptr<Turntable> {
@@ -240,6 +246,15 @@ const ChamberDialect& chamber_dialect(std::string_view model) {
 const TurntableDialect& turntable_dialect(std::string_view model) {
   return find(turntable_dialects(), model, "turntable");
 }
+
+std::optional<TurntableRateLimit> turntable_rate_limit(const DeviceSpec& spec) {
+  const auto own = turntable_dialect(spec.model).rate_limit_dps;
+  if (own && (!spec.max_rate_dps || *own < *spec.max_rate_dps))
+    return TurntableRateLimit{*own, true};
+  if (spec.max_rate_dps) return TurntableRateLimit{*spec.max_rate_dps, false};
+  return std::nullopt;
+}
+
 std::string chamber_models() {
   return names(chamber_dialects());
 }

@@ -7,7 +7,7 @@
 #include <optional>
 #include <string>
 
-#include "drivers/registry/dialects.hpp"
+#include "drivers/registry/rate_limit.hpp"
 
 namespace station {
 namespace {
@@ -24,20 +24,15 @@ constexpr double kWindowEdgeS = 2.0;
 void check_table_limits(const Step& s, const std::string& where, const StationConfig& config) {
   if (s.kind != StepKind::rate_ladder || !config.turntable) return;
   const auto& spec = *config.turntable;
-  std::optional<double> rate_limit = spec.max_rate_dps;
-  const char* rate_source = "[turntable] max_rate_dps";
-  if (const auto own = dr::turntable_dialect(spec.model).rate_limit_dps;
-      own && (!rate_limit || *own < *rate_limit)) {
-    rate_limit = own;
-    rate_source = "its dialect's own limit";
-  }
-  if (rate_limit) {
+  if (const auto limit = dr::turntable_rate_limit(spec)) {
+    const char* source =
+        limit->dialects_own ? "its dialect's own limit" : "[turntable] max_rate_dps";
     for (std::size_t i = 0; i < s.rates_dps.size(); ++i) {
-      if (s.rates_dps[i] > *rate_limit)
+      if (s.rates_dps[i] > limit->dps)
         throw InputError(
             fmt::format("{}: rates_dps entry {}: {:g} deg/s is beyond the "
                         "turntable's rate limit {:g} deg/s ({}, model {})",
-                        where, i, s.rates_dps[i], *rate_limit, rate_source, spec.model));
+                        where, i, s.rates_dps[i], limit->dps, source, spec.model));
     }
   }
   if (spec.max_accel_dps2 && s.accel_dps2 > *spec.max_accel_dps2)
