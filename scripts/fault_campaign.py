@@ -257,8 +257,11 @@ def ladder_fault(rig, db, log, begin):
     taken just before it."""
     deadline = time.time() + LADDER_S + 30
     while time.time() < deadline:
-        if os.path.exists(db) and LADDER_CUT_POINT - 1 in ladder_points(db):
-            break
+        try:
+            if os.path.exists(db) and LADDER_CUT_POINT - 1 in ladder_points(db):
+                break
+        except sqlite3.OperationalError:
+            pass  # the daemon has created the file but not yet its tables (its migrations)
         time.sleep(0.2)
     else:
         return {"fault": "ladder_drive_fault", "error": "the ladder's first point never reported"}, None
