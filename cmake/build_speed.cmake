@@ -1,0 +1,50 @@
+# The cold build's cost, decided in one place (issue 37; docs/BENCHMARKS.md, "The cold build").
+# Included last from the top-level CMakeLists.txt, when every target exists.
+#
+# 1. Precompiled headers. Most of a translation unit's time here went to parsing the same
+#    third-party headers again: nlohmann/json (~2.5 s of CPU), Eigen/Dense (~1.8 s), GoogleTest
+#    (~2.3 s), toml++ (~1.6 s), CLI11 (~3 s), fmt and <chrono> (~1 s each), in every one of up
+#    to 70 files a target. Each target of many files that include them parses them once into its
+#    precompiled header, which its files then load. Only headers that most of the target's files
+#    already include, with the target's own flags (toml++ only where TOML_HEADER_ONLY=0 comes
+#    with the target), so no file sees another meaning of a header. Off for a build with
+#    -DCMAKE_DISABLE_PRECOMPILE_HEADERS=ON (CMake's own switch). compensation has none: its
+#    time is Eigen's instantiations (JacobiSVD, QR), which a precompiled header does not hold.
+set(_station_pch_core <chrono> <fmt/format.h> <nlohmann/json.hpp> <Eigen/Dense>)
+
+function(station_pch target)
+  if(TARGET ${target})
+    target_precompile_headers(${target} PRIVATE ${ARGN})
+  endif()
+endfunction()
+
+station_pch(station_drivers <chrono> <fmt/format.h>)
+station_pch(station_sim_devices <chrono> <fmt/format.h>)
+foreach(room IN ITEMS store parts acceptance release report fleet daemon session http)
+  station_pch(station_${room} ${_station_pch_core})
+endforeach()
+station_pch(station_cli ${_station_pch_core} <CLI/CLI.hpp>)
+station_pch(station_bench ${_station_pch_core} <benchmark/benchmark.h>)
+
+# 2. The test programs' debug information: line tables (-g1), not the full -g of RelWithDebInfo.
+#    A test program is neither shipped nor debugged in CI; a failure names its file and line, a
+#    crash's backtrace (and ASan's report) still has functions, files and lines. Full DWARF for
+#    the test files was about a third of their compile time (-ftime-report: "phase opt and
+#    generate" 22 s with -g, 11 s without, of 48 s for tests/station/test_acceptance_steps.cpp).
+#    The libraries and programs under test keep -g: `station` and `simrig` are built as before.
+#    To step through a test with its locals: -DSTATION_TEST_DEBUG_INFO=-g.
+set(STATION_TEST_DEBUG_INFO -g1 CACHE STRING
+    "debug information of the test programs' own files in RelWithDebInfo (-g1: line tables)")
+set(_station_test_pch <chrono> <gtest/gtest.h>)
+foreach(area IN ITEMS compensation drivers calibration fleet station)
+  if(TARGET test_${area})
+    target_compile_options(test_${area} PRIVATE
+                           $<$<CONFIG:RelWithDebInfo>:${STATION_TEST_DEBUG_INFO}>)
+  endif()
+endforeach()
+station_pch(test_compensation ${_station_test_pch} <Eigen/Dense>)
+station_pch(test_calibration ${_station_test_pch} <Eigen/Dense>)
+station_pch(test_drivers ${_station_test_pch} <fmt/format.h>)
+station_pch(test_fleet ${_station_test_pch} <fmt/format.h> <nlohmann/json.hpp> <Eigen/Dense>)
+station_pch(test_station ${_station_test_pch} <fmt/format.h> <nlohmann/json.hpp> <Eigen/Dense>
+            <toml++/toml.h>)
