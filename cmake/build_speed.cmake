@@ -6,10 +6,10 @@
 #    (~2.3 s), toml++ (~1.6 s), CLI11 (~3 s), fmt and <chrono> (~1 s each), in every one of up
 #    to 70 files a target. Each target of many files that include them parses them once into its
 #    precompiled header, which its files then load. Only headers that most of the target's files
-#    already include, with the target's own flags (toml++ only where TOML_HEADER_ONLY=0 comes
-#    with the target), so no file sees another meaning of a header. Off for a build with
-#    -DCMAKE_DISABLE_PRECOMPILE_HEADERS=ON (CMake's own switch). compensation has none: its
-#    time is Eigen's instantiations (JacobiSVD, QR), which a precompiled header does not hold.
+#    already include, with the target's own flags; toml++ in none (twelve files read TOML, the
+#    others only name TomlView). Off with -DCMAKE_DISABLE_PRECOMPILE_HEADERS=ON (CMake's own
+#    switch). compensation has none: its time is Eigen's instantiations (JacobiSVD, QR), which a
+#    precompiled header does not hold.
 set(_station_pch_core <chrono> <fmt/format.h> <nlohmann/json.hpp> <Eigen/Dense>)
 
 function(station_pch target)
@@ -46,5 +46,4 @@ station_pch(test_compensation ${_station_test_pch} <Eigen/Dense>)
 station_pch(test_calibration ${_station_test_pch} <Eigen/Dense>)
 station_pch(test_drivers ${_station_test_pch} <fmt/format.h>)
 station_pch(test_fleet ${_station_test_pch} <fmt/format.h> <nlohmann/json.hpp> <Eigen/Dense>)
-station_pch(test_station ${_station_test_pch} <fmt/format.h> <nlohmann/json.hpp> <Eigen/Dense>
-            <toml++/toml.h>)
+station_pch(test_station ${_station_test_pch} <fmt/format.h> <nlohmann/json.hpp> <Eigen/Dense>)
