@@ -1,15 +1,16 @@
 # The cold build's cost, decided in one place (issue 37; docs/BENCHMARKS.md, "The cold build").
 # Included last from the top-level CMakeLists.txt, when every target exists.
 #
-# 1. Precompiled headers. Most of a translation unit's time here went to parsing the same
-#    third-party headers again: nlohmann/json (~2.5 s of CPU), Eigen/Dense (~1.8 s), GoogleTest
-#    (~2.3 s), toml++ (~1.6 s), CLI11 (~3 s), fmt and <chrono> (~1 s each), in every one of up
-#    to 70 files a target. Each target of many files that include them parses them once into its
-#    precompiled header, which its files then load. Only headers that most of the target's files
-#    already include, with the target's own flags; toml++ in none (twelve files read TOML, the
-#    others only name TomlView). Off with -DCMAKE_DISABLE_PRECOMPILE_HEADERS=ON (CMake's own
-#    switch). compensation has none: its time is Eigen's instantiations (JacobiSVD, QR), which a
-#    precompiled header does not hold.
+# 1. Precompiled headers. Each file of a target parsed the same third-party headers again:
+#    nlohmann/json (~2.5 s of CPU), GoogleTest (~2.3 s), Eigen/Dense (~1.8 s), CLI11 (~3 s), fmt
+#    and <chrono> (~1 s each), in up to 70 files a target. A target of many files that include
+#    them parses them once into its precompiled header (GCC and the fuzz build's clang alike).
+#    Only headers most of the target's files already include, with the target's own flags;
+#    toml++ in none (twelve files read TOML, the others only name TomlView). Measured per file
+#    (docs/BENCHMARKS.md): station_store -13 %, its header's 13.5 s included. compensation has
+#    none: its time is Eigen's instantiations (JacobiSVD, QR), which a precompiled header does
+#    not hold; drivers and sim_devices none either (fmt and <chrono> alone: within the noise).
+#    Off with -DCMAKE_DISABLE_PRECOMPILE_HEADERS=ON (CMake's own switch).
 set(_station_pch_core <chrono> <fmt/format.h> <nlohmann/json.hpp> <Eigen/Dense>)
 
 function(station_pch target)
@@ -18,8 +19,6 @@ function(station_pch target)
   endif()
 endfunction()
 
-station_pch(station_drivers <chrono> <fmt/format.h>)
-station_pch(station_sim_devices <chrono> <fmt/format.h>)
 foreach(room IN ITEMS store parts acceptance release report fleet daemon session http)
   station_pch(station_${room} ${_station_pch_core})
 endforeach()
