@@ -19,11 +19,21 @@ function(station_pch target)
   endif()
 endfunction()
 
-foreach(room IN ITEMS store parts acceptance release report fleet daemon session http)
-  station_pch(station_${room} ${_station_pch_core})
-endforeach()
-station_pch(station_cli ${_station_pch_core} <CLI/CLI.hpp>)
-station_pch(station_bench ${_station_pch_core} <benchmark/benchmark.h>)
+# Built here without a new warning: store and test_drivers. In the other targets a precompiled
+# header changes GCC 12's inlining enough for its -Warray-bounds false positive on
+# `std::string(...) + "literal"` to appear (tests/compensation/test_allan_stable32.cpp:26 with
+# one; without, none), and they were not all built with one yet: STATION_PCH_WIDE=ON adds them
+# (an estimated -13 % for the rooms, more for the tests) once a whole build shows no new warning.
+option(STATION_PCH_WIDE "precompiled headers for every room and test program too" OFF)
+station_pch(station_store ${_station_pch_core})
+station_pch(test_drivers <chrono> <gtest/gtest.h> <fmt/format.h>)
+if(STATION_PCH_WIDE)
+  foreach(room IN ITEMS parts acceptance release report fleet daemon session http)
+    station_pch(station_${room} ${_station_pch_core})
+  endforeach()
+  station_pch(station_cli ${_station_pch_core} <CLI/CLI.hpp>)
+  station_pch(station_bench ${_station_pch_core} <benchmark/benchmark.h>)
+endif()
 
 # 2. The test programs' debug information: line tables (-g1), not the full -g of RelWithDebInfo.
 #    A test program is neither shipped nor debugged in CI; a failure names its file and line, a
@@ -34,15 +44,16 @@ station_pch(station_bench ${_station_pch_core} <benchmark/benchmark.h>)
 #    To step through a test with its locals: -DSTATION_TEST_DEBUG_INFO=-g.
 set(STATION_TEST_DEBUG_INFO -g1 CACHE STRING
     "debug information of the test programs' own files in RelWithDebInfo (-g1: line tables)")
-set(_station_test_pch <chrono> <gtest/gtest.h>)
 foreach(area IN ITEMS compensation drivers calibration fleet station)
   if(TARGET test_${area})
     target_compile_options(test_${area} PRIVATE
                            $<$<CONFIG:RelWithDebInfo>:${STATION_TEST_DEBUG_INFO}>)
   endif()
 endforeach()
-station_pch(test_compensation ${_station_test_pch} <Eigen/Dense>)
-station_pch(test_calibration ${_station_test_pch} <Eigen/Dense>)
-station_pch(test_drivers ${_station_test_pch} <fmt/format.h>)
-station_pch(test_fleet ${_station_test_pch} <fmt/format.h> <nlohmann/json.hpp> <Eigen/Dense>)
-station_pch(test_station ${_station_test_pch} <fmt/format.h> <nlohmann/json.hpp> <Eigen/Dense>)
+if(STATION_PCH_WIDE)
+  set(_station_test_pch <chrono> <gtest/gtest.h>)
+  station_pch(test_compensation ${_station_test_pch} <Eigen/Dense>)
+  station_pch(test_calibration ${_station_test_pch} <Eigen/Dense>)
+  station_pch(test_fleet ${_station_test_pch} <fmt/format.h> <nlohmann/json.hpp> <Eigen/Dense>)
+  station_pch(test_station ${_station_test_pch} <fmt/format.h> <nlohmann/json.hpp> <Eigen/Dense>)
+endif()
