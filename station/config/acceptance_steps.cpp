@@ -8,6 +8,8 @@
 #include <optional>
 #include <string>
 
+#include "station/config/toml_reader.hpp"
+
 namespace station {
 namespace {
 

@@ -8,9 +8,10 @@
 #include <vector>
 
 #include "station/config/protocol.hpp"
-#include "station/config/toml_reader.hpp"
 
 namespace station {
+
+class TomlView;  // station/config/toml_reader.hpp: toml++ only where a file is read
 
 /// rate_ladder, positions or power_cycles.
 bool is_acceptance_step(StepKind k);

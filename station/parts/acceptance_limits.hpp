@@ -5,7 +5,6 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
-#include "station/config/toml_reader.hpp"
 #include "station/parts/limit_range.hpp"
 
 namespace station {

@@ -3,6 +3,8 @@
 
 #include <fmt/format.h>
 
+#include "station/config/toml_reader.hpp"
+
 namespace station {
 
 using nlohmann::json;

@@ -5,9 +5,9 @@
 #include <optional>
 #include <string_view>
 
-#include "station/config/toml_reader.hpp"
-
 namespace station {
+
+class TomlView;  // station/config/toml_reader.hpp: toml++ only where a file is read
 
 /// A closed interval; either end may be open (absent).
 struct LimitRange {
