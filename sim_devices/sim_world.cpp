@@ -284,13 +284,23 @@ void SimWorld::advance_to(double t_s) {
 namespace station::sim {
 
 std::string SimWorld::devices_toml() const {
-  return device_toml("chamber", config_.chamber_model, chamber_endpoint(), &config_.panel,
-                     config_.chamber_gateway) +
-         "\n" + device_toml("turntable", config_.turntable_model, turntable_endpoint(), nullptr) +
-         // The simulated table's own limits (TurntableSimConfig): the start checks a protocol's
-         // ladders against them as against a real table's rating.
-         fmt::format("max_rate_dps = {}\nmax_accel_dps2 = {}\n", config_.table.max_rate_mode_dps,
-                     config_.table.max_accel_dps2);
+  // The simulated table's own limits (TurntableSimConfig): the start checks a protocol's ladders
+  // against them as against a real table's rating.
+  std::string out =
+      device_toml("chamber", config_.chamber_model, chamber_endpoint(), &config_.panel,
+                  config_.chamber_gateway) +
+      "\n" + device_toml("turntable", config_.turntable_model, turntable_endpoint(), nullptr) +
+      fmt::format("max_rate_dps = {}\nmax_accel_dps2 = {}\n", config_.table.max_rate_mode_dps,
+                  config_.table.max_accel_dps2);
+  // A dialect whose own rate bound is lower (generic_plc's 500 deg/s) holds the demands to it:
+  // both printed, and which one applies, so the rating is not read as the table's limit.
+  if (const auto own = dialect_rate_limit_dps(config_.turntable_model);
+      own && *own < config_.table.max_rate_mode_dps)
+    out += fmt::format(
+        "# the {} dialect holds rate demands to {} deg/s (docs/DEVICES.md), below the simulated "
+        "table's {} deg/s: {} deg/s applies\n",
+        config_.turntable_model, *own, config_.table.max_rate_mode_dps, *own);
+  return out;
 }
 
 }  // namespace station::sim

@@ -79,6 +79,14 @@ ServedDevice serve_turntable(std::string_view name, TurntableSim& table, int por
       fmt::format("no simulated turntable '{}' (known: {})", model, drivers::turntable_models()));
 }
 
+std::optional<double> dialect_rate_limit_dps(std::string_view name) {
+  // docs/DEVICES.md, generic_plc: "A rate demand is bounded at +-500 deg/s by the station's own
+  // specification". An ACUTROL's is the unit's own setting (:Limit:Rate), read at connect.
+  constexpr double kGenericPlcRateDemandDps = 500.0;
+  if (drivers::turntable_dialect(name).model == "generic_plc") return kGenericPlcRateDemandDps;
+  return std::nullopt;
+}
+
 std::string device_toml(const char* section, std::string_view model, const std::string& endpoint,
                         const WatlowPanel* panel, bool gateway) {
   std::string out =

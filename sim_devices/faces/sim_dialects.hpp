@@ -3,6 +3,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -29,6 +30,11 @@ ServedDevice serve_chamber(std::string_view model, ChamberSim& chamber, const Wa
 /// The table model served as `model`; an ACUTROL frames its replies as `acutrol_framing` says.
 ServedDevice serve_turntable(std::string_view model, TurntableSim& table, int port,
                              AclFraming acutrol_framing = AclFraming::bare);
+/// A turntable dialect's own bound on a rate demand, deg/s, as its document gives it (empty: none
+/// fixed). The simulator's reading of docs/DEVICES.md, not the driver's (drivers/registry's
+/// `rate_limit_dps`): tests/drivers/test_sim_rate_limit.cpp holds the two readings equal.
+std::optional<double> dialect_rate_limit_dps(std::string_view model);
+
 /// The [chamber] / [turntable] table text a station config needs for a served model (its
 /// run event, unit id, word order and gateway as the panel and the serving say).
 std::string device_toml(const char* section, std::string_view model, const std::string& endpoint,
