@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <variant>
@@ -139,8 +140,7 @@ Result<std::vector<std::uint16_t>> ModbusClient::read_registers(FunctionCode fc,
                                                                 std::uint16_t addr, int count) {
   if (auto c = ensure_connected(); !c) return c.error();
   int code = static_cast<int>(fc);
-  tap(TapDirection::tx, "modbus-read", read_request_adu(unit, code, addr, count),
-      fmt::format("unit={} fc={} addr={} count={}", unit, code, addr, count));
+  tap_read_request(fc, unit, addr, count);
   std::vector<std::uint16_t> words(static_cast<std::size_t>(count));
   int rc = wire_->read(fc, unit, addr, count, words.data());
   if (rc == -1)
@@ -148,11 +148,56 @@ Result<std::vector<std::uint16_t>> ModbusClient::read_registers(FunctionCode fc,
   if (rc != count)
     return fail(EMBBADDATA, unit,
                 fmt::format("read addr={}: {} registers, wanted {}", addr, rc, count));
+  read_answered(fc, unit, addr, words);
+  return words;
+}
+
+void ModbusClient::tap_read_request(FunctionCode fc, int unit, std::uint16_t addr, int count) {
+  const int code = static_cast<int>(fc);
+  tap(TapDirection::tx, "modbus-read", read_request_adu(unit, code, addr, count),
+      fmt::format("unit={} fc={} addr={} count={}", unit, code, addr, count));
+}
+
+// A reply read: the unit answered, the link is fresh, the tap has it.
+void ModbusClient::read_answered(FunctionCode fc, int unit, std::uint16_t addr,
+                                 std::span<const std::uint16_t> words) {
   link_.answered();
   unit_answered_ = true;
-  tap(TapDirection::rx, "modbus-read", read_reply_adu(unit, code, words),
+  tap(TapDirection::rx, "modbus-read", read_reply_adu(unit, static_cast<int>(fc), words),
       fmt::format("unit={} addr={}", unit, addr));
-  return words;
+}
+
+// The tap has each request and its outcome in the order read_registers would have made them
+// (a session replays the same whether it was read in a batch or not); the requests after a failed
+// one were sent and are abandoned, not recorded.
+Result<std::vector<std::vector<std::uint16_t>>> ModbusClient::read_group(
+    std::span<const ReadBlock> group) {
+  std::vector<std::vector<std::uint16_t>> words(group.size());
+  if (group.size() == 1) {
+    auto one = read_registers(group[0].function, group[0].unit_id, group[0].start, group[0].count);
+    if (!one) return one.error();
+    words[0] = std::move(one).value();
+    return words;
+  }
+  if (auto c = ensure_connected(); !c) return c.error();
+  std::vector<ReadRequest> requests;
+  for (std::size_t i = 0; i < group.size(); ++i) {
+    const auto& b = group[i];
+    words[i].resize(static_cast<std::size_t>(b.count));
+    requests.push_back({b.function, b.unit_id, b.start, b.count, words[i].data()});
+  }
+  const auto done = static_cast<std::size_t>(wire_->read_batch(requests));
+  const int err = errno;
+  for (std::size_t i = 0; i < done; ++i) {
+    tap_read_request(group[i].function, group[i].unit_id, group[i].start, group[i].count);
+    read_answered(group[i].function, group[i].unit_id, group[i].start, words[i]);
+  }
+  if (done == group.size()) return words;
+  const auto& b = group[done];
+  tap_read_request(b.function, b.unit_id, b.start, b.count);
+  return fail(
+      err, b.unit_id,
+      fmt::format("read fc={} addr={} count={}", static_cast<int>(b.function), b.start, b.count));
 }
 
 Result<void> ModbusClient::write_registers(int unit, std::uint16_t addr,
@@ -200,15 +245,19 @@ void ModbusClient::tap(TapDirection dir, const char* kind, std::vector<std::uint
 Result<std::vector<double>> ModbusClient::read_points(std::span<const Point> points,
                                                       std::span<const ReadBlock> plan) {
   std::vector<double> v(points.size());
-  for (const auto& b : plan) {
-    auto words = read_registers(b.function, b.unit_id, b.start, b.count);
+  const auto step = static_cast<std::size_t>(pipeline_);
+  for (std::size_t first = 0; first < plan.size(); first += step) {
+    const auto group = plan.subspan(first, std::min(step, plan.size() - first));
+    auto words = read_group(group);
     if (!words) return words.error();
-    for (std::size_t i : b.points) {
-      const Point& p = points[i];
-      auto value =
-          checked(device_, p, decode_point(p, words.value().data() + (p.pdu_address() - b.start)));
-      if (!value) return value.error();
-      v[i] = value.value();
+    for (std::size_t k = 0; k < group.size(); ++k) {
+      for (std::size_t i : group[k].points) {
+        const Point& p = points[i];
+        const std::uint16_t* at = words.value()[k].data() + (p.pdu_address() - group[k].start);
+        auto value = checked(device_, p, decode_point(p, at));
+        if (!value) return value.error();
+        v[i] = value.value();
+      }
     }
   }
   return v;

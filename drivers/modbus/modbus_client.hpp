@@ -59,7 +59,8 @@ class ModbusClient {
   /// Writes one rw point (function 6 for one word, 16 for two); blocks up to the timeout.
   Result<void> write(const Point& p, double value);
   /// Reads `points` with the block reads of `plan` (from plan_reads) and decodes each with the
-  /// shared codec; values in the order of `points`. A non-finite value is a protocol error.
+  /// shared codec; values in the order of `points`. A non-finite value is a protocol error. With
+  /// a pipeline (set_pipeline), up to that many block reads are on the wire at once.
   Result<std::vector<double>> read_points(std::span<const Point> points,
                                           std::span<const ReadBlock> plan);
   /// Reads `count` raw registers (function 3 or 4) at a PDU address; blocks up to the timeout.
@@ -78,6 +79,12 @@ class ModbusClient {
     gap_s_ = gap_s;
     wire_->set_request_gap_s(gap_s);
   }
+  /// Lets read_points have up to `max_outstanding` block reads on the wire before the first
+  /// reply (ModbusWire::read_batch; [chamber]/[turntable] `modbus_pipeline`); 1, the default:
+  /// one request, its reply, the next. Below 1 counts as 1. No I/O.
+  void set_pipeline(int max_outstanding) { pipeline_ = max_outstanding < 1 ? 1 : max_outstanding; }
+  /// The most block reads read_points has outstanding at once.
+  int pipeline() const { return pipeline_; }
   /// The pause set by set_request_gap_s, seconds.
   double request_gap_s() const { return gap_s_; }
   /// True once the unit itself answered (a reply or its own exception) since the link opened.
@@ -85,6 +92,12 @@ class ModbusClient {
 
  private:
   Result<void> ensure_connected();
+  /// The block reads of `group`: one read_registers, or all sent as one batch (read_batch).
+  Result<std::vector<std::vector<std::uint16_t>>> read_group(std::span<const ReadBlock> group);
+  /// The tap records of a read request and of its reply.
+  void tap_read_request(FunctionCode fc, int unit, std::uint16_t addr, int count);
+  void read_answered(FunctionCode fc, int unit, std::uint16_t addr,
+                     std::span<const std::uint16_t> words);
   Error fail(int err, int unit, const std::string& what);
   std::string unit_hint(int err, int unit) const;
   void tap(TapDirection dir, const char* kind, std::vector<std::uint8_t> bytes, std::string detail);
@@ -93,6 +106,7 @@ class ModbusClient {
   Endpoint endpoint_;
   double timeout_s_;
   double gap_s_ = 0;
+  int pipeline_ = 1;            ///< most block reads outstanding at once (set_pipeline)
   bool unit_answered_ = false;  ///< the unit answered since the link opened
   std::unique_ptr<ModbusWire> wire_;
   Tap* tap_ = nullptr;

@@ -145,4 +145,9 @@ int check_reply(Framing f, std::span<const std::uint8_t> request,
   return check_values(f, request, reply);
 }
 
+void reply_words(Framing f, std::span<const std::uint8_t> reply, int count, std::uint16_t* dest) {
+  const std::size_t data = header_length(f) + 2;  // function, byte count
+  for (int i = 0; i < count; ++i) dest[i] = u16(reply, data + 2 * static_cast<std::size_t>(i));
+}
+
 }  // namespace station::drivers::modbus

@@ -46,6 +46,9 @@ int reply_frame_length(Framing f, std::span<const std::uint8_t> head);
 int check_reply(Framing f, std::span<const std::uint8_t> request,
                 std::span<const std::uint8_t> reply);
 
+/// The `count` register values of a read reply already checked by check_reply, into `dest`.
+void reply_words(Framing f, std::span<const std::uint8_t> reply, int count, std::uint16_t* dest);
+
 /// The transaction id of a TCP frame (its first two bytes).
 inline std::uint16_t transaction_id(std::span<const std::uint8_t> frame) {
   return static_cast<std::uint16_t>((frame[0] << 8) | frame[1]);

@@ -96,6 +96,20 @@ void set_connect_timeout(modbus_t* ctx, double s) {
 
 }  // namespace
 
+int ModbusWire::read_batch(std::span<const ReadRequest> requests) {
+  int done = 0;
+  for (const auto& r : requests) {
+    const int rc = read(r.fc, r.unit, r.addr, r.count, r.dest);
+    if (rc == -1) return done;
+    if (rc != r.count) {
+      errno = EMBBADDATA;  // as ModbusClient reads a short count
+      return done;
+    }
+    ++done;
+  }
+  return done;
+}
+
 double LibmodbusWire::quiet_interval_s(const RtuEndpoint& ep, double timeout_s) {
   const int bits = 1 + ep.data_bits + (ep.parity == 'N' ? 0 : 1) + ep.stop_bits;
   const double t35_s = ep.baud > 19200 ? 1.75e-3 : 3.5 * bits / ep.baud;
@@ -135,6 +149,7 @@ void LibmodbusWire::close() {
   tid_ = 0;
   late_.clear();
   late_ids_.clear();
+  rx_.clear();
 }
 
 Framing LibmodbusWire::framing() const {
@@ -206,10 +221,30 @@ int LibmodbusWire::receive_frame(std::vector<std::uint8_t>& frame,
       return -1;
     }
     if (need == 0) return 0;
+    if (!rx_.empty()) {  // read ahead by a batch: the stream's next bytes
+      const auto take = static_cast<std::ptrdiff_t>(std::min<std::size_t>(need, rx_.size()));
+      frame.insert(frame.end(), rx_.begin(), rx_.begin() + take);
+      rx_.erase(rx_.begin(), rx_.begin() + take);
+      continue;
+    }
     const bool rest_of_tcp_frame = !frame.empty() && framing() == Framing::tcp;
     if (read_some(fd, frame, static_cast<std::size_t>(need), deadline, rest_of_tcp_frame) == -1)
       return -1;
   }
+}
+
+int LibmodbusWire::receive_batch_frame(std::vector<std::uint8_t>& frame,
+                                       SteadyClock::time_point deadline) {
+  constexpr std::size_t kReadAhead = 256;  // read_some's most: a batch's replies in one read
+  if (rx_.empty() &&
+      read_some(modbus_get_socket(ctx_.get()), rx_, kReadAhead, deadline, false) == -1)
+    return -1;
+  return receive_frame(frame, deadline);
+}
+
+void LibmodbusWire::abandon(std::uint16_t tid) {
+  if (late_ids_.size() == kLateIdsKept) late_ids_.erase(late_ids_.begin());
+  late_ids_.push_back(tid);
 }
 
 int LibmodbusWire::drop_late(SteadyClock::time_point deadline) {
@@ -263,10 +298,7 @@ int LibmodbusWire::exchange(const std::vector<std::uint8_t>& adu,
         in_flight_ = true;
         quiet_since_ = SteadyClock::now();
       }
-      if (errno == ETIMEDOUT && reply.empty() && framing() == Framing::tcp) {
-        if (late_ids_.size() == kLateIdsKept) late_ids_.erase(late_ids_.begin());
-        late_ids_.push_back(tid_);
-      }
+      if (errno == ETIMEDOUT && reply.empty() && framing() == Framing::tcp) abandon(tid_);
       if (errno == ETIMEDOUT && !reply.empty()) {
         late_ = reply;  // its rest is dropped as it comes
         errno = ETIME;  // begun, not finished by the deadline
@@ -293,9 +325,7 @@ int LibmodbusWire::read(FunctionCode fc, int unit, std::uint16_t addr, int count
                         std::uint16_t* dest) {
   std::vector<std::uint8_t> reply;
   if (exchange(read_request_adu(unit, static_cast<int>(fc), addr, count), reply) == -1) return -1;
-  const std::size_t data = header_length(framing()) + 2;  // function, byte count
-  for (int i = 0; i < count; ++i)
-    dest[i] = static_cast<std::uint16_t>((reply[data + 2 * i] << 8) | reply[data + 2 * i + 1]);
+  reply_words(framing(), reply, count, dest);
   return count;
 }
 
@@ -309,6 +339,7 @@ void LibmodbusWire::flush() {
   if (!ctx_) return;
   // What has come of an abandoned reply is framed and dropped now (no wait); its rest later.
   if (!late_.empty() && drop_late(SteadyClock::now()) == -1) return;
+  rx_.clear();
   modbus_flush(ctx_.get());
 }
 

@@ -15,6 +15,16 @@
 
 namespace station::drivers::modbus {
 
+/// One read of a batch (ModbusWire::read_batch): `count` registers (function `fc`) of `unit` at
+/// PDU address `addr`, decoded into `dest` (count words).
+struct ReadRequest {
+  FunctionCode fc = FunctionCode::holding;
+  int unit = 1;
+  std::uint16_t addr = 0;
+  int count = 1;
+  std::uint16_t* dest = nullptr;
+};
+
 /// One Modbus link. Calls return like libmodbus's: 0 / a count, or -1 with errno set.
 class ModbusWire {
  public:
@@ -28,6 +38,11 @@ class ModbusWire {
   /// Reads `count` registers (function `fc`) of `unit` at PDU address `addr` into `dest`.
   virtual int read(FunctionCode fc, int unit, std::uint16_t addr, int count,
                    std::uint16_t* dest) = 0;
+  /// Reads `requests` as one batch: returns how many of them, from the first, were answered; when
+  /// fewer than all, errno says why the next one failed (as read() would). Here one read() after
+  /// another, stopping at the first failure; a link that may have several requests outstanding
+  /// sends them back to back (LibmodbusWire on TCP).
+  virtual int read_batch(std::span<const ReadRequest> requests);
   /// Writes holding registers of `unit` at `addr` (function 6 for one word, 16 for more).
   virtual int write(int unit, std::uint16_t addr, std::span<const std::uint16_t> words) = 0;
   /// Discards unread input (after a timeout or a garbled reply).
@@ -59,6 +74,15 @@ class LibmodbusWire final : public ModbusWire {
   int open(double timeout_s) override;
   void close() override;
   int read(FunctionCode fc, int unit, std::uint16_t addr, int count, std::uint16_t* dest) override;
+  /// TCP (no request gap): every request sent back to back in one send, then the replies matched
+  /// to them by transaction id in whatever order they come (Modbus Messaging on TCP/IP
+  /// Implementation Guide v1.0b §3.1.3, §4.2: a server may serve several transactions at once),
+  /// the whole batch bounded by one deadline as one exchange is. What fails is what failed the
+  /// same request read alone: no reply by the deadline (ETIMEDOUT, ETIME when begun), a reply
+  /// that answers no request of the batch (EMBBADDATA) or answers it wrongly (check_reply); the
+  /// requests after it are abandoned, their late replies dropped by id. RTU, a gap, or one
+  /// request: read() one after another.
+  int read_batch(std::span<const ReadRequest> requests) override;
   int write(int unit, std::uint16_t addr, std::span<const std::uint16_t> words) override;
   void flush() override;
   void set_request_gap_s(double gap_s) override { gap_ = to_steady(gap_s); }
@@ -87,8 +111,20 @@ class LibmodbusWire final : public ModbusWire {
   /// Sends the request `adu` (unit id and PDU) and reads its reply into `reply` by one deadline;
   /// 0, or -1 with errno set.
   int exchange(const std::vector<std::uint8_t>& adu, std::vector<std::uint8_t>& reply);
-  /// Reads the rest of the frame begun in `frame` until the deadline; 0 or -1 with errno.
+  /// Reads the rest of the frame begun in `frame` until the deadline, first from what was read
+  /// ahead (rx_); 0 or -1 with errno.
   int receive_frame(std::vector<std::uint8_t>& frame, SteadyClock::time_point deadline);
+  /// The next whole frame of a batch's replies: whatever the socket holds is read ahead into rx_
+  /// (several replies in one read), the frame cut from it; 0 or -1 with errno (`frame` holds the
+  /// part of a frame begun).
+  int receive_batch_frame(std::vector<std::uint8_t>& frame, SteadyClock::time_point deadline);
+  /// Reads the replies to a batch of read `requests` sent as `frames`, by the deadline, each
+  /// into its dest; returns how many from the first were answered, errno set when not all.
+  int collect_batch(std::span<const ReadRequest> requests,
+                    const std::vector<std::vector<std::uint8_t>>& frames,
+                    SteadyClock::time_point deadline);
+  /// Remembers the transaction id of a request abandoned before its reply came (TCP).
+  void abandon(std::uint16_t tid);
   /// Drops the rest of an abandoned reply (late_), reading until the deadline; 0 or -1.
   int drop_late(SteadyClock::time_point deadline);
   /// Writes the whole request frame by the deadline; 0 or -1 with errno.
@@ -106,6 +142,7 @@ class LibmodbusWire final : public ModbusWire {
   std::uint16_t tid_ = 0;                ///< the last request's transaction id (TCP)
   std::vector<std::uint8_t> late_;       ///< the bytes read of a reply abandoned at its deadline
   std::vector<std::uint16_t> late_ids_;  ///< transaction ids of replies abandoned before a byte
+  std::vector<std::uint8_t> rx_;         ///< bytes a batch read ahead, not yet framed (TCP)
 };
 
 }  // namespace station::drivers::modbus

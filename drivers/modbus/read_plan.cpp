@@ -37,4 +37,13 @@ std::vector<ReadBlock> plan_reads(std::span<const Point> points, int max_gap_reg
   return blocks;
 }
 
+std::vector<ReadBlock> plan_each(std::span<const Point> points) {
+  std::vector<ReadBlock> blocks;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Point& p = points[i];
+    blocks.push_back({p.unit_id, p.function, p.pdu_address(), p.word_count(), {i}});
+  }
+  return blocks;
+}
+
 }  // namespace station::drivers::modbus

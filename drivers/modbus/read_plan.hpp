@@ -28,5 +28,8 @@ struct ReadBlock {
 /// no block exceeds kMaxReadRegisters. max_gap_registers = 0 merges only adjacent points; < 0
 /// gives one block per point. Blocks come out sorted by unit, function, address. No I/O.
 std::vector<ReadBlock> plan_reads(std::span<const Point> points, int max_gap_registers);
+/// One block per point, in the order of `points`: the reads of reading each point by itself (the
+/// same requests in the same order), for a client that may have them on the wire together. No I/O.
+std::vector<ReadBlock> plan_each(std::span<const Point> points);
 
 }  // namespace station::drivers::modbus

@@ -57,6 +57,7 @@ std::unique_ptr<D> hooked(std::unique_ptr<D> d, const DeviceSpec& s, const LinkO
   d->set_readback_every(s.readback_every);
   d->client().set_clock(o.clock);
   d->client().set_request_gap_s(s.request_gap_s);
+  d->client().set_pipeline(s.modbus_pipeline);
   return d;
 }
 template <typename D>
@@ -272,7 +273,8 @@ void validate_link(const Dialect<Device>& dialect, const DeviceSpec& spec) {
   if (dialect.transport != Transport::modbus) {
     for (const auto& [set, key] : {std::pair{spec.gateway, "gateway"},
                                    {spec.word_order.has_value(), "word_order"},
-                                   {spec.request_gap_s > 0, "request_gap_s"}})
+                                   {spec.request_gap_s > 0, "request_gap_s"},
+                                   {spec.modbus_pipeline > 1, "modbus_pipeline"}})
       if (set)
         throw std::invalid_argument(
             fmt::format("{}: model '{}' speaks ASCII: {} applies to Modbus links only", key,
@@ -284,6 +286,17 @@ void validate_link(const Dialect<Device>& dialect, const DeviceSpec& spec) {
     throw std::invalid_argument(
         "gateway: the endpoint is a serial line already (rtu:); gateway = true is for a tcp:// "
         "gateway in front of one");
+  // Several requests outstanding is Modbus TCP's (Implementation Guide v1.0b §3.1.3, the
+  // transaction id); a serial line, or a gateway in front of one, carries one at a time.
+  if (spec.modbus_pipeline > 1 && serial_unit(spec))
+    throw std::invalid_argument(fmt::format(
+        "modbus_pipeline {}: {} carries one request at a time; pipelining is for a Modbus TCP "
+        "unit that serves several transactions at once",
+        spec.modbus_pipeline, rtu ? "a serial line" : "the serial line behind a gateway"));
+  if (spec.modbus_pipeline > 1 && spec.request_gap_s > 0)
+    throw std::invalid_argument(
+        "modbus_pipeline: a request_gap_s between requests and several requests on the wire at "
+        "once exclude each other");
   if (spec.unit_id == 0 && serial_unit(spec))
     throw std::invalid_argument(
         "unit_id 0 is the broadcast address of a serial line: no unit answers it (Modbus over "

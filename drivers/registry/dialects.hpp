@@ -53,6 +53,9 @@ struct DeviceSpec {
   /// dialect reads it as a serial unit (F4T: units register 14080, the serial pause).
   bool gateway = false;
   int readback_every = modbus::ReadbackSchedule::kDefaultEvery;
+  /// Modbus TCP: the most reads of one device reading on the wire at once (ModbusClient::
+  /// set_pipeline); 1, the default: one request, its reply, then the next (what every unit serves).
+  int modbus_pipeline = 1;
   std::vector<modbus::PointOverride> overrides;  ///< Modbus dialects: point overrides
   int run_event = 1;  ///< Watlow F4/F4T: event output that runs the chamber (builder's wiring)
   /// Watlow F4/F4T: the input (F4) or loop (F4T) carrying the product temperature; 0: none. An

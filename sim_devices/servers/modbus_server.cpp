@@ -26,6 +26,17 @@ constexpr int kPollMs = 100;
 // once within microseconds, so a few ms of silence delimit frames without splitting one.
 constexpr int kRtuSilenceMs = 5;
 
+// Whole Modbus TCP frames at the front of `buf` (by their MBAP headers; a bad one ends the count).
+std::size_t whole_tcp_frames(const std::vector<std::uint8_t>& buf) {
+  std::size_t n = 0;
+  for (std::size_t at = 0; at + 6 <= buf.size(); ++n) {
+    const std::size_t length = (std::size_t{buf[at + 4]} << 8) | buf[at + 5];
+    if (buf[at + 2] != 0 || buf[at + 3] != 0 || length < 2 || at + 6 + length > buf.size()) break;
+    at += 6 + length;
+  }
+  return n;
+}
+
 double steady_now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
@@ -159,14 +170,32 @@ void ModbusServer::open_capture() {
 bool ModbusServer::send_reply(const std::function<int()>& build) {
   const int fd = modbus_get_socket(ctx_.get());
   const double interval_s = faults_.drip_interval_s();
-  if (interval_s <= 0 && !drips_.busy(fd)) return build() != -1;
+  const bool drip = interval_s > 0 || drips_.busy(fd);
+  if (drip && gathering_ && !send_gathered(fd)) return false;  // what was before it, first
+  if (!drip && !gathering_) return build() != -1;
   modbus_set_socket(ctx_.get(), capture_[0]);
   const int rc = build();
   modbus_set_socket(ctx_.get(), fd);
+  if (gathering_) return rc != -1;
   std::uint8_t bytes[MODBUS_TCP_MAX_ADU_LENGTH];
   const ssize_t n = recv(capture_[1], bytes, sizeof bytes, MSG_DONTWAIT);
   if (n > 0) drips_.push(fd, {bytes, static_cast<std::size_t>(n)}, interval_s);
   return rc != -1;
+}
+
+bool ModbusServer::send_gathered(int fd) {
+  gathering_ = false;
+  std::vector<std::uint8_t> out;
+  std::uint8_t chunk[4096];
+  for (ssize_t n; (n = recv(capture_[1], chunk, sizeof chunk, MSG_DONTWAIT)) > 0;)
+    out.insert(out.end(), chunk, chunk + n);
+  for (std::size_t done = 0; done < out.size();) {
+    const ssize_t n = send(fd, out.data() + done, out.size() - done, MSG_NOSIGNAL);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return false;
+    done += static_cast<std::size_t>(n);
+  }
+  return true;
 }
 
 void ModbusServer::accept_client(std::vector<int>& clients) {
@@ -241,26 +270,33 @@ void ModbusServer::run_rtu() {
 // cut from the client's byte stream by its MBAP header (Modbus Messaging on TCP/IP
 // Implementation Guide v1.0b, 3.1.3: transaction id, protocol id 0, length of the unit id and
 // PDU). A frame split across segments waits for the rest; a bad header closes the connection,
-// as libmodbus does.
+// as libmodbus does. Several requests in one read (a client with several outstanding, §3.1.3)
+// are answered in order and their replies sent in one send, each reply's bytes as alone (one
+// wake-up of the client, not one a reply); what came before a drop or a bad header still goes.
 bool ModbusServer::serve_one(int fd) {
   auto& buf = pending_[fd];
   std::uint8_t chunk[MODBUS_TCP_MAX_ADU_LENGTH];
   const ssize_t n = recv(fd, chunk, sizeof chunk, MSG_DONTWAIT);
   if (n == 0 || (n < 0 && errno != EAGAIN && errno != EINTR)) return forget(fd);
   if (n > 0) buf.insert(buf.end(), chunk, chunk + n);
+  gathering_ = whole_tcp_frames(buf) > 1;
+  const auto close_it = [&] {
+    if (gathering_) (void)send_gathered(fd);
+    return forget(fd);
+  };
   constexpr std::size_t kMbap = 7;  // transaction 2, protocol 2, length 2, unit 1
   while (buf.size() >= kMbap) {
     const std::size_t length = (std::size_t{buf[4]} << 8) | buf[5];  // unit id + PDU
     if (buf[2] != 0 || buf[3] != 0 || length < 2 || 6 + length > MODBUS_TCP_MAX_ADU_LENGTH)
-      return forget(fd);
+      return close_it();
     if (buf.size() < 6 + length) break;
     std::uint8_t query[MODBUS_TCP_MAX_ADU_LENGTH];
     std::copy_n(buf.begin(), 6 + length, query);
     buf.erase(buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(6 + length));
     modbus_set_socket(ctx_.get(), fd);
-    if (!dispatch(query, static_cast<int>(6 + length), steady_now_s())) return forget(fd);
+    if (!dispatch(query, static_cast<int>(6 + length), steady_now_s())) return close_it();
   }
-  return true;
+  return !gathering_ || send_gathered(fd) || forget(fd);
 }
 
 bool ModbusServer::forget(int fd) {

@@ -103,8 +103,12 @@ class ModbusServer final : public SimServer {
   bool dispatch(const std::uint8_t* query, int len, double arrived_s);
   bool handle(const std::uint8_t* query, int len, bool reply);
   /// Sends the reply `build` makes (a libmodbus modbus_reply*): at once, or a byte at a time
-  /// while a drip is on (or queued behind one), captured from a socketpair first.
+  /// while a drip is on (or queued behind one), captured from a socketpair first; while a batch
+  /// is gathered, captured for send_gathered.
   bool send_reply(const std::function<int()>& build);
+  /// Sends `fd` the replies gathered in the capture socketpair, in one send; false when the
+  /// client is gone. Ends the gathering.
+  bool send_gathered(int fd);
   void open_capture();
   std::uint8_t strict_exception(std::span<const std::uint8_t> pdu) const;
   void apply_writes(std::span<const std::uint8_t> pdu);
@@ -126,7 +130,8 @@ class ModbusServer final : public SimServer {
   std::vector<double> arrivals_s_;  // guarded by arrivals_mutex_
   std::thread thread_;
   std::map<int, std::vector<std::uint8_t>> pending_;  // per TCP client: bytes of a partial frame
-  int capture_[2] = {-1, -1};                         // socketpair a dripped reply is built into
+  int capture_[2] = {-1, -1};  // socketpair a dripped or gathered reply is built into
+  bool gathering_ = false;     // the replies to the requests of one read go out in one send
   DripQueue drips_;
 };
 

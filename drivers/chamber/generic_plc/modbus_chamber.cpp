@@ -43,6 +43,8 @@ ModbusChamber::ModbusChamber(std::string name, modbus::Endpoint endpoint, modbus
                         cm::kSetpointLow, cm::kSetpointHigh, cm::kRun})
     (void)map_.at(p);  // throws naming the missing point
   for (const char* p : kReadPoints) read_points_.push_back(map_.at(p));
+  limit_points_ = {map_.at(cm::kSetpointLow), map_.at(cm::kSetpointHigh)};
+  limit_plan_ = modbus::plan_each(limit_points_);
   set_max_read_gap(kDefaultMaxReadGap);
 }
 
@@ -53,10 +55,6 @@ void ModbusChamber::set_max_read_gap(int registers) {
 
 Result<void> ModbusChamber::connect() {
   return client_.connect();
-}
-
-Result<double> ModbusChamber::get(const char* point) {
-  return client_.read(map_.at(point));
 }
 
 Result<std::vector<double>> ModbusChamber::read_values() {
@@ -97,29 +95,30 @@ Result<ChamberState> ModbusChamber::read() {
   return s;
 }
 
+Result<std::vector<double>> ModbusChamber::limits() {
+  return client_.read_points(limit_points_, limit_plan_);
+}
+
 Result<void> ModbusChamber::check_setpoint(double setpoint_c) {
-  auto lo = get(cm::kSetpointLow);
-  if (!lo) return lo.error();
-  auto hi = get(cm::kSetpointHigh);
-  if (!hi) return hi.error();
-  if (!std::isfinite(setpoint_c) || setpoint_c < lo.value() || setpoint_c > hi.value())
+  const auto lim = limits();
+  if (!lim) return lim.error();
+  const double lo = lim.value()[0], hi = lim.value()[1];
+  if (!std::isfinite(setpoint_c) || setpoint_c < lo || setpoint_c > hi)
     return make_error(ErrorKind::range,
                       fmt::format("{}: setpoint {} C outside the chamber limits [{}, {}] C", name_,
-                                  setpoint_c, lo.value(), hi.value()));
+                                  setpoint_c, lo, hi));
   return {};
 }
 
 Result<ChamberIdentity> ModbusChamber::identify() {
-  auto lo = get(cm::kSetpointLow);
-  if (!lo) return lo.error();
-  auto hi = get(cm::kSetpointHigh);
-  if (!hi) return hi.error();
+  const auto lim = limits();
+  if (!lim) return lim.error();
   ChamberIdentity id;
   id.model = "generic_plc";
   id.identity = "station map '" + map_.device() + "' (no identity register)";
   id.units = "C";
-  id.setpoint_low_c = lo.value();
-  id.setpoint_high_c = hi.value();
+  id.setpoint_low_c = lim.value()[0];
+  id.setpoint_high_c = lim.value()[1];
   id.notes = "scaling from the map";
   return id;
 }

@@ -56,16 +56,19 @@ class ModbusChamber final : public Chamber {
   modbus::ModbusClient& client() { return client_; }
 
  private:
-  Result<double> get(const char* point);
   Result<std::vector<double>> read_values();
   Result<void> check_setpoint(double setpoint_c);
+  /// The setpoint limits, low and high: two reads, on the wire together with a pipeline.
+  Result<std::vector<double>> limits();
 
   std::string name_;
   modbus::RegisterMap map_;
   modbus::ModbusClient client_;
   std::vector<modbus::Point> read_points_;  // in the order of the state fields (see .cpp)
   std::vector<modbus::ReadBlock> read_plan_;
-  std::vector<modbus::ReadBlock> live_plan_;  // alarms, air, setpoint
+  std::vector<modbus::ReadBlock> live_plan_;   // alarms, air, setpoint
+  std::vector<modbus::Point> limit_points_;    // setpoint low, high
+  std::vector<modbus::ReadBlock> limit_plan_;  // one read each, low first (as read alone)
   modbus::ReadbackSchedule readback_;
   ChamberMode mode_ = ChamberMode::off;        // read back last
   double product_c_ = 0, ramp_c_per_min_ = 0;  // read back last
