@@ -20,13 +20,23 @@ std::optional<EnuAxis> axis_from_name(std::string_view name) {
   return std::nullopt;
 }
 
-EnuAxis horizontal_axis(double heading_deg) {
+namespace {
+
+// A heading within +-kMaxAbsHeadingDeg normalised to [0, 360); throws DataError beyond.
+double normalized_heading_deg(double heading_deg) {
   if (!std::isfinite(heading_deg) || std::abs(heading_deg) > kMaxAbsHeadingDeg) {
     throw DataError("heading " + number_text(heading_deg) + " is not within +-360 deg");
   }
   double psi_deg = std::fmod(heading_deg, 360.0);  // exact
   if (psi_deg < 0) psi_deg += 360.0;
   if (psi_deg >= 360.0) psi_deg = 0.0;  // -tiny + 360 rounds to 360
+  return psi_deg;
+}
+
+}  // namespace
+
+EnuAxis horizontal_axis(double heading_deg) {
+  const double psi_deg = normalized_heading_deg(heading_deg);
   const double psi = psi_deg * std::numbers::pi / 180.0;
   return EnuAxis{std::sin(psi), std::cos(psi), 0};
 }
@@ -49,6 +59,20 @@ EnuAxis parse_axis(std::string_view text) {
     throw DataError("heading " + std::string(deg) + " is not within +-360 deg");
   }
   return horizontal_axis(v);
+}
+
+std::optional<double> axis_heading_deg(std::string_view text) {
+  const EnuAxis a = parse_axis(text);  // validates
+  if (a.up != 0.0) return std::nullopt;
+  if (text == "north") return 0.0;
+  if (text == "east") return 90.0;
+  if (text == "south") return 180.0;
+  if (text == "west") return 270.0;
+  // "heading:DEG", DEG read as parse_axis read it (exact: no round trip through sin and cos).
+  const std::string_view deg = text.substr(text.find(':') + 1);
+  double v = 0;
+  std::from_chars(deg.data(), deg.data() + deg.size(), v);
+  return normalized_heading_deg(v);
 }
 
 double earth_rate_along_axis_dph(double latitude_deg, const EnuAxis& axis) {

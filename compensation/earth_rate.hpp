@@ -32,6 +32,11 @@ EnuAxis horizontal_axis(double heading_deg);
 /// Throws DataError saying what is wrong (unknown name, DEG not a number or out of range).
 EnuAxis parse_axis(std::string_view text);
 
+/// The heading of a horizontal axis written as parse_axis reads it ("north", "east", "south",
+/// "west", "heading:DEG"), deg clockwise from north in [0, 360); empty for up and down. Throws
+/// DataError as parse_axis.
+std::optional<double> axis_heading_deg(std::string_view text);
+
 /// The gyro's bias: its output minus the Earth rate along its input axis (the paper, sec. 2: the
 /// table holds still, so all a perfect gyro would sense is the Earth's rotation), deg/h.
 inline double bias_dph(double rate_dph, double earth_rate_dph) {

@@ -64,6 +64,20 @@ double warmup_mean_dph(const AcceptanceTruth& a, double from_s, double to_s) {
          (to_s - from_s);
 }
 
+AcceptanceTruth mounted_horizontal(AcceptanceTruth a, double nominal_heading_deg) {
+  const double m = a.misalignment_rad, az = a.misalignment_azimuth_deg * kRadPerDeg;
+  a.input_axis = InputAxis::horizontal;
+  a.nominal_heading_deg = nominal_heading_deg;
+  a.north_at_table_deg = nominal_heading_deg + m * std::cos(az) / kRadPerDeg;
+  a.misalignment_rad = m * std::sin(az);  // the elevation (AcceptanceTruth)
+  return a;
+}
+
+double heading_error_rad(const AcceptanceTruth& a) {
+  if (a.input_axis != InputAxis::horizontal) return 0.0;
+  return std::remainder(a.north_at_table_deg - a.nominal_heading_deg, 360.0) * kRadPerDeg;
+}
+
 AcceptanceTruth sim_acceptance_truth(std::uint64_t seed, int index) {
   // A stream of its own (sim_coefficients uses seed*1000003 + index): the thermal truth stays.
   std::mt19937_64 rng(seed * 2000029u + static_cast<std::uint64_t>(index) + 0x36u);

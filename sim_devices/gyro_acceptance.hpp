@@ -36,10 +36,26 @@ struct AcceptanceTruth {
   double misalignment_rad = 0;
   /// vertical only: the table angle at which the tilt leans towards north, deg.
   double misalignment_azimuth_deg = 0;
-  /// horizontal only: the table angle at which the input axis points north, deg.
+  /// horizontal only: the table angle at which the input axis points north, deg. The table
+  /// turns counterclockwise seen from above for a positive angle, so the axis's heading
+  /// (clockwise from north) at table angle theta is north_at_table_deg - theta: this is also its
+  /// true heading at table angle 0.
   double north_at_table_deg = 0;
+  /// horizontal only: the heading the slot states for the axis at table angle 0 (its [[slot]]
+  /// axis), deg clockwise from north; north_at_table_deg - this is the heading error.
+  double nominal_heading_deg = 0;
   InputAxis input_axis = InputAxis::vertical;
 };
+
+/// The same gyro mounted with its input axis horizontal at `nominal_heading_deg` (clockwise
+/// from north at table angle 0): its drawn misalignment (magnitude m = misalignment_rad towards
+/// the drawn misalignment_azimuth_deg a) becomes a heading error m cos(a) and an elevation out
+/// of the table's plane m sin(a), so the axis is m from where the slot says, as drawn.
+AcceptanceTruth mounted_horizontal(AcceptanceTruth a, double nominal_heading_deg);
+
+/// horizontal: the true heading less the nominal one, wrapped to +-180 deg, in rad (positive:
+/// the axis turned clockwise seen from above); 0 for a vertical axis.
+double heading_error_rad(const AcceptanceTruth& a);
 
 /// One power-up of a simulated gyro: when (its own clock, s) and the turn-on bias drawn, deg/h.
 struct PowerUp {

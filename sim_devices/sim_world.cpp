@@ -119,8 +119,13 @@ SimWorld::SimWorld(const SimWorldConfig& config) : config_(config) {
     if (config_.acceptance_truth) acceptance = sim_acceptance_truth(config_.seed, i);
     if (auto it = config_.acceptance_by_node.find(node); it != config_.acceptance_by_node.end())
       acceptance = it->second;
+    if (auto it = config_.horizontal_heading_by_node.find(node);
+        it != config_.horizontal_heading_by_node.end())
+      acceptance = mounted_horizontal(acceptance, it->second);
     gyros_.push_back({node, sim_serial(config_.preset, i), config_.pulse_weight_arcsec,
                       sim_coefficients(config_.seed, i, config_.preset), acceptance});
+    if (acceptance.input_axis == InputAxis::horizontal)
+      gyros_.back().axis = fmt::format("heading:{}", acceptance.nominal_heading_deg);
   }
   if (config_.can_unix_path.empty()) {
     int sv[2];

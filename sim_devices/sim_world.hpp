@@ -71,6 +71,9 @@ struct SimWorldConfig {
   bool relay_power = false;
   /// A gyro's truth by node, over acceptance_truth's (or the all-zero default).
   std::map<std::uint8_t, AcceptanceTruth> acceptance_by_node;
+  /// Gyro n's input axis horizontal at this heading (deg clockwise from north at table angle 0):
+  /// its truth mounted so (mounted_horizontal); a node not here keeps its axis (up).
+  std::map<std::uint8_t, double> horizontal_heading_by_node;
 };
 
 /// One simulated gyro as the station will see it.
@@ -80,6 +83,9 @@ struct SimGyro {
   double pulse_weight_arcsec = 1.5;
   TrueCoefficients truth;
   AcceptanceTruth acceptance;  ///< its acceptance-test truth (all zero unless configured)
+  /// Its [[slot]] axis as a station configuration writes it: "up", or "heading:DEG" for a
+  /// horizontal input axis (the nominal heading of its truth).
+  std::string axis = "up";
 };
 
 /// The simulated rig. Construction starts the Modbus servers (loopback, configured ports) and

@@ -131,8 +131,8 @@ void print_config(const sim::SimWorld& world, const Options& o) {
   if (!o.control.empty())
     fmt::print("# fault commands: simrig --control {} --send 'help'\n", o.control);
   for (const auto& g : world.gyros()) {
-    fmt::print("\n[[slot]]\nnode = {}\nserial = \"{}\"\npulse_weight_arcsec = {}\naxis = \"up\"\n",
-               g.node, g.serial, g.pulse_weight_arcsec);
+    fmt::print("\n[[slot]]\nnode = {}\nserial = \"{}\"\npulse_weight_arcsec = {}\naxis = \"{}\"\n",
+               g.node, g.serial, g.pulse_weight_arcsec, g.axis);
   }
   std::fflush(stdout);
 }

@@ -61,7 +61,44 @@ json ladder_json(const LadderFigures& l) {
   return j;
 }
 
+/// A horizontal input axis's positions. "tilt_mrad" (what a part's max_tilt_mrad judges, the
+/// store keeps and history charts) is its heading error: of the input-axis misalignment (IEEE Std
+/// 647-2006 and 952-1997 test items; IEEE Std 528's terms: the angle between the input axis and
+/// its input reference axis, here the slot's axis) the part the Earth rate's projection shows,
+/// the one in the table's plane. The elevation out of that plane adds W sin(lat) sin(e) to the
+/// constant, which holds the bias as well: no figure without a known bias (positions.hpp), so
+/// not judged, and "bias_dph" is the bias if the axis is level.
+json horizontal_positions_json(const PositionFigures& p) {
+  json j{{"step_index", p.step_index}, {"label", p.label},
+         {"points", p.points},         {"excluded", p.excluded},
+         {"axis", "horizontal"},       {"nominal_heading_deg", *p.nominal_heading_deg}};
+  if (std::isfinite(p.temp_c)) j["temp_c"] = p.temp_c;
+  if (!p.horizontal) {
+    j.update(not_computed(p.horizontal));
+    return j;
+  }
+  const auto& h = *p.horizontal;
+  const double err_mrad = heading_error_rad(h) * 1e3,
+               se_mrad = h.in_plane_misalignment_se_rad * 1e3;
+  j.update({{"ok", true},
+            {"heading_error_mrad", err_mrad},
+            {"heading_error_se_mrad", se_mrad},
+            {"tilt_mrad", err_mrad},
+            {"tilt_se_mrad", se_mrad},
+            {"bias_dph", h.bias_if_level_dph},
+            {"bias_se_dph", h.bias_if_level_se_dph},
+            {"bias_note", "the bias if the axis is level: its elevation's Earth rate is in it"},
+            {"elevation_note",
+             "the axis's elevation out of the table's plane and the bias are one constant on a "
+             "table turning about up; not measured"},
+            {"amplitude_ratio", h.amplitude_ratio},
+            {"amplitude_ratio_se", h.amplitude_ratio_se},
+            {"amplitude_resolved", h.fit.amplitude_resolved}});
+  return j;
+}
+
 json positions_json(const PositionFigures& p) {
+  if (p.nominal_heading_deg) return horizontal_positions_json(p);
   json j = step_json(p, {{"excluded", p.excluded}});
   if (!p.fit) return j;
   const auto& f = *p.fit;

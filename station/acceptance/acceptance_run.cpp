@@ -11,6 +11,7 @@
 #include "compensation/acceptance_windows.hpp"
 #include "compensation/earth_rate.hpp"
 #include "station/config/acceptance_steps.hpp"
+#include "station/config/config.hpp"
 #include "station/config/protocol.hpp"
 
 namespace station {
@@ -226,9 +227,51 @@ void hold_to_nominal(LadderFigures& f, const RunSlot& slot) {
   }
 }
 
+/// The site's latitude for the positions of a horizontal axis: the run's configuration
+/// snapshot's (what its slots' Earth rates came from), or why there is none.
+struct SiteLatitude {
+  std::optional<double> deg;
+  std::string why;
+};
+
+SiteLatitude run_latitude(const RunRecord& run) {
+  try {
+    return {parse_station_config(run.config_text, "run " + std::to_string(run.id) + " config")
+                .latitude_deg,
+            {}};
+  } catch (const std::exception& e) {
+    return {std::nullopt, std::string("the run's configuration gives no latitude: ") + e.what()};
+  }
+}
+
+/// The slot's horizontal heading (positions.hpp via heading_error_rad's conventions), empty for
+/// an axis up or down or one that does not read.
+std::optional<double> slot_heading_deg(const RunSlot& slot) {
+  try {
+    return comp::axis_heading_deg(slot.axis);
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+}
+
+/// The horizontal axis's figures (heading_error_rad states the conventions): the zero mark at
+/// north, the axis at table angle -heading; no known bias (the table turns about up only, so
+/// the bias and the axis's elevation are one constant: positions.hpp).
+void analyze_horizontal(const std::vector<comp::PositionPoint>& points, double heading_deg,
+                        const SiteLatitude& latitude, PositionFigures& f) {
+  f.nominal_heading_deg = heading_deg;
+  f.fit = comp::NotComputed{"the input axis is horizontal"};
+  if (!latitude.deg) {
+    f.horizontal = comp::NotComputed{latitude.why};
+    return;
+  }
+  f.horizontal =
+      comp::analyze_positions_axis_horizontal(points, {*latitude.deg, 0.0}, -heading_deg);
+}
+
 PositionFigures positions_of(const Step& s, int index, const std::map<int, PointEvent>& events,
                              const std::vector<SampleRow>& rows, const RunSlot& slot,
-                             std::optional<double> white_pps2_s) {
+                             std::optional<double> white_pps2_s, const SiteLatitude& latitude) {
   PositionFigures f;
   f.step_index = index;
   f.label = s.label;
@@ -250,6 +293,10 @@ PositionFigures positions_of(const Step& s, int index, const std::map<int, Point
     temps.insert(temps.end(), w.window.temp_c.begin(), w.window.temp_c.end());
   }
   f.temp_c = mean_temp_c(temps);
+  if (const auto heading = slot_heading_deg(slot)) {
+    analyze_horizontal(points, *heading, latitude, f);
+    return f;
+  }
   // The axis is up: its Earth rate is Omega sin(phi) (earth_rate.hpp), so the site's latitude
   // is the one the run's slot was given.
   const double s_phi = std::clamp(slot.earth_rate_dph / comp::kEarthRateDph, -1.0, 1.0);
@@ -325,7 +372,8 @@ void turn_ons_of(const Step& s, int index, const std::map<int, PointEvent>& even
 
 void analyze_step(const Protocol& p, int index, const StepPoints& events,
                   const std::vector<SampleRow>& rows, const RunSlot& slot,
-                  std::optional<double> white_pps2_s, SerialAcceptance& out) {
+                  std::optional<double> white_pps2_s, const SiteLatitude& latitude,
+                  SerialAcceptance& out) {
   const Step& s = p.steps[static_cast<std::size_t>(index)];
   static const std::map<int, PointEvent> kNone;
   const auto it = events.find(index);
@@ -339,11 +387,11 @@ void analyze_step(const Protocol& p, int index, const StepPoints& events,
           slot.axis};
     out.ladders.push_back(std::move(f));
   } else if (s.kind == StepKind::positions) {
-    if (slot.axis == "up")
-      out.positions.push_back(positions_of(s, index, mine, rows, slot, white_pps2_s));
+    if (slot.axis == "up" || slot_heading_deg(slot))
+      out.positions.push_back(positions_of(s, index, mine, rows, slot, white_pps2_s, latitude));
     else
       out.positions_note =
-          "positions are analysed for an input axis up only (this one: " + slot.axis + ")";
+          "positions are analysed for an input axis up or horizontal (this one: " + slot.axis + ")";
   } else if (s.kind == StepKind::power_cycles) {
     turn_ons_of(s, index, mine, rows, slot, white_pps2_s, out);
   }
@@ -362,6 +410,22 @@ void fit_across_plateaus(SerialAcceptance& a, double ref_temp_c) {
 
 }  // namespace
 
+const comp::ProjectionFit* positions_projection(const PositionFigures& p, std::string* why) {
+  if (p.nominal_heading_deg) {
+    if (p.horizontal) return &p.horizontal->fit;
+    if (why) *why = p.horizontal.error();
+    return nullptr;
+  }
+  if (p.fit) return &p.fit->fit;
+  if (why) *why = p.fit.error();
+  return nullptr;
+}
+
+double positions_bias_dph(const PositionFigures& p) {
+  if (p.nominal_heading_deg) return p.horizontal ? p.horizontal->bias_if_level_dph : 0.0;
+  return p.fit ? p.fit->bias_dph : 0.0;
+}
+
 std::vector<SerialAcceptance> run_acceptance(Store& store, std::int64_t run_id, double ref_temp_c) {
   std::vector<SerialAcceptance> out;
   const auto run = store.find_run(run_id);
@@ -372,13 +436,18 @@ std::vector<SerialAcceptance> run_acceptance(Store& store, std::int64_t run_id, 
     if (is_acceptance_step(p.steps[i].kind)) steps.push_back(static_cast<int>(i));
   if (steps.empty()) return out;
   const StepPoints events = point_events(store, run_id);
-  for (const auto& slot : store.run_slots(run_id)) {
+  const auto slots = store.run_slots(run_id);
+  // Only a horizontal axis needs the latitude (a vertical one's comes from its Earth rate).
+  const bool horizontal = std::any_of(
+      slots.begin(), slots.end(), [](const RunSlot& s) { return slot_heading_deg(s).has_value(); });
+  const SiteLatitude latitude = horizontal ? run_latitude(*run) : SiteLatitude{};
+  for (const auto& slot : slots) {
     SerialAcceptance a;
     a.serial = slot.serial;
     a.earth_rate_dph = slot.earth_rate_dph;
     const auto rows = store.samples(run_id, slot.serial, false);
     const auto white_pps2_s = serial_white_density(p, steps, events, rows);
-    for (int i : steps) analyze_step(p, i, events, rows, slot, white_pps2_s, a);
+    for (int i : steps) analyze_step(p, i, events, rows, slot, white_pps2_s, latitude, a);
     fit_across_plateaus(a, ref_temp_c);
     // A drifting plateau's ladder brought to its slope's temperature with the run's own TC
     // (scale_factor.hpp, "A drifting plateau"), then K against temperature again.

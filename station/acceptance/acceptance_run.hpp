@@ -35,9 +35,36 @@ struct PositionFigures {
   double temp_c = 0;
   int points = 0, excluded = 0;
   std::vector<double> angles_deg;  ///< the table angle of each point the fit took, in its order
+  /// The input axis up (the slot's axis "up"): its tilt from the table's axis.
   compensation::Computed<compensation::VerticalAxisResult> fit{
       compensation::NotComputed{"not analysed"}};
+  /// The input axis horizontal (north, south, east, west, heading:DEG): its nominal heading at
+  /// table angle 0, deg clockwise from north, and its figures (`fit` is then left unset: see
+  /// positions_projection).
+  std::optional<double> nominal_heading_deg;
+  compensation::Computed<compensation::HorizontalAxisResult> horizontal{
+      compensation::NotComputed{"not analysed"}};
 };
+
+/// Sign conventions of a horizontal axis's positions, stated once. The table angle theta is
+/// counterclockwise seen from above (right-handed about up: the sense of a positive table rate,
+/// which an up axis senses positively); a heading is clockwise from north (a [[slot]] axis
+/// heading:DEG). The axis at heading H at theta = 0 points at H - theta at theta, so the
+/// analysis takes the table's zero mark at north (psi_z = 0) and the axis at table angle -H
+/// (compensation/positions.hpp). The heading error is the true heading less the nominal one,
+/// positive clockwise: the negated in-plane misalignment (counterclockwise) of positions.hpp.
+inline double heading_error_rad(const compensation::HorizontalAxisResult& r) {
+  return -r.in_plane_misalignment_rad;
+}
+
+/// The fitted projection of a positions step, whichever the mounting; nullptr when its figures
+/// were not computed, `why` then saying why.
+const compensation::ProjectionFit* positions_projection(const PositionFigures& p,
+                                                        std::string* why = nullptr);
+
+/// The bias a positions step's projection is drawn less of, deg/h: the vertical axis's bias, or
+/// for a horizontal axis the fit's constant (its bias if level: bias_if_level_dph).
+double positions_bias_dph(const PositionFigures& p);
 
 /// One turn-on's bias in kTurnOnBinS bins from its power-up: what its warm-up was judged on.
 struct TurnOnCurve {
@@ -72,7 +99,7 @@ struct SerialAcceptance {
   /// block is often at another temperature: pooling its biases would add a temperature effect
   /// to the repeatability); every one is judged.
   std::vector<TurnOnStep> turn_on_steps;
-  std::string positions_note;  ///< why positions were not analysed (an axis not up or down)
+  std::string positions_note;  ///< why positions were not analysed (an axis down)
 };
 
 /// Bin width of a turn-on's bias series, s: long enough that a bin's white noise (ARW 0.003

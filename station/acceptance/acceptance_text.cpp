@@ -66,9 +66,28 @@ std::string tc_line(const json& s) {
       truth(t, "tc_ppm_per_c", "{:+.2f}"), t["plateaus"].get<int>());
 }
 
+/// A horizontal axis's figures (acceptance_json.cpp: horizontal_positions_json).
+std::string horizontal_figures(const json& s, const json& p) {
+  return fmt::format(
+      "input axis at heading {:g} deg: heading error {:+.3f} +- {:.3f} mrad{} (clockwise), "
+      "bias if level {:+.4f} +- {:.4f} deg/h (the elevation out of the plane is in it: not "
+      "measured{}), Earth-rate amplitude {:.5f} +- {:.5f} of W cos(lat)",
+      p["nominal_heading_deg"].get<double>(), p["heading_error_mrad"].get<double>(),
+      p["heading_error_se_mrad"].get<double>(), truth(s, "heading_error_mrad", "{:+.3f}"),
+      p["bias_dph"].get<double>(), p["bias_se_dph"].get<double>(),
+      truth(s, "elevation_mrad", "{:+.3f} mrad"), p["amplitude_ratio"].get<double>(),
+      p["amplitude_ratio_se"].get<double>());
+}
+
 std::string positions_line(const json& s, const json& p) {
   std::string out = fmt::format("  positions     {:<28} {}  ", p.value("label", ""), temp(p));
   if (!p.value("ok", false)) return out + "not computed: " + p.value("error", "") + "\n";
+  if (p.value("axis", "") == "horizontal") {
+    out += horizontal_figures(s, p);
+    if (p.value("excluded", 0) > 0)
+      out += fmt::format("; {} angles left out", p["excluded"].get<int>());
+    return out + "\n";
+  }
   out += fmt::format(
       "input-axis tilt {:.3f} +- {:.3f} mrad{} toward {:.0f} +- {:.0f} deg of the "
       "table, bias {:+.4f} +- {:.4f} deg/h",

@@ -76,7 +76,12 @@ json verdict_of(const json& s, const PartLimits& part) {
   }
   if (!judged.empty() || j.not_judged.empty())
     judge_each(j, judged, "asymmetry_ppm", a.max_asymmetry_ppm, "asymmetry", "ppm");
-  judge_each(j, s["positions"], "tilt_mrad", a.max_tilt_mrad, "tilt", "mrad");
+  // A horizontal input axis's "tilt_mrad" is its heading error (acceptance_json.cpp says why):
+  // the same limit, named as what it is. A serial's positions share its slot's axis.
+  const bool horizontal =
+      !s["positions"].empty() && s["positions"][0].value("axis", "") == "horizontal";
+  judge_each(j, s["positions"], "tilt_mrad", a.max_tilt_mrad, horizontal ? "heading error" : "tilt",
+             "mrad");
   // Every power_cycles step (turn_on_steps when there are two or more, else turn_on).
   if (s.contains("turn_on_steps")) {
     judge_each(j, s["turn_on_steps"], "repeatability_dph", a.max_turn_on_repeatability_dph,

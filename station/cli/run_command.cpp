@@ -59,8 +59,9 @@ struct RunOptions {
   std::string turntable_model = "generic_plc";
   std::string acutrol_framing = "bare";  ///< --sim: a simulated ACUTROL's reply framing
   double latitude_deg = 39.9;
-  double speed = 0;  ///< --sim: simulated s per wall s (0: as fast as possible)
-  std::string http;  ///< --http HOST:PORT (empty: no HTTP service)
+  std::vector<std::string> axes;  ///< --sim --axis: slot i's input axis
+  double speed = 0;               ///< --sim: simulated s per wall s (0: as fast as possible)
+  std::string http;               ///< --http HOST:PORT (empty: no HTTP service)
   std::string token_file;
 };
 
@@ -211,6 +212,7 @@ SimRunOptions sim_options(const RunOptions& o, const std::string& db) {
   so.turntable_model = o.turntable_model;
   so.acutrol_framing = o.acutrol_framing;
   so.latitude_deg = o.latitude_deg;
+  so.axes = o.axes;
   so.protocol = o.protocol;
   so.db_path = db;
   so.fresh = o.fresh;
@@ -280,6 +282,10 @@ void add_sim_world_options(CLI::App* cmd, RunOptions& o) {
       ->capture_default_str();
   cmd->add_option("--latitude", o.latitude_deg, "simulated site latitude, deg")
       ->capture_default_str();
+  cmd->add_option("--axis", o.axes,
+                  "--sim: the input axis of slot 1, 2, ... in turn (up, north, south, east, west "
+                  "or heading:DEG; the rest up): a horizontal one is mounted so on the "
+                  "simulated table (positions, issue 36)");
 }
 
 /// What a run records and the simulation's fault script and parts.

@@ -230,11 +230,13 @@ Figure positions_figure(std::string id, const SerialAcceptanceReport& a) {
   for (std::size_t i = 0; i < acc.positions.size(); ++i) {
     const auto& p = acc.positions[i];
     const std::string name = step_label(p.label, p.step_index, p.temp_c);
-    if (!p.fit) {
-      why.push_back(name + ": " + p.fit.error());
+    std::string not_computed;
+    const auto* projection = positions_projection(p, &not_computed);
+    if (projection == nullptr) {
+      why.push_back(name + ": " + not_computed);
       continue;
     }
-    const auto& v = p.fit->fit;
+    const auto& v = *projection;
     const auto& angles =
         i < a.position_angles_deg.size() ? a.position_angles_deg[i] : std::vector<double>{};
     if (angles.size() != v.residuals_dph.size()) {
@@ -242,7 +244,7 @@ Figure positions_figure(std::string id, const SerialAcceptanceReport& a) {
       continue;
     }
     // y = c + A cos(theta - theta0) (positions.hpp), less the bias: the projection alone.
-    const double offset = v.constant_dph - p.fit->bias_dph;
+    const double offset = v.constant_dph - positions_bias_dph(p);
     const auto model = [&](double deg) {
       return offset + v.amplitude_dph * std::cos((deg - v.phase_deg) * std::numbers::pi / 180.0);
     };
@@ -260,7 +262,9 @@ Figure positions_figure(std::string id, const SerialAcceptanceReport& a) {
       curve.y.push_back(model(deg));
     }
     if (!v.amplitude_resolved)
-      notes.push_back(name + ": amplitude below 3 SE, the tilt is an upper bound");
+      notes.push_back(name + (p.nominal_heading_deg
+                                  ? ": amplitude below 3 SE, the heading error is not resolved"
+                                  : ": amplitude below 3 SE, the tilt is an upper bound"));
     f.series.push_back(std::move(curve));  // under its points
     f.series.push_back(std::move(pts));
   }

@@ -91,8 +91,41 @@ std::string turn_on_table(const SerialAcceptance& a) {
   return t + "</table>\n";
 }
 
+/// A horizontal input axis's positions (acceptance_run.hpp: heading_error_rad's conventions).
+std::string horizontal_positions_table(const SerialAcceptance& a) {
+  std::string t =
+      "<table class=\"acceptance-figures\">\n<tr><th>positions</th><th>gyro temperature "
+      "(&deg;C)</th><th>nominal heading at table angle 0 (&deg;)</th><th>heading error "
+      "&plusmn; 1&sigma; (mrad, clockwise)</th><th>bias if level &plusmn; 1&sigma; "
+      "(&deg;/h)</th><th>Earth rate amplitude / &Omega; cos &phi; &plusmn; 1&sigma;</th>"
+      "<th>positions used (count)</th><th>left out (count)</th></tr>\n";
+  for (const auto& p : a.positions) {
+    if (!p.nominal_heading_deg) continue;
+    t += "<tr><td>" + html_escape(p.label) + "</td><td>" + num(p.temp_c, "{:.2f}") + "</td><td>" +
+         num(*p.nominal_heading_deg, "{:g}") + "</td>";
+    if (!p.horizontal) {
+      t += "<td colspan=\"5\" class=\"note\">Not computed: " + html_escape(p.horizontal.error()) +
+           "</td></tr>\n";
+      continue;
+    }
+    const auto& h = *p.horizontal;
+    t += "<td>" +
+         pm(heading_error_rad(h) * kMradPerRad, h.in_plane_misalignment_se_rad * kMradPerRad,
+            "{:.3g}") +
+         "</td><td>" + pm(h.bias_if_level_dph, h.bias_if_level_se_dph, "{:.3g}") + "</td><td>" +
+         pm(h.amplitude_ratio, h.amplitude_ratio_se, "{:.5f}") + "</td><td>" +
+         std::to_string(h.fit.positions) + "</td><td>" + std::to_string(p.excluded) +
+         "</td></tr>\n";
+  }
+  return t +
+         "</table>\n<p class=\"note\">The axis's elevation out of the table's plane adds "
+         "&Omega; sin &phi; sin e to the constant with the bias: on a table turning about up it "
+         "is not measured, and the bias is the bias if the axis is level.</p>\n";
+}
+
 std::string positions_table(const SerialAcceptance& a) {
   if (a.positions.empty()) return "";
+  if (a.positions.front().nominal_heading_deg) return horizontal_positions_table(a);
   std::string t =
       "<table class=\"acceptance-figures\">\n<tr><th>positions</th><th>gyro temperature "
       "(&deg;C)</th><th>input axis tilt &plusmn; 1&sigma; (mrad)</th><th>tilt direction on the "
@@ -159,8 +192,10 @@ std::string method_note(AcceptancePage p) {
              "its final value (compensation/turn_on.hpp).</p>\n";
     case AcceptancePage::positions:
       return "<p class=\"method\">The output at rest at each table angle, fitted with c + "
-             "A&middot;cos(&theta; &minus; &theta;0); the input axis's tilt from A against the "
-             "horizontal Earth rate, the bias from c (compensation/positions.hpp).</p>\n";
+             "A&middot;cos(&theta; &minus; &theta;0); for an input axis up its tilt from A "
+             "against the horizontal Earth rate and the bias from c, for a horizontal one its "
+             "heading error from &theta;0 (the table angle &theta; counterclockwise seen from "
+             "above, headings clockwise from north) (compensation/positions.hpp).</p>\n";
   }
   return "";
 }

@@ -14,13 +14,22 @@ namespace comp = station::compensation;
 
 nlohmann::json serial_truth(const sim::SimGyro& g) {
   const auto& a = g.acceptance;
-  return {{"sf_pulse_per_arcsec", (1.0 + a.sf_error_ppm * 1e-6) / g.pulse_weight_arcsec},
-          {"sf_tc_ppm_per_c", a.sf_tc_ppm_per_c},
-          {"asymmetry_ppm", a.asymmetry_ppm},
-          {"misalignment_mrad", a.misalignment_rad * 1e3},
-          {"turn_on_sigma_dph", a.turn_on_sigma_dph},
-          {"warmup_tau_s", a.warmup_tau_s},
-          {"warmup_amplitude_dph", a.warmup_amplitude_dph}};
+  nlohmann::json j{{"sf_pulse_per_arcsec", (1.0 + a.sf_error_ppm * 1e-6) / g.pulse_weight_arcsec},
+                   {"sf_tc_ppm_per_c", a.sf_tc_ppm_per_c},
+                   {"asymmetry_ppm", a.asymmetry_ppm},
+                   {"turn_on_sigma_dph", a.turn_on_sigma_dph},
+                   {"warmup_tau_s", a.warmup_tau_s},
+                   {"warmup_amplitude_dph", a.warmup_amplitude_dph}};
+  if (a.input_axis == sim::InputAxis::horizontal) {
+    // The positions' figures of a horizontal axis (acceptance_run.hpp, heading_error_rad): the
+    // heading error clockwise, and the elevation out of the table's plane the run cannot see.
+    j["nominal_heading_deg"] = a.nominal_heading_deg;
+    j["heading_error_mrad"] = sim::heading_error_rad(a) * 1e3;
+    j["elevation_mrad"] = a.misalignment_rad * 1e3;
+  } else {
+    j["misalignment_mrad"] = a.misalignment_rad * 1e3;
+  }
+  return j;
 }
 
 /// The ladder's figures on the gyro's noise-free output: pulses/s = (3600 w_in (1 + e(w, dT))

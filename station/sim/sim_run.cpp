@@ -49,9 +49,9 @@ std::string sim_config_text(sim::SimWorld& world, const SimRunOptions& o,
   for (std::size_t i = 0; i < world.gyros().size(); ++i) {
     const auto& g = world.gyros()[i];
     t += fmt::format(
-        "\n[[slot]]\nnode = {}\nserial = \"{}\"\npulse_weight_arcsec = {}\naxis = \"up\"\n"
+        "\n[[slot]]\nnode = {}\nserial = \"{}\"\npulse_weight_arcsec = {}\naxis = \"{}\"\n"
         "relay = \"GYRO_PWR{}\"\n",
-        g.node, g.serial, g.pulse_weight_arcsec, i + 1);
+        g.node, g.serial, g.pulse_weight_arcsec, g.axis, i + 1);
     if (part) t += fmt::format("part = \"{}\"\n", *part);
   }
   if (!o.on_foreign_setpoint.empty()) {
@@ -157,6 +157,28 @@ void check_fault_commands(const SimRunOptions& o, const sim::SimWorldConfig& wc,
 
 namespace {
 
+/// --axis: each horizontal slot's gyro mounted at the heading its axis names (the simulator
+/// learns the mounting from its own configuration, as the slot's other figures).
+void add_sim_axes(const SimRunOptions& o, sim::SimWorldConfig& wc) {
+  if (o.axes.size() > static_cast<std::size_t>(o.gyros))
+    throw InputError(
+        fmt::format("--axis: {} axes given for {} simulated gyros", o.axes.size(), o.gyros));
+  for (std::size_t i = 0; i < o.axes.size(); ++i) {
+    std::optional<double> heading_deg;
+    try {
+      heading_deg = compensation::axis_heading_deg(o.axes[i]);
+    } catch (const std::exception& e) {
+      throw InputError(fmt::format("--axis {} (slot {}): {}", o.axes[i], i + 1, e.what()));
+    }
+    if (heading_deg)
+      wc.horizontal_heading_by_node[static_cast<std::uint8_t>(i + 1)] = *heading_deg;
+    else if (o.axes[i] != "up")
+      throw InputError(
+          fmt::format("--axis {} (slot {}): a simulated gyro's input axis is up or horizontal",
+                      o.axes[i], i + 1));
+  }
+}
+
 sim::SimWorldConfig world_config(const SimRunOptions& o) {
   sim::SimWorldConfig wc;
   wc.gyros = o.gyros;
@@ -177,6 +199,7 @@ sim::SimWorldConfig world_config(const SimRunOptions& o) {
   wc.earth_rate_dph = compensation::earth_rate_along_axis_dph(o.latitude_deg, {0, 0, 1});
   // Its north component: what a tilted input axis sees turn with the table (issue 36).
   wc.earth_rate_north_dph = compensation::earth_rate_along_axis_dph(o.latitude_deg, {0, 1, 0});
+  add_sim_axes(o, wc);
   return wc;
 }
 

@@ -30,6 +30,10 @@ struct SimRunOptions {
   std::string acutrol_framing = "bare";  ///< a simulated ACUTROL's replies: "bare" or "header"
   std::string gyro_preset = "station";   ///< sim::GyroPreset by name: "station" or "paper"
   double latitude_deg = 39.9;
+  /// Slot i's input axis (a [[slot]] axis: up, north, south, east, west or heading:DEG), the
+  /// slots past the list up; the simulated gyro is mounted so (SimWorldConfig::
+  /// horizontal_heading_by_node). An axis neither up nor horizontal is an InputError.
+  std::vector<std::string> axes;
   std::string protocol = "paper";   ///< shipped name or file
   std::string db_path;              ///< empty: station-sim.db in the current directory
   bool fresh = false;               ///< ignore an unfinished run in the database
