@@ -75,6 +75,10 @@ void AcceptanceRunner::enter(const Step& step, int step_index, double started_s)
     current_ = -1;
     rested_ = false;
     stats_ = {};
+    waited_s_ = 0;
+    sent_s_.reset();
+    arrived_ = true;
+    holding_ = unreached_ = false;
   }
   // Entered again (after a safe hold: the table stopped, the relays off): the point being
   // measured lost part of its window and, for power cycles, its turn-on.
@@ -96,13 +100,17 @@ AcceptanceActions AcceptanceRunner::leave() {
 }
 
 void AcceptanceRunner::send(const AcceptancePoint& p, double t_s, AcceptanceActions& a) {
-  const double in_s = t_s - started_s_;
+  const double in_s = schedule_s(t_s);
   switch (step_->kind) {
     case StepKind::rate_ladder:
       a.table = dr::TurntableCommand{dr::TurntableMode::rate, std::nullopt, p.demand, false};
       break;
     case StepKind::positions:
       a.table = dr::TurntableCommand{dr::TurntableMode::position, p.demand, std::nullopt, false};
+      if (!resend_ || current_ != p.index) {  // a new point: its move is waited for
+        sent_s_ = t_s;
+        arrived_ = holding_ = unreached_ = false;
+      }
       break;
     case StepKind::power_cycles:
       power_on_ = in_s >= p.measure_s;
@@ -111,6 +119,26 @@ void AcceptanceRunner::send(const AcceptancePoint& p, double t_s, AcceptanceActi
     default:
       break;
   }
+}
+
+void AcceptanceRunner::wait_for_table(const AcceptancePoint& p, double t_s,
+                                      const TableObservation& table) {
+  if (step_->kind != StepKind::positions || !sent_s_) return;
+  if (!arrived_) {
+    const bool there =
+        table.in_position && table.angle_deg &&
+        std::abs(std::remainder(*table.angle_deg - p.demand, 360.0)) <= kAngleToleranceDeg;
+    unreached_ = !there && t_s - *sent_s_ > kPositionMoveDeadlineS;
+    arrived_ = there || unreached_;
+    // Held at the window's start while the table moved: settle_s from its arrival.
+    if (there && holding_) waited_s_ = t_s - started_s_ - p.start_s;
+    holding_ = holding_ && !arrived_;
+  }
+  if (arrived_ || schedule_s(t_s) < p.measure_s) return;
+  // The settle time is over and the table is not there yet: the clock waits at the window's
+  // start (no reading of a table on its way counts).
+  holding_ = true;
+  waited_s_ = t_s - started_s_ - p.measure_s;
 }
 
 void AcceptanceRunner::measure(const AcceptancePoint& p, double t_s,
@@ -140,13 +168,13 @@ void AcceptanceRunner::close(const AcceptancePoint& p, AcceptanceActions& a) {
   const double tolerance =
       step_->kind == StepKind::rate_ladder ? step_->rate_tolerance_dps : kAngleToleranceDeg;
   const bool held =
-      spanned && !cut_ &&
+      spanned && !cut_ && !unreached_ &&
       (power || (stats_.readings > 0 && stats_.all_in_position && stats_.max_dev <= tolerance));
   nlohmann::json data{{"step_index", step_index_},
                       {"point", p.index},
                       {"demand", p.demand},
-                      {"measure_s", started_s_ + p.measure_s},
-                      {"end_s", started_s_ + p.end_s},
+                      {"measure_s", started_s_ + waited_s_ + p.measure_s},
+                      {"end_s", started_s_ + waited_s_ + p.end_s},
                       {"readings", stats_.readings},
                       {"table_mean", nullptr},
                       {"table_max_dev", nullptr},
@@ -161,6 +189,10 @@ void AcceptanceRunner::close(const AcceptancePoint& p, AcceptanceActions& a) {
        held ? (power ? fmt::format("{} {:g} measured", what, p.demand)
                      : fmt::format("{} {:g} measured ({} table readings)", what, p.demand,
                                    stats_.readings))
+       : unreached_
+           ? fmt::format("{} {:g} not reached: the table was not in position {:g} s after its "
+                         "demand: left out",
+                         what, p.demand, kPositionMoveDeadlineS)
        : !spanned || cut_
            ? fmt::format("{} {:g} measured over part of its window only (a stop, a kill or a "
                          "safe hold): left out",
@@ -186,7 +218,8 @@ void AcceptanceRunner::rest(AcceptanceActions& a) {
 AcceptanceActions AcceptanceRunner::tick(double t_s, const TableObservation& table) {
   AcceptanceActions a;
   if (step_ == nullptr) return a;
-  const double in_s = t_s - started_s_;
+  if (current_ >= 0) wait_for_table(points_[static_cast<std::size_t>(current_)], t_s, table);
+  double in_s = schedule_s(t_s);
   int now = -1;
   for (const auto& p : points_) {
     if (in_s < p.end_s) {
@@ -207,12 +240,16 @@ AcceptanceActions AcceptanceRunner::tick(double t_s, const TableObservation& tab
   if (now != current_ || resend_ || power_edge) send(p, t_s, a);
   current_ = now;
   resend_ = false;
-  if (in_s >= p.measure_s) measure(p, t_s, table);
+  // A new point's move (a resumed run's point met past its settle time and its table not there
+  // is measured whole from the table's arrival).
+  wait_for_table(p, t_s, table);
+  in_s = schedule_s(t_s);
+  if (in_s >= p.measure_s && !holding_) measure(p, t_s, table);
   return a;
 }
 
 bool AcceptanceRunner::finished(double t_s) const {
-  return step_ != nullptr && rested_ && t_s - started_s_ >= duration_s_;
+  return step_ != nullptr && rested_ && schedule_s(t_s) >= duration_s_;
 }
 
 }  // namespace station

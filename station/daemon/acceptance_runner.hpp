@@ -35,12 +35,22 @@ struct AcceptanceActions {
   std::vector<EventNote> events;
 };
 
+/// positions: the longest the runner waits for the table to report in position at a point's
+/// angle before that point's settle time starts, s. A table still moving after it has faulted
+/// (a half turn at 1 deg/s takes 180 s): the point is left out, said in its event.
+inline constexpr double kPositionMoveDeadlineS = 300.0;
+
 class AcceptanceRunner {
  public:
   /// Enters `step` (step `step_index`, started at run time `started_s`). Entering the same step
   /// again (after a safe hold) keeps the point being measured and sends its demand again.
   void enter(const Step& step, int step_index, double started_s);
-  /// One tick at run time `t_s`.
+  /// One tick at run time `t_s`. positions: a table not yet in position at the point's angle
+  /// when its settle_s (counted from the demand) is over holds the schedule's clock there until
+  /// it is (at most kPositionMoveDeadlineS after the demand), then settle_s runs again from its
+  /// arrival: a move longer than settle_s delays the step, and its point is measured whole.
+  /// A table there within settle_s keeps the schedule as it was. Each point's event gives the
+  /// window it measured.
   AcceptanceActions tick(double t_s, const TableObservation& table);
   /// The whole schedule has run (the ladder's table back at rest).
   bool finished(double t_s) const;
@@ -61,6 +71,10 @@ class AcceptanceRunner {
   void measure(const AcceptancePoint& p, double t_s, const TableObservation& table);
   void close(const AcceptancePoint& p, AcceptanceActions& a);
   void rest(AcceptanceActions& a);
+  /// positions: holds the schedule's clock at the window's start while the move is under way.
+  void wait_for_table(const AcceptancePoint& p, double t_s, const TableObservation& table);
+  /// The time into the step on the schedule's clock: run time less the moves waited for, s.
+  double schedule_s(double t_s) const { return t_s - started_s_ - waited_s_; }
 
   const Step* step_ = nullptr;
   int step_index_ = -1;
@@ -71,7 +85,12 @@ class AcceptanceRunner {
   bool resend_ = false;    ///< entered again: send the current demand at the next tick
   bool rested_ = false;    ///< the end-of-step demand was sent
   bool power_on_ = true;
-  bool cut_ = false;  ///< the current point's window was interrupted (a safe hold): left out
+  bool cut_ = false;     ///< the current point's window was interrupted (a safe hold): left out
+  double waited_s_ = 0;  ///< positions: the moves waited for so far in this step, s
+  std::optional<double> sent_s_;  ///< positions: when the current point's demand went out
+  bool arrived_ = true;           ///< positions: the table reported in position at the angle
+  bool holding_ = false;          ///< positions: the clock is held at the window's start
+  bool unreached_ = false;        ///< positions: the deadline passed first: the point is left out
   PointStats stats_;
 };
 

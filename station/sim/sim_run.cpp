@@ -116,7 +116,9 @@ double protocol_span_s(const Protocol& p, double start_c) {
     const Step& s = p.steps[i];
     // lock_turntable waits for the table to be at its angle and locked: nominally 0 s, it takes
     // the table's travel (a --fault in the final lock's last seconds is within the run).
+    // positions waits for the table's moves longer than its settle_s (acceptance_runner.hpp).
     const bool waits = s.kind == StepKind::soak || s.kind == StepKind::lock_turntable ||
+                       s.kind == StepKind::positions ||
                        (s.kind == StepKind::set_temperature && s.wait);
     const double d = nominal[i].value_or(0.0);
     span_s += s.timeout_s > 0 ? std::max(s.timeout_s, d) : waits ? d + kUntimedWaitS : d;
