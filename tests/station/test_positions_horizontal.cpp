@@ -20,6 +20,8 @@
 #include "station/acceptance/acceptance_run.hpp"
 #include "station/acceptance/acceptance_verdict.hpp"
 #include "station/common/input_error.hpp"
+#include "station/report/report_acceptance.hpp"
+#include "station/report/report_page.hpp"
 #include "station/sim/sim_run.hpp"
 #include "station/store/store.hpp"
 #include "tests/station/temp_db.hpp"
@@ -156,6 +158,22 @@ TEST(PositionsHorizontal, ARunWithHorizontalSlotsGivesTheirHeadingErrors) {
   ASSERT_NE(fit, nullptr) << why;
   EXPECT_EQ(fit->positions, kAngles.size());
   EXPECT_NE(station::positions_projection(figures[0].positions[0]), nullptr);
+  // The report's positions figure of the heading:30 slot: the output less the fitted constant
+  // is the Earth rate's projection W cos(lat) cos(H - theta) (its heading error and noise within
+  // 0.05 deg/h of 11.5), on the fitted cosine; its page has the heading-error table.
+  const auto loaded = station::report::load_acceptance(store, *store.find_run(r["run_id"]));
+  ASSERT_EQ(loaded.size(), 4u);
+  const auto fig = station::report::positions_figure("P1.3", loaded[2]);
+  ASSERT_EQ(fig.series.size(), 2u) << fig.note;
+  const auto& pts = fig.series[1];
+  ASSERT_EQ(pts.x.size(), kAngles.size());
+  for (std::size_t i = 0; i < pts.x.size(); ++i)
+    EXPECT_NEAR(pts.y[i], sensed_dph(39.9, 30.0, 0.0, pts.x[i]), 0.05) << pts.x[i];
+  const auto page = station::report::report_page(store, "run-1-positions.html", "");
+  ASSERT_TRUE(page);
+  EXPECT_NE(page->find("heading error &plusmn; 1&sigma; (mrad, clockwise)"), std::string::npos);
+  EXPECT_NE(page->find("input axis tilt &plusmn; 1&sigma; (mrad)"), std::string::npos);
+  EXPECT_NE(page->find("Fig. P1.4"), std::string::npos);
 }
 
 // A horizontal axis's heading error is what the part's misalignment limit judges, named so.
