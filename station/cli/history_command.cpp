@@ -185,6 +185,7 @@ json acceptance_row_json(const AcceptanceRow& r) {
           {"tilt_mrad", opt(r.tilt_mrad)},
           {"turn_on_repeatability_dph", opt(r.turn_on_repeatability_dph)},
           {"max_warmup_s", opt(r.max_warmup_s)},
+          {"turn_on_steps", turn_on_steps_json(r.turn_on_steps)},
           {"verdict", v}};
 }
 
@@ -234,6 +235,16 @@ void print_drift(const ScaleFactorDrift& d) {
                  : "");
 }
 
+/// Each power_cycles step of a run: its turn-on sigma with its interval and longest warm-up.
+void print_turn_on_steps(const AcceptanceRow& r) {
+  for (const auto& t : r.turn_on_steps) {
+    const std::string name = turn_on_step_name(t);
+    const std::string where =
+        fmt::format("  run {} turn-on{}{}", r.run_id, name.empty() ? "" : " ", name);
+    fmt::print("{}: {}\n", where, turn_on_step_text(t));
+  }
+}
+
 void print_acceptance_history(const std::optional<std::vector<AcceptanceRow>>& rows) {
   if (!rows) {
     fmt::print(
@@ -249,6 +260,7 @@ void print_acceptance_history(const std::optional<std::vector<AcceptanceRow>>& r
                pm_text(r.sf_pulse_per_arcsec, r.sf_se_pulse_per_arcsec, "{:.7f}"),
                r.sf_temp_c ? fmt::format("{:.1f}", *r.sf_temp_c) : "-",
                pm_text(r.tc_ppm_per_c, r.tc_se_ppm_per_c, "{:+.3f}"), row_verdict_text(r));
+  for (const auto& r : *rows) print_turn_on_steps(r);
   for (const auto& d : scale_factor_drift(*rows)) print_drift(d);
 }
 

@@ -111,7 +111,41 @@ json result_json(const AcceptancePoint& p, std::size_t x) {
           {"sf_missing", why(p.sf_missing)},
           {"tc_ppm_per_c", opt(p.tc_ppm_per_c)},
           {"tc_se_ppm_per_c", opt(p.tc_se_ppm_per_c)},
-          {"tc_missing", why(p.tc_missing)}};
+          {"tc_missing", why(p.tc_missing)},
+          {"turn_on_steps", turn_on_steps_json(p.turn_on_steps)}};
+}
+
+bool has_table(PgConnection& pg, const char* name) {
+  return pg.exec("SELECT to_regclass($1) IS NOT NULL", {std::string(name)}).text(0, 0) == "t";
+}
+
+/// Each point's power_cycles steps from the central acceptance_turn_on_steps (schema 7).
+void read_turn_on_steps(PgConnection& pg, std::vector<AcceptancePoint>& points) {
+  if (points.empty() || !has_table(pg, "acceptance_turn_on_steps")) return;
+  std::map<std::pair<std::int64_t, std::string>, AcceptancePoint*> by_key;
+  for (auto& p : points) by_key[{p.run_fleet_id, p.serial}] = &p;
+  auto r = pg.exec(
+      "SELECT r.fleet_id, t.serial, t.step_no, t.step_index, t.label, t.temp_c, t.ok, t.error, "
+      "t.turn_ons, t.repeatability_dph, t.repeatability_lower_dph, t.repeatability_upper_dph, "
+      "t.max_warmup_s FROM acceptance_turn_on_steps AS t JOIN runs AS r ON r.uuid = t.run_uuid "
+      "ORDER BY r.fleet_id, t.serial, t.step_no");
+  for (int i = 0; i < r.rows(); ++i) {
+    const auto it = by_key.find({r.integer(i, 0), r.text(i, 1)});
+    if (it == by_key.end()) continue;  // a result the filter left out
+    TurnOnStepRow t;
+    t.step_no = static_cast<int>(r.integer(i, 2));
+    if (!r.is_null(i, 3)) t.step_index = static_cast<int>(r.integer(i, 3));
+    t.label = r.opt_text(i, 4);
+    t.temp_c = opt_number(r, i, 5);
+    t.ok = r.integer(i, 6) != 0;
+    t.error = r.opt_text(i, 7);
+    if (!r.is_null(i, 8)) t.turn_ons = static_cast<int>(r.integer(i, 8));
+    t.repeatability_dph = opt_number(r, i, 9);
+    t.repeatability_lower_dph = opt_number(r, i, 10);
+    t.repeatability_upper_dph = opt_number(r, i, 11);
+    t.max_warmup_s = opt_number(r, i, 12);
+    it->second->turn_on_steps.push_back(std::move(t));
+  }
 }
 
 json part_json(const std::string& part, const std::vector<const AcceptancePoint*>& pts) {
@@ -203,6 +237,7 @@ std::vector<AcceptancePoint> fleet_acceptance_points(PgConnection& pg, const Cha
     if (!p.tc_ppm_per_c && p.tc_missing.empty()) p.tc_missing = "not stored";
     out.push_back(std::move(p));
   }
+  read_turn_on_steps(pg, out);
   return out;
 }
 
@@ -215,7 +250,7 @@ json fleet_acceptance_json(const std::vector<AcceptancePoint>& points) {
 }
 
 bool has_acceptance_table(PgConnection& pg) {
-  return pg.exec("SELECT to_regclass('acceptance_results') IS NOT NULL").text(0, 0) == "t";
+  return has_table(pg, "acceptance_results");
 }
 
 std::optional<std::vector<AcceptanceRow>> fleet_acceptance_rows_of_serial(
@@ -267,6 +302,14 @@ std::string fleet_acceptance_text(const json& acceptance) {
                              r["station"].get<std::string>(), r["serial"].get<std::string>(),
                              r["run_fleet_id"].get<long long>(),
                              r["run_started_utc"].get<std::string>(), r[key].get<std::string>());
+      // The steps as turn_on_steps_json gave them: the keys turn_on_step_rows reads.
+      for (const auto& t :
+           turn_on_step_rows(json{{"turn_on_steps", r.value("turn_on_steps", json::array())}})) {
+        const std::string name = turn_on_step_name(t);
+        out += fmt::format("  turn-on {} {} run {}{}{}: {}\n", r["station"].get<std::string>(),
+                           r["serial"].get<std::string>(), r["run_fleet_id"].get<long long>(),
+                           name.empty() ? "" : " ", name, turn_on_step_text(t));
+      }
     }
     for (const auto& o : part["outside"])
       out += fmt::format("  {} {} {} run {} ({}): {:.7g} {} beyond the {}\n",

@@ -26,6 +26,8 @@ struct AcceptancePoint {
   std::optional<double> sf_pulse_per_arcsec, sf_se_pulse_per_arcsec, sf_temp_c;
   std::optional<double> tc_ppm_per_c, tc_se_ppm_per_c;
   std::string sf_missing, tc_missing;  ///< why K / TC is not there (empty when it is)
+  /// Every power_cycles step's turn-on figures (fleet schema 7; empty on a server before it).
+  std::vector<TurnOnStepRow> turn_on_steps;
 };
 
 /// Why a serial's object (acceptance_json, as stored) has no held scale factor: "no rate_ladder
@@ -42,7 +44,8 @@ std::vector<AcceptancePoint> fleet_acceptance_points(PgConnection& pg, const Cha
 /// The charts per part as JSON: {"parts": [{"part", "results", "stations", "verdicts",
 /// "held_temp_c", "charts": [{"metric": "K" | "TC", "unit", "overall", "points": [{"x",
 /// "station", "serial", "run_fleet_id", "run_started_utc", "value", "se", "held_temp_c"?,
-/// "outside_overall"}]}], "results_list": [...every result, with "sf_missing" / "tc_missing"],
+/// "outside_overall"}]}], "results_list": [...every result, with "sf_missing" / "tc_missing" and
+/// "turn_on_steps" (turn_on_steps_json: each power_cycles step's sigma and warm-up)],
 /// "outside"}]}. x: the result's place among the part's results (1..n, the same in both charts);
 /// the chart's limits over the K held within 1 C of 25 C only (another temperature is another
 /// quantity; such points are drawn apart and named).
@@ -64,8 +67,8 @@ std::optional<std::vector<AcceptanceRow>> fleet_acceptance_rows_of_serial(
 /// bars of one standard error) and the table of results; appends the figures' JSON to `figures`.
 std::string fleet_acceptance_html(const nlohmann::json& acceptance, nlohmann::json& figures);
 
-/// The text output: per part one line of counts, then each result without K or TC and why, and
-/// each point beyond a limit.
+/// The text output: per part one line of counts, then each result without K or TC and why, each
+/// result's turn-on figures per power_cycles step, and each point beyond a limit.
 std::string fleet_acceptance_text(const nlohmann::json& acceptance);
 
 }  // namespace station::fleet

@@ -85,12 +85,25 @@ report::Figure metric_figure(const json& chart, std::size_t part_index, double r
   return f;
 }
 
+/// A result's power_cycles steps, one line each: "'warm' (step 12, 35.0 C): sigma ...".
+std::string turn_on_cell(const json& result) {
+  std::string t;
+  for (const auto& s :
+       turn_on_step_rows(json{{"turn_on_steps", result.value("turn_on_steps", json::array())}})) {
+    const std::string name = turn_on_step_name(s);
+    t += (t.empty() ? "" : "<br>") +
+         html_escape((name.empty() ? "" : name + ": ") + turn_on_step_text(s));
+  }
+  return t.empty() ? "-" : t;
+}
+
 std::string results_table(const json& part) {
-  std::string t = "<table class=\"acceptance-results\">\n" +
-                  cells({"result (place)", "station", "serial", "run (fleet id)",
-                         "run started (UTC)", "K \u00b1 SE (pulse/arcsec)", "K held at (C)",
-                         "TC \u00b1 SE (ppm/C)", "acceptance verdict"},
-                        "th");
+  std::string t =
+      "<table class=\"acceptance-results\">\n" +
+      cells({"result (place)", "station", "serial", "run (fleet id)", "run started (UTC)",
+             "K \u00b1 SE (pulse/arcsec)", "K held at (C)", "TC \u00b1 SE (ppm/C)",
+             "turn-on \u03c3 per power_cycles step (deg/h)", "acceptance verdict"},
+            "th");
   for (const auto& r : part["results_list"]) {
     const std::string k = r["sf_missing"].is_string()
                               ? "<span class=\"missing\">not computed: " +
@@ -110,7 +123,7 @@ std::string results_table(const json& part) {
          std::to_string(r["run_fleet_id"].get<long long>()),
          html_escape(r["run_started_utc"].get<std::string>()), k,
          r["sf_temp_c"].is_number() ? fmt::format("{:.1f}", r["sf_temp_c"].get<double>()) : "-", tc,
-         verdict});
+         turn_on_cell(r), verdict});
   }
   return t + "</table>\n";
 }

@@ -64,6 +64,16 @@ const std::vector<FleetTable> kTables = {
      "a.turn_on_repeatability_upper_dph, a.max_warmup_s, a.figures_json FROM acceptance_results "
      "AS a JOIN runs AS r ON r.id = a.run_id WHERE a.run_id = :id",
      Merge::replace_set},
+    // Every power_cycles step's turn-on figures (station migration 15, fleet version 7).
+    {"acceptance_turn_on_steps", Item::run,
+     "run_uuid,serial,step_no,step_index,label,temp_c,ok,error,turn_ons,repeatability_dph,"
+     "repeatability_lower_dph,repeatability_upper_dph,max_warmup_s",
+     "run_uuid,serial,step_no",
+     "SELECT r.uuid, t.serial, t.step_no, t.step_index, t.label, t.temp_c, t.ok, t.error, "
+     "t.turn_ons, t.repeatability_dph, t.repeatability_lower_dph, t.repeatability_upper_dph, "
+     "t.max_warmup_s FROM acceptance_turn_on_steps AS t JOIN runs AS r ON r.id = t.run_id WHERE "
+     "t.run_id = :id",
+     Merge::replace_set},
     {"events", Item::run, "run_uuid,local_id,t_s,wall_utc,severity,source,kind,message,data_json",
      "run_uuid,local_id",
      "SELECT r.uuid, e.id, e.t_s, e.wall_utc, e.severity, e.source, e.kind, e.message, "

@@ -1,8 +1,11 @@
-// Acceptance figures stored per (run, serial): migration 12.
+// Acceptance figures stored per (run, serial): migration 12; their turn-on steps: migration 15.
 #include "station/store/acceptance_results.hpp"
+
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 namespace station {
 namespace {
@@ -54,6 +57,76 @@ std::vector<std::optional<double>*> numbers(AcceptanceRow& r) {
           &r.max_warmup_s};
 }
 
+/// A value of `obj` of JSON type `T`, when it has one.
+template <typename T>
+std::optional<T> typed(const json& obj, const char* key) {
+  if (!obj.contains(key)) return std::nullopt;
+  const json& v = obj[key];
+  if constexpr (std::is_same_v<T, std::string>) {
+    if (v.is_string()) return v.get<std::string>();
+  } else if constexpr (std::is_same_v<T, int>) {
+    if (v.is_number_integer()) return v.get<int>();
+  } else {
+    if (v.is_number()) return v.get<double>();
+  }
+  return std::nullopt;
+}
+
+constexpr const char* kStepColumns =
+    "step_no, step_index, label, temp_c, ok, error, turn_ons, repeatability_dph, "
+    "repeatability_lower_dph, repeatability_upper_dph, max_warmup_s";
+
+/// The step's optional figures in kStepColumns' order (from repeatability_dph).
+std::vector<std::optional<double>*> step_numbers(TurnOnStepRow& t) {
+  return {&t.repeatability_dph, &t.repeatability_lower_dph, &t.repeatability_upper_dph,
+          &t.max_warmup_s};
+}
+
+void insert_steps(Store& store, std::int64_t run_id, const AcceptanceRow& r) {
+  auto ins =
+      store.db().prepare(std::string("INSERT INTO acceptance_turn_on_steps (run_id, serial, ") +
+                         kStepColumns + ") VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?)");
+  for (auto t : r.turn_on_steps) {
+    ins.bind(1, run_id).bind(2, r.serial).bind(3, t.step_no);
+    t.step_index ? ins.bind(4, *t.step_index) : ins.bind_null(4);
+    t.label ? ins.bind(5, *t.label) : ins.bind_null(5);
+    ins.bind(6, t.temp_c).bind(7, t.ok ? 1 : 0);
+    t.error ? ins.bind(8, *t.error) : ins.bind_null(8);
+    t.turn_ons ? ins.bind(9, *t.turn_ons) : ins.bind_null(9);
+    int c = 10;
+    for (auto* v : step_numbers(t)) ins.bind(c++, *v);
+    ins.step();
+    ins.reset();
+  }
+}
+
+/// Each row's stored turn-on steps, in step order.
+void read_steps(Store& store, std::vector<AcceptanceRow>& rows) {
+  auto st = store.cached(std::string("SELECT ") + kStepColumns +
+                         " FROM acceptance_turn_on_steps WHERE run_id = ? AND serial = ? ORDER "
+                         "BY step_no");
+  for (auto& r : rows) {
+    st->bind(1, r.run_id).bind(2, r.serial);
+    while (st->step()) {
+      TurnOnStepRow t;
+      t.step_no = static_cast<int>(st->column_int(0));
+      if (!st->column_is_null(1)) t.step_index = static_cast<int>(st->column_int(1));
+      if (!st->column_is_null(2)) t.label = st->column_text(2);
+      if (!st->column_is_null(3)) t.temp_c = st->column_double(3);
+      t.ok = st->column_int(4) != 0;
+      if (!st->column_is_null(5)) t.error = st->column_text(5);
+      if (!st->column_is_null(6)) t.turn_ons = static_cast<int>(st->column_int(6));
+      int c = 7;
+      for (auto* v : step_numbers(t)) {
+        if (!st->column_is_null(c)) *v = st->column_double(c);
+        ++c;
+      }
+      r.turn_on_steps.push_back(std::move(t));
+    }
+    st->reset();
+  }
+}
+
 std::vector<AcceptanceRow> read_rows(StatementLease& st) {
   std::vector<AcceptanceRow> out;
   while (st->step()) {
@@ -75,6 +148,76 @@ std::vector<AcceptanceRow> read_rows(StatementLease& st) {
 }
 
 }  // namespace
+
+std::vector<TurnOnStepRow> turn_on_step_rows(const json& serial) {
+  std::vector<TurnOnStepRow> out;
+  if (!serial.is_object()) return out;
+  // Two or more steps: turn_on_steps (acceptance_json); one: its turn_on object.
+  json one = json::array();
+  const json* list = &one;
+  if (serial.contains("turn_on_steps") && serial["turn_on_steps"].is_array())
+    list = &serial["turn_on_steps"];
+  else if (serial.contains("turn_on") && serial["turn_on"].is_object())
+    one.push_back(serial["turn_on"]);
+  for (std::size_t i = 0; i < list->size(); ++i) {
+    const json& o = (*list)[i];
+    if (!o.is_object()) continue;
+    TurnOnStepRow t;
+    t.step_no = static_cast<int>(i + 1);
+    t.step_index = typed<int>(o, "step_index");
+    t.label = typed<std::string>(o, "label");
+    t.temp_c = typed<double>(o, "temp_c");
+    t.ok = o.contains("ok") && o["ok"].is_boolean() && o["ok"].get<bool>();
+    if (!t.ok) {
+      t.error = typed<std::string>(o, "error").value_or("not computed");
+    } else {
+      t.turn_ons = typed<int>(o, "turn_ons");
+      t.repeatability_dph = figure(o, "repeatability_dph");
+      t.repeatability_lower_dph = figure(o, "repeatability_lower_dph");
+      t.repeatability_upper_dph = figure(o, "repeatability_upper_dph");
+      t.max_warmup_s = figure(o, "max_warmup_s");
+    }
+    out.push_back(std::move(t));
+  }
+  return out;
+}
+
+std::string turn_on_step_name(const TurnOnStepRow& s) {
+  std::string out = s.label ? "'" + *s.label + "'" : "";
+  std::string where = s.step_index ? fmt::format("step {}", *s.step_index + 1) : "";
+  if (s.temp_c) where += fmt::format("{}{:.1f} C", where.empty() ? "" : ", ", *s.temp_c);
+  if (where.empty()) return out;
+  return out.empty() ? where : out + " (" + where + ")";
+}
+
+std::string turn_on_step_text(const TurnOnStepRow& t) {
+  if (!t.ok) return "not computed: " + t.error.value_or("?");
+  return fmt::format("sigma {} deg/h{}, longest warm-up {}",
+                     t.repeatability_dph ? fmt::format("{:.3g}", *t.repeatability_dph) : "-",
+                     t.repeatability_lower_dph && t.repeatability_upper_dph
+                         ? fmt::format(" (interval {:.3g} to {:.3g})", *t.repeatability_lower_dph,
+                                       *t.repeatability_upper_dph)
+                         : "",
+                     t.max_warmup_s ? fmt::format("{:.0f} s", *t.max_warmup_s) : "none settled");
+}
+
+json turn_on_steps_json(const std::vector<TurnOnStepRow>& steps) {
+  const auto opt = [](const auto& v) { return v ? json(*v) : json(nullptr); };
+  json out = json::array();
+  for (const auto& t : steps)
+    out.push_back({{"step_no", t.step_no},
+                   {"step_index", opt(t.step_index)},
+                   {"label", opt(t.label)},
+                   {"temp_c", opt(t.temp_c)},
+                   {"ok", t.ok},
+                   {"error", opt(t.error)},
+                   {"turn_ons", opt(t.turn_ons)},
+                   {"repeatability_dph", opt(t.repeatability_dph)},
+                   {"repeatability_lower_dph", opt(t.repeatability_lower_dph)},
+                   {"repeatability_upper_dph", opt(t.repeatability_upper_dph)},
+                   {"max_warmup_s", opt(t.max_warmup_s)}});
+  return out;
+}
 
 std::optional<HeldScaleFactor> held_scale_factor(const json& serial) {
   if (serial.contains("sf_vs_temp")) {
@@ -132,6 +275,7 @@ AcceptanceRow acceptance_row(std::int64_t run_id, const json& serial) {
   r.turn_on_repeatability_lower_dph = figure(on, "repeatability_lower_dph");
   r.turn_on_repeatability_upper_dph = figure(on, "repeatability_upper_dph");
   r.max_warmup_s = figure(on, "max_warmup_s");
+  r.turn_on_steps = turn_on_step_rows(serial);
   return r;
 }
 
@@ -139,9 +283,11 @@ void replace_acceptance_rows(Store& store, std::int64_t run_id,
                              const std::vector<AcceptanceRow>& rows) {
   store.flush();
   Transaction tx(store.db());
-  auto del = store.db().prepare("DELETE FROM acceptance_results WHERE run_id = ?");
-  del.bind(1, run_id);
-  del.step();
+  for (const char* table : {"acceptance_turn_on_steps", "acceptance_results"}) {
+    auto del = store.db().prepare(fmt::format("DELETE FROM {} WHERE run_id = ?", table));
+    del.bind(1, run_id);
+    del.step();
+  }
   auto ins = store.db().prepare(std::string("INSERT INTO acceptance_results (run_id, serial, ") +
                                 kColumns + ") VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)");
   const std::string now = utc_now_iso();
@@ -154,6 +300,7 @@ void replace_acceptance_rows(Store& store, std::int64_t run_id,
     ins.bind(c, r.figures.dump());
     ins.step();
     ins.reset();
+    insert_steps(store, run_id, r);
   }
   tx.commit();
 }
@@ -162,14 +309,18 @@ std::vector<AcceptanceRow> acceptance_rows_of_run(Store& store, std::int64_t run
   auto st = store.cached(std::string("SELECT run_id, serial, ") + kColumns +
                          " FROM acceptance_results WHERE run_id = ? ORDER BY rowid");
   st->bind(1, run_id);
-  return read_rows(st);
+  auto rows = read_rows(st);
+  read_steps(store, rows);
+  return rows;
 }
 
 std::vector<AcceptanceRow> acceptance_rows_of_serial(Store& store, const std::string& serial) {
   auto st = store.cached(std::string("SELECT run_id, serial, ") + kColumns +
                          " FROM acceptance_results WHERE serial = ? ORDER BY run_id");
   st->bind(1, serial);
-  return read_rows(st);
+  auto rows = read_rows(st);
+  read_steps(store, rows);
+  return rows;
 }
 
 std::optional<AcceptanceRow> newest_acceptance_row(Store& store, const std::string& serial,

@@ -1,7 +1,8 @@
 // A run's acceptance figures as stored (migration 12, issue 36): one row per (run, serial), the
 // figures compared across runs as columns and the serial's whole object (acceptance_json with its
-// verdict) as JSON. Computed and written by station/acceptance/acceptance_record.hpp; read by the
-// API, `history`, `fit` and the end summary.
+// verdict) as JSON; every power_cycles step's turn-on figures in a row of their own (migration 15).
+// Computed and written by station/acceptance/acceptance_record.hpp; read by the API, `history`,
+// `fit` and the end summary.
 #pragma once
 
 #include <cstdint>
@@ -31,6 +32,35 @@ inline constexpr double kHeldTempToleranceC = 1.0;
 /// kHeldScaleFactorTempC at its temperature; empty when no ladder was computed.
 std::optional<HeldScaleFactor> held_scale_factor(const nlohmann::json& serial);
 
+/// One power_cycles step's turn-on figures of one serial (migration 15): the step's object of the
+/// serial's turn_on_steps, or its one turn_on object as step 1.
+struct TurnOnStepRow {
+  int step_no = 0;                ///< its place among the run's power_cycles steps, 1..n
+  std::optional<int> step_index;  ///< in the protocol, 0-based; empty for a run's only step
+  std::optional<std::string> label;
+  std::optional<double> temp_c;      ///< sensor A's mean over the powered windows, C
+  bool ok = false;                   ///< computed
+  std::optional<std::string> error;  ///< why not computed
+  std::optional<int> turn_ons;
+  std::optional<double> repeatability_dph, repeatability_lower_dph, repeatability_upper_dph,
+      max_warmup_s;
+  bool operator==(const TurnOnStepRow&) const = default;
+};
+
+/// Every power_cycles step of one serial's object (acceptance_json), in the protocol's order.
+std::vector<TurnOnStepRow> turn_on_step_rows(const nlohmann::json& serial);
+
+/// "'hot' (step 9, 70.0 C)", "step 2", or "" for a run's only step: a step's name in text.
+std::string turn_on_step_name(const TurnOnStepRow& s);
+
+/// "sigma 0.0041 deg/h (interval 0.0021 to 0.025), longest warm-up 120 s", or "not computed: why":
+/// a step's figures in text (`history`, `station fleet`).
+std::string turn_on_step_text(const TurnOnStepRow& s);
+
+/// The steps as JSON (`history --json`, `station fleet --json`): an object per step with the
+/// struct's fields under their names, null where empty.
+nlohmann::json turn_on_steps_json(const std::vector<TurnOnStepRow>& steps);
+
 /// One stored row.
 struct AcceptanceRow {
   std::int64_t run_id = 0;
@@ -42,16 +72,18 @@ struct AcceptanceRow {
   std::optional<double> nonlinearity_max_ppm_fs, asymmetry_ppm, asymmetry_se_ppm;
   std::optional<double> tilt_mrad, tilt_se_mrad;
   std::optional<double> turn_on_repeatability_dph, turn_on_repeatability_lower_dph,
-      turn_on_repeatability_upper_dph, max_warmup_s;
+      turn_on_repeatability_upper_dph, max_warmup_s;  ///< the first power_cycles step's
+  std::vector<TurnOnStepRow> turn_on_steps;           ///< every power_cycles step's
   nlohmann::json figures;  ///< the serial's object as acceptance_json and the verdict gave it
 };
 
-/// The row of run `run_id` for one serial's object (acceptance_json, judged): its columns taken
-/// from the object, computed_utc left empty.
+/// The row of run `run_id` for one serial's object (acceptance_json, judged): its columns and its
+/// turn-on steps taken from the object, computed_utc left empty.
 AcceptanceRow acceptance_row(std::int64_t run_id, const nlohmann::json& serial);
 
-/// Replaces every stored row of run `run_id` with `rows` in one transaction (a recomputation, a
-/// resumed or replayed run's end: the newest computation is the run's). Throws SqliteError.
+/// Replaces every stored row of run `run_id` (and its turn-on steps) with `rows` in one transaction
+/// (a recomputation, a resumed or replayed run's end: the newest computation is the run's). Throws
+/// SqliteError.
 void replace_acceptance_rows(Store& store, std::int64_t run_id,
                              const std::vector<AcceptanceRow>& rows);
 
