@@ -358,6 +358,8 @@ void add_run_command(CLI::App& app, CommandStatus& status) {
     setup_daemon_logging(o->sim ? spdlog::level::warn : spdlog::level::info, o->log_file);
     on_stop_signals(on_stop_signal);
     if (!o->sim && o->speed > 0) throw InputError("--speed is for --sim (a rig runs at 1 Hz)");
+    if (!o->sim && !o->axes.empty())
+      throw InputError("--axis is for --sim (a rig's input axes are its [[slot]] axis keys)");
     if (o->sim && !o->slots.empty())
       throw InputError("--slot is for --config (the simulated gyros are SIM-0001, ...)");
     if (!o->sim && (o->config.empty() || o->db.empty())) {
