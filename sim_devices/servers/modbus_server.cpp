@@ -187,8 +187,10 @@ bool ModbusServer::send_gathered(int fd) {
   gathering_ = false;
   std::vector<std::uint8_t> out;
   std::uint8_t chunk[4096];
-  for (ssize_t n; (n = recv(capture_[1], chunk, sizeof chunk, MSG_DONTWAIT)) > 0;)
-    out.insert(out.end(), chunk, chunk + n);
+  for (ssize_t n = sizeof chunk; n == static_cast<ssize_t>(sizeof chunk);) {  // all of it
+    n = recv(capture_[1], chunk, sizeof chunk, MSG_DONTWAIT);
+    if (n > 0) out.insert(out.end(), chunk, chunk + n);
+  }
   for (std::size_t done = 0; done < out.size();) {
     const ssize_t n = send(fd, out.data() + done, out.size() - done, MSG_NOSIGNAL);
     if (n < 0 && errno == EINTR) continue;

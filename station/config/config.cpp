@@ -67,6 +67,7 @@ void read_link(const TomlView& v, DeviceConfig& d) {
     d.timeout_s = *t;
   }
   d.request_gap_s = v.opt_number_in("request_gap_s", 0.0, 1.0, "s").value_or(0.0);
+  d.modbus_pipeline = static_cast<int>(v.opt_integer_in("modbus_pipeline", 1, 8).value_or(1));
   d.gateway = v.opt_bool("gateway").value_or(false);
   if (auto w = v.opt_string("word_order"))
     d.word_order = at_key(v, "word_order", [&] { return mb::parse_float_word_order(*w); });
@@ -83,10 +84,13 @@ void link_defaults(const TomlView& v, const Dialect& dialect, DeviceConfig& d) {
 // [chamber] / [turntable]: the model picks the dialect (drivers/registry), which says what
 // endpoint and keys it takes; everything is checked here, before anything moves.
 DeviceConfig read_device(const TomlView& v, bool is_chamber) {
-  v.allow_only({"endpoint", "model", "preset", "unit_id", "timeout_s", "readback_every", "point",
-                "run_event", "product_input", "humidity_event", "setpoint_low_c", "setpoint_high_c",
-                "request_gap_s", "word_order", "gateway", "framing", "on_foreign_setpoint",
-                "max_rate_dps", "max_accel_dps2"});
+  v.allow_only({"endpoint",       "model",           "preset",
+                "unit_id",        "timeout_s",       "readback_every",
+                "point",          "run_event",       "product_input",
+                "humidity_event", "setpoint_low_c",  "setpoint_high_c",
+                "request_gap_s",  "modbus_pipeline", "word_order",
+                "gateway",        "framing",         "on_foreign_setpoint",
+                "max_rate_dps",   "max_accel_dps2"});
   if (!is_chamber && v.table().contains("on_foreign_setpoint"))
     throw v.error("on_foreign_setpoint", "is a [chamber] key");
   for (const char* key : {"max_rate_dps", "max_accel_dps2"})
@@ -126,8 +130,9 @@ DeviceConfig read_device(const TomlView& v, bool is_chamber) {
       drivers::validate(*dialect, d);
     } catch (const std::invalid_argument& e) {
       const std::string_view what = e.what();
-      for (const char* key : {"product_input", "humidity_event", "setpoint_low_c", "run_event",
-                              "unit_id", "gateway", "word_order", "request_gap_s", "framing"})
+      for (const char* key :
+           {"product_input", "humidity_event", "setpoint_low_c", "run_event", "unit_id", "gateway",
+            "word_order", "request_gap_s", "framing", "modbus_pipeline"})
         if (what.rfind(key, 0) == 0 && v.table().contains(key)) throw v.error(key, what);
       throw v.error(d.run_event != 1 ? "run_event" : "point", what);
     }

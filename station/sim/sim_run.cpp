@@ -64,6 +64,16 @@ std::string sim_config_text(sim::SimWorld& world, const SimRunOptions& o,
     if (at != std::string::npos)
       t.insert(at + 12, fmt::format("timeout_s = {}\n", o.turntable_timeout_s));
   }
+  // The simulator's servers answer several requests read at once (sim_devices/servers/
+  // modbus_server.cpp): the simulated rig has a Modbus device's block reads on the wire together
+  // (issue 37); a real rig leaves it off unless its unit serves so (docs/DEVICES.md).
+  const auto pipeline = [&t](std::string_view section, drivers::Transport transport) {
+    if (const auto at = t.find(section);
+        transport == drivers::Transport::modbus && at != std::string::npos)
+      t.insert(at + section.size(), "modbus_pipeline = 8\n");
+  };
+  pipeline("[chamber]\n", drivers::chamber_dialect(o.chamber_model).transport);
+  pipeline("[turntable]\n", drivers::turntable_dialect(o.turntable_model).transport);
   return t;
 }
 
