@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "station/common/number_text.hpp"
 #include "station/store/acceptance_results.hpp"
 
 namespace station {
@@ -27,9 +28,11 @@ struct Judge {
     }
     const double v = value;
     if (r.min && v < *r.min)
-      failed.push_back(fmt::format("{} {:.7g} {} below {:g}", what, v, unit, *r.min));
+      failed.push_back(fmt::format("{} {} {} below {}", what, beside_limit(v, *r.min, 7), unit,
+                                   as_written(*r.min)));
     if (r.max && v > *r.max)
-      failed.push_back(fmt::format("{} {:.7g} {} above {:g}", what, v, unit, *r.max));
+      failed.push_back(fmt::format("{} {} {} above {}", what, beside_limit(v, *r.max, 7), unit,
+                                   as_written(*r.max)));
   }
   void at_most(const std::string& what, const json& value, const std::optional<double>& max,
                const char* unit) {
@@ -37,9 +40,10 @@ struct Judge {
     ++checked;
     if (!value.is_number())
       failed.push_back(what + " not measured");
-    else if (std::abs(value.get<double>()) > *max)
-      failed.push_back(
-          fmt::format("{} {:.4g} {} above {:g}", what, value.get<double>(), unit, *max));
+    else if (const double v = value.get<double>(); std::abs(v) > *max)
+      failed.push_back(fmt::format("{} {} {} above {}", what,
+                                   beside_limit(v, v < 0 ? -*max : *max, 4), unit,
+                                   as_written(*max)));
   }
 };
 

@@ -83,8 +83,8 @@ std::optional<double> TomlView::opt_number_in(std::string_view key, double lo, d
                                               std::string_view unit) const {
   const auto v = opt_number(key);
   if (v && (*v < lo || *v > hi)) {
-    throw error(key, fmt::format("{:g} is outside {:g}..{:g}{}{}", *v, lo, hi,
-                                 unit.empty() ? "" : " ", unit));
+    throw error(key,
+                fmt::format("{} is outside {}..{}{}{}", *v, lo, hi, unit.empty() ? "" : " ", unit));
   }
   return v;
 }
@@ -144,7 +144,7 @@ std::vector<double> TomlView::number_array_in(std::string_view key, double lo, d
     const double v =
         e.is_integer() ? static_cast<double>(*e.value<std::int64_t>()) : *e.value<double>();
     if (!std::isfinite(v) || v < lo || v > hi) {
-      throw error(key, fmt::format("entry {}: {:g} is outside {:g}..{:g}{}{}", i, v, lo, hi,
+      throw error(key, fmt::format("entry {}: {} is outside {}..{}{}{}", i, v, lo, hi,
                                    unit.empty() ? "" : " ", unit));
     }
     out.push_back(v);

@@ -36,7 +36,7 @@ std::optional<AcceptanceLimits> read_acceptance_limits(const TomlView& part) {
   for (const auto& m : kMaxima) {
     const auto x = t->opt_number(m.key);
     // A bound of zero or less would fail every gyro.
-    if (x && !(*x > 0)) throw t->error(m.key, fmt::format("{:g} must be above 0", *x));
+    if (x && !(*x > 0)) throw t->error(m.key, fmt::format("{} must be above 0", *x));
     a.*m.field = x;
   }
   return a;

@@ -16,7 +16,7 @@ LimitRange read_range(const TomlView& part, std::string_view key) {
   LimitRange r{t->opt_number("min"), t->opt_number("max")};
   if (!r.min && !r.max) throw part.error(key, "give min, max or both");
   if (r.min && r.max && *r.min > *r.max) {
-    throw t->error("min", fmt::format("min {:g} is above max {:g}", *r.min, *r.max));
+    throw t->error("min", fmt::format("min {} is above max {}", *r.min, *r.max));
   }
   return r;
 }

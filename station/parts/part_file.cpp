@@ -21,7 +21,7 @@ using nlohmann::json;
 // A positive upper bound: zero or less would fail every gyro.
 std::optional<double> positive(const TomlView& v, std::string_view key) {
   const auto x = v.opt_number(key);
-  if (x && !(*x > 0)) throw v.error(key, fmt::format("{:g} must be above 0", *x));
+  if (x && !(*x > 0)) throw v.error(key, fmt::format("{} must be above 0", *x));
   return x;
 }
 
@@ -31,7 +31,7 @@ std::optional<double> noise_term(const TomlView& t, std::string_view key, bool z
   const auto x = t.opt_number(key);
   if (!x) return x;
   if (!(zero_ok ? *x >= 0 : *x > 0) || !(*x <= compensation::kMaxNoiseTerm))
-    throw t.error(key, fmt::format("{:g} is outside {}..{:g}", *x, zero_ok ? "0" : "(0",
+    throw t.error(key, fmt::format("{} is outside {}..{}", *x, zero_ok ? "0" : "(0",
                                    compensation::kMaxNoiseTerm));
   return *x == 0 ? 0.0 : *x;
 }
@@ -49,8 +49,7 @@ std::optional<compensation::NoisePrior> read_noise(const TomlView& part) {
   n.rrw_dph_rt_h = noise_term(*t, "rrw_dph_rt_h", true);
   if (const auto f = t->opt_number("trust_factor")) {
     if (!(*f >= kMinTrust && *f <= kMaxTrust))
-      throw t->error("trust_factor",
-                     fmt::format("{:g} is outside {:g}..{:g}", *f, kMinTrust, kMaxTrust));
+      throw t->error("trust_factor", fmt::format("{} is outside {}..{}", *f, kMinTrust, kMaxTrust));
     n.trust_factor = *f;
   }
   if (n.empty())

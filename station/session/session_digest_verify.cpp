@@ -78,7 +78,12 @@ std::map<std::string, FileDigest> read_digest(const std::string& read_as, std::s
       file_line[std::string(name)] = line_no;
     } else if (kind == "tags") {
       auto it = out.find(std::string(name));
-      if (it == out.end() || static_cast<std::int64_t>(it->second.tags.size()) + 1 != n ||
+      if (it == out.end())  // its `file` line deleted: the file is what is missing
+        throw bad(fmt::format("tags of {0} with no 'file {0} LINES SHA256' line before them: the "
+                              "digest's entry for {0} is missing",
+                              name)
+                      .c_str());
+      if (static_cast<std::int64_t>(it->second.tags.size()) + 1 != n ||
           !append_tags(value, it->second.tags))
         throw bad("tags out of order or not 4-digit hex");
       tag_lines[std::string(name)][n] = line_no;
@@ -210,6 +215,14 @@ std::optional<DigestMismatch> SessionReads::check_up_front() {
   }
   rec.files = read_digest(rec.read_as, have, rec.tag_lines);
   if (after_end) return DigestMismatch{rec.read_as, std::nullopt, *after_end};
+  // A file there without its entry (its `file` line deleted, a file of no lines has no tags):
+  // named, not the line that now stands where its entry was.
+  for (const auto& name : digested_files())
+    if (!rec.files.contains(name) && session_file_exists((fs::path(dir_) / name).string()))
+      return DigestMismatch{rec.read_as, std::nullopt,
+                            fmt::format("no 'file {}' line: the digest's entry for {} is "
+                                        "missing, the file is there",
+                                        name, name)};
   if (auto m = not_canonical(rec.read_as, have, rec.files)) return m;
   return check_file(digested_files().front());  // session.toml: read for its meaning first
 }
