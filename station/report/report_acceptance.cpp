@@ -132,15 +132,53 @@ Figure sf_temperature_figure(std::string id, const SerialAcceptance& a) {
   return f;
 }
 
+std::string turn_on_step_title(const TurnOnStep& s) {
+  if (s.step_index < 0) return "";  // a serial's figures built without their steps
+  return step_label(s.label.empty() ? std::string("power cycles") : s.label, s.step_index,
+                    s.temp_c);
+}
+
+std::vector<TurnOnStep> turn_on_steps_of(const SerialAcceptanceReport& a) {
+  const auto& f = a.figures;
+  if (!f.turn_on_steps.empty()) return f.turn_on_steps;
+  TurnOnStep one;
+  one.step_index = -1;
+  one.temp_c = std::nan("");
+  one.result =
+      f.turn_on ? *f.turn_on : sc::Computed<sc::TurnOnResult>(sc::NotComputed{"no power cycles"});
+  one.curves = a.warmups;
+  one.band_dph = f.turn_on_band_dph;
+  return {one};
+}
+
+namespace {
+
+/// "SN1" or "SN1, hot (step 9, 70.0 °C)": whose figure, and which step's.
+std::string whose(const std::string& serial, const TurnOnStep& step) {
+  const std::string t = turn_on_step_title(step);
+  return t.empty() ? serial : serial + ", " + t;
+}
+
+TurnOnStep first_step(const SerialAcceptanceReport& a) {
+  return turn_on_steps_of(a).front();
+}
+
+}  // namespace
+
 Figure turn_on_figure(std::string id, const SerialAcceptance& a) {
-  Figure f = make_figure(std::move(id),
-                         "Turn-on biases with the turn-on-to-turn-on repeatability, " + a.serial,
-                         "turn-on (number)", "bias (\u00b0/h)");
-  if (!a.turn_on || !*a.turn_on) {
-    f.note = "Not computed: " + (a.turn_on ? a.turn_on->error() : std::string("no power cycles"));
+  return turn_on_figure(std::move(id), a.serial, first_step({a, {}, {}}));
+}
+
+Figure turn_on_figure(std::string id, const std::string& serial, const TurnOnStep& step) {
+  Figure f = make_figure(
+      std::move(id),
+      "Turn-on biases with the turn-on-to-turn-on repeatability, " + whose(serial, step),
+      "turn-on (number)", "bias (\u00b0/h)");
+  if (!step.result) {
+    f.note = "Not computed: " + step.result.error();
     return f;
   }
-  const auto& r = a.turn_on->value();
+  const auto& r = step.result.value();
   Series b, band;
   b.label = "turn-on bias (\u00b11\u03c3)";
   b.whiskers = true;
@@ -164,28 +202,32 @@ Figure turn_on_figure(std::string id, const SerialAcceptance& a) {
 }
 
 Figure warmup_figure(std::string id, const SerialAcceptanceReport& a) {
-  const auto& acc = a.figures;
+  return warmup_figure(std::move(id), a.figures.serial, first_step(a));
+}
+
+Figure warmup_figure(std::string id, const std::string& serial, const TurnOnStep& step) {
   Figure f = make_figure(
       std::move(id),
-      "Warm-up: bias minus its final value against the time since power-up, " + acc.serial,
+      "Warm-up: bias minus its final value against the time since power-up, " + whose(serial, step),
       "time since power-up (s)", "bias \u2212 final value (\u00b0/h)");
-  if (!acc.turn_on || !*acc.turn_on) {
-    f.note =
-        "Not computed: " + (acc.turn_on ? acc.turn_on->error() : std::string("no power cycles"));
+  if (!step.result) {
+    f.note = "Not computed: " + step.result.error();
     return f;
   }
-  const auto& r = acc.turn_on->value();
-  if (a.warmups.size() != r.turn_ons.size()) {
+  const auto& r = step.result.value();
+  const auto& warmups = step.curves;
+  const double band_dph = step.band_dph;
+  if (warmups.size() != r.turn_ons.size()) {
     f.note = fmt::format("Not drawn: {} turn-ons analysed, {} read from the samples.",
-                         r.turn_ons.size(), a.warmups.size());
+                         r.turn_ons.size(), warmups.size());
     return f;
   }
   double t_hi = -INFINITY;
   for (std::size_t k = 0; k < r.turn_ons.size(); ++k) {
-    const auto& c = a.warmups[k];
+    const auto& c = warmups[k];
     const auto& t = r.turn_ons[k];
     // The curve is what the analysis judged: it gives the analysis' own warm-up time.
-    const auto again = sc::warmup_time_s({c.t_s, c.bias_dph}, t.final_dph, acc.turn_on_band_dph);
+    const auto again = sc::warmup_time_s({c.t_s, c.bias_dph}, t.final_dph, band_dph);
     if (!again || again->has_value() != t.warmup_s.has_value() ||
         (t.warmup_s && std::abs(**again - *t.warmup_s) > 1e-6)) {
       f.series.clear();
@@ -206,13 +248,13 @@ Figure warmup_figure(std::string id, const SerialAcceptanceReport& a) {
   }
   if (std::isfinite(t_hi)) {
     Series band;
-    band.label = fmt::format("final value \u00b1 band ({:.3g} \u00b0/h)", acc.turn_on_band_dph);
+    band.label = fmt::format("final value \u00b1 band ({:.3g} \u00b0/h)", band_dph);
     band.line = true;
     // From power-up to the end of the last bin: the whole powered time.
     band.x = {0.0, t_hi + kTurnOnBinS / 2};
     band.y = {0.0, 0.0};
-    band.y_low = {-acc.turn_on_band_dph, -acc.turn_on_band_dph};
-    band.y_high = {acc.turn_on_band_dph, acc.turn_on_band_dph};
+    band.y_low = {-band_dph, -band_dph};
+    band.y_high = {band_dph, band_dph};
     f.series.push_back(std::move(band));
   }
   return f;

@@ -20,7 +20,8 @@ using WarmupCurve = TurnOnCurve;  ///< a turn-on's bins (acceptance_run.hpp)
 /// One serial's acceptance figures with what the report draws them from beyond the structs.
 struct SerialAcceptanceReport {
   SerialAcceptance figures;
-  /// Per turn-on of the power cycles (the ones the analysis took, in its order).
+  /// Per turn-on of the first power_cycles step (the ones the analysis took, in its order); each
+  /// step's own are in figures.turn_on_steps.
   std::vector<WarmupCurve> warmups;
   /// Per positions step (figures.positions' order): the table angles the fit took, in its order,
   /// deg; empty when they could not be matched to the fit's positions.
@@ -61,12 +62,25 @@ Figure sf_temperature_figure(std::string id, const SerialAcceptance& a);
 double sf_line_se(const std::vector<LadderFigures>& ladders,
                   const compensation::ScaleFactorTemperatureFit& fit, double temp_c);
 
-/// Fig. T1: each turn-on's bias with its standard error, and the mean with the +-sigma band of
-/// the turn-on-to-turn-on repeatability (compensation/turn_on.hpp).
+/// A serial's power_cycles steps as the turn-on page draws them, each with its own figures, bins
+/// and band: figures.turn_on_steps, or (figures built without them) its one turn_on with
+/// `warmups` as a step of step_index -1 (not computed, "no power cycles", without one).
+std::vector<TurnOnStep> turn_on_steps_of(const SerialAcceptanceReport& a);
+
+/// "hot (step 9, 70.0 °C)": a step's name on the page ("" for a step of step_index -1).
+std::string turn_on_step_title(const TurnOnStep& s);
+
+/// Fig. T1 of one power_cycles step: each turn-on's bias with its standard error, and the mean
+/// with the +-sigma band of the turn-on-to-turn-on repeatability (compensation/turn_on.hpp).
+Figure turn_on_figure(std::string id, const std::string& serial, const TurnOnStep& step);
+/// Fig. T1 of the serial's first step ("no power cycles" without one).
 Figure turn_on_figure(std::string id, const SerialAcceptance& a);
 
-/// Fig. T2: each turn-on's bias minus its final value against the time since power-up, and the
-/// warm-up band around the final value (the warm-up time is where a curve last leaves it).
+/// Fig. T2 of one power_cycles step: each turn-on's bias minus its final value against the time
+/// since power-up (the step's bins), and the step's warm-up band around the final value (the
+/// warm-up time is where a curve last leaves it).
+Figure warmup_figure(std::string id, const std::string& serial, const TurnOnStep& step);
+/// Fig. T2 of the serial's first step.
 Figure warmup_figure(std::string id, const SerialAcceptanceReport& a);
 
 /// Fig. P1: the Earth rate's projection on the input axis (the output minus the fitted bias)

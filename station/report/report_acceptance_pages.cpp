@@ -64,9 +64,9 @@ std::string ladder_table(const SerialAcceptance& a) {
          kv("plateaus (count)", {std::to_string(tc.plateaus)}) + "</table>\n";
 }
 
-std::string turn_on_table(const SerialAcceptance& a) {
-  if (!a.turn_on || !*a.turn_on) return "";
-  const auto& r = a.turn_on->value();
+std::string turn_on_table(const TurnOnStep& step) {
+  if (!step.result) return "";
+  const auto& r = step.result.value();
   const auto& rep = r.repeatability;
   std::string t =
       "<table class=\"acceptance-figures\">\n<tr><th>turn-on</th><th>bias &plusmn; 1&sigma; "
@@ -84,8 +84,8 @@ std::string turn_on_table(const SerialAcceptance& a) {
            num(rep.repeatability_upper_dph, "{:.3g}")});
   t += kv("mean turn-on bias (&deg;/h)", {num(rep.mean_bias_dph, "{:.4g}")});
   t += kv("RMS of the turn-on biases' own 1&sigma; (&deg;/h)", {num(r.mean_bias_se_dph, "{:.3g}")});
-  t += kv("warm-up band, &plusmn; around the final value (&deg;/h)",
-          {num(a.turn_on_band_dph, "{:.3g}")});
+  t +=
+      kv("warm-up band, &plusmn; around the final value (&deg;/h)", {num(step.band_dph, "{:.3g}")});
   t += kv("longest warm-up (s)", {r.max_warmup_s ? num(*r.max_warmup_s, "{:.0f}") : "-"});
   t += kv("turn-ons not settled (count)", {std::to_string(r.not_settled)});
   return t + "</table>\n";
@@ -150,6 +150,23 @@ std::string positions_table(const SerialAcceptance& a) {
   return t + "</table>\n";
 }
 
+/// Each power_cycles step of a serial: its name, table and figures (T1.n and T2.n with one step,
+/// T1.n.j and T2.n.j, j the step's place, with several).
+std::string turn_on_steps_html(const SerialAcceptanceReport& s, const std::string& n, json& data) {
+  const auto steps = turn_on_steps_of(s);
+  std::string t;
+  for (std::size_t j = 0; j < steps.size(); ++j) {
+    const auto& step = steps[j];
+    const std::string id = steps.size() == 1 ? n : n + "." + std::to_string(j + 1);
+    if (const auto title = turn_on_step_title(step); !title.empty())
+      t += "<h3 class=\"turn-on-step\">" + html_escape(title) + "</h3>\n";
+    t += turn_on_table(step) + figures_html({turn_on_figure("T1." + id, s.figures.serial, step),
+                                             warmup_figure("T2." + id, s.figures.serial, step)},
+                                            data);
+  }
+  return t;
+}
+
 /// One serial's section of page `p`: its table, then its figures (ids numbered by serial).
 std::string serial_section(const SerialAcceptanceReport& s, std::size_t k, AcceptancePage p,
                            json& data) {
@@ -164,9 +181,7 @@ std::string serial_section(const SerialAcceptanceReport& s, std::size_t k, Accep
                  data) +
              "</section>\n";
     case AcceptancePage::turn_on:
-      return t + turn_on_table(a) +
-             figures_html({turn_on_figure("T1." + n, a), warmup_figure("T2." + n, s)}, data) +
-             "</section>\n";
+      return t + turn_on_steps_html(s, n, data) + "</section>\n";
     case AcceptancePage::positions:
       return t + positions_table(a) + figures_html({positions_figure("P1." + n, s)}, data) +
              "</section>\n";

@@ -394,12 +394,22 @@ def expected_acceptance(serial):
         ok = [i for i in items if i.get("ok")]
         return None if ok else "; ".join(i.get("error", "?") for i in items) or "none"
     sf = serial.get("sf_vs_temp")
-    turn_on = serial.get("turn_on") or {"ok": False, "error": "no power cycles"}
-    return {"S1": why(serial["ladders"]),
-            "S2": None if sf and sf.get("ok") else (sf or {}).get("error", "plateaus"),
-            "T1": None if turn_on.get("ok") else turn_on["error"],
-            "T2": None if turn_on.get("ok") else turn_on["error"],
-            "P1": why(serial["positions"])}
+    out = {"S1": why(serial["ladders"]),
+           "S2": None if sf and sf.get("ok") else (sf or {}).get("error", "plateaus"),
+           "P1": why(serial["positions"])}
+    # Every power_cycles step has its own T1 and T2 (figure id T1.n.j with two or more steps).
+    steps = serial.get("turn_on_steps") or \
+        [serial.get("turn_on") or {"ok": False, "error": "no power cycles"}]
+    for j, step in enumerate(steps):
+        for fig in ("T1", "T2"):
+            out[fig if len(steps) == 1 else f"{fig}.{j + 1}"] = \
+                None if step.get("ok") else step["error"]
+    return out
+
+
+def acceptance_figures(slug, expect):
+    """The page's figure kinds of one serial: T1 and T2 once per power_cycles step."""
+    return [f for f in expect if f.split(".")[0] in ACCEPTANCE_PAGES[slug]]
 
 
 FIGURE_TEXT_JS = """
@@ -433,8 +443,17 @@ def check_acceptance_page(drv, path, slug, report, artifacts, name):
     drawn = []
     for k, serial in enumerate(report["acceptance"]):
         expect = expected_acceptance(serial)
-        for fig in ACCEPTANCE_PAGES[slug]:
-            fid = f"{fig}.{k + 1}"
+        figs = acceptance_figures(slug, expect)
+        if slug == "turn-on" and "turn_on_steps" in serial:
+            # Each step named above its figures (label, step number, temperature).
+            shown = [h.text for h in drv.find_elements(By.CSS_SELECTOR, "h3.turn-on-step")]
+            for step in serial["turn_on_steps"]:
+                head = f"{step['label']} (step {step['step_index'] + 1}"
+                if not any(h.startswith(head) for h in shown):
+                    fail(f"{path}: no heading for power_cycles step {head!r}: {shown}")
+        for fig in figs:
+            head, _, step = fig.partition(".")
+            fid = f"{head}.{k + 1}" + (f".{step}" if step else "")
             els = drv.find_elements(By.CSS_SELECTOR, f'[data-figure="{fid}"]')
             if len(els) != 1:
                 fail(f"{path}: {len(els)} elements with data-figure={fid}")

@@ -241,6 +241,14 @@ TEST(ReportAcceptance, TheRunsPagesAreServedByNameWithTheirFigures) {
   }
   EXPECT_NE(rp::report_page(store, "run-1-positions.html", "")->find("Fig. P1.2"),
             std::string::npos);
+  // Two power_cycles steps (room, warm): each with its heading, table and figures T1.n.j, T2.n.j.
+  const auto turn_on = *rp::report_page(store, "run-1-turn-on.html", "");
+  for (const char* id : {"Fig. T1.2.1", "Fig. T2.2.1", "Fig. T1.2.2", "Fig. T2.2.2"})
+    EXPECT_NE(turn_on.find(id), std::string::npos) << id;
+  EXPECT_EQ(turn_on.find("Fig. T1.2:"), std::string::npos);  // no unnumbered step
+  EXPECT_NE(turn_on.find("<h3 class=\"turn-on-step\">turn-ons, room (step 2, "), std::string::npos);
+  EXPECT_NE(turn_on.find("<h3 class=\"turn-on-step\">turn-ons, warm (step 11, "),
+            std::string::npos);
   EXPECT_FALSE(rp::report_page(store, "run-1-warmup.html", ""));
 }
 
