@@ -222,7 +222,7 @@ void Forwarder::send_run(std::int64_t run_id, const std::string& uuid, Sent& sen
 // forwarding at once would meet a duplicate key: the item is refused, retried, and compared.
 void Forwarder::append_from(const FleetTable& t, Statement& st, std::optional<double> mark,
                             int mark_col, Sent& sent, std::int64_t& budget, std::int64_t run_id,
-                            std::optional<double>& reached) {
+                            std::optional<double>& reached, std::span<const PgType> binary) {
   bool row = st.step();
   if (mark) {
     if (!row || st.column_double(mark_col) != *mark)
@@ -237,14 +237,28 @@ void Forwarder::append_from(const FleetTable& t, Statement& st, std::optional<do
   std::int64_t fresh = 0;
   reached = mark;
   if (row) {
-    sent.rows += pg_->copy_in(fmt::format("{} ({})", t.name, t.columns), [&](std::string& piece) {
+    const auto copy = fmt::format("{} ({})", t.name, t.columns);
+    const auto names = split_columns(t.columns);
+    bool first = true;
+    const auto fill = [&](std::string& piece) {
+      if (first && !binary.empty()) append_binary_copy_header(piece);
+      first = false;
       for (; row && piece.size() < kPgCopyPieceBytes; row = st.step()) {
-        append_copy_row(st, piece);
+        if (binary.empty())
+          append_copy_row(st, piece);
+        else
+          append_binary_copy_row(st, binary, names, piece);
         reached = st.column_double(mark_col);
         ++fresh;
       }
+      if (!row && !binary.empty()) append_binary_copy_trailer(piece);
       return row;
-    });
+    };
+    try {
+      sent.rows += binary.empty() ? pg_->copy_in(copy, fill) : pg_->copy_in_binary(copy, fill);
+    } catch (const CopyValueError& e) {  // as the server refuses a text value it cannot read
+      throw ItemRefused(fmt::format("run {}: {}: {}", run_id, t.name, e.what()), false);
+    }
   }
   sent.appended += fresh;
   budget -= fresh;
@@ -286,7 +300,7 @@ void Forwarder::append_samples(std::int64_t run_id, const std::string& run_uuid,
       // t_s > the double just below the mark: from the mark itself.
       bind_named(st, ":after", mark ? std::nextafter(*mark, -HUGE_VAL) : kBeforeAnySample);
       bind_named(st, ":limit", budget + 1);
-      append_from(t, st, mark, 2, sent, budget, run_id, reached);
+      append_from(t, st, mark, 2, sent, budget, run_id, reached, kCentralSampleTypes);
     } else {
       sent.complete = false;
     }

@@ -12,9 +12,11 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <span>
 #include <string>
 
 #include "station/config/fleet_config.hpp"
+#include "station/fleet/copy_binary.hpp"
 #include "station/fleet/fleet_tables.hpp"
 #include "station/fleet/pg.hpp"
 #include "station/store/sqlite.hpp"
@@ -94,9 +96,10 @@ class Forwarder {
                      std::int64_t& budget);
   void append_samples(std::int64_t run_id, const std::string& run_uuid, Sent& sent,
                       std::int64_t& budget);
+  /// `binary`: the central columns' types, to send the rows in COPY's binary format.
   void append_from(const FleetTable& t, Statement& st, std::optional<double> mark, int mark_col,
                    Sent& sent, std::int64_t& budget, std::int64_t run_id,
-                   std::optional<double>& reached);
+                   std::optional<double>& reached, std::span<const PgType> binary = {});
   void acknowledge(Item item, std::int64_t local_id, std::int64_t changes, const Sent& sent);
   void record_error(Item item, std::int64_t local_id, const std::string& error, bool hold);
 

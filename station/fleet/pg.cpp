@@ -262,13 +262,22 @@ PgResult PgConnection::exec(std::string_view sql,
   });
 }
 
+long long PgConnection::copy_in(std::string_view table_and_columns,
+                                const std::function<bool(std::string&)>& fill) {
+  return copy_in_as(fmt::format("COPY {} FROM STDIN", table_and_columns), fill);
+}
+
+long long PgConnection::copy_in_binary(std::string_view table_and_columns,
+                                       const std::function<bool(std::string&)>& fill) {
+  return copy_in_as(fmt::format("COPY {} FROM STDIN (FORMAT binary)", table_and_columns), fill);
+}
+
 // A piece at a time: PQputCopyData (it returns 0 while libpq's buffer is full on a non-blocking
 // connection: wait until the socket takes more), then PQflush until the socket has it all, so
 // the next piece is made while the server reads this one; then PQputCopyEnd and the COPY's own
 // result, all under one deadline (libpq-copy.html, libpq-async.html).
-long long PgConnection::copy_in(std::string_view table_and_columns,
-                                const std::function<bool(std::string&)>& fill) {
-  const std::string sql = fmt::format("COPY {} FROM STDIN", table_and_columns);
+long long PgConnection::copy_in_as(const std::string& sql,
+                                   const std::function<bool(std::string&)>& fill) {
   exec(sql);
   const auto started = Clock::now();
   const auto deadline = call_deadline();

@@ -124,6 +124,10 @@ class PgConnection {
   /// pace, holding one piece.
   long long copy_in(std::string_view table_and_columns,
                     const std::function<bool(std::string&)>& fill);
+  /// The same in COPY's binary format: `fill` writes the header, the tuples and the trailer
+  /// (station/fleet/copy_binary.hpp).
+  long long copy_in_binary(std::string_view table_and_columns,
+                           const std::function<bool(std::string&)>& fill);
   /// Asks the server to cancel the statement in flight (PQcancel with the PGcancel made at
   /// connect, libpq-cancel.html), waiting at most kPgCancelTimeoutS. False: no answer.
   bool cancel() const;
@@ -146,6 +150,7 @@ class PgConnection {
   /// Hands libpq one piece of a COPY's data and sends it (waiting while the socket is full).
   void put_copy_piece(std::string_view piece, Deadline deadline, std::string_view what,
                       Deadline started);
+  long long copy_in_as(const std::string& sql, const std::function<bool(std::string&)>& fill);
   /// Ends a COPY (CopyFail with `why` when `why` is given) and reads its result.
   long long end_copy(const char* why, Deadline deadline, std::string_view what, Deadline started);
   /// Sends with `send` (PQsendQuery...), then reads every result: the first error, else the last.
