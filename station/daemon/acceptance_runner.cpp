@@ -81,8 +81,10 @@ void AcceptanceRunner::enter(const Step& step, int step_index, double started_s)
     holding_ = unreached_ = false;
   }
   // Entered again (after a safe hold: the table stopped, the relays off): the point being
-  // measured lost part of its window and, for power cycles, its turn-on.
+  // measured lost part of its window and, for power cycles, its turn-on; a move under way has
+  // its whole deadline again from the demand sent anew.
   if (current_ >= 0 && stats_.first_s) cut_ = true;
+  if (!arrived_) sent_s_.reset();
   resend_ = true;
 }
 
@@ -110,6 +112,8 @@ void AcceptanceRunner::send(const AcceptancePoint& p, double t_s, AcceptanceActi
       if (!resend_ || current_ != p.index) {  // a new point: its move is waited for
         sent_s_ = t_s;
         arrived_ = holding_ = unreached_ = false;
+      } else if (!arrived_) {
+        sent_s_ = t_s;  // sent again after a hold
       }
       break;
     case StepKind::power_cycles:
@@ -123,12 +127,12 @@ void AcceptanceRunner::send(const AcceptancePoint& p, double t_s, AcceptanceActi
 
 void AcceptanceRunner::wait_for_table(const AcceptancePoint& p, double t_s,
                                       const TableObservation& table) {
-  if (step_->kind != StepKind::positions || !sent_s_) return;
+  if (step_->kind != StepKind::positions) return;
   if (!arrived_) {
     const bool there =
         table.in_position && table.angle_deg &&
         std::abs(std::remainder(*table.angle_deg - p.demand, 360.0)) <= kAngleToleranceDeg;
-    unreached_ = !there && t_s - *sent_s_ > kPositionMoveDeadlineS;
+    unreached_ = !there && sent_s_ && t_s - *sent_s_ > kPositionMoveDeadlineS;
     arrived_ = there || unreached_;
     // Held at the window's start while the table moved: settle_s from its arrival.
     if (there && holding_) waited_s_ = t_s - started_s_ - p.start_s;

@@ -126,6 +126,31 @@ TEST(PositionsSettle, ATableThatNeverArrivesLeavesItsPointOut) {
   EXPECT_TRUE(events[2].data["held"].get<bool>()) << events[2].message;
 }
 
+// A safe hold in the middle of a move (the runner not ticked, the table stopped) longer than the
+// deadline: entered again, the demand goes out anew with its whole deadline, and the point is
+// measured once the table arrives.
+TEST(PositionsSettle, ASafeHoldDuringAMoveGivesItTheWholeDeadlineAgain) {
+  const Step s = positions({0, 180, 90}, 3, 10);
+  AcceptanceRunner r;
+  r.enter(s, 2, 0.0);
+  Table table;
+  std::vector<station::EventNote> events;
+  const double back_s = 20 + station::kPositionMoveDeadlineS + 80;
+  for (double t = 0; t <= back_s + 60; t += 1) {
+    if (t > 20 && t < back_s) continue;  // the hold: no ticks, the table still
+    if (t == back_s) r.enter(s, 2, 0.0);
+    auto a = r.tick(t, table.seen());
+    if (a.table && a.table->position_deg) table.demand = *a.table->position_deg;
+    for (auto& e : a.events) events.push_back(std::move(e));
+    table.step(1.0);
+  }
+  ASSERT_GE(events.size(), 2u);
+  EXPECT_TRUE(events[1].data["held"].get<bool>()) << events[1].message;
+  // 80 deg done before the hold (ticks 13..20), 100 after it: there at back_s + 10, measured
+  // settle_s later.
+  EXPECT_DOUBLE_EQ(events[1].data["measure_s"].get<double>(), back_s + 10 + 3);
+}
+
 // Through the simulated rig: half turns at the simulated table's 20 deg/s (about 11 s with its
 // acceleration) and settle_s 3: every point of every serial used, none left out.
 TEST(PositionsSettle, ASimulatedRunWithAShortSettleUsesEveryPoint) {
