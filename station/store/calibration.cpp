@@ -9,6 +9,7 @@
 #include "compensation/binning.hpp"
 #include "compensation/earth_rate.hpp"
 #include "station/common/input_error.hpp"
+#include "station/store/fit_bins.hpp"
 #include "station/store/sample_series.hpp"
 
 namespace station {
@@ -85,7 +86,8 @@ SerialFit fit_serial(Store& store, const std::string& serial, std::vector<std::i
   SerialFit out;
   out.serial = serial;
   out.runs = runs;
-  const sc::ModelData data = store.model_data(serial, runs);
+  const FitBins bins = fit_bins(store, serial, runs);
+  const sc::ModelData& data = bins.data;
   try {
     out.fit = sc::fit_model(data.view(), spec);
   } catch (const std::invalid_argument& e) {
@@ -102,7 +104,7 @@ SerialFit fit_serial(Store& store, const std::string& serial, std::vector<std::i
                       id));
   }
   out.fit.warnings.insert(out.fit.warnings.end(), warnings.begin(), warnings.end());
-  out.fit_id = store.save_fit(serial, runs, out.fit, out.eval, store.bins_span(serial, runs));
+  out.fit_id = store.save_fit(serial, runs, out.fit, out.eval, bins.span);
   return out;
 }
 
