@@ -23,7 +23,7 @@ constexpr std::size_t kMaxPoints = 64;
 
 double time_in(const TomlView& v, const char* key, double fallback, double lo) {
   const double t = v.opt_number_in(key, 0.0, kMaxTimeS, "s").value_or(fallback);
-  if (t < lo) throw v.error(key, fmt::format("{:g} s is shorter than {:g} s", t, lo));
+  if (t < lo) throw v.error(key, fmt::format("{} s is shorter than {} s", t, lo));
   return t;
 }
 
@@ -35,8 +35,8 @@ void refuse_repeats(const TomlView& v, const char* key, const std::vector<double
   for (std::size_t j = 1; j < values.size(); ++j) {
     for (std::size_t i = 0; i < j; ++i) {
       if (distance(values[i], values[j]) < resolution)
-        throw v.error(key, fmt::format("entries {} and {}: {:g} and {:g} are one {}", i, j,
-                                       values[i], values[j], what));
+        throw v.error(key, fmt::format("entries {} and {}: {} and {} are one {}", i, j, values[i],
+                                       values[j], what));
     }
   }
 }

@@ -57,6 +57,12 @@ TEST(LimitMessages, TheProtocolsRangesPrintTheValueAsWritten) {
       << e;
   const std::string r = protocol_error("type = \"rate_ladder\"\nrates_dps = [1, 1000.0001]\n");
   EXPECT_NE(r.find("entry 1: 1000.0001 is outside 0..1000 deg/s"), std::string::npos) << r;
+  // The acceptance steps' own bounds ("2 s is shorter than 2 s", "100 and 100 are one rate").
+  const std::string s =
+      protocol_error("type = \"rate_ladder\"\nrates_dps = [10, 20]\nsettle_s = 1.9999999\n");
+  EXPECT_NE(s.find("1.9999999 s is shorter than 2 s"), std::string::npos) << s;
+  const std::string two = protocol_error("type = \"rate_ladder\"\nrates_dps = [100, 100.0001]\n");
+  EXPECT_NE(two.find("entries 0 and 1: 100 and 100.0001 are one rate"), std::string::npos) << two;
 }
 
 TEST(LimitMessages, ThePartFilesLimitsPrintTheValueAsWritten) {
