@@ -33,8 +33,10 @@ struct AcceptancePoint {
 
 /// The step's points in order. rate_ladder: for each magnitude r as given, +r then -r; the
 /// table's travel to a demand is |change| / accel_dps2 (it starts at rest), then settle_s, then
-/// dwell_s. positions: settle_s (the move and settling), then dwell_s, per angle. power_cycles:
-/// off_s unpowered, then dwell_s powered, per cycle. Empty for other kinds.
+/// dwell_s. positions: settle_s, then dwell_s, per angle (the nominal schedule: a table not in
+/// position when settle_s is over is waited for, and settles settle_s from its arrival,
+/// station/daemon/acceptance_runner.cpp). power_cycles: off_s unpowered, then dwell_s powered,
+/// per cycle. Empty for other kinds.
 std::vector<AcceptancePoint> acceptance_schedule(const Step& s);
 /// The step's whole time, s: its last point's end, and for a ladder the table's travel back to
 /// rest and settle_s.
