@@ -16,6 +16,9 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kRadPerDeg = kPi / 180.0;
 // cos phi or sin phi below this: the Earth-rate component that carries the figure vanishes.
 constexpr double kMinProjection = 1e-9;
+// A horizontal axis's projection amplitude over Omega cos phi: cos(elevation)(1 + SF error).
+constexpr double kMinHorizontalRatio = 0.5;
+constexpr double kMaxHorizontalRatio = 1.5;
 
 std::string point_problem(std::size_t i, const PositionPoint& p) {
   const std::string at = "position " + std::to_string(i) + ": ";
@@ -193,6 +196,17 @@ Computed<HorizontalAxisResult> analyze_positions_axis_horizontal(
   r.in_plane_misalignment_se_rad = r.fit.phase_se_deg * kRadPerDeg;
   r.amplitude_ratio = r.fit.amplitude_dph / horizontal_dph;
   r.amplitude_ratio_se = r.fit.amplitude_se_dph / horizontal_dph;
+  // The phase, so the heading, means something only for an amplitude resolved (A > 3 SE(A), as
+  // for the vertical axis) and near Omega cos phi: the ratio is cos(delta_v)(1 + SF error), so a
+  // ratio under kMinHorizontalRatio (an elevation over 60 deg) beyond its 3 SE is an axis that is
+  // not horizontal as configured, or a wrong latitude.
+  if (!r.fit.amplitude_resolved ||
+      r.amplitude_ratio + 3 * r.amplitude_ratio_se < kMinHorizontalRatio ||
+      r.amplitude_ratio - 3 * r.amplitude_ratio_se > kMaxHorizontalRatio)
+    return NotComputed{"the Earth rate's projection is " + number_text(r.amplitude_ratio) + " +- " +
+                       number_text(r.amplitude_ratio_se) +
+                       " of the horizontal Earth rate, not about 1: the input axis is not "
+                       "horizontal as configured (or the latitude is wrong); no heading"};
   r.bias_if_level_dph = r.fit.constant_dph;
   r.bias_if_level_se_dph = r.fit.constant_se_dph;
   if (known_bias) add_out_of_plane(kEarthRateDph * std::sin(phi), *known_bias, r);

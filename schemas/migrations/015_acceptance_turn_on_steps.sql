@@ -77,4 +77,4 @@ FROM acceptance_results AS a,
                       THEN '[' || json_extract(a.figures_json, '$.turn_on') || ']'
                       ELSE '[]' END
                ELSE '[]' END) AS s
-WHERE json_type(s.value) = 'object';
+WHERE s.type = 'object';  -- json_each's own type: s.value of a string element is its bare text

@@ -159,16 +159,28 @@ std::vector<Window> noise_windows(const Step& s, const std::map<int, PointEvent>
   return out;
 }
 
+/// Whether a rate ladder measures this slot's gyro: an input axis along the table's axis (up or
+/// down). A horizontal axis turning with the table sees the Earth rate's horizontal component
+/// swing through +-W cos(lat) over a ladder's window, so its ladder is neither analysed nor a
+/// window of constant input for the noise.
+bool ladder_measures(const RunSlot& slot) {
+  return slot.axis == "up" || slot.axis == "down";
+}
+
 /// The serial's white rate noise density, pulses^2/s: pooled over the measuring windows of all
 /// its acceptance steps (noise_windows; acceptance_windows.hpp: the gyro's N is one number, and
-/// one window alone estimates it poorly).
+/// one window alone estimates it poorly), each a window of constant input (ladder_measures).
 std::optional<double> serial_white_density(const Protocol& p, const std::vector<int>& steps,
                                            const StepPoints& events,
-                                           const std::vector<SampleRow>& rows) {
+                                           const std::vector<SampleRow>& rows,
+                                           const RunSlot& slot) {
   std::vector<Window> windows;
   for (int i : steps) {
     const auto it = events.find(i);
     if (it == events.end()) continue;
+    if (p.steps[static_cast<std::size_t>(i)].kind == StepKind::rate_ladder &&
+        !ladder_measures(slot))
+      continue;
     for (auto& w : noise_windows(p.steps[static_cast<std::size_t>(i)], it->second, rows))
       windows.push_back(std::move(w));
   }
@@ -380,7 +392,7 @@ void analyze_step(const Protocol& p, int index, const StepPoints& events,
   const auto& mine = it == events.end() ? kNone : it->second;
   if (s.kind == StepKind::rate_ladder) {
     LadderFigures f = ladder_of(s, index, mine, rows, slot, white_pps2_s);
-    if (slot.axis != "up" && slot.axis != "down")
+    if (!ladder_measures(slot))
       f.fit = comp::NotComputed{
           "a ladder is analysed for an input axis along the table's (up or "
           "down); this one is " +
@@ -446,7 +458,7 @@ std::vector<SerialAcceptance> run_acceptance(Store& store, std::int64_t run_id, 
     a.serial = slot.serial;
     a.earth_rate_dph = slot.earth_rate_dph;
     const auto rows = store.samples(run_id, slot.serial, false);
-    const auto white_pps2_s = serial_white_density(p, steps, events, rows);
+    const auto white_pps2_s = serial_white_density(p, steps, events, rows, slot);
     for (int i : steps) analyze_step(p, i, events, rows, slot, white_pps2_s, latitude, a);
     fit_across_plateaus(a, ref_temp_c);
     // A drifting plateau's ladder brought to its slope's temperature with the run's own TC

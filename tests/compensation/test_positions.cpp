@@ -108,6 +108,28 @@ TEST(Positions, ExactHorizontalAxisGivesExactMisalignments) {
   EXPECT_NEAR(u->bias_if_level_dph, 0.05 + kW * std::sin(45 * kDeg) * std::sin(1e-3), 1e-12);
 }
 
+// A gyro standing up but configured horizontal (review 2026-11-29): its projection is the tilt's
+// tiny swing, so the phase, the "heading", is noise; so is an axis 70 deg out of the plane
+// (ratio cos 70 = 0.34). Both say why instead of a heading; 50 deg out (0.64) still fits.
+TEST(Positions, AHorizontalFitOfAnAxisThatIsNotHorizontalSaysSo) {
+  Mount up;
+  up.elevation_rad = kPi / 2 - 2e-3;  // vertical, tilted 2 mrad
+  std::mt19937_64 rng(7);
+  const auto r = sc::analyze_positions_axis_horizontal(positions(up, 8, 5e-3, &rng), site(up), 0);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().find("not horizontal as configured"), std::string::npos) << r.error();
+  Mount steep;
+  steep.elevation_rad = 70 * kDeg;
+  const auto s70 =
+      sc::analyze_positions_axis_horizontal(positions(steep, 8, 1e-3, nullptr), site(steep), 0);
+  EXPECT_FALSE(s70.ok());
+  steep.elevation_rad = 50 * kDeg;
+  const auto s50 =
+      sc::analyze_positions_axis_horizontal(positions(steep, 8, 1e-3, nullptr), site(steep), 0);
+  ASSERT_TRUE(s50.ok()) << s50.error();
+  EXPECT_NEAR(s50->amplitude_ratio, std::cos(50 * kDeg), 1e-9);
+}
+
 TEST(Positions, BadInputIsAnErrorResult) {
   Mount m;
   m.elevation_rad = kPi / 2 - 1e-3;

@@ -133,6 +133,33 @@ TEST(AcceptanceTurnOnSteps, MigrationFifteenTakesTheStoredRowsStepsAndTheyTravel
   }
 }
 
+// Steps that are not objects (a string, a number, null) are no steps, in the migration as in
+// acceptance_row (review 2026-11-29: a string element made json_type() read its bare text and
+// the migration abort, "malformed JSON", the file left at version 13).
+TEST(AcceptanceTurnOnSteps, MigrationFifteenSkipsStepsThatAreNotObjects) {
+  const json odd = json::parse(R"({"serial": "D", "ladders": [], "positions": [],
+    "turn_on_steps": ["junk", 3, null, {"ok": false, "error": "e", "step_index": 2}]})");
+  const auto path = station::testing_support::fresh_db("turn_on_steps_odd");
+  {
+    station::Database db(path);
+    for (std::size_t i = 0; i < 13; ++i) db.exec(station::schemas::kMigrations[i].second);
+    db.exec("PRAGMA user_version = 13");
+    db.exec(
+        "INSERT INTO runs (id, started_utc, state, protocol_name, protocol_text, config_text, "
+        "software_version, station) VALUES (1, 'x', 'completed', 'p', '', '', '0.1', 'rig')");
+    auto ins = db.prepare(
+        "INSERT INTO acceptance_results (run_id, serial, computed_utc, figures_json) VALUES "
+        "(1, 'D', 'then', ?)");
+    ins.bind(1, odd.dump());
+    ins.step();
+  }
+  station::Store s(path);
+  const auto rows = station::acceptance_rows_of_run(s, 1);
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(rows[0].turn_on_steps, station::turn_on_step_rows(odd));
+  EXPECT_EQ(rows[0].turn_on_steps.size(), 1u);
+}
+
 // A simulated run with a power_cycles block at room and one warm: both stored, each equal to its
 // object of the run's judged JSON; `station history --json` lists both.
 TEST(AcceptanceTurnOnSteps, ARunsTwoPowerCyclesStepsAreStoredAndShownByHistory) {

@@ -177,6 +177,35 @@ TEST(PositionsHorizontal, ARunWithHorizontalSlotsGivesTheirHeadingErrors) {
 }
 
 // A horizontal axis's heading error is what the part's misalignment limit judges, named so.
+// A protocol with a rate ladder (review 2026-11-29): a horizontal axis turning with the table sees
+// the Earth rate's horizontal part swing through +-W cos(lat) (about 10 deg/h) over a ladder's
+// window, so those windows are no estimate of its white noise (ladder_measures). Pooled in, they
+// made its heading SE 70 mrad and its warm-up band 3.9 deg/h; without the ladder step the same
+// slot gives 1.7 mrad and 0.095 deg/h (4 angles of 60 s: SE(phase) = sigma sqrt(2/4) / A). The
+// vertical slot beside it keeps its ladder.
+TEST(PositionsHorizontal, ALadderDoesNotEnterAHorizontalAxissNoise) {
+  station::SimRunOptions o;
+  o.db_path = station::testing_support::fresh_db("positions_horizontal_ladder");
+  o.protocol = std::string(STATION_TEST_DATA_DIR) + "/acceptance_short.toml";
+  o.progress = false;
+  o.fresh = true;
+  o.gyros = 2;
+  o.axes = {"up", "north"};
+  const auto r = station::run_simulated(o);
+  ASSERT_EQ(r["state"], "completed") << r.dump();
+  const auto& acc = r["acceptance"];
+  ASSERT_EQ(acc.size(), 2u) << r.dump();
+  ASSERT_TRUE(acc[0]["ladders"][0]["ok"].get<bool>()) << acc[0].dump();
+  const auto& p = acc[1]["positions"][0];
+  ASSERT_TRUE(p["ok"].get<bool>()) << p.dump();
+  const double se = p["heading_error_se_mrad"];
+  EXPECT_LT(se, 5.0) << p.dump();
+  EXPECT_NEAR(p["heading_error_mrad"].get<double>(),
+              acc[1]["true"]["heading_error_mrad"].get<double>(), 4 * se);
+  const double band_up = acc[0]["turn_on"]["band_dph"], band_north = acc[1]["turn_on"]["band_dph"];
+  EXPECT_LT(band_north, 3 * band_up) << acc[1]["turn_on"].dump();
+}
+
 TEST(PositionsHorizontal, TheMisalignmentLimitJudgesTheHeadingError) {
   auto serials = nlohmann::json::parse(R"([{"serial": "A", "ladders": [], "positions": [
       {"label": "room", "ok": true, "axis": "horizontal", "heading_error_mrad": -5.5,
